@@ -1,0 +1,133 @@
+#include "nudge/flags.hpp"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <iostream>
+#include <sstream>
+
+namespace nudge {
+
+double parse_double(const std::string& text, const std::string& what) {
+  errno = 0;
+  char* end = nullptr;
+  const double value = std::strtod(text.c_str(), &end);
+  if (text.empty() || end != text.c_str() + text.size() || errno == ERANGE || !std::isfinite(value)) {
+    throw FlagError(what + ": expected a finite number, got '" + text + "'");
+  }
+  return value;
+}
+
+int parse_int(const std::string& text, const std::string& what) {
+  errno = 0;
+  char* end = nullptr;
+  const long value = std::strtol(text.c_str(), &end, 10);
+  if (text.empty() || end != text.c_str() + text.size() || errno == ERANGE || value < -2147483647L ||
+      value > 2147483647L) {
+    throw FlagError(what + ": expected an integer, got '" + text + "'");
+  }
+  return static_cast<int>(value);
+}
+
+Flags::Flags(std::string program, std::string summary)
+    : program_(std::move(program)), summary_(std::move(summary)) {}
+
+void Flags::add(const std::string& name, int arity, const std::string& help, std::string default_text,
+                std::function<void(const std::vector<std::string>&)> assign) {
+  specs_[name] = Spec{arity, help, std::move(default_text), std::move(assign)};
+  order_.push_back(name);
+}
+
+void Flags::add_string(const std::string& name, std::string* value, const std::string& help) {
+  add(name, 1, help, *value, [value](const std::vector<std::string>& v) { *value = v[0]; });
+}
+
+void Flags::add_int(const std::string& name, int* value, const std::string& help) {
+  add(name, 1, help, std::to_string(*value),
+      [value, name](const std::vector<std::string>& v) { *value = parse_int(v[0], "--" + name); });
+}
+
+void Flags::add_double(const std::string& name, double* value, const std::string& help) {
+  std::ostringstream def;
+  def << *value;
+  add(name, 1, help, def.str(),
+      [value, name](const std::vector<std::string>& v) { *value = parse_double(v[0], "--" + name); });
+}
+
+void Flags::add_bool(const std::string& name, bool* value, const std::string& help) {
+  add(name, 0, help, *value ? "on" : "off", [value](const std::vector<std::string>&) { *value = true; });
+}
+
+void Flags::add_doubles(const std::string& name, std::vector<double>* values, int arity,
+                        const std::string& help) {
+  std::ostringstream def;
+  for (size_t i = 0; i < values->size(); ++i) def << (i ? " " : "") << (*values)[i];
+  add(name, arity, help, def.str(), [values, name](const std::vector<std::string>& v) {
+    values->clear();
+    for (const auto& s : v) values->push_back(parse_double(s, "--" + name));
+  });
+}
+
+void Flags::set_positional(const std::string& name, const std::string& help) {
+  positional_name_ = name;
+  positional_help_ = help;
+}
+
+bool Flags::parse(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    std::string arg = argv[i];
+    if (arg == "--help" || arg == "-h") {
+      std::cout << help();
+      return false;
+    }
+    if (arg.size() < 3 || arg.compare(0, 2, "--") != 0) {
+      positional_.push_back(arg);
+      continue;
+    }
+    std::string name = arg.substr(2);
+    std::vector<std::string> values;
+    const auto eq = name.find('=');
+    if (eq != std::string::npos) {
+      values.push_back(name.substr(eq + 1));
+      name = name.substr(0, eq);
+    }
+    const auto it = specs_.find(name);
+    if (it == specs_.end()) throw FlagError("unknown flag --" + name + " (see --help)");
+    const Spec& spec = it->second;
+    if (spec.arity == 0 && !values.empty()) throw FlagError("--" + name + " takes no value");
+    while (static_cast<int>(values.size()) < spec.arity) {
+      if (i + 1 >= argc) {
+        throw FlagError("--" + name + " needs " + std::to_string(spec.arity) + " value(s)");
+      }
+      values.push_back(argv[++i]);
+    }
+    spec.assign(values);
+    given_[name] = true;
+  }
+  return true;
+}
+
+std::string Flags::help() const {
+  std::ostringstream out;
+  out << "usage: " << program_ << " [options]";
+  if (!positional_name_.empty()) out << " " << positional_name_;
+  out << "\n" << summary_ << "\n";
+  if (!positional_name_.empty()) out << "\n  " << positional_name_ << "  " << positional_help_ << "\n";
+  out << "\noptions:\n";
+  for (const auto& name : order_) {
+    const Spec& spec = specs_.at(name);
+    std::string head = "  --" + name;
+    if (spec.arity == 1) head += " V";
+    for (int k = 0; k < spec.arity && spec.arity > 1; ++k) head += " V" + std::to_string(k + 1);
+    out << head;
+    if (head.size() < 26) out << std::string(26 - head.size(), ' ');
+    else out << "\n" << std::string(26, ' ');
+    out << spec.help;
+    if (!spec.default_text.empty()) out << " [" << spec.default_text << "]";
+    out << "\n";
+  }
+  out << "  --help                  this text\n";
+  return out.str();
+}
+
+}  // namespace nudge

@@ -1,0 +1,10 @@
+#include "nudge/timing.hpp"
+
+namespace nudge {
+
+int64_t wall_utime() {
+  using namespace std::chrono;
+  return duration_cast<microseconds>(system_clock::now().time_since_epoch()).count();
+}
+
+}  // namespace nudge

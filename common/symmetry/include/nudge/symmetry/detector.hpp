@@ -1,0 +1,142 @@
+#pragma once
+// Fast bilateral symmetry detection (Li 2008, ch. 3, Algorithm 1).
+//
+// Conventions (SPEC.md): a line is (R, theta) about the image centre ((w-1)/2, (h-1)/2);
+// (cos theta, sin theta) is its normal, so theta = 0 is a vertical line; theta in (-90, 90] deg.
+// The Hough accumulator has 180 theta bins of 1 degree (bin k <-> theta = k - 89 deg) and 1 px R bins.
+#include <opencv2/core.hpp>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace nudge::symmetry {
+
+// Edge detection in front of the detector (thesis: OpenCV Canny, aperture 3, 30/90).
+struct EdgeParams {
+  double blur_sigma = 0.0;  // Gaussian blur before Canny; 0 = none
+  double canny_low = 30.0;
+  double canny_high = 90.0;
+  bool auto_canny = false;  // derive the thresholds from the image's gradient statistics
+};
+
+struct Params {
+  double dmin = 25.0;          // minimum pairing distance, px
+  double dmax = 250.0;         // maximum pairing distance, px; <= 0 or inf: no limit
+  double theta_min_deg = -90;  // orientation limits, degrees; theta_min > theta_max wraps across +-90
+  double theta_max_deg = 90;
+  int num_lines = 5;           // Nlines
+  double min_peak_ratio = 0.1; // reject peaks below this fraction of the highest peak
+  int suppress_r = 10;         // non-maximum suppression half-size, R bins (px)
+  int suppress_theta = 10;     // non-maximum suppression half-size, theta bins (deg)
+  bool refine_log = true;      // sub-bin fit (eq. 3.1-3.2) on log(1 + votes); false: on raw votes
+  // Extensions of thesis sec. 3.2.3 (all off by default: Algorithm 1 as published).
+  int max_row_pixels = 0;      // straight-line suppression: skip rows of Rot with more pixels; 0 = off
+  bool once_per_row = false;   // each row of Rot increments a given bin at most once
+  bool anti_alias = false;     // 3x3 Gaussian vote kernel (applied as an accumulator blur)
+  std::vector<double> skew_deg;// skew angles to vote for (skew symmetry); empty = bilateral only
+  int threads = 1;             // threads across theta; results are identical for any count
+};
+
+// Throws std::invalid_argument naming the offending parameter.
+void validate(const Params& params);
+void validate(const EdgeParams& params);
+
+// Edge pixel locations of one image, row-major order.
+struct EdgeSet {
+  int width = 0;
+  int height = 0;
+  std::vector<cv::Point> points;
+};
+
+struct Line {
+  double r = 0;          // px
+  double theta = 0;      // radians
+  double votes = 0;      // accumulator value at the (discrete) peak
+  double skew = 0;       // radians; 0 for bilateral symmetry
+  cv::Point2d end1, end2;// where the line meets the image border
+  cv::Point2d seg1, seg2;// extent along the line covered by the voting edge pairs
+  int r_bin = 0, theta_bin = 0, skew_index = 0;  // the discrete peak
+};
+
+struct Timing {
+  double edges_ms = 0, vote_ms = 0, peaks_ms = 0;
+  double total_ms() const { return edges_ms + vote_ms + peaks_ms; }
+};
+
+struct Result {
+  int width = 0, height = 0;
+  int num_edges = 0;
+  std::vector<Line> lines;
+  Timing ms;
+};
+
+// Hough accumulator: one CV_32S matrix of 180 x num_r per skew angle (index 0 = no skew).
+struct Accumulator {
+  int r_max = 0;                 // R bin b <-> R = b - r_max px
+  std::vector<cv::Mat> votes;    // [skew index] -> 180 x (2 r_max + 1), CV_32S
+  int num_r() const { return 2 * r_max + 1; }
+};
+
+// One edge pair that voted for a line (for pictures, fig. 3.8, and the support segment).
+struct VotingPair {
+  cv::Point a, b;
+};
+
+constexpr int kThetaBins = 180;
+inline double theta_of_bin_deg(double bin) { return bin - 89.0; }
+
+// The bins (0..179) whose centre lies inside [theta_min, theta_max] (wrapping if min > max).
+std::vector<int> theta_bins_in_range(double theta_min_deg, double theta_max_deg);
+
+// Canny edge pixels of an image (grey or colour, 8-bit).
+EdgeSet detect_edges(const cv::Mat& image, const EdgeParams& params, cv::Mat* edge_image = nullptr);
+EdgeSet edges_from_mask(const cv::Mat& mask);  // non-zero pixels of an 8-bit mask
+
+// Where the line meets the border of a w x h image.
+void border_endpoints(double r, double theta, int width, int height, cv::Point2d* p1, cv::Point2d* p2);
+
+class Detector {
+ public:
+  explicit Detector(Params params = {}, EdgeParams edge_params = {});
+
+  const Params& params() const { return params_; }
+  const EdgeParams& edge_params() const { return edge_params_; }
+
+  // Full pipeline: edges, voting, peaks. Throws std::invalid_argument for an empty image.
+  Result detect(const cv::Mat& image);
+  Result detect(const EdgeSet& edges);
+
+  // The pieces, for tests, benchmarks and pictures.
+  const Accumulator& vote(const EdgeSet& edges);        // fast voting (this detector's scratch)
+  std::vector<Line> find_peaks(const Accumulator& acc, int width, int height) const;
+  const Accumulator& last_accumulator() const { return acc_; }
+  std::vector<VotingPair> voting_pairs(const EdgeSet& edges, const Line& line) const;
+
+ private:
+  struct Scratch {  // per-thread working memory, kept between frames to avoid allocation
+    std::vector<int32_t> xq, row, sorted, starts, fill, fine, bins, stamp;
+  };
+  void vote_thetas(const EdgeSet& edges, const std::vector<int>& thetas, size_t first, size_t step,
+                   Scratch& scratch);
+  void add_support(const EdgeSet& edges, Line* line) const;
+
+  Params params_;
+  EdgeParams edge_params_;
+  Accumulator acc_;
+  std::vector<Scratch> scratch_;
+  // Edge pixels in the two orders the fast voting needs (see vote.cpp).
+  std::vector<int32_t> by_col_u_, by_col_v_, by_row_u_, by_row_v_;
+};
+
+// Plain, obviously-correct Algorithm 1 (every pair of every row checked against Dmin/Dmax).
+// Uses the same rotation table and quantisation as Detector::vote, so accumulators must be equal.
+Accumulator reference_vote(const EdgeSet& edges, const Params& params);
+
+// Visualisations (fig. 3.6-3.8): lines over the edges; the accumulator as an image.
+cv::Mat draw_lines(const cv::Mat& background, const std::vector<Line>& lines);
+cv::Mat accumulator_image(const Accumulator& acc, int skew_index = 0);
+cv::Mat draw_voting_pairs(const cv::Mat& background, const std::vector<VotingPair>& pairs,
+                          const Line& line);
+
+}  // namespace nudge::symmetry

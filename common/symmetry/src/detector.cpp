@@ -1,0 +1,323 @@
+#include "nudge/symmetry/detector.hpp"
+
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "nudge/timing.hpp"
+#include "quantise.hpp"
+
+namespace nudge::symmetry {
+
+namespace {
+void require(bool ok, const std::string& message) {
+  if (!ok) throw std::invalid_argument(message);
+}
+double deg2rad(double d) { return d * M_PI / 180.0; }
+}  // namespace
+
+void validate(const Params& p) {
+  require(std::isfinite(p.dmin) && p.dmin >= 0, "symmetry parameter dmin must be a finite number >= 0");
+  require(!std::isnan(p.dmax), "symmetry parameter dmax must be a number (<= 0 or inf: no limit)");
+  require(!(p.dmax > 0) || std::isinf(p.dmax) || p.dmax >= p.dmin,
+          "symmetry parameters: dmin must not exceed dmax");
+  require(std::isfinite(p.theta_min_deg) && p.theta_min_deg >= -90 && p.theta_min_deg <= 90,
+          "symmetry parameter theta_min must be in [-90, 90] degrees");
+  require(std::isfinite(p.theta_max_deg) && p.theta_max_deg >= -90 && p.theta_max_deg <= 90,
+          "symmetry parameter theta_max must be in [-90, 90] degrees");
+  require(p.num_lines >= 0 && p.num_lines <= 1000, "symmetry parameter num_lines must be in [0, 1000]");
+  require(std::isfinite(p.min_peak_ratio) && p.min_peak_ratio >= 0 && p.min_peak_ratio <= 1,
+          "symmetry parameter min_peak_ratio must be in [0, 1]");
+  require(p.suppress_r >= 0 && p.suppress_theta >= 0 && p.suppress_theta < 90,
+          "symmetry parameters suppress_r >= 0 and suppress_theta in [0, 90) are required");
+  require(p.max_row_pixels >= 0, "symmetry parameter max_row_pixels must be >= 0");
+  require(p.threads >= 1 && p.threads <= 256, "symmetry parameter threads must be in [1, 256]");
+  for (double s : p.skew_deg) {
+    require(std::isfinite(s) && std::fabs(s) <= 60, "symmetry skew angles must be within [-60, 60] degrees");
+  }
+}
+
+void validate(const EdgeParams& p) {
+  require(std::isfinite(p.blur_sigma) && p.blur_sigma >= 0 && p.blur_sigma <= 50,
+          "edge parameter blur sigma must be in [0, 50]");
+  require(std::isfinite(p.canny_low) && std::isfinite(p.canny_high) && p.canny_low >= 0 &&
+              p.canny_high >= p.canny_low,
+          "edge parameters: Canny thresholds must satisfy 0 <= low <= high");
+}
+
+std::vector<int> theta_bins_in_range(double theta_min_deg, double theta_max_deg) {
+  std::vector<int> bins;
+  for (int k = 0; k < kThetaBins; ++k) {
+    const double t = theta_of_bin_deg(k);
+    // theta = 90 is also theta = -90: a range starting at -90 includes the bin at +90.
+    const double t_alt = (k == kThetaBins - 1) ? -90.0 : t;
+    const bool inside = theta_min_deg <= theta_max_deg
+                            ? (t >= theta_min_deg && t <= theta_max_deg) ||
+                                  (t_alt >= theta_min_deg && t_alt <= theta_max_deg)
+                            : (t >= theta_min_deg || t <= theta_max_deg || t_alt <= theta_max_deg);
+    if (inside) bins.push_back(k);
+  }
+  return bins;
+}
+
+EdgeSet edges_from_mask(const cv::Mat& mask) {
+  require(mask.type() == CV_8UC1, "edge mask must be 8-bit single channel");
+  EdgeSet edges;
+  edges.width = mask.cols;
+  edges.height = mask.rows;
+  for (int y = 0; y < mask.rows; ++y) {
+    const uint8_t* row = mask.ptr<uint8_t>(y);
+    for (int x = 0; x < mask.cols; ++x) {
+      if (row[x]) edges.points.emplace_back(x, y);
+    }
+  }
+  return edges;
+}
+
+namespace {
+// Thresholds from the image itself, for photographs of any exposure: the high threshold is a high
+// quantile of the L1 gradient magnitude that Canny uses, the low one 40 % of it.
+void auto_thresholds(const cv::Mat& grey, double* low, double* high) {
+  cv::Mat gx, gy;
+  cv::Sobel(grey, gx, CV_16S, 1, 0, 3);
+  cv::Sobel(grey, gy, CV_16S, 0, 1, 3);
+  cv::Mat mag;
+  cv::add(cv::abs(gx), cv::abs(gy), mag, cv::noArray(), CV_32S);
+  std::vector<int> values;
+  values.reserve(mag.total());
+  for (int y = 0; y < mag.rows; ++y) {
+    const int* row = mag.ptr<int>(y);
+    for (int x = 0; x < mag.cols; ++x) {
+      if (row[x] > 0) values.push_back(row[x]);
+    }
+  }
+  if (values.empty()) {
+    *low = 30;
+    *high = 90;
+    return;
+  }
+  auto q = values.begin() + static_cast<long>(0.85 * (values.size() - 1));
+  std::nth_element(values.begin(), q, values.end());
+  *high = std::max(20.0, static_cast<double>(*q));
+  *low = 0.4 * *high;
+}
+}  // namespace
+
+EdgeSet detect_edges(const cv::Mat& image, const EdgeParams& params, cv::Mat* edge_image) {
+  validate(params);
+  require(!image.empty(), "image is empty");
+  require(image.depth() == CV_8U && (image.channels() == 1 || image.channels() == 3 || image.channels() == 4),
+          "image must be 8-bit grey, BGR or BGRA");
+  cv::Mat grey;
+  if (image.channels() == 3) {
+    cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
+  } else if (image.channels() == 4) {
+    cv::cvtColor(image, grey, cv::COLOR_BGRA2GRAY);
+  } else {
+    grey = image;
+  }
+  if (params.blur_sigma > 0) cv::GaussianBlur(grey, grey, cv::Size(0, 0), params.blur_sigma);
+  double low = params.canny_low, high = params.canny_high;
+  if (params.auto_canny) auto_thresholds(grey, &low, &high);
+  cv::Mat edges;
+  if (grey.rows >= 3 && grey.cols >= 3) {
+    cv::Canny(grey, edges, low, high, 3);
+  } else {
+    edges = cv::Mat::zeros(grey.size(), CV_8U);  // too small for a 3x3 aperture: no edges
+  }
+  if (edge_image) *edge_image = edges;
+  return edges_from_mask(edges);
+}
+
+void border_endpoints(double r, double theta, int width, int height, cv::Point2d* p1, cv::Point2d* p2) {
+  const double cx = 0.5 * (width - 1), cy = 0.5 * (height - 1);
+  const cv::Point2d pivot(r * std::cos(theta) + cx, r * std::sin(theta) + cy);
+  const cv::Point2d dir(-std::sin(theta), std::cos(theta));
+  // Liang-Barsky clip of the infinite line against [0, w-1] x [0, h-1].
+  double t0 = -1e12, t1 = 1e12;
+  auto clip = [&](double p, double q) {  // p t <= q
+    if (std::fabs(p) < 1e-12) return q >= 0;
+    const double t = q / p;
+    if (p < 0) t0 = std::max(t0, t);
+    else t1 = std::min(t1, t);
+    return true;
+  };
+  const bool ok = clip(-dir.x, pivot.x) && clip(dir.x, (width - 1) - pivot.x) && clip(-dir.y, pivot.y) &&
+                  clip(dir.y, (height - 1) - pivot.y) && t0 <= t1;
+  if (!ok) {  // the line misses the image: report the pivot twice
+    *p1 = *p2 = pivot;
+    return;
+  }
+  *p1 = pivot + t0 * dir;
+  *p2 = pivot + t1 * dir;
+}
+
+Detector::Detector(Params params, EdgeParams edge_params)
+    : params_(std::move(params)), edge_params_(edge_params) {
+  validate(params_);
+  validate(edge_params_);
+}
+
+Result Detector::detect(const cv::Mat& image) {
+  Stopwatch watch;
+  const EdgeSet edges = detect_edges(image, edge_params_);
+  const double edges_ms = watch.elapsed_ms();
+  Result result = detect(edges);
+  result.ms.edges_ms = edges_ms;
+  return result;
+}
+
+Result Detector::detect(const EdgeSet& edges) {
+  require(edges.width > 0 && edges.height > 0, "image is empty");
+  require(edges.width <= detail::kMaxSide && edges.height <= detail::kMaxSide,
+          "image is larger than 16384 px on a side");
+  Result result;
+  result.width = edges.width;
+  result.height = edges.height;
+  result.num_edges = static_cast<int>(edges.points.size());
+  Stopwatch watch;
+  vote(edges);
+  result.ms.vote_ms = watch.lap_ms();
+  result.lines = find_peaks(acc_, edges.width, edges.height);
+  for (auto& line : result.lines) add_support(edges, &line);
+  result.ms.peaks_ms = watch.lap_ms();
+  return result;
+}
+
+namespace {
+
+// Reads an accumulator layer with theta wrapping: bin 180 is bin 0 with R mirrored.
+struct WrappedView {
+  const cv::Mat& m;
+  float at(int k, int b) const {
+    bool mirror = false;
+    if (k < 0) { k += kThetaBins; mirror = true; }
+    if (k >= kThetaBins) { k -= kThetaBins; mirror = true; }
+    if (mirror) b = m.cols - 1 - b;
+    if (b < 0 || b >= m.cols) return 0.f;
+    return m.at<float>(k, b);
+  }
+};
+
+// Sub-bin refinement, eq. 3.1-3.2: Newton step on the 3x3 neighbourhood (x = R, y = theta).
+// With log_votes the quadratic is fitted to log(1 + V), i.e. a Gaussian peak model: convergent
+// voting gives sharp, non-parabolic peaks, and on synthetic shapes between bins this halves the
+// worst angle error (0.50 -> 0.29 deg over 200 random bottles; see the unit tests).
+cv::Point2d refine(const WrappedView& v, int k, int b, bool log_votes) {
+  auto V = [&](int dr, int dt) {
+    const double x = v.at(k + dt, b + dr);
+    return log_votes ? std::log1p(x) : x;
+  };
+  const double v0 = V(0, 0);
+  const double gr = (V(1, 0) - V(-1, 0)) / 2, gt = (V(0, 1) - V(0, -1)) / 2;
+  const double hrr = V(1, 0) + V(-1, 0) - 2 * v0;
+  const double htt = V(0, 1) + V(0, -1) - 2 * v0;
+  const double hrt = (V(1, 1) + V(-1, -1) - V(-1, 1) - V(1, -1)) / 4;
+  const double det = hrr * htt - hrt * hrt;
+  double dr = 0, dt = 0;
+  if (hrr < 0 && det > 1e-12) {  // a proper maximum: solve H x = -g
+    dr = (-gr * htt + gt * hrt) / det;
+    dt = (-gt * hrr + gr * hrt) / det;
+  }
+  if (!(std::fabs(dr) <= 1 && std::fabs(dt) <= 1)) {  // fall back to separate 1D parabolas
+    dr = hrr < 0 ? -gr / hrr : 0;
+    dt = htt < 0 ? -gt / htt : 0;
+  }
+  return {std::clamp(dr, -1.0, 1.0), std::clamp(dt, -1.0, 1.0)};
+}
+
+}  // namespace
+
+std::vector<Line> Detector::find_peaks(const Accumulator& acc, int width, int height) const {
+  std::vector<Line> lines;
+  const int layers = static_cast<int>(acc.votes.size());
+  std::vector<cv::Mat> work(layers);
+  for (int l = 0; l < layers; ++l) {
+    acc.votes[l].convertTo(work[l], CV_32F);
+    if (params_.anti_alias) {
+      // 3x3 Gaussian vote kernel == accumulator blur (linear); theta wraps with R mirrored.
+      cv::Mat padded(kThetaBins + 2, work[l].cols, CV_32F);
+      work[l].copyTo(padded.rowRange(1, kThetaBins + 1));
+      cv::flip(work[l].row(kThetaBins - 1), padded.row(0), 1);
+      cv::flip(work[l].row(0), padded.row(kThetaBins + 1), 1);
+      cv::Mat blurred;
+      cv::sepFilter2D(padded, blurred, CV_32F, cv::Mat(cv::Matx13f(0.25f, 0.5f, 0.25f)),
+                      cv::Mat(cv::Matx31f(0.25f, 0.5f, 0.25f)), cv::Point(-1, -1), 0, cv::BORDER_CONSTANT);
+      blurred.rowRange(1, kThetaBins + 1).copyTo(work[l]);
+    }
+  }
+  // Per-row maxima make each of the Nlines searches O(rows) instead of O(bins).
+  std::vector<std::vector<float>> row_max(layers, std::vector<float>(kThetaBins, 0.f));
+  auto update_row = [&](int l, int k) {
+    double mx;
+    cv::minMaxLoc(work[l].row(k), nullptr, &mx);
+    row_max[l][k] = static_cast<float>(mx);
+  };
+  for (int l = 0; l < layers; ++l)
+    for (int k = 0; k < kThetaBins; ++k) update_row(l, k);
+
+  float first_peak = 0;
+  for (int i = 0; i < params_.num_lines; ++i) {
+    int best_l = 0, best_k = 0;
+    float best = 0;
+    for (int l = 0; l < layers; ++l)
+      for (int k = 0; k < kThetaBins; ++k)
+        if (row_max[l][k] > best) { best = row_max[l][k]; best_l = l; best_k = k; }
+    if (best <= 0) break;
+    if (i == 0) first_peak = best;
+    if (best < params_.min_peak_ratio * first_peak) break;
+    cv::Point loc;
+    cv::minMaxLoc(work[best_l].row(best_k), nullptr, nullptr, nullptr, &loc);
+    const int b = loc.x;
+    const cv::Point2d off = refine(WrappedView{work[best_l]}, best_k, b, params_.refine_log);
+
+    Line line;
+    line.votes = best;
+    line.r_bin = b;
+    line.theta_bin = best_k;
+    line.skew_index = best_l;
+    double r = b + off.x - acc.r_max;
+    double theta_deg = theta_of_bin_deg(best_k + off.y);
+    if (theta_deg > 90) { theta_deg -= 180; r = -r; }
+    if (theta_deg <= -90) { theta_deg += 180; r = -r; }
+    double theta = deg2rad(theta_deg);
+    if (best_l > 0) {
+      // Skew symmetry: pairs are horizontal in the rotated frame but their midpoints lie on
+      // x' = R + y' tan(phi); that axis is the line (R cos(phi), theta - phi).
+      const double phi = deg2rad(params_.skew_deg[best_l - 1]);
+      line.skew = phi;
+      r *= std::cos(phi);
+      theta -= phi;
+      if (theta > M_PI / 2) { theta -= M_PI; r = -r; }
+      if (theta <= -M_PI / 2) { theta += M_PI; r = -r; }
+    }
+    line.r = r;
+    line.theta = theta;
+    border_endpoints(line.r, line.theta, width, height, &line.end1, &line.end2);
+    line.seg1 = line.end1;
+    line.seg2 = line.end2;
+    lines.push_back(line);
+
+    // Non-maximum suppression: zero the neighbourhood (wrapping in theta) in every layer.
+    for (int dt = -params_.suppress_theta; dt <= params_.suppress_theta; ++dt) {
+      int k = best_k + dt;
+      bool mirror = false;
+      if (k < 0) { k += kThetaBins; mirror = true; }
+      if (k >= kThetaBins) { k -= kThetaBins; mirror = true; }
+      for (int l = 0; l < layers; ++l) {
+        float* row = work[l].ptr<float>(k);
+        for (int dr = -params_.suppress_r; dr <= params_.suppress_r; ++dr) {
+          int bb = b + dr;
+          if (mirror) bb = work[l].cols - 1 - bb;
+          if (bb >= 0 && bb < work[l].cols) row[bb] = 0.f;
+        }
+        update_row(l, k);
+      }
+    }
+  }
+  return lines;
+}
+
+}  // namespace nudge::symmetry

@@ -1,0 +1,316 @@
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include <cmath>
+#include <random>
+
+#include "nudge/symmetry/detector.hpp"
+#include "nudge/symmetry/synthetic.hpp"
+
+using namespace nudge::symmetry;
+namespace syn = nudge::symmetry::synthetic;
+
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+// Difference of two lines' angles, folded into [0, 90] degrees.
+double angle_diff_deg(double a, double b) {
+  double d = std::fabs(a - b) / kDeg;
+  d = std::fmod(d, 180.0);
+  return std::min(d, 180.0 - d);
+}
+
+// Distance in R between two lines, allowing for (R, theta) == (-R, theta +- 180).
+double r_diff(const Line& l, double r, double theta) {
+  const double direct = std::fabs(l.r - r);
+  const double flipped = std::fabs(l.r + r);
+  return std::fabs(l.theta - theta) > M_PI / 2 ? flipped : direct;
+}
+
+cv::Mat blank(int w = 320, int h = 240, int grey = 220) { return cv::Mat(h, w, CV_8UC1, cv::Scalar(grey)); }
+
+Params synthetic_params() {
+  Params p;
+  p.dmin = 10;
+  p.dmax = 0;  // no limit (thesis: synthetic images)
+  return p;
+}
+
+void expect_same_accumulator(const Accumulator& a, const Accumulator& b) {
+  ASSERT_EQ(a.r_max, b.r_max);
+  ASSERT_EQ(a.votes.size(), b.votes.size());
+  for (size_t l = 0; l < a.votes.size(); ++l) {
+    EXPECT_EQ(cv::countNonZero(a.votes[l] != b.votes[l]), 0) << "layer " << l;
+    EXPECT_GT(cv::sum(a.votes[l])[0], 0) << "layer " << l << " has no votes: the comparison proves nothing";
+  }
+}
+
+}  // namespace
+
+TEST(SymmetryVote, FastEqualsPlainOnScenesAndOptions) {
+  struct Case {
+    double dmin, dmax, tmin, tmax;
+    bool once;
+    int max_row;
+    std::vector<double> skew;
+  };
+  const std::vector<Case> cases = {
+      {25, 250, -90, 90, false, 0, {}},  {10, 0, -90, 90, false, 0, {}},  {25, 250, -20, 25, false, 0, {}},
+      {25, 250, 70, -70, false, 0, {}},  {5, 60, -90, 90, true, 0, {}},   {25, 250, -90, 90, false, 40, {}},
+      {20, 200, -30, 30, false, 0, {-20, 15}}, {0, 30, -90, 90, false, 0, {}},
+  };
+  for (size_t i = 0; i < cases.size(); ++i) {
+    const Case& c = cases[i];
+    Params p;
+    p.dmin = c.dmin;
+    p.dmax = c.dmax;
+    p.theta_min_deg = c.tmin;
+    p.theta_max_deg = c.tmax;
+    p.once_per_row = c.once;
+    p.max_row_pixels = c.max_row;
+    p.skew_deg = c.skew;
+    const cv::Mat scene = syn::indoor_scene(static_cast<uint32_t>(100 + i), 320, 240, 2);
+    const EdgeSet edges = detect_edges(scene, EdgeParams{1.0, 30, 90, false});
+    ASSERT_GT(edges.points.size(), 500u);
+    Detector fast(p);
+    SCOPED_TRACE("case " + std::to_string(i));
+    expect_same_accumulator(fast.vote(edges), reference_vote(edges, p));
+  }
+}
+
+TEST(SymmetryVote, ThreadsGiveTheSameAccumulator) {
+  const cv::Mat scene = syn::indoor_scene(7);
+  const EdgeSet edges = detect_edges(scene, EdgeParams{1.0, 30, 90, false});
+  Params one;
+  Params two = one;
+  two.threads = 2;
+  Detector a(one), b(two);
+  expect_same_accumulator(a.vote(edges), b.vote(edges));
+}
+
+TEST(SymmetryDetect, FindsAxisBetweenBinsToSubBinPrecision) {
+  // True axes between the 1 deg / 1 px bins.
+  const std::vector<std::pair<double, double>> axes = {{40.5, 12.5}, {-25.5, -7.5}, {10.5, 33.5}, {0.5, 0.5}};
+  for (const auto& [r, theta_deg] : axes) {
+    cv::Mat img = blank();
+    syn::draw_shape(img, syn::bottle_profile(150, 28), r, theta_deg * kDeg, 0, cv::Scalar(40));
+    Params p = synthetic_params();
+    p.num_lines = 1;
+    p.theta_min_deg = -60;  // upright-ish objects: keeps the self-symmetric straight sides out
+    p.theta_max_deg = 60;
+    Detector detector(p);
+    const Result res = detector.detect(img);
+    ASSERT_EQ(res.lines.size(), 1u);
+    EXPECT_LT(angle_diff_deg(res.lines[0].theta, theta_deg * kDeg), 0.25) << "theta " << theta_deg;
+    EXPECT_LT(r_diff(res.lines[0], r, theta_deg * kDeg), 0.5) << "r " << r;
+  }
+}
+
+TEST(SymmetryDetect, AxesAcrossTheNinetyDegreeWrap) {
+  // Nearly horizontal axes: theta close to +-90 where the accumulator wraps with R mirrored.
+  for (double theta_deg : {89.6, -89.4, 88.0}) {
+    cv::Mat img = blank(240, 320);
+    syn::draw_shape(img, syn::bottle_profile(150, 30), 12.0, theta_deg * kDeg, 0, cv::Scalar(30));
+    Params p = synthetic_params();
+    p.num_lines = 1;
+    const Result res = Detector(p).detect(img);
+    ASSERT_EQ(res.lines.size(), 1u);
+    EXPECT_LT(angle_diff_deg(res.lines[0].theta, theta_deg * kDeg), 0.5) << theta_deg;
+    EXPECT_LT(r_diff(res.lines[0], 12.0, theta_deg * kDeg), 1.0) << theta_deg;
+    EXPECT_GT(res.lines[0].theta, -M_PI / 2);
+    EXPECT_LE(res.lines[0].theta, M_PI / 2);
+  }
+}
+
+TEST(SymmetryDetect, FindsSeveralShapes) {
+  cv::Mat img = blank(640, 480);
+  const std::vector<std::pair<double, double>> axes = {{-200, 3}, {-60, -4}, {90, 0}, {220, 6}};
+  for (size_t i = 0; i < axes.size(); ++i) {
+    syn::draw_shape(img, i % 2 ? syn::cup_profile(120, 40, 32) : syn::bottle_profile(200, 35), axes[i].first,
+                    axes[i].second * kDeg, 20, cv::Scalar(30 + 40 * i));
+  }
+  Params p;  // thesis indoor parameters, orientation limits for upright objects
+  p.num_lines = 5;
+  p.theta_min_deg = -25;
+  p.theta_max_deg = 25;
+  const Result res = Detector(p).detect(img);
+  for (const auto& [r, t] : axes) {
+    bool found = false;
+    for (const auto& l : res.lines) found |= angle_diff_deg(l.theta, t * kDeg) < 1.0 && r_diff(l, r, t * kDeg) < 1.5;
+    EXPECT_TRUE(found) << "axis r=" << r << " theta=" << t << " not among the lines";
+  }
+}
+
+TEST(SymmetryDetect, MugHandleAndNoiseKeepTheBodyAxisOnTop) {
+  cv::Mat img = blank(320, 240);
+  const double r = -12.0, theta = 4.0 * kDeg;
+  syn::draw_mug(img, r, theta, 0, 130, 45, cv::Scalar(50));
+  Params p = synthetic_params();
+  p.num_lines = 1;
+  p.theta_min_deg = -25;  // thesis: +-15..25 deg of vertical for upright objects
+  p.theta_max_deg = 25;
+  EdgeSet edges = detect_edges(img, EdgeParams{});
+  const Result clean = Detector(p).detect(edges);
+  ASSERT_EQ(clean.lines.size(), 1u);
+  EXPECT_LT(angle_diff_deg(clean.lines[0].theta, theta), 1.0);
+  EXPECT_LT(r_diff(clean.lines[0], r, theta), 1.0);
+  // 50 % extra random edge pixels.
+  std::mt19937 rng(3);
+  const size_t extra = edges.points.size() / 2;
+  for (size_t i = 0; i < extra; ++i) {
+    edges.points.emplace_back(std::uniform_int_distribution<int>(0, img.cols - 1)(rng),
+                              std::uniform_int_distribution<int>(0, img.rows - 1)(rng));
+  }
+  const Result noisy = Detector(p).detect(edges);
+  ASSERT_EQ(noisy.lines.size(), 1u);
+  EXPECT_LT(angle_diff_deg(noisy.lines[0].theta, theta), 1.0);
+  EXPECT_LT(r_diff(noisy.lines[0], r, theta), 1.0);
+}
+
+TEST(SymmetryDetect, OncePerRowStopsAStraightEdgeOutvotingAUContour) {
+  // Fig. 3.4: a long straight edge (many collinear pixels in one row of Rot) against a U.
+  EdgeSet edges;
+  edges.width = 400;
+  edges.height = 300;
+  for (int x = 20; x < 220; ++x) edges.points.emplace_back(x, 40);  // straight edge, centre x = 119.5
+  for (int y = 150; y < 250; ++y) {                                   // U contour, axis x = 300
+    edges.points.emplace_back(260, y);
+    edges.points.emplace_back(340, y);
+  }
+  for (int x = 260; x <= 340; ++x) edges.points.emplace_back(x, 250);
+  Params p = synthetic_params();
+  p.num_lines = 1;
+  p.min_peak_ratio = 0;
+  const Result plain = Detector(p).detect(edges);
+  ASSERT_EQ(plain.lines.size(), 1u);
+  // Without the rule the straight edge, symmetric about its own perpendicular bisector, wins.
+  EXPECT_LT(angle_diff_deg(plain.lines[0].theta, 0), 0.5);
+  EXPECT_NEAR(plain.lines[0].r, 119.5 - 199.5, 1.0);
+  p.once_per_row = true;
+  const Result once = Detector(p).detect(edges);
+  ASSERT_EQ(once.lines.size(), 1u);
+  EXPECT_LT(angle_diff_deg(once.lines[0].theta, 0), 0.5);
+  EXPECT_NEAR(once.lines[0].r, 300 - 199.5, 0.6);
+}
+
+TEST(SymmetryDetect, SupportSegmentCoversTheShape) {
+  cv::Mat img = blank();
+  syn::draw_shape(img, syn::bottle_profile(100, 25), 0, 0, 0, cv::Scalar(30));
+  Params p = synthetic_params();
+  p.num_lines = 1;
+  p.theta_min_deg = -30;
+  p.theta_max_deg = 30;
+  const Result res = Detector(p).detect(img);
+  ASSERT_EQ(res.lines.size(), 1u);
+  const Line& l = res.lines[0];
+  const double top = std::min(l.seg1.y, l.seg2.y), bottom = std::max(l.seg1.y, l.seg2.y);
+  EXPECT_NEAR(top, 119.5 - 50, 3.0);
+  EXPECT_NEAR(bottom, 119.5 + 50, 3.0);
+  EXPECT_NEAR(l.seg1.x, 159.5, 1.0);
+  // The border endpoints span the whole image height.
+  EXPECT_NEAR(std::min(l.end1.y, l.end2.y), 0, 1e-6);
+  EXPECT_NEAR(std::max(l.end1.y, l.end2.y), 239, 1e-6);
+}
+
+TEST(SymmetryDetect, RecoversSkewAngle) {
+  // A sheared bottle: horizontal chords, midpoints on an axis tilted by the skew angle; not
+  // bilaterally symmetric about any line.
+  EdgeSet edges;
+  edges.width = 320;
+  edges.height = 240;
+  const double skew = 20 * kDeg;
+  const syn::Profile profile = syn::bottle_profile(140, 40);
+  for (size_t i = 0; i < profile.half_width.size(); ++i) {
+    const int y = 50 + static_cast<int>(i);
+    const double mid = 160 + (y - 119.5) * std::tan(skew);
+    edges.points.emplace_back(static_cast<int>(std::lround(mid - profile.half_width[i])), y);
+    edges.points.emplace_back(static_cast<int>(std::lround(mid + profile.half_width[i])), y);
+  }
+  Params p = synthetic_params();
+  p.num_lines = 1;
+  p.skew_deg = {-20, -10, 10, 20};
+  p.once_per_row = true;  // the straight sides would otherwise vote for their own bisectors
+  const Result res = Detector(p).detect(edges);
+  ASSERT_EQ(res.lines.size(), 1u);
+  EXPECT_NEAR(std::fabs(res.lines[0].skew), 20 * kDeg, 1e-9);
+  // The axis itself is tilted by the skew angle from vertical.
+  EXPECT_LT(angle_diff_deg(res.lines[0].theta, -skew), 1.0);
+}
+
+TEST(SymmetryDetect, OrientationLimitsExcludeOtherAngles) {
+  cv::Mat img = blank();
+  syn::draw_shape(img, syn::bottle_profile(150, 28), 0, 30 * kDeg, 0, cv::Scalar(40));
+  Params p = synthetic_params();
+  p.theta_min_deg = -15;
+  p.theta_max_deg = 15;
+  const Result res = Detector(p).detect(img);
+  for (const auto& l : res.lines) EXPECT_LE(std::fabs(l.theta) / kDeg, 16.0);
+}
+
+TEST(SymmetryBadInput, EmptyImageIsAClearError) {
+  Detector d;
+  EXPECT_THROW(d.detect(cv::Mat()), std::invalid_argument);
+}
+
+TEST(SymmetryBadInput, TinyAndEdgelessImagesGiveNoLines) {
+  Detector d;
+  EXPECT_TRUE(d.detect(cv::Mat(1, 1, CV_8UC1, cv::Scalar(0))).lines.empty());
+  EXPECT_TRUE(d.detect(cv::Mat(2, 5, CV_8UC3, cv::Scalar(9, 9, 9))).lines.empty());
+  const Result flat = d.detect(blank());
+  EXPECT_EQ(flat.num_edges, 0);
+  EXPECT_TRUE(flat.lines.empty());
+}
+
+TEST(SymmetryBadInput, BadParametersAreRejectedNamingTheParameter) {
+  auto message_of = [](Params p) {
+    try {
+      Detector d(p);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  Params p;
+  p.dmin = 300;
+  p.dmax = 100;
+  EXPECT_NE(message_of(p).find("dmin"), std::string::npos);
+  p = Params{};
+  p.theta_min_deg = -120;
+  EXPECT_NE(message_of(p).find("theta_min"), std::string::npos);
+  p = Params{};
+  p.theta_max_deg = std::nan("");
+  EXPECT_NE(message_of(p).find("theta_max"), std::string::npos);
+  p = Params{};
+  p.dmin = std::nan("");
+  EXPECT_NE(message_of(p).find("dmin"), std::string::npos);
+  p = Params{};
+  p.dmax = std::nan("");
+  EXPECT_NE(message_of(p).find("dmax"), std::string::npos);
+  EdgeParams e;
+  e.canny_low = 100;
+  e.canny_high = 10;
+  EXPECT_THROW(Detector(Params{}, e), std::invalid_argument);
+}
+
+TEST(SymmetryGeometry, BorderEndpointsOfVerticalAndDiagonalLines) {
+  cv::Point2d a, b;
+  border_endpoints(10, 0, 101, 51, &a, &b);
+  EXPECT_NEAR(a.x, 60, 1e-9);
+  EXPECT_NEAR(b.x, 60, 1e-9);
+  EXPECT_NEAR(std::min(a.y, b.y), 0, 1e-9);
+  EXPECT_NEAR(std::max(a.y, b.y), 50, 1e-9);
+  border_endpoints(0, M_PI / 4, 101, 101, &a, &b);  // anti-diagonal through the centre
+  EXPECT_NEAR(a.x + a.y, 100, 1e-9);
+  EXPECT_NEAR(b.x + b.y, 100, 1e-9);
+  EXPECT_NEAR(std::fabs(a.x - b.x), 100, 1e-9);
+}
+
+TEST(SymmetryGeometry, ThetaRangesIncludingWrap) {
+  EXPECT_EQ(theta_bins_in_range(-90, 90).size(), 180u);
+  EXPECT_EQ(theta_bins_in_range(-15, 15).size(), 31u);
+  const auto wrap = theta_bins_in_range(80, -80);  // 80..90 and -89..-80
+  EXPECT_EQ(wrap.size(), 21u);
+  EXPECT_EQ(theta_bins_in_range(0, 0).size(), 1u);
+}
