@@ -108,9 +108,9 @@ cv::Mat indoor_scene(uint32_t seed, int width, int height, int clutter) {
     img.row(y).setTo(cv::Scalar(shade * uni(0.97, 1.0), shade, shade * 0.95));
   }
   // Clutter: posters, boxes and texture patches (asymmetric edges, as in real rooms).
-  for (int i = 0; i < clutter * 4; ++i) {
+  for (int i = 0; i < clutter * 3; ++i) {
     const cv::Point2d c(uni(0, width), uni(0, height));
-    const cv::Size2f s(static_cast<float>(uni(15, 120)), static_cast<float>(uni(15, 120)));
+    const cv::Size2f s(static_cast<float>(uni(15, 90)), static_cast<float>(uni(15, 90)));
     const cv::RotatedRect rect(c, s, static_cast<float>(uni(-40, 40)));
     cv::Point2f corners[4];
     rect.points(corners);
@@ -118,10 +118,13 @@ cv::Mat indoor_scene(uint32_t seed, int width, int height, int clutter) {
     for (auto& p : corners) poly.emplace_back(static_cast<int>(p.x), static_cast<int>(p.y));
     cv::fillConvexPoly(img, poly, cv::Scalar(uni(30, 230), uni(30, 230), uni(30, 230)), cv::LINE_AA);
   }
-  for (int i = 0; i < clutter * 6; ++i) {
-    cv::line(img, cv::Point(static_cast<int>(uni(0, width)), static_cast<int>(uni(0, height))),
-             cv::Point(static_cast<int>(uni(0, width)), static_cast<int>(uni(0, height))),
-             cv::Scalar(uni(0, 255), uni(0, 255), uni(0, 255)), static_cast<int>(uni(1, 4)), cv::LINE_AA);
+  for (int i = 0; i < clutter * 4; ++i) {  // short strokes: cables, shelf edges, shadows
+    const cv::Point2d a(uni(0, width), uni(0, height));
+    const double length = uni(15, 90), angle = uni(0, M_PI);
+    const cv::Point2d b = a + length * cv::Point2d(std::cos(angle), std::sin(angle));
+    cv::line(img, cv::Point(static_cast<int>(a.x), static_cast<int>(a.y)),
+             cv::Point(static_cast<int>(b.x), static_cast<int>(b.y)), cv::Scalar(uni(0, 255), uni(0, 255), uni(0, 255)),
+             static_cast<int>(uni(1, 4)), cv::LINE_AA);
   }
   for (int i = 0; i < clutter; ++i) {  // a patterned patch (book spines, tiles)
     const int x0 = static_cast<int>(uni(0, width - 100)), y0 = static_cast<int>(uni(0, height - 80));
@@ -131,11 +134,17 @@ cv::Mat indoor_scene(uint32_t seed, int width, int height, int clutter) {
                     cv::Scalar(uni(0, 255), uni(0, 255), uni(0, 255)), cv::FILLED);
     }
   }
+  for (int i = 0; i < clutter * 40; ++i) {  // small marks: print, labels, wood grain, crumbs
+    const cv::Point c(static_cast<int>(uni(0, width)), static_cast<int>(uni(0, height)));
+    const cv::Size axes(static_cast<int>(uni(2, 9)), static_cast<int>(uni(1, 5)));
+    cv::ellipse(img, c, axes, uni(0, 180), 0, 360, cv::Scalar(uni(0, 255), uni(0, 255), uni(0, 255)), cv::FILLED,
+                cv::LINE_AA);
+  }
   // Symmetric objects standing on the table: bottles, cups, mugs.
-  const int objects = 3 + static_cast<int>(uni(0, 3));
+  const int objects = 4 + static_cast<int>(uni(0, 3));
   for (int i = 0; i < objects; ++i) {
     const double x = uni(0.1, 0.9) * width;
-    const double h = uni(0.2, 0.45) * height;
+    const double h = uni(0.3, 0.55) * height;
     const double base = uni(horizon + 0.3 * (height - horizon), height - 5);
     const double theta = uni(-5, 5) * M_PI / 180.0;
     const double r = x - 0.5 * (width - 1);

@@ -1,0 +1,74 @@
+#pragma once
+// Typed LCM subscriptions for Debian's LCM 1.3.1, which has no lambda subscribe.
+// A message that fails to decode (wrong size, truncated) or whose handler throws is reported
+// naming the channel, counted, and skipped; the service keeps running.
+#include <lcm/lcm-cpp.hpp>
+
+#include <atomic>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "nudge/log.hpp"
+
+namespace nudge::bus {
+
+struct Counters {
+  std::atomic<int64_t> messages_in{0};
+  std::atomic<int64_t> messages_out{0};
+  std::atomic<int64_t> errors{0};
+};
+
+class Subscriptions {
+ public:
+  Subscriptions(lcm::LCM& lcm, Counters& counters) : lcm_(lcm), counters_(counters) {}
+  Subscriptions(const Subscriptions&) = delete;
+  Subscriptions& operator=(const Subscriptions&) = delete;
+  ~Subscriptions() {
+    for (auto& h : handlers_) lcm_.unsubscribe(h->subscription);
+  }
+
+  // handler(msg, channel, receive_utime). Returns nothing; errors are logged and counted.
+  template <typename Msg>
+  void subscribe(const std::string& channel,
+                 std::function<void(const Msg&, const std::string& channel)> handler) {
+    auto h = std::make_unique<Typed<Msg>>(std::move(handler), counters_);
+    h->subscription = lcm_.subscribe(channel, &Typed<Msg>::on_raw, h.get());
+    handlers_.push_back(std::move(h));
+  }
+
+ private:
+  struct Base {
+    virtual ~Base() = default;
+    lcm::Subscription* subscription = nullptr;
+  };
+  template <typename Msg>
+  struct Typed : Base {
+    Typed(std::function<void(const Msg&, const std::string&)> f, Counters& c) : fn(std::move(f)), counters(c) {}
+    void on_raw(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+      ++counters.messages_in;
+      Msg msg;
+      if (msg.decode(rbuf->data, 0, rbuf->data_size) < 0) {
+        ++counters.errors;
+        log::error() << "skipped a malformed message on " << channel << ": " << rbuf->data_size
+                     << " bytes do not decode as " << Msg::getTypeName();
+        return;
+      }
+      try {
+        fn(msg, channel);
+      } catch (const std::exception& e) {
+        ++counters.errors;
+        log::error() << "skipped a message on " << channel << ": " << e.what();
+      }
+    }
+    std::function<void(const Msg&, const std::string&)> fn;
+    Counters& counters;
+  };
+
+  lcm::LCM& lcm_;
+  Counters& counters_;
+  std::vector<std::unique_ptr<Base>> handlers_;
+};
+
+}  // namespace nudge::bus

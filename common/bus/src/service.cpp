@@ -1,0 +1,121 @@
+#include "nudge/bus/service.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <csignal>
+#include <iostream>
+
+#include "nudge/heartbeat_t.hpp"
+#include "nudge/log.hpp"
+#include "nudge/timing.hpp"
+
+namespace nudge::bus {
+
+namespace {
+volatile std::sig_atomic_t g_signalled = 0;
+void on_signal(int) { g_signalled = 1; }
+}  // namespace
+
+Service::Service(std::string name, std::string summary)
+    : name_(std::move(name)), flags_("nudge-" + name_, std::move(summary)) {
+  log::set_component(name_);
+  flags_.add_string("lcm-url", &lcm_url_, "LCM URL for input and output");
+  flags_.add_string("lcm-in", &lcm_in_, "LCM URL to read from (e.g. file://in.lcmlog?speed=0); default --lcm-url");
+  flags_.add_string("lcm-out", &lcm_out_, "LCM URL to publish to (e.g. file://out.lcmlog?mode=w); default --lcm-url");
+  flags_.add_string("instance", &instance_, "instance name in heartbeats");
+  flags_.add_bool("verbose", &verbose_, "log every message");
+}
+
+Service::~Service() {
+  subscriptions_.reset();
+}
+
+bool Service::parse(int argc, char** argv) {
+  if (!flags_.parse(argc, argv)) return false;
+  if (verbose_) log::set_level(log::Level::Debug);
+  if (instance_.empty()) instance_ = name_;
+  return true;
+}
+
+bool Service::input_is_log() const {
+  const std::string& url = lcm_in_.empty() ? lcm_url_ : lcm_in_;
+  return url.rfind("file://", 0) == 0;
+}
+
+void Service::start() {
+  const std::string in_url = lcm_in_.empty() ? lcm_url_ : lcm_in_;
+  const std::string out_url = lcm_out_.empty() ? lcm_url_ : lcm_out_;
+  in_ = std::make_unique<lcm::LCM>(in_url);
+  if (!in_->good()) throw std::runtime_error("cannot open LCM input '" + in_url + "'");
+  if (out_url != in_url) {
+    out_ = std::make_unique<lcm::LCM>(out_url);
+    if (!out_->good()) throw std::runtime_error("cannot open LCM output '" + out_url + "'");
+  }
+  subscriptions_ = std::make_unique<Subscriptions>(*in_, counters_);
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  log::info() << "started: in " << in_url << ", out " << out_url;
+}
+
+bool Service::stop_requested() const { return stop_requested_ || g_signalled; }
+
+void Service::publish_heartbeat(int8_t state) {
+  heartbeat_t hb;
+  hb.utime = wall_utime();
+  hb.service = name_;
+  hb.instance = instance_;
+  hb.pid = static_cast<int32_t>(getpid());
+  hb.state = state;
+  hb.messages_in = counters_.messages_in;
+  hb.messages_out = counters_.messages_out;
+  hb.errors = counters_.errors;
+  hb.status = status_;
+  output().publish(kHeartbeatChannel, &hb);
+}
+
+int Service::run(const std::function<int()>& tick, int wait_ms) {
+  const bool from_log = input_is_log();
+  publish_heartbeat(heartbeat_t::STATE_RUNNING);
+  int64_t next_heartbeat = wall_utime() + 1000000;
+  int exit_code = 0;
+  int wait = wait_ms;
+  while (!stop_requested()) {
+    const int rc = in_->handleTimeout(std::max(0, wait));
+    if (rc < 0) {
+      if (stop_requested()) break;  // a signal interrupted the wait
+      if (from_log) {
+        log::info() << "input log finished";
+      } else {
+        log::error() << "LCM input failed";
+        exit_code = 1;
+      }
+      break;
+    }
+    wait = tick ? std::min(wait_ms, tick()) : wait_ms;
+    const int64_t now = wall_utime();
+    if (now >= next_heartbeat) {
+      publish_heartbeat(counters_.errors > 0 ? heartbeat_t::STATE_DEGRADED : heartbeat_t::STATE_RUNNING);
+      next_heartbeat = now + 1000000;
+    }
+  }
+  publish_heartbeat(heartbeat_t::STATE_STOPPING);
+  log::info() << "stopping: " << counters_.messages_in << " in, " << counters_.messages_out << " out, "
+              << counters_.errors << " errors";
+  return exit_code;
+}
+
+int guarded_main(const std::string& name, const std::function<int()>& body) {
+  log::set_component(name);
+  try {
+    return body();
+  } catch (const FlagError& e) {
+    std::cerr << "nudge-" << name << ": " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    log::error() << e.what();
+    return 1;
+  }
+}
+
+}  // namespace nudge::bus

@@ -1,0 +1,9 @@
+#!/usr/bin/env bash
+# Installs what is missing, builds, and runs every test (unit, service, integration).
+# Extra arguments go to ctest, e.g. scripts/test.sh -L unit   or   scripts/test.sh -R symmetry
+set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
+nudge_install_packages
+nudge_build
+cd "$NUDGE_BUILD_DIR"
+ctest --output-on-failure -j "$NUDGE_JOBS" --timeout 600 "$@"

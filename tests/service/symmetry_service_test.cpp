@@ -1,0 +1,120 @@
+// Service test: the symmetry service as a pure function from log to log, through LCM's file
+// provider (file://in?speed=0 in, file://out?mode=w out). The input log holds synthetic frames
+// with known axes, a truncated message and an image with an unknown pixel format.
+#include <gtest/gtest.h>
+#include <lcm/lcm-cpp.hpp>
+#include <sys/wait.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <map>
+#include <string>
+
+#include "nudge/bus/image.hpp"
+#include "nudge/heartbeat_t.hpp"
+#include "nudge/symmetry/detector.hpp"
+#include "nudge/symmetry/synthetic.hpp"
+#include "nudge/symmetry_lines_t.hpp"
+
+namespace syn = nudge::symmetry::synthetic;
+
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+struct Truth {
+  double r, theta;
+};
+
+void write_event(lcm::LogFile& log, int64_t utime, const std::string& channel, const std::vector<uint8_t>& bytes) {
+  lcm::LogEvent ev{};
+  ev.timestamp = utime;
+  ev.channel = channel;
+  ev.datalen = static_cast<int32_t>(bytes.size());
+  ev.data = const_cast<uint8_t*>(bytes.data());
+  ASSERT_EQ(log.writeEvent(&ev), 0);
+}
+
+template <typename Msg>
+std::vector<uint8_t> encode(const Msg& msg) {
+  std::vector<uint8_t> bytes(msg.getEncodedSize());
+  msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  return bytes;
+}
+
+// Frames with one upright bottle each, at known axes.
+std::map<int64_t, Truth> write_input_log(const std::string& path) {
+  lcm::LogFile log(path, "w");
+  std::map<int64_t, Truth> truth;
+  for (int i = 0; i < 6; ++i) {
+    cv::Mat img(240, 320, CV_8UC3, cv::Scalar(200, 210, 220));
+    const Truth t{-60.0 + 25.0 * i, (-6.0 + 2.5 * i) * kDeg};
+    syn::draw_shape(img, syn::bottle_profile(160, 30), t.r, t.theta, 0, cv::Scalar(40, 60, 90));
+    const int64_t utime = 1000000 + 40000 * i;
+    const int8_t format = i % 2 ? nudge::image_t::FORMAT_PNG : nudge::image_t::FORMAT_GRAY8;
+    write_event(log, utime, "CAMERA", encode(nudge::bus::to_message(img, format, utime, i, "mono")));
+    truth[utime] = t;
+    if (i == 2) {  // a truncated message: must be reported and skipped
+      auto bytes = encode(nudge::bus::to_message(img, nudge::image_t::FORMAT_GRAY8, utime + 1, 99, "mono"));
+      bytes.resize(bytes.size() / 2);
+      write_event(log, utime + 1, "CAMERA", bytes);
+    }
+    if (i == 4) {  // an unknown pixel format
+      auto bad = nudge::bus::to_message(img, nudge::image_t::FORMAT_GRAY8, utime + 2, 98, "mono");
+      bad.pixel_format = 42;
+      write_event(log, utime + 2, "CAMERA", encode(bad));
+    }
+  }
+  return truth;
+}
+
+}  // namespace
+
+TEST(SymmetryService, LogInLogOutMatchesTheKnownAxesAndSkipsBadMessages) {
+  const std::string dir = testing::TempDir();
+  const std::string in = dir + "/symmetry_in.lcmlog", out = dir + "/symmetry_out.lcmlog";
+  std::remove(out.c_str());
+  const auto truth = write_input_log(in);
+
+  const std::string cmd = std::string(NUDGE_BIN_DIR) + "/nudge-symmetry --inputs CAMERA --lines 3 --dmin 10 --dmax 0" +
+                          " --theta-min -30 --theta-max 30 --lcm-in 'file://" + in + "?speed=0'" +
+                          " --lcm-out 'file://" + out + "?mode=w'";
+  const int status = std::system(cmd.c_str());
+  ASSERT_TRUE(WIFEXITED(status)) << cmd;
+  ASSERT_EQ(WEXITSTATUS(status), 0) << cmd;
+
+  lcm::LogFile log(out, "r");
+  ASSERT_TRUE(log.good());
+  std::map<int64_t, nudge::symmetry_lines_t> results;
+  int64_t errors_reported = -1;
+  for (const lcm::LogEvent* ev = log.readNextEvent(); ev; ev = log.readNextEvent()) {
+    if (ev->channel == "SYMMETRY") {
+      nudge::symmetry_lines_t msg;
+      ASSERT_GE(msg.decode(ev->data, 0, ev->datalen), 0);
+      results[msg.utime] = msg;
+    } else if (ev->channel == "HEARTBEAT") {
+      nudge::heartbeat_t hb;
+      ASSERT_GE(hb.decode(ev->data, 0, ev->datalen), 0);
+      errors_reported = hb.errors;
+    }
+  }
+  ASSERT_EQ(results.size(), truth.size()) << "one SYMMETRY message per good frame";
+  EXPECT_EQ(errors_reported, 2) << "the truncated and the unknown-format messages are counted";
+  for (const auto& [utime, t] : truth) {
+    const auto& msg = results.at(utime);
+    ASSERT_GE(msg.num_lines, 1);
+    EXPECT_EQ(msg.width, 320);
+    EXPECT_GT(msg.num_edges, 100);
+    EXPECT_NEAR(msg.lines[0].r, t.r, 1.0) << "utime " << utime;
+    EXPECT_NEAR(msg.lines[0].theta, t.theta, 1.0 * kDeg) << "utime " << utime;
+  }
+}
+
+TEST(SymmetryService, BadFlagsAreRefusedWithAUsageError) {
+  const std::string bin = std::string(NUDGE_BIN_DIR) + "/nudge-symmetry";
+  for (const std::string args : {" --dmin 300 --dmax 100", " --theta-min -200", " --lines x", " --no-such-flag"}) {
+    const int status = std::system((bin + args + " 2>/dev/null").c_str());
+    ASSERT_TRUE(WIFEXITED(status));
+    EXPECT_EQ(WEXITSTATUS(status), 2) << args;
+  }
+}
