@@ -1,24 +1,27 @@
 // Fast, exact voting for Algorithm 1.
 //
 // Per theta bin the plain algorithm rotates every edge pixel, groups them into rows of Rot and
-// checks every pair of every row against [Dmin, Dmax]. Here the same votes are cast with far less
-// work:
-//  * Rotation is integer fixed-point (quantise.hpp), a loop the compiler vectorises.
-//  * Rows are built by one counting sort. The pixels are visited in an order in which x' is
-//    already almost monotone along every row of Rot (column-major for |theta| <= 45 deg, row-major
-//    otherwise; see below), so the rows come out nearly sorted and an insertion sort finishes them
-//    in linear time.
-//  * In a sorted row the partners of x_i that satisfy Dmin <= x_j - x_i <= Dmax are a contiguous
-//    window found by two monotone pointers, so pairs outside [Dmin, Dmax] cost nothing and a vote is
-//    one increment: fine[x_i + x_j]++. The fine array (quarter-pixel R) is folded into 1 px bins
-//    once per theta.
-// Why the visiting order works: on a row of Rot (fixed y'), x' = u / cos(theta) + y' tan(theta), so
-// x' increases with u when |theta| < 90 deg; inside the 1 px high row y' varies by < 1, moving x' by
-// at most |tan(theta)| <= 1 px for |theta| <= 45 deg. For |theta| > 45 deg the same holds with v
-// (x' = v / sin(theta) - y' / tan(theta)), in reverse order when theta < 0.
+// checks every pair of every row against [Dmin, Dmax]. The same votes are cast here with far less
+// work per vote:
+//  * Rotation is integer fixed-point (quantise.hpp) in a loop the compiler vectorises; rows are
+//    built with one counting sort.
+//  * Pairs are checked sixteen at a time without branches (AVX-512: one compare mask per pixel and
+//    block of partners), and the R bins of the valid pairs are compress-stored into a buffer. The
+//    plain loop's unpredictable "is dx inside [Dmin, Dmax]" branch is what makes it slow.
+//  * The buffer is histogrammed into four interleaved copies of the accumulator row, so that
+//    consecutive increments of one bin do not wait on each other; the copies are summed once per
+//    theta.
+// The accumulator is bit-identical to reference_vote() (tests compare them).
 #include <algorithm>
 #include <cstring>
 #include <thread>
+
+#if defined(__AVX512F__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"  // GCC 12 false positive inside avx512fintrin.h
+#include <immintrin.h>
+#pragma GCC diagnostic pop
+#endif
 
 #include "nudge/symmetry/detector.hpp"
 #include "quantise.hpp"
@@ -30,51 +33,46 @@ using detail::ThetaTable;
 
 namespace {
 
-// Sort an almost-sorted short run in place (elements are at most a few places from home).
-inline void insertion_sort(int32_t* x, int n) {
-  for (int i = 1; i < n; ++i) {
-    const int32_t v = x[i];
-    int j = i - 1;
-    while (j >= 0 && x[j] > v) {
-      x[j + 1] = x[j];
-      --j;
-    }
-    x[j + 1] = v;
-  }
-}
+// Band test and bin index for one pair, shared by the scalar path.
+struct PairRule {
+  int32_t dmin2;    // minimum |xq_a - xq_b|
+  uint32_t span;    // dmax2 - dmin2: valid iff (|d| - dmin2) <= span, as unsigned
+  int32_t offset;   // added to xq_a + xq_b (+2 to round, + skew shift); >> 2 gives the histogram index
+};
 
-// All votes of one sorted row: every pair with dmin2 <= x_j - x_i <= dmax2 increments
-// fine[x_i + x_j + shift] (shift folds in the skew offset of this row and the array offset).
-inline void vote_row(const int32_t* x, int n, int32_t dmin2, int32_t dmax2, int32_t* fine_shifted) {
-  int lo = 0, hi = 0;
-  for (int i = 0; i < n; ++i) {
-    const int32_t lo_val = x[i] + dmin2;
-    const int32_t hi_val = x[i] + dmax2;
-    if (lo <= i) lo = i + 1;
-    while (lo < n && x[lo] < lo_val) ++lo;
-    if (hi < lo) hi = lo;
-    while (hi < n && x[hi] <= hi_val) ++hi;
-    int32_t* base = fine_shifted + x[i];
-    for (int j = lo; j < hi; ++j) ++base[x[j]];
-  }
-}
-
-// The same votes, but a bin is incremented at most once per row (thesis sec. 3.2.3).
-inline void vote_row_once(const int32_t* x, int n, int32_t dmin2, int32_t dmax2, int32_t shift,
-                          const Layout& layout, int32_t row_id, int32_t* bins, int32_t* stamp) {
-  int lo = 0, hi = 0;
-  for (int i = 0; i < n; ++i) {
-    if (lo <= i) lo = i + 1;
-    while (lo < n && x[lo] < x[i] + dmin2) ++lo;
-    if (hi < lo) hi = lo;
-    while (hi < n && x[hi] <= x[i] + dmax2) ++hi;
-    for (int j = lo; j < hi; ++j) {
-      const int b = layout.bin_of_sum(x[i] + x[j] + shift);
-      if (b < 0 || b >= layout.num_r() || stamp[b] == row_id) continue;
-      stamp[b] = row_id;
-      ++bins[b];
+// Writes the histogram index of every valid pair of the row x[0..n) to out; returns how many.
+// out needs room for n (n - 1) / 2 + 16 entries.
+inline int row_pair_bins(const int32_t* x, int n, const PairRule& rule, int32_t* out) {
+  int count = 0;
+#if defined(__AVX512F__)
+  const __m512i dmin = _mm512_set1_epi32(rule.dmin2);
+  const __m512i span = _mm512_set1_epi32(static_cast<int32_t>(rule.span));
+  const __m512i offset = _mm512_set1_epi32(rule.offset);
+  for (int i = 0; i + 1 < n; ++i) {
+    const __m512i xi = _mm512_set1_epi32(x[i]);
+    const __m512i base = _mm512_add_epi32(xi, offset);
+    for (int j = i + 1; j < n; j += 16) {
+      const int left = n - j;
+      const __mmask16 lanes = left >= 16 ? static_cast<__mmask16>(0xFFFF) : static_cast<__mmask16>((1u << left) - 1);
+      const __m512i xj = _mm512_maskz_loadu_epi32(lanes, x + j);
+      const __m512i d = _mm512_abs_epi32(_mm512_sub_epi32(xj, xi));
+      const __mmask16 ok = _mm512_mask_cmple_epu32_mask(lanes, _mm512_sub_epi32(d, dmin), span);
+      const __m512i bins = _mm512_srai_epi32(_mm512_add_epi32(xj, base), 2);
+      _mm512_storeu_si512(out + count, _mm512_maskz_compress_epi32(ok, bins));
+      count += __builtin_popcount(static_cast<unsigned>(ok));
     }
   }
+#else
+  for (int i = 0; i + 1 < n; ++i) {
+    const int32_t xi = x[i];
+    for (int j = i + 1; j < n; ++j) {  // branch-free: always store, advance only when valid
+      const int32_t d = std::abs(x[j] - xi);
+      out[count] = (xi + x[j] + rule.offset) >> 2;
+      count += static_cast<uint32_t>(d - rule.dmin2) <= rule.span;
+    }
+  }
+#endif
+  return count;
 }
 
 // Skew offsets are whole quarter-pixels of the pair sum: R_skew = x'_mid - y' tan(phi).
@@ -82,7 +80,7 @@ inline int32_t skew_shift(int row, double tan_phi) {
   return static_cast<int32_t>(std::lround(-4.0 * row * tan_phi));
 }
 
-// Largest |tan(phi)| in the skew list, rounded up: sizes the margins of the fine array.
+// Largest |tan(phi)| in the skew list, rounded up: sizes the margins of the histogram.
 int skew_margin(const std::vector<double>& skew_deg) {
   double m = 0;
   for (double s : skew_deg) m = std::max(m, std::fabs(std::tan(s * M_PI / 180.0)));
@@ -101,25 +99,13 @@ const Accumulator& Detector::vote(const EdgeSet& edges) {
     m.create(kThetaBins, layout.num_r(), CV_32S);
     m.setTo(0);
   }
-  // Two visiting orders of the edge pixels (see the comment at the top of this file).
   const size_t n = edges.points.size();
-  by_row_u_.resize(n);
-  by_row_v_.resize(n);
+  u2_.resize(n);
+  v2_.resize(n);
   for (size_t i = 0; i < n; ++i) {
-    by_row_u_[i] = 2 * edges.points[i].x - (edges.width - 1);
-    by_row_v_[i] = 2 * edges.points[i].y - (edges.height - 1);
+    u2_[i] = 2 * edges.points[i].x - (edges.width - 1);
+    v2_[i] = 2 * edges.points[i].y - (edges.height - 1);
   }
-  std::vector<int32_t> column_start(edges.width + 1, 0);
-  for (const auto& p : edges.points) ++column_start[p.x + 1];
-  for (int x = 0; x < edges.width; ++x) column_start[x + 1] += column_start[x];
-  by_col_u_.resize(n);
-  by_col_v_.resize(n);
-  for (size_t i = 0; i < n; ++i) {  // stable: rows stay in increasing y within a column
-    const int32_t k = column_start[edges.points[i].x]++;
-    by_col_u_[k] = by_row_u_[i];
-    by_col_v_[k] = by_row_v_[i];
-  }
-
   const std::vector<int> thetas = theta_bins_in_range(params_.theta_min_deg, params_.theta_max_deg);
   const int num_threads = std::max(1, std::min<int>(params_.threads, static_cast<int>(thetas.size())));
   scratch_.resize(num_threads);
@@ -136,38 +122,36 @@ const Accumulator& Detector::vote(const EdgeSet& edges) {
   return acc_;
 }
 
-void Detector::vote_thetas(const EdgeSet& edges, const std::vector<int>& thetas, size_t first,
-                           size_t step, Scratch& s) {
+void Detector::vote_thetas(const EdgeSet& edges, const std::vector<int>& thetas, size_t first, size_t step,
+                           Scratch& s) {
   const Layout layout = detail::make_layout(edges.width, edges.height, params_);
-  const size_t n = by_row_u_.size();
+  const size_t n = u2_.size();
   const int num_rows = 2 * layout.row_max + 1;
-  const int margin = skew_margin(params_.skew_deg);
-  // Fine array: index = xq_a + xq_b + skew shift + fine_offset, one cell per quarter pixel of R.
-  const int32_t fine_offset = layout.sum_offset + 4 * (layout.r_max + 2) * margin;
-  const size_t fine_size = static_cast<size_t>(2 * fine_offset + 8);
+  const int num_layers = static_cast<int>(acc_.votes.size());
+  // Histogram index = (xq_a + xq_b + shift + offset + 2) >> 2; offset keeps it >= 0 for any skew.
+  const int32_t offset = 4 * (layout.r_max + 2) * (1 + skew_margin(params_.skew_deg));
+  const int index_of_bin0 = offset / 4 - layout.r_max;  // histogram index of R bin 0
+  const size_t hist_size = static_cast<size_t>(2 * (offset / 4) + 8);
+  constexpr int kCopies = 4;
   s.xq.resize(n);
   s.row.resize(n);
   s.sorted.resize(n);
   s.starts.resize(num_rows + 1);
   s.fill.resize(num_rows);
-  s.fine.assign(fine_size, 0);
-  s.bins.assign(layout.num_r(), 0);
-  s.stamp.assign(layout.num_r(), -1);
+  s.hist.assign(kCopies * hist_size, 0);
+  s.stamp.assign(hist_size, -1);
   std::vector<double> tan_skew;
   for (double d : params_.skew_deg) tan_skew.push_back(std::tan(d * M_PI / 180.0));
+  const PairRule base_rule{layout.dmin2, static_cast<uint32_t>(layout.dmax2 - layout.dmin2), offset + 2};
 
   for (size_t ti = first; ti < thetas.size(); ti += step) {
     const int k = thetas[ti];
     const ThetaTable t = detail::theta_table(k);
-    const double theta_deg = theta_of_bin_deg(k);
-    const bool by_column = std::fabs(theta_deg) <= 45.0;
-    const int32_t* u = by_column ? by_col_u_.data() : by_row_u_.data();
-    const int32_t* v = by_column ? by_col_v_.data() : by_row_v_.data();
-    const bool reverse = !by_column && theta_deg < 0;
-
     // Rotate (vectorised) and count the pixels of each row of Rot.
     int32_t* xq = s.xq.data();
     int32_t* row = s.row.data();
+    const int32_t* u = u2_.data();
+    const int32_t* v = v2_.data();
     for (size_t i = 0; i < n; ++i) {
       xq[i] = detail::rotated_xq(u[i], v[i], t);
       row[i] = detail::rotated_row(u[i], v[i], t) + layout.row_max;
@@ -175,44 +159,48 @@ void Detector::vote_thetas(const EdgeSet& edges, const std::vector<int>& thetas,
     std::fill(s.starts.begin(), s.starts.end(), 0);
     for (size_t i = 0; i < n; ++i) ++s.starts[row[i] + 1];
     for (int r = 0; r < num_rows; ++r) s.starts[r + 1] += s.starts[r];
-    // Scatter into rows, keeping the visiting order (so rows are nearly sorted).
     std::copy(s.starts.begin(), s.starts.end() - 1, s.fill.begin());
     int32_t* fill = s.fill.data();
-    if (!reverse) {
-      for (size_t i = 0; i < n; ++i) s.sorted[fill[row[i]]++] = xq[i];
-    } else {
-      for (size_t i = n; i-- > 0;) s.sorted[fill[row[i]]++] = xq[i];
-    }
+    for (size_t i = 0; i < n; ++i) s.sorted[fill[row[i]]++] = xq[i];
 
-    for (int sk = 0; sk < static_cast<int>(acc_.votes.size()); ++sk) {
-      const double tan_phi = sk == 0 ? 0.0 : tan_skew[sk - 1];
-      int32_t* out = acc_.votes[sk].ptr<int32_t>(k);
+    for (int layer = 0; layer < num_layers; ++layer) {
+      const double tan_phi = layer == 0 ? 0.0 : tan_skew[layer - 1];
       for (int r = 0; r < num_rows; ++r) {
         const int count = s.starts[r + 1] - s.starts[r];
-        if (count < 2) continue;
-        int32_t* x = s.sorted.data() + s.starts[r];
-        if (sk == 0) insertion_sort(x, count);
-        if (params_.max_row_pixels > 0 && count > params_.max_row_pixels) continue;
-        const int32_t shift = sk == 0 ? 0 : skew_shift(r - layout.row_max, tan_phi);
+        if (count < 2 || (params_.max_row_pixels > 0 && count > params_.max_row_pixels)) continue;
+        PairRule rule = base_rule;
+        if (layer > 0) rule.offset += skew_shift(r - layout.row_max, tan_phi);
+        const size_t need = static_cast<size_t>(count) * (count - 1) / 2 + 16;
+        if (s.pairs.size() < need) s.pairs.resize(need);
+        const int votes = row_pair_bins(s.sorted.data() + s.starts[r], count, rule, s.pairs.data());
+        const int32_t* bins = s.pairs.data();
+        int32_t* h = s.hist.data();
         if (params_.once_per_row) {
-          vote_row_once(x, count, layout.dmin2, layout.dmax2, shift, layout,
-                        static_cast<int32_t>((k * static_cast<int>(acc_.votes.size()) + sk) * num_rows + r), s.bins.data(), s.stamp.data());
-        } else {
-          vote_row(x, count, layout.dmin2, layout.dmax2, s.fine.data() + fine_offset + shift);
+          const int32_t row_id = (k * num_layers + layer) * num_rows + r;
+          for (int q = 0; q < votes; ++q) {
+            if (s.stamp[bins[q]] == row_id) continue;
+            s.stamp[bins[q]] = row_id;
+            ++h[bins[q]];
+          }
+          continue;
         }
+        int q = 0;
+        for (; q + kCopies <= votes; q += kCopies) {
+          ++h[bins[q]];
+          ++h[hist_size + bins[q + 1]];
+          ++h[2 * hist_size + bins[q + 2]];
+          ++h[3 * hist_size + bins[q + 3]];
+        }
+        for (; q < votes; ++q) ++h[bins[q]];
       }
-      if (params_.once_per_row) {
-        std::memcpy(out, s.bins.data(), sizeof(int32_t) * layout.num_r());
-        std::fill(s.bins.begin(), s.bins.end(), 0);
-        continue;
-      }
-      // Fold quarter-pixel cells into 1 px bins: bin b takes sums s with round(s/4) = b - r_max.
+      // Sum the copies into the accumulator row and clear them for the next theta.
+      int32_t* out = acc_.votes[layer].ptr<int32_t>(k);
+      int32_t* h = s.hist.data();
       for (int b = 0; b < layout.num_r(); ++b) {
-        const int32_t sum_lo = 4 * (b - layout.r_max) - 2;
-        const int32_t* f = s.fine.data() + fine_offset + sum_lo;
-        out[b] = f[0] + f[1] + f[2] + f[3];
+        const size_t idx = static_cast<size_t>(index_of_bin0 + b);
+        out[b] = h[idx] + h[hist_size + idx] + h[2 * hist_size + idx] + h[3 * hist_size + idx];
       }
-      std::fill(s.fine.begin(), s.fine.end(), 0);
+      std::fill(s.hist.begin(), s.hist.end(), 0);
     }
   }
 }

@@ -115,7 +115,7 @@ class Detector {
 
  private:
   struct Scratch {  // per-thread working memory, kept between frames to avoid allocation
-    std::vector<int32_t> xq, row, sorted, starts, fill, fine, bins, stamp;
+    std::vector<int32_t> xq, row, sorted, starts, fill, pairs, hist, stamp;
   };
   void vote_thetas(const EdgeSet& edges, const std::vector<int>& thetas, size_t first, size_t step,
                    Scratch& scratch);
@@ -125,8 +125,8 @@ class Detector {
   EdgeParams edge_params_;
   Accumulator acc_;
   std::vector<Scratch> scratch_;
-  // Edge pixels in the two orders the fast voting needs (see vote.cpp).
-  std::vector<int32_t> by_col_u_, by_col_v_, by_row_u_, by_row_v_;
+  // Edge pixels in doubled coordinates about the image centre (see quantise.hpp).
+  std::vector<int32_t> u2_, v2_;
 };
 
 // Plain, obviously-correct Algorithm 1 (every pair of every row checked against Dmin/Dmax).
