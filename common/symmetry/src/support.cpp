@@ -19,39 +19,42 @@ void for_each_voting_pair(const EdgeSet& edges, const Params& params, const Line
   const double tan_phi =
       line.skew_index > 0 ? std::tan(params.skew_deg[line.skew_index - 1] * M_PI / 180.0) : 0.0;
   struct Item {
-    int32_t row, xq, index;
+    int32_t xq, index;
   };
-  std::vector<Item> items;
-  items.reserve(edges.points.size());
+  // Group by row of Rot with one counting sort, then sort each (short) row by xq.
+  const int num_rows = 2 * layout.row_max + 1;
+  std::vector<int32_t> row_of(edges.points.size()), starts(num_rows + 1, 0);
+  std::vector<Item> items(edges.points.size());
   for (size_t i = 0; i < edges.points.size(); ++i) {
     const int32_t u2 = 2 * edges.points[i].x - (edges.width - 1);
     const int32_t v2 = 2 * edges.points[i].y - (edges.height - 1);
-    items.push_back({detail::rotated_row(u2, v2, t), detail::rotated_xq(u2, v2, t), static_cast<int32_t>(i)});
+    row_of[i] = detail::rotated_row(u2, v2, t) + layout.row_max;
+    items[i] = {detail::rotated_xq(u2, v2, t), static_cast<int32_t>(i)};
+    ++starts[row_of[i] + 1];
   }
-  std::sort(items.begin(), items.end(),
-            [](const Item& a, const Item& b) { return a.row != b.row ? a.row < b.row : a.xq < b.xq; });
+  for (int r = 0; r < num_rows; ++r) starts[r + 1] += starts[r];
+  std::vector<Item> sorted(items.size());
+  {
+    std::vector<int32_t> fill(starts.begin(), starts.end() - 1);
+    for (size_t i = 0; i < items.size(); ++i) sorted[fill[row_of[i]]++] = items[i];
+  }
   // Pair sums s with bin_of_sum(s + shift) == r_bin lie in [s_lo, s_lo + 3].
   const int32_t s_lo_base = 4 * (line.r_bin - layout.r_max) - 2;
-  for (size_t begin = 0; begin < items.size();) {
-    size_t end = begin;
-    while (end < items.size() && items[end].row == items[begin].row) ++end;
-    const int count = static_cast<int>(end - begin);
-    if (count >= 2 && !(params.max_row_pixels > 0 && count > params.max_row_pixels)) {
-      const int32_t shift = static_cast<int32_t>(std::lround(-4.0 * items[begin].row * tan_phi));
-      const int32_t s_lo = s_lo_base - shift;
-      for (size_t i = begin; i < end; ++i) {
-        // Partners x_j in [s_lo - x_i, s_lo + 3 - x_i], j > i, and within [Dmin, Dmax].
-        const int32_t want_lo = std::max(s_lo - items[i].xq, items[i].xq + layout.dmin2);
-        const int32_t want_hi = std::min(s_lo + 3 - items[i].xq, items[i].xq + layout.dmax2);
-        if (want_lo > want_hi) continue;
-        auto it = std::lower_bound(items.begin() + i + 1, items.begin() + end, want_lo,
-                                   [](const Item& a, int32_t v) { return a.xq < v; });
-        for (; it != items.begin() + end && it->xq <= want_hi; ++it) {
-          visit(edges.points[items[i].index], edges.points[it->index]);
-        }
-      }
+  for (int r = 0; r < num_rows; ++r) {
+    const int count = starts[r + 1] - starts[r];
+    if (count < 2 || (params.max_row_pixels > 0 && count > params.max_row_pixels)) continue;
+    const auto begin = sorted.begin() + starts[r], end = sorted.begin() + starts[r + 1];
+    std::sort(begin, end, [](const Item& a, const Item& b) { return a.xq < b.xq; });
+    const int32_t shift = static_cast<int32_t>(std::lround(-4.0 * (r - layout.row_max) * tan_phi));
+    const int32_t s_lo = s_lo_base - shift;
+    for (auto a = begin; a != end; ++a) {
+      // Partners x_b in [s_lo - x_a, s_lo + 3 - x_a], after a, and within [Dmin, Dmax].
+      const int32_t want_lo = std::max(s_lo - a->xq, a->xq + layout.dmin2);
+      const int32_t want_hi = std::min(s_lo + 3 - a->xq, a->xq + layout.dmax2);
+      if (want_lo > want_hi) continue;
+      auto b = std::lower_bound(a + 1, end, want_lo, [](const Item& it, int32_t v) { return it.xq < v; });
+      for (; b != end && b->xq <= want_hi; ++b) visit(edges.points[a->index], edges.points[b->index]);
     }
-    begin = end;
   }
 }
 
