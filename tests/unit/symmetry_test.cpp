@@ -6,6 +6,7 @@
 #include <random>
 
 #include "nudge/symmetry/detector.hpp"
+#include "nudge/symmetry/gst.hpp"
 #include "nudge/symmetry/synthetic.hpp"
 
 using namespace nudge::symmetry;
@@ -313,4 +314,16 @@ TEST(SymmetryGeometry, ThetaRangesIncludingWrap) {
   const auto wrap = theta_bins_in_range(80, -80);  // 80..90 and -89..-80
   EXPECT_EQ(wrap.size(), 21u);
   EXPECT_EQ(theta_bins_in_range(0, 0).size(), 1u);
+}
+
+TEST(GeneralizedSymmetry, PeaksOnTheAxisOfAMirrorSymmetricShape) {
+  cv::Mat img(41, 41, CV_8UC1, cv::Scalar(200));
+  cv::rectangle(img, cv::Rect(12, 8, 17, 25), cv::Scalar(30), cv::FILLED);  // axis x = 20
+  const GstResult g = generalized_symmetry(img, GstParams{50.0, 1e-6});
+  ASSERT_GT(g.pairs, 0);
+  // The column through the axis collects more symmetry than the columns 5 px to either side.
+  const double on_axis = cv::sum(g.magnitude.col(20))[0];
+  EXPECT_GT(on_axis, 2 * cv::sum(g.magnitude.col(15))[0]);
+  EXPECT_GT(on_axis, 2 * cv::sum(g.magnitude.col(25))[0]);
+  EXPECT_THROW(generalized_symmetry(cv::Mat(), GstParams{}), std::invalid_argument);
 }
