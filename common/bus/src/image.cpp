@@ -64,13 +64,15 @@ nudge::image_t to_message(const cv::Mat& image, int8_t format, int64_t utime, in
   msg.width = image.cols;
   msg.height = image.rows;
   msg.pixel_format = format;
-  cv::Mat pixels = image;
+  cv::Mat pixels;  // never aliases `image`: a conversion must not write into the caller's pixels
   switch (format) {
     case image_t::FORMAT_GRAY8:
       if (image.channels() == 3) cv::cvtColor(image, pixels, cv::COLOR_BGR2GRAY);
+      else pixels = image;
       break;
     case image_t::FORMAT_BGR8:
       if (image.channels() == 1) cv::cvtColor(image, pixels, cv::COLOR_GRAY2BGR);
+      else pixels = image;
       break;
     case image_t::FORMAT_RGB8:
       cv::cvtColor(image, pixels, image.channels() == 1 ? cv::COLOR_GRAY2RGB : cv::COLOR_BGR2RGB);

@@ -1,6 +1,7 @@
 #include "nudge/camera/source.hpp"
 
 #include <glob.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <opencv2/imgcodecs.hpp>
@@ -75,12 +76,18 @@ std::unique_ptr<FrameSource> open_source(const std::string& spec) {
   const std::string arg = colon == std::string::npos ? "" : spec.substr(colon + 1);
   if (kind == "images" && !arg.empty()) return std::make_unique<ImageFiles>(arg);
   if (kind == "video" && !arg.empty()) {
+    if (::access(arg.c_str(), R_OK) != 0) throw std::invalid_argument("video:" + arg + " cannot be opened: no such file");
     cv::VideoCapture cap(arg);
     if (!cap.isOpened()) throw std::invalid_argument("video:" + arg + " cannot be opened");
     return std::make_unique<Capture>(spec, std::move(cap), true);
   }
   if (kind == "device" && !arg.empty()) {
-    const int index = parse_int(arg, "device index in '" + spec + "'");
+    int index = 0;
+    try {
+      index = parse_int(arg, "device index in '" + spec + "'");
+    } catch (const FlagError& e) {
+      throw std::invalid_argument(e.what());
+    }
     cv::VideoCapture cap(index);
     if (!cap.isOpened()) throw std::invalid_argument(spec + ": capture device cannot be opened");
     return std::make_unique<Capture>(spec, std::move(cap), false);

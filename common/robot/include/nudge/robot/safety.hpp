@@ -1,0 +1,58 @@
+#pragma once
+// Safety checks the arm service applies to every motion, whatever the backend (sim or hardware):
+// joint limits, the workspace ring around the arm base (Li 2008, sec. 6.3: roughly 150-350 mm),
+// clearance above the table, and densely sampled joint-space paths. Each check returns a reason
+// when it fails. All positions are in the arm base frame (see puma260.hpp).
+#include <Eigen/Geometry>
+
+#include <vector>
+
+#include "nudge/robot/kinematics.hpp"
+#include "nudge/robot/puma260.hpp"
+#include "nudge/robot/trajectory.hpp"
+#include "nudge/robot/types.hpp"
+
+namespace nudge::robot {
+
+struct SafetyConfig {
+  // Height of the table plane in the base frame (the shoulder is the origin, so this is
+  // negative). Assumed: the arm stands on the table with its shoulder about 0.33 m above it.
+  double table_z = -0.33;
+  double table_margin = 0.005;  // tool point, wrist centre and elbow stay this far above the table
+  double ring_inner = 0.150;    // tool point's distance from the joint 1 axis, metres
+  double ring_outer = 0.350;
+  bool enforce_ring = true;     // the arm service may lift this for parking poses outside the ring
+  double path_step = deg_to_rad(1.0);  // largest joint change between checked path samples
+};
+
+// Throws std::invalid_argument naming the field when the configuration makes no sense.
+void validate(const SafetyConfig& config);
+
+CheckResult check_joint_limits(const ArmModel& model, const JointVector& q);
+
+// The tool point's horizontal distance from the base axis must lie within the ring.
+CheckResult check_workspace_ring(const SafetyConfig& config, const Eigen::Vector3d& tool_point);
+
+// Tool point, wrist centre and elbow above table_z + table_margin.
+CheckResult check_table_clearance(const ArmModel& model, const SafetyConfig& config,
+                                  const JointVector& q);
+
+// Joint limits, then table clearance, then (if enforced) the workspace ring.
+CheckResult check_configuration(const ArmModel& model, const SafetyConfig& config,
+                                const JointVector& q);
+
+// The straight joint-space line from `from` to `to`, sampled so that no joint moves more than
+// config.path_step between samples (both ends included). Names the first unsafe fraction.
+CheckResult check_joint_path(const ArmModel& model, const SafetyConfig& config,
+                             const JointVector& from, const JointVector& to);
+
+// Every segment of a piecewise-linear joint path (e.g. LinearTrajectory waypoints).
+CheckResult check_joint_path(const ArmModel& model, const SafetyConfig& config,
+                             const std::vector<JointVector>& waypoints);
+
+// A tool pose the arm can reach safely: the IK solution nearest the seed, refused with a reason
+// when it is unreachable or fails check_configuration (the arm service's move-to-pose).
+IkResult safe_inverse_kinematics(const ArmModel& model, const SafetyConfig& config,
+                                 const Eigen::Isometry3d& tool_pose, const JointVector& seed);
+
+}  // namespace nudge::robot

@@ -1,0 +1,143 @@
+#include "nudge/robot/safety.hpp"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace nudge::robot {
+namespace {
+
+CheckResult check_above_table(const char* what, const Eigen::Vector3d& point,
+                              const SafetyConfig& config) {
+  const double lowest = config.table_z + config.table_margin;
+  if (point.z() >= lowest) return CheckResult::pass();
+  return CheckResult::fail(std::string(what) + " at z = " + format_number(point.z(), 4) +
+                           " m, below the table clearance limit " + format_number(lowest, 4) +
+                           " m (table at " + format_number(config.table_z) + " m + " +
+                           format_number(config.table_margin) + " m margin)");
+}
+
+}  // namespace
+
+void validate(const SafetyConfig& config) {
+  auto require = [](bool ok, const char* message) {
+    if (!ok) throw std::invalid_argument(std::string("safety config: ") + message);
+  };
+  require(std::isfinite(config.table_z), "table_z must be finite");
+  require(std::isfinite(config.table_margin) && config.table_margin >= 0,
+          "table_margin must be finite and non-negative");
+  require(std::isfinite(config.ring_inner) && config.ring_inner >= 0,
+          "ring_inner must be finite and non-negative");
+  require(std::isfinite(config.ring_outer) && config.ring_outer > config.ring_inner,
+          "ring_outer must be finite and larger than ring_inner");
+  require(std::isfinite(config.path_step) && config.path_step > 0,
+          "path_step must be finite and positive");
+}
+
+CheckResult check_joint_limits(const ArmModel& model, const JointVector& q) {
+  for (int j = 0; j < kNumJoints; ++j) {
+    if (!std::isfinite(q[j])) {
+      return CheckResult::fail("joint " + std::to_string(j + 1) + " is not a finite number");
+    }
+    if (q[j] < model.limits.lower[j] || q[j] > model.limits.upper[j]) {
+      return CheckResult::fail("joint " + std::to_string(j + 1) + " at " +
+                               format_number(rad_to_deg(q[j]), 1) + " deg, outside its limits [" +
+                               format_number(rad_to_deg(model.limits.lower[j]), 1) + ", " +
+                               format_number(rad_to_deg(model.limits.upper[j]), 1) + "] deg");
+    }
+  }
+  return CheckResult::pass();
+}
+
+CheckResult check_workspace_ring(const SafetyConfig& config, const Eigen::Vector3d& tool_point) {
+  const double radius = std::hypot(tool_point.x(), tool_point.y());
+  if (radius >= config.ring_inner && radius <= config.ring_outer) return CheckResult::pass();
+  return CheckResult::fail("tool point " + format_number(radius) +
+                           " m from the base axis, outside the " +
+                           format_number(config.ring_inner) + "-" +
+                           format_number(config.ring_outer) + " m workspace ring");
+}
+
+CheckResult check_table_clearance(const ArmModel& model, const SafetyConfig& config,
+                                  const JointVector& q) {
+  const ArmPoints points = arm_points(model, q);
+  for (const auto& [what, point] : {std::pair{"tool point", points.tool},
+                                    std::pair{"wrist centre", points.wrist},
+                                    std::pair{"elbow", points.elbow}}) {
+    CheckResult result = check_above_table(what, point, config);
+    if (!result.ok()) return result;
+  }
+  return CheckResult::pass();
+}
+
+CheckResult check_configuration(const ArmModel& model, const SafetyConfig& config,
+                                const JointVector& q) {
+  CheckResult result = check_joint_limits(model, q);
+  if (!result.ok()) return result;
+  result = check_table_clearance(model, config, q);
+  if (!result.ok() || !config.enforce_ring) return result;
+  return check_workspace_ring(config, forward_kinematics(model, q).translation());
+}
+
+CheckResult check_joint_path(const ArmModel& model, const SafetyConfig& config,
+                             const JointVector& from, const JointVector& to) {
+  validate(config);
+  const double largest_change = (to - from).cwiseAbs().maxCoeff();
+  if (!std::isfinite(largest_change)) {
+    return CheckResult::fail("path has non-finite joint values");
+  }
+  const int steps = std::max(1, static_cast<int>(std::ceil(largest_change / config.path_step)));
+  for (int k = 0; k <= steps; ++k) {
+    const double fraction = static_cast<double>(k) / steps;
+    const JointVector q = k == steps ? to : JointVector(from + fraction * (to - from));
+    CheckResult result = check_configuration(model, config, q);
+    if (!result.ok()) {
+      return CheckResult::fail("unsafe at " + format_number(100.0 * fraction, 1) +
+                               "% of the path: " + result.reason);
+    }
+  }
+  return CheckResult::pass();
+}
+
+CheckResult check_joint_path(const ArmModel& model, const SafetyConfig& config,
+                             const std::vector<JointVector>& waypoints) {
+  if (waypoints.empty()) return CheckResult::fail("path has no waypoints");
+  if (waypoints.size() == 1) return check_configuration(model, config, waypoints.front());
+  for (size_t i = 1; i < waypoints.size(); ++i) {
+    CheckResult result = check_joint_path(model, config, waypoints[i - 1], waypoints[i]);
+    if (!result.ok()) {
+      return CheckResult::fail("segment " + std::to_string(i) + " of " +
+                               std::to_string(waypoints.size() - 1) + ": " + result.reason);
+    }
+  }
+  return CheckResult::pass();
+}
+
+IkResult safe_inverse_kinematics(const ArmModel& model, const SafetyConfig& config,
+                                 const Eigen::Isometry3d& tool_pose, const JointVector& seed) {
+  const IkResult nearest = nearest_inverse_kinematics(model, tool_pose, seed);
+  if (!nearest.ok()) return nearest;
+  // The nearest solution may dip the elbow below the table while another configuration is
+  // fine: then take the nearest safe one.
+  IkResult best;
+  best.failure = IkFailure::Unsafe;
+  best.reason = check_configuration(model, config, nearest.q).reason;
+  if (best.reason.empty()) return nearest;
+  double best_distance = std::numeric_limits<double>::infinity();
+  IkOptions options;
+  options.seed = seed;
+  for (const ArmConfiguration& configuration : all_configurations()) {
+    options.configuration = configuration;
+    const IkResult candidate = inverse_kinematics(model, tool_pose, options);
+    if (!candidate.ok() || !check_configuration(model, config, candidate.q).ok()) continue;
+    const double distance = joint_distance(candidate.q, seed);
+    if (distance < best_distance) {
+      best_distance = distance;
+      best = candidate;
+    }
+  }
+  return best;
+}
+
+}  // namespace nudge::robot

@@ -1,0 +1,63 @@
+#pragma once
+// The object library: household objects generated from profiles. A body of revolution is a
+// closed (r, z) profile curve turned about the object's z axis into a triangle mesh with texture
+// coordinates (u = angle / 2pi, v = arc length along the profile / the widest circumference, so
+// that a texture's cells are square at the widest radius). A mug adds a
+// handle, a tube swept along an arc. Object frame: origin at the centre of the base on the table,
+// z up along the symmetry axis; a mug's handle points along +x.
+//
+// Masses and inertias are those of thin shells (empty objects): the mass is spread over the
+// surface, so the centre of mass and the inertia follow from the triangles.
+#include <Eigen/Core>
+
+#include <string>
+#include <vector>
+
+namespace nudge::sim {
+
+struct Mesh {
+  std::vector<Eigen::Vector3f> vertices;
+  std::vector<Eigen::Vector2f> texcoords;  // one per vertex
+  std::vector<Eigen::Vector3i> faces;      // counter-clockwise seen from outside
+  double area() const;
+  double volume() const;  // signed: positive when the faces point outwards
+};
+
+struct MassProperties {
+  double mass = 0;
+  Eigen::Vector3d com = Eigen::Vector3d::Zero();      // object frame
+  Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();  // about the com, object-frame axes
+};
+
+// Mass properties of a thin shell of total mass `mass` spread uniformly over the meshes' area.
+MassProperties shell_mass_properties(const std::vector<const Mesh*>& meshes, double mass);
+
+struct ObjectModel {
+  std::string kind;
+  std::vector<Eigen::Vector2d> profile;  // (r, z) of the body of revolution, axis to axis
+  std::vector<Mesh> parts;    // each part is one mesh geom (its convex hull collides)
+  double height = 0;          // m, top of the object above its base
+  double base_radius = 0;     // m, radius of the footprint
+  double max_radius = 0;      // m, widest point of the body of revolution (handle excluded)
+  double default_mass = 0;    // kg
+  double default_friction = 0.5;
+
+  // Outer radius of the body of revolution at height z (largest r where the profile crosses z;
+  // handle excluded); 0 outside [0, height]. Where a pad at that height first touches the object.
+  double radius_at(double z) const;
+};
+
+// Kinds known to the library, e.g. {"bottle", "can", "cup", "mug"}.
+std::vector<std::string> object_kinds();
+bool is_object_kind(const std::string& kind);
+
+// Builds the model of a kind; throws std::invalid_argument for an unknown kind.
+// `segments`: number of facets around the axis.
+ObjectModel make_object(const std::string& kind, int segments = 48);
+
+// Turns a profile about the z axis. `profile` goes from a point on the axis (r = 0) along the
+// object's surface to another point on the axis (e.g. bottom centre, out, up the wall, in, top
+// centre). Either direction works: the faces are turned to point outwards.
+Mesh revolve(const std::vector<Eigen::Vector2d>& profile, int segments);
+
+}  // namespace nudge::sim

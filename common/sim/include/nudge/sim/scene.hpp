@@ -1,0 +1,110 @@
+#pragma once
+// Scene description of the simulated world: what stands on the table, what the table and the
+// backdrop look like, where the stereo cameras are, and how physics and rendering are set up.
+// A scene is plain data: build one in code, or load it from a cv::FileStorage YAML file
+// (format in docs/sim.md). Units: metres, radians in code, degrees in files (`*_deg` fields).
+//
+// World frame: origin on the PUMA's base axis at table-top height, z up (table top is z = 0),
+// x from the arm base towards the workspace and the cameras, y to the left seen from the arm.
+#include <Eigen/Core>
+
+#include <cmath>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace nudge::sim {
+
+// Any error in a scene: the message names the file (or "scene") and the offending field.
+class SceneError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// The look of a surface (table top, backdrop, or an object).
+struct Appearance {
+  enum class Kind { Plain, Checker, Image };
+  Kind kind = Kind::Plain;
+  Eigen::Vector3d colour{0.8, 0.8, 0.8};   // RGB in [0, 1]
+  Eigen::Vector3d colour2{0.3, 0.3, 0.3};  // second colour of a checker
+  std::string file;                        // PNG for Kind::Image (absolute, or relative to the scene file)
+  double repeat = 4.0;                     // texture repetitions across the surface
+  double specular = 0.3;
+  double shininess = 0.3;
+  double reflectance = 0.0;                // only drawn when Render::reflections is on
+};
+
+struct ObjectSpec {
+  std::string name;                // unique; defaults to "<kind><index>"
+  std::string kind;                // a kind of the object library: cup, mug, bottle, can
+  Eigen::Vector2d position{0.25, 0.0};  // of the base centre on the table, world x y
+  double yaw = 0.0;                // about the world z axis (turns a mug's handle)
+  Appearance appearance;
+  double mass = 0.0;               // kg; 0 = the library's default for the kind
+  double friction = 0.0;           // sliding friction; 0 = the library's default
+};
+
+// A verged stereo pair (thesis ch. 4.3). The rig's centre looks at `target` from `distance`,
+// `elevation` above the horizontal (look-down angle), from the direction `azimuth` (0: from +x).
+// The two cameras sit `baseline` apart on the rig's horizontal axis and are each turned inwards by
+// vergence / 2 (their optical axes meet at baseline / 2 / tan(vergence / 2) in front of the rig).
+struct RigSpec {
+  Eigen::Vector3d target{0.25, 0.0, 0.06};
+  double distance = 0.7;
+  double elevation = 30.0 * M_PI / 180.0;
+  double azimuth = 0.0;
+  double baseline = 0.25;
+  double vergence = 15.0 * M_PI / 180.0;
+  int width = 640;
+  int height = 480;
+  double fovy = 45.0 * M_PI / 180.0;  // vertical field of view
+};
+
+struct RenderSpec {
+  bool shadows = false;
+  bool reflections = false;
+  bool antialias = false;        // 4x multisampling (slower; masks get mixed ids on edges)
+  double noise_sigma = 0.0;      // Gaussian pixel noise (grey levels), seeded by the scene seed
+  int snapshot_scale = 2;        // high-resolution stills (thesis ch. 6: 1280x960) = scale x rig size
+  double ambient = 0.35;         // headlight ambient
+  double light = 0.55;           // diffuse intensity of the overhead lights
+};
+
+struct PhysicsSpec {
+  double timestep = 0.002;       // s, fixed
+  double settle_time = 0.5;      // s simulated when the world is built, so objects start at rest
+  double position_jitter = 0.0;  // m, std of a seeded random offset added to each object position
+  double yaw_jitter = 0.0;       // rad, likewise for the yaw
+  double table_friction = 0.5;
+  // MuJoCo's contacts are soft: friction lets objects creep under any sideways force. An
+  // elliptic friction cone with a high impratio, plus the no-slip solver, make friction hard
+  // enough that a pushed object tips when pushed high instead of sliding.
+  bool elliptic_cone = true;
+  double impratio = 10.0;
+  int noslip_iterations = 0;
+};
+
+struct Scene {
+  std::string source = "scene";  // file the scene came from (for messages)
+  uint64_t seed = 1;
+  Appearance table;              // table top
+  Appearance background;         // backdrop wall behind the table
+  std::vector<ObjectSpec> objects;
+  RigSpec rig;
+  RenderSpec render;
+  PhysicsSpec physics;
+};
+
+// Defaults for the table and backdrop: light wood-coloured table, plain off-white wall.
+Scene default_scene();
+
+// Loads a YAML (or XML/JSON) cv::FileStorage scene file. Missing fields take default_scene()'s
+// values. Throws SceneError naming the file and the field ("scenes/x.yaml: objects[1].kind: ...").
+Scene load_scene(const std::string& path);
+
+// Checks a scene built in code (kinds exist, names unique, numbers finite and in range, texture
+// files readable). Throws SceneError naming scene.source and the field. load_scene() calls it.
+void validate(const Scene& scene);
+
+}  // namespace nudge::sim

@@ -1,0 +1,124 @@
+#pragma once
+// The simulated world: MuJoCo physics of a table, household objects and a kinematic pusher, seen
+// by a verged stereo pair rendered offscreen through OSMesa. A pure library (no LCM): the world
+// service and the camera's sim backend wrap it.
+//
+// Deterministic: the same scene (including its seed) and the same calls give bit-identical
+// states and images. Not thread-safe: use one World from one thread at a time.
+#include "nudge/sim/camera.hpp"
+#include "nudge/sim/scene.hpp"
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+
+#include <array>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace nudge::sim {
+
+class Renderer;
+
+// Failures of MuJoCo (model compilation, rendering context) and misuse of the pusher.
+class SimError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct ObjectState {
+  std::string name;
+  std::string kind;
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();  // base centre, world frame
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
+  Eigen::Vector3d linear_velocity = Eigen::Vector3d::Zero();   // of the body origin
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();  // world frame
+  double height = 0;  // along the symmetry axis
+  double tilt() const;  // angle between the symmetry axis and the world z axis, radians
+};
+
+struct StereoImages {
+  double time = 0;                  // simulated time of the physics state both were rendered from
+  std::array<cv::Mat, 2> colour;    // BGR, CV_8UC3
+  std::array<cv::Mat, 2> mask;      // CV_8U: object index + 1, 0 = table/background/pusher (if asked)
+};
+
+struct PushResult {
+  double start_time = 0, end_time = 0;  // simulated time
+  bool contact = false;                 // the pad touched an object
+};
+
+class World {
+ public:
+  // Builds the model (objects placed with the scene's seeded jitter), then simulates
+  // scene.physics.settle_time so that objects start at rest. Throws SceneError / SimError.
+  explicit World(const Scene& scene);
+  ~World();
+  World(const World&) = delete;
+  World& operator=(const World&) = delete;
+
+  const Scene& scene() const { return scene_; }  // with the jittered positions actually used
+  const std::string& mjcf() const { return mjcf_; }
+  const StereoRig& rig() const { return rig_; }
+  const CameraModel& camera(int index) const { return rig_.cameras.at(index); }
+
+  // ---- physics
+  double time() const;
+  double timestep() const;
+  void step(int n = 1);
+  void step_for(double seconds);  // whole steps, rounded to the nearest
+  // Generalised positions and velocities of the whole world (for determinism checks, logging).
+  std::vector<double> state() const;
+
+  // ---- objects and ground truth
+  int num_objects() const { return static_cast<int>(scene_.objects.size()); }
+  int object_index(const std::string& name) const;  // -1 if unknown
+  ObjectState object(int index) const;
+  // Teleports an object (base centre and orientation, world frame) and stops it. For resetting
+  // a scene or putting an object back (thesis ch. 7); the caller steps physics afterwards.
+  void set_object_pose(int index, const Eigen::Vector3d& position,
+                       const Eigen::Quaterniond& orientation);
+  // Upright on the table at (x, y) with the given yaw.
+  void place_object(int index, const Eigen::Vector2d& xy, double yaw);
+  // The object's symmetry axis: its local z axis through the base centre.
+  Axis3d axis(int index) const;
+  ImageLine axis_in_image(int index, int camera) const;
+
+  // ---- the kinematic pusher (the seam where the arm's end effector will go)
+  // Places the pad (its centre) at `position`, its face turned to push along the horizontal
+  // direction of angle `yaw` (rad, about world z). Moves instantly: the caller steps physics.
+  void set_pusher(const Eigen::Vector3d& position, double yaw);
+  void park_pusher();
+  Eigen::Vector3d pusher_position() const;
+  // A straight push: the pad appears at `from` (must not touch an object: SimError otherwise),
+  // moves in a straight line to `to` at `speed` m/s, goes back to `from`, is parked, and the world
+  // settles for `settle` s. The pad faces the direction of motion.
+  PushResult push(const Eigen::Vector3d& from, const Eigen::Vector3d& to, double speed = 0.05,
+                  double settle = 1.0);
+  // True when the pad currently touches one of the objects.
+  bool pusher_in_contact() const;
+
+  // ---- rendering (OSMesa context created on first use)
+  cv::Mat render(int camera);       // BGR, rig width x height
+  cv::Mat render_mask(int camera);  // CV_8U, object index + 1 (255 caps), 0 elsewhere
+  StereoImages render_stereo(bool masks = false);
+  // High-resolution still (scene.render.snapshot_scale x the rig size, e.g. 1280x960) and the
+  // camera model that goes with it.
+  cv::Mat render_snapshot(int camera);
+  cv::Mat render_snapshot_mask(int camera);
+  CameraModel snapshot_camera(int camera) const;
+  bool pusher_visible = true;       // draw the pusher pad in colour images
+
+ private:
+  Renderer& renderer();
+  cv::Mat colour_image(int camera, cv::Size size);
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  Scene scene_;
+  std::string mjcf_;
+  StereoRig rig_;
+};
+
+}  // namespace nudge::sim

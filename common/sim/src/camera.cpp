@@ -1,0 +1,119 @@
+#include "nudge/sim/camera.hpp"
+
+#include <Eigen/Geometry>
+
+#include <cmath>
+#include <stdexcept>
+
+namespace nudge::sim {
+
+using Eigen::Matrix3d;
+using Eigen::Vector2d;
+using Eigen::Vector3d;
+
+Vector2d CameraModel::project(const Vector3d& world, double* depth) const {
+  const Vector3d c = to_camera(world);
+  if (depth) *depth = c.z();
+  const Vector3d p = K * c;
+  return Vector2d(p.x() / p.z(), p.y() / p.z());
+}
+
+Matrix3d StereoRig::R_right_left() const {
+  return cameras[1].R * cameras[0].R.transpose();
+}
+
+Vector3d StereoRig::t_right_left() const {
+  return cameras[1].t - R_right_left() * cameras[0].t;
+}
+
+StereoRig make_rig(const RigSpec& spec) {
+  if (!(spec.distance > 0) || !(spec.baseline > 0) || spec.width <= 0 || spec.height <= 0 ||
+      !(spec.fovy > 0 && spec.fovy < M_PI))
+    throw std::invalid_argument("make_rig: distance, baseline, size and fovy must be positive");
+  const double ce = std::cos(spec.elevation), se = std::sin(spec.elevation);
+  const Vector3d from_target(ce * std::cos(spec.azimuth), ce * std::sin(spec.azimuth), se);
+  const Vector3d centre = spec.target + spec.distance * from_target;
+  const Vector3d forward = -from_target;
+  const Vector3d right = forward.cross(Vector3d::UnitZ()).normalized();
+  const Vector3d down = forward.cross(right);
+
+  const double f = 0.5 * spec.height / std::tan(0.5 * spec.fovy);
+  Matrix3d K = Matrix3d::Identity();
+  K(0, 0) = f;
+  K(1, 1) = f;
+  K(0, 2) = 0.5 * (spec.width - 1);
+  K(1, 2) = 0.5 * (spec.height - 1);
+
+  StereoRig rig;
+  const double half = 0.5 * spec.vergence;
+  for (int i = 0; i < 2; ++i) {
+    const double side = i == 0 ? -1.0 : 1.0;  // left camera on -right
+    // Each camera turns inwards by half the vergence, about the rig's vertical (down) axis.
+    const Vector3d fwd = std::cos(half) * forward - side * std::sin(half) * right;
+    const Vector3d rgt = std::cos(half) * right + side * std::sin(half) * forward;
+    CameraModel& cam = rig.cameras[i];
+    cam.name = i == 0 ? "left" : "right";
+    cam.width = spec.width;
+    cam.height = spec.height;
+    cam.fovy = spec.fovy;
+    cam.K = K;
+    cam.R.row(0) = rgt.transpose();
+    cam.R.row(1) = down.transpose();
+    cam.R.row(2) = fwd.transpose();
+    const Vector3d position = centre + side * 0.5 * spec.baseline * right;
+    cam.t = -cam.R * position;
+  }
+  return rig;
+}
+
+CameraModel scaled(const CameraModel& camera, int scale) {
+  if (scale < 1) throw std::invalid_argument("scaled: scale must be >= 1");
+  CameraModel out = camera;
+  out.width = camera.width * scale;
+  out.height = camera.height * scale;
+  out.K(0, 0) = camera.K(0, 0) * scale;
+  out.K(1, 1) = camera.K(1, 1) * scale;
+  out.K(0, 2) = 0.5 * (out.width - 1);
+  out.K(1, 2) = 0.5 * (out.height - 1);
+  return out;
+}
+
+ImageLine line_through(const Vector2d& a, const Vector2d& b, int width, int height) {
+  ImageLine line;
+  line.bottom = a;
+  line.top = b;
+  const Vector2d d = b - a;
+  if (!(d.norm() > 1e-9)) return line;
+  // A normal of direction d is (d.y, -d.x) / |d| (or its opposite): theta = atan2(-d.x, d.y),
+  // then folded into (-pi/2, pi/2] (R changes sign with the normal).
+  double theta = std::atan2(-d.x(), d.y());
+  if (theta <= -M_PI / 2) theta += M_PI;
+  if (theta > M_PI / 2) theta -= M_PI;
+  const Vector2d n(std::cos(theta), std::sin(theta));
+  const Vector2d c(0.5 * (width - 1), 0.5 * (height - 1));
+  line.theta = theta;
+  line.r = n.dot(a - c);
+  line.valid = true;
+  return line;
+}
+
+ImageLine project_axis(const CameraModel& camera, const Axis3d& axis) {
+  double z0 = 0, z1 = 0;
+  const Vector2d a = camera.project(axis.base, &z0);
+  const Vector2d b = camera.project(axis.top(), &z1);
+  if (!(z0 > 0 && z1 > 0)) {
+    ImageLine line;
+    line.bottom = a;
+    line.top = b;
+    return line;
+  }
+  return line_through(a, b, camera.width, camera.height);
+}
+
+double signed_distance(const ImageLine& line, const Vector2d& pixel, int width, int height) {
+  const Vector2d c(0.5 * (width - 1), 0.5 * (height - 1));
+  return std::cos(line.theta) * (pixel.x() - c.x()) + std::sin(line.theta) * (pixel.y() - c.y()) -
+         line.r;
+}
+
+}  // namespace nudge::sim

@@ -1,0 +1,188 @@
+#include "nudge/sim/mjcf.hpp"
+
+#include "nudge/sim/camera.hpp"
+#include "nudge/sim/objects.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <locale>
+#include <sstream>
+
+namespace nudge::sim {
+
+namespace {
+
+// Table top extent (world frame) and the backdrop wall behind it (at its -x edge).
+constexpr double kTableXMin = -0.6, kTableXMax = 1.1, kTableHalfY = 1.0;
+
+class Xml {
+ public:
+  Xml() {
+    out_.imbue(std::locale::classic());
+    out_.precision(9);
+  }
+  template <typename T>
+  Xml& operator<<(const T& v) {
+    out_ << v;
+    return *this;
+  }
+  std::string str() const { return out_.str(); }
+
+ private:
+  std::ostringstream out_;
+};
+
+std::string vec(const Eigen::Vector3d& v) {
+  std::ostringstream s;
+  s.imbue(std::locale::classic());
+  s.precision(9);
+  s << v.x() << ' ' << v.y() << ' ' << v.z();
+  return s.str();
+}
+
+std::string rgba(const Eigen::Vector3d& c) { return vec(c) + " 1"; }
+
+// A texture + material pair for an appearance. Returns the material name.
+std::string add_material(Xml& assets, const std::string& name, const Appearance& a, bool mesh) {
+  const std::string tex = name + "_tex";
+  bool textured = false;
+  if (a.kind == Appearance::Kind::Checker) {
+    assets << "    <texture name=\"" << tex << "\" type=\"2d\""
+           << " builtin=\"checker\" rgb1=\"" << vec(a.colour) << "\" rgb2=\"" << vec(a.colour2)
+           << "\" width=\"256\" height=\"256\"/>\n";
+    textured = true;
+  } else if (a.kind == Appearance::Kind::Image) {
+    assets << "    <texture name=\"" << tex << "\" type=\"2d\" file=\"" << a.file
+           << "\"/>\n";
+    textured = true;
+  }
+  assets << "    <material name=\"" << name << "\"";
+  if (textured) {
+    assets << " texture=\"" << tex << "\" rgba=\"1 1 1 1\"";
+    if (!mesh) assets << " texrepeat=\"" << a.repeat << ' ' << a.repeat << "\" texuniform=\"false\"";
+  } else {
+    assets << " rgba=\"" << rgba(a.colour) << "\"";
+  }
+  assets << " specular=\"" << a.specular << "\" shininess=\"" << a.shininess
+         << "\" reflectance=\"" << a.reflectance << "\"/>\n";
+  return name;
+}
+
+// `repeat`: texture repetitions around the object (MuJoCo's texrepeat does not apply to mesh
+// texture coordinates, so they are scaled here).
+void add_mesh(Xml& assets, const std::string& name, const Mesh& mesh, double repeat) {
+  assets << "    <mesh name=\"" << name << "\" vertex=\"";
+  for (const auto& v : mesh.vertices) assets << v.x() << ' ' << v.y() << ' ' << v.z() << ' ';
+  assets << "\" texcoord=\"";
+  for (const auto& t : mesh.texcoords) assets << repeat * t.x() << ' ' << repeat * t.y() << ' ';
+  assets << "\" face=\"";
+  for (const auto& f : mesh.faces) assets << f[0] << ' ' << f[1] << ' ' << f[2] << ' ';
+  assets << "\"/>\n";
+}
+
+}  // namespace
+
+const Eigen::Vector3d& pusher_park_position() {
+  static const Eigen::Vector3d park(-1.0, 0.0, 0.5);  // behind the backdrop
+  return park;
+}
+
+const Eigen::Vector3d& pusher_pad_half_size() {
+  static const Eigen::Vector3d half(0.01, 0.04, 0.015);
+  return half;
+}
+
+std::string build_mjcf(const Scene& scene) {
+  validate(scene);
+  const RigSpec& rs = scene.rig;
+  const StereoRig rig = make_rig(rs);
+  const int samples = scene.render.antialias ? 4 : 0;
+
+  Xml assets, bodies;
+  add_material(assets, "table_mat", scene.table, false);
+  add_material(assets, "backdrop_mat", scene.background, false);
+
+  for (size_t i = 0; i < scene.objects.size(); ++i) {
+    const ObjectSpec& spec = scene.objects[i];
+    const ObjectModel model = make_object(spec.kind);
+    const std::string id = "obj" + std::to_string(i);
+    add_material(assets, id + "_mat", spec.appearance, true);
+    std::vector<const Mesh*> parts;
+    for (size_t k = 0; k < model.parts.size(); ++k) {
+      add_mesh(assets, id + "_part" + std::to_string(k), model.parts[k], spec.appearance.repeat);
+      parts.push_back(&model.parts[k]);
+    }
+    const double mass = spec.mass > 0 ? spec.mass : model.default_mass;
+    const double friction = spec.friction > 0 ? spec.friction : model.default_friction;
+    const MassProperties props = shell_mass_properties(parts, mass);
+    const Eigen::Matrix3d& I = props.inertia;
+    bodies << "    <body name=\"" << id << "\" pos=\"" << spec.position.x() << ' '
+           << spec.position.y() << " 0\" euler=\"0 0 " << spec.yaw << "\">\n"
+           << "      <freejoint name=\"" << id << "_joint\"/>\n"
+           << "      <inertial pos=\"" << vec(props.com) << "\" mass=\"" << mass
+           << "\" fullinertia=\"" << I(0, 0) << ' ' << I(1, 1) << ' ' << I(2, 2) << ' ' << I(0, 1)
+           << ' ' << I(0, 2) << ' ' << I(1, 2) << "\"/>\n";
+    for (size_t k = 0; k < model.parts.size(); ++k) {
+      bodies << "      <geom name=\"" << id << "_part" << k << "\" type=\"mesh\" mesh=\"" << id
+             << "_part" << k << "\" material=\"" << id << "_mat\" contype=\"3\" conaffinity=\"3\""
+             << " condim=\"3\" friction=\"" << friction << " 0.005 0.0001\"/>\n";
+    }
+    bodies << "    </body>\n";
+  }
+
+  const Eigen::Vector3d pad = pusher_pad_half_size();
+  const double light = scene.render.light;
+  const double ambient = scene.render.ambient;
+  const Eigen::Vector3d table_centre(0.5 * (kTableXMin + kTableXMax), 0, 0);
+
+  Xml x;
+  x << "<mujoco model=\"nudge_world\">\n"
+    << "  <compiler angle=\"radian\"/>\n"
+    << "  <option timestep=\"" << scene.physics.timestep << "\" gravity=\"0 0 -9.81\""
+    << " integrator=\"Euler\" cone=\"" << (scene.physics.elliptic_cone ? "elliptic" : "pyramidal")
+    << "\" impratio=\"" << scene.physics.impratio << "\" noslip_iterations=\""
+    << scene.physics.noslip_iterations << "\"/>\n"
+    << "  <size njmax=\"2000\" nconmax=\"500\"/>\n"
+    << "  <statistic extent=\"2\" center=\"" << vec(table_centre) << "\"/>\n"
+    << "  <visual>\n"
+    << "    <global offwidth=\"" << rs.width * scene.render.snapshot_scale << "\" offheight=\""
+    << rs.height * scene.render.snapshot_scale << "\"/>\n"
+    << "    <quality offsamples=\"" << samples << "\" shadowsize=\"2048\"/>\n"
+    << "    <headlight ambient=\"" << ambient << ' ' << ambient << ' ' << ambient
+    << "\" diffuse=\"0.25 0.25 0.25\" specular=\"0.1 0.1 0.1\"/>\n"
+    << "    <map znear=\"0.01\" zfar=\"20\"/>\n"
+    << "  </visual>\n"
+    << "  <asset>\n"
+    << assets.str() << "  </asset>\n"
+    << "  <worldbody>\n"
+    << "    <light name=\"overhead\" directional=\"true\" pos=\"0.25 0.3 2\" dir=\"0.1 -0.15 -1\""
+    << " diffuse=\"" << light << ' ' << light << ' ' << light
+    << "\" specular=\"0.2 0.2 0.2\" castshadow=\"true\"/>\n"
+    << "    <light name=\"front\" directional=\"true\" pos=\"1.5 0 1.2\" dir=\"-1 0 -0.8\""
+    << " diffuse=\"" << 0.5 * light << ' ' << 0.5 * light << ' ' << 0.5 * light
+    << "\" specular=\"0.1 0.1 0.1\" castshadow=\"false\"/>\n"
+    << "    <geom name=\"table\" type=\"plane\" pos=\"" << vec(table_centre) << "\" size=\""
+    << 0.5 * (kTableXMax - kTableXMin) << ' ' << kTableHalfY << " 0.05\" material=\"table_mat\""
+    << " contype=\"1\" conaffinity=\"1\" condim=\"3\" friction=\"" << scene.physics.table_friction
+    << " 0.005 0.0001\"/>\n"
+    // A vertical plane facing +x (towards the cameras) along the table's far edge.
+    << "    <geom name=\"backdrop\" type=\"plane\" pos=\"" << kTableXMin << " 0 0.55\""
+    << " euler=\"0 1.5707963267948966 0\" size=\"0.6 " << kTableHalfY + 0.4 << " 0.05\""
+    << " material=\"backdrop_mat\" contype=\"0\" conaffinity=\"0\"/>\n";
+  for (const CameraModel& cam : rig.cameras) {
+    const Eigen::Vector3d right = cam.R.row(0).transpose();
+    const Eigen::Vector3d up = -cam.R.row(1).transpose();
+    x << "    <camera name=\"" << cam.name << "\" pos=\"" << vec(cam.centre()) << "\" xyaxes=\""
+      << vec(right) << ' ' << vec(up) << "\" fovy=\"" << rs.fovy * 180.0 / M_PI << "\"/>\n";
+  }
+  x << "    <body name=\"pusher\" mocap=\"true\" pos=\"" << vec(pusher_park_position()) << "\">\n"
+    << "      <geom name=\"pusher_pad\" type=\"box\" size=\"" << vec(pad) << "\""
+    << " rgba=\"0.95 0.8 0.25 1\" group=\"2\" contype=\"2\" conaffinity=\"2\" condim=\"3\""
+    << " friction=\"0.8 0.005 0.0001\" solmix=\"10\" solref=\"0.03 1\" solimp=\"0.6 0.9 0.01\"/>\n"
+    << "    </body>\n"
+    << bodies.str() << "  </worldbody>\n"
+    << "</mujoco>\n";
+  return x.str();
+}
+
+}  // namespace nudge::sim

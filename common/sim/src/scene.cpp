@@ -1,0 +1,331 @@
+#include "nudge/sim/scene.hpp"
+
+#include "nudge/sim/objects.hpp"
+
+#include <opencv2/core.hpp>
+
+#include <cctype>
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+namespace nudge::sim {
+
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+[[noreturn]] void fail(const std::string& source, const std::string& field, const std::string& what) {
+  throw SceneError(source + ": " + field + ": " + what);
+}
+
+std::string join(const std::string& ctx, const std::string& key) {
+  return ctx.empty() ? key : ctx + "." + key;
+}
+
+// Reads one map of the file, remembering which keys were used so that unknown ones (typos) are
+// reported instead of silently ignored.
+class MapReader {
+ public:
+  MapReader(const cv::FileNode& node, std::string source, std::string ctx)
+      : node_(node), source_(std::move(source)), ctx_(std::move(ctx)) {
+    if (!node_.isMap()) fail(source_, ctx_.empty() ? "(top level)" : ctx_, "expected a map");
+  }
+
+  bool has(const std::string& key) {
+    used_.insert(key);
+    return !node_[key].empty() && !node_[key].isNone();
+  }
+
+  double number(const std::string& key, double def) {
+    if (!has(key)) return def;
+    const cv::FileNode n = node_[key];
+    if (!n.isReal() && !n.isInt()) fail(source_, join(ctx_, key), "expected a number");
+    const double v = static_cast<double>(n);
+    if (!std::isfinite(v)) fail(source_, join(ctx_, key), "must be finite");
+    return v;
+  }
+
+  int integer(const std::string& key, int def) {
+    if (!has(key)) return def;
+    const cv::FileNode n = node_[key];
+    if (!n.isInt()) fail(source_, join(ctx_, key), "expected an integer");
+    return static_cast<int>(n);
+  }
+
+  bool boolean(const std::string& key, bool def) {
+    if (!has(key)) return def;
+    const cv::FileNode n = node_[key];
+    if (n.isInt()) {
+      const int v = static_cast<int>(n);
+      if (v == 0 || v == 1) return v == 1;
+    } else if (n.isString()) {
+      const std::string s = static_cast<std::string>(n);
+      if (s == "true" || s == "yes" || s == "on") return true;
+      if (s == "false" || s == "no" || s == "off") return false;
+    }
+    fail(source_, join(ctx_, key), "expected a boolean (0/1, true/false)");
+  }
+
+  std::string string(const std::string& key, const std::string& def) {
+    if (!has(key)) return def;
+    const cv::FileNode n = node_[key];
+    if (!n.isString()) fail(source_, join(ctx_, key), "expected a string");
+    return static_cast<std::string>(n);
+  }
+
+  std::vector<double> numbers(const std::string& key, size_t min_count, size_t max_count) {
+    const cv::FileNode n = node_[key];
+    std::ostringstream expect;
+    expect << "expected a sequence of " << min_count;
+    if (max_count != min_count) expect << " to " << max_count;
+    expect << " numbers";
+    if (!n.isSeq() || n.size() < min_count || n.size() > max_count)
+      fail(source_, join(ctx_, key), expect.str());
+    std::vector<double> out;
+    for (size_t i = 0; i < n.size(); ++i) {
+      const cv::FileNode e = n[static_cast<int>(i)];
+      if (!e.isReal() && !e.isInt()) fail(source_, join(ctx_, key), expect.str());
+      out.push_back(static_cast<double>(e));
+      if (!std::isfinite(out.back())) fail(source_, join(ctx_, key), "must be finite");
+    }
+    return out;
+  }
+
+  Eigen::Vector3d vec3(const std::string& key, const Eigen::Vector3d& def) {
+    if (!has(key)) return def;
+    const auto v = numbers(key, 3, 3);
+    return Eigen::Vector3d(v[0], v[1], v[2]);
+  }
+
+  cv::FileNode node(const std::string& key) {
+    used_.insert(key);
+    return node_[key];
+  }
+
+  // Throws for keys that were never asked for.
+  void finish() const {
+    for (auto it = node_.begin(); it != node_.end(); ++it) {
+      const std::string name = (*it).name();
+      if (!used_.count(name)) fail(source_, join(ctx_, name), "unknown field");
+    }
+  }
+
+  const std::string& ctx() const { return ctx_; }
+
+ private:
+  cv::FileNode node_;
+  std::string source_, ctx_;
+  std::set<std::string> used_;
+};
+
+std::string directory_of(const std::string& path) {
+  const auto slash = path.find_last_of('/');
+  return slash == std::string::npos ? std::string(".") : path.substr(0, slash);
+}
+
+std::string resolve(const std::string& file, const std::string& dir) {
+  if (file.empty() || file[0] == '/') return file;
+  return dir + "/" + file;
+}
+
+// Appearance keys may sit in their own map (table, background) or inline in an object's map.
+void read_appearance(MapReader& r, Appearance& a, const std::string& source, const std::string& dir) {
+  if (r.has("type")) {
+    const std::string type = r.string("type", "plain");
+    if (type == "plain")
+      a.kind = Appearance::Kind::Plain;
+    else if (type == "checker")
+      a.kind = Appearance::Kind::Checker;
+    else if (type == "image")
+      a.kind = Appearance::Kind::Image;
+    else
+      fail(source, join(r.ctx(), "type"), "expected plain, checker or image, got '" + type + "'");
+  }
+  a.colour = r.vec3("colour", a.colour);
+  a.colour2 = r.vec3("colour2", a.colour2);
+  a.file = resolve(r.string("file", a.file), dir);
+  a.repeat = r.number("repeat", a.repeat);
+  a.specular = r.number("specular", a.specular);
+  a.shininess = r.number("shininess", a.shininess);
+  a.reflectance = r.number("reflectance", a.reflectance);
+}
+
+void check_appearance(const Appearance& a, const std::string& source, const std::string& ctx) {
+  for (int i = 0; i < 3; ++i) {
+    if (!(a.colour[i] >= 0 && a.colour[i] <= 1)) fail(source, join(ctx, "colour"), "components must be in [0, 1]");
+    if (!(a.colour2[i] >= 0 && a.colour2[i] <= 1)) fail(source, join(ctx, "colour2"), "components must be in [0, 1]");
+  }
+  if (!(a.repeat > 0)) fail(source, join(ctx, "repeat"), "must be positive");
+  if (!(a.specular >= 0 && a.specular <= 1)) fail(source, join(ctx, "specular"), "must be in [0, 1]");
+  if (!(a.shininess >= 0 && a.shininess <= 1)) fail(source, join(ctx, "shininess"), "must be in [0, 1]");
+  if (!(a.reflectance >= 0 && a.reflectance <= 1)) fail(source, join(ctx, "reflectance"), "must be in [0, 1]");
+  if (a.kind == Appearance::Kind::Image) {
+    if (a.file.empty()) fail(source, join(ctx, "file"), "type image needs a PNG file");
+    const auto dot = a.file.find_last_of('.');
+    if (dot == std::string::npos || a.file.substr(dot) != ".png")
+      fail(source, join(ctx, "file"), "'" + a.file + "' must be a .png file");
+    std::ifstream in(a.file, std::ios::binary);
+    if (!in) fail(source, join(ctx, "file"), "cannot read '" + a.file + "'");
+  }
+}
+
+bool valid_name(const std::string& name) {
+  if (name.empty()) return false;
+  for (char c : name)
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-')) return false;
+  return true;
+}
+
+}  // namespace
+
+Scene default_scene() {
+  Scene scene;
+  scene.table.colour = Eigen::Vector3d(0.72, 0.58, 0.42);
+  scene.table.specular = 0.1;
+  scene.table.shininess = 0.1;
+  scene.table.reflectance = 0.1;
+  scene.background.colour = Eigen::Vector3d(0.9, 0.9, 0.87);
+  scene.background.specular = 0.0;
+  scene.background.shininess = 0.0;
+  return scene;
+}
+
+Scene load_scene(const std::string& path) {
+  cv::FileStorage fs;
+  try {
+    if (!fs.open(path, cv::FileStorage::READ)) throw SceneError(path + ": cannot open scene file");
+  } catch (const cv::Exception& e) {
+    throw SceneError(path + ": not a valid scene file: " + e.msg);
+  }
+  Scene scene = default_scene();
+  scene.source = path;
+  const std::string dir = directory_of(path);
+  MapReader top(fs.root(), path, "");
+
+  if (top.has("seed")) {
+    const double seed = top.number("seed", 1);
+    if (seed < 0 || seed != std::floor(seed)) fail(path, "seed", "expected a non-negative integer");
+    scene.seed = static_cast<uint64_t>(seed);
+  }
+  if (top.has("table")) {
+    MapReader r(top.node("table"), path, "table");
+    read_appearance(r, scene.table, path, dir);
+    r.finish();
+  }
+  if (top.has("background")) {
+    MapReader r(top.node("background"), path, "background");
+    read_appearance(r, scene.background, path, dir);
+    r.finish();
+  }
+  if (top.has("cameras")) {
+    MapReader r(top.node("cameras"), path, "cameras");
+    RigSpec& rig = scene.rig;
+    rig.target = r.vec3("target", rig.target);
+    rig.distance = r.number("distance", rig.distance);
+    rig.elevation = r.number("elevation_deg", rig.elevation / kDeg) * kDeg;
+    rig.azimuth = r.number("azimuth_deg", rig.azimuth / kDeg) * kDeg;
+    rig.baseline = r.number("baseline", rig.baseline);
+    rig.vergence = r.number("vergence_deg", rig.vergence / kDeg) * kDeg;
+    rig.width = r.integer("width", rig.width);
+    rig.height = r.integer("height", rig.height);
+    rig.fovy = r.number("fovy_deg", rig.fovy / kDeg) * kDeg;
+    r.finish();
+  }
+  if (top.has("render")) {
+    MapReader r(top.node("render"), path, "render");
+    RenderSpec& render = scene.render;
+    render.shadows = r.boolean("shadows", render.shadows);
+    render.reflections = r.boolean("reflections", render.reflections);
+    render.antialias = r.boolean("antialias", render.antialias);
+    render.noise_sigma = r.number("noise_sigma", render.noise_sigma);
+    render.snapshot_scale = r.integer("snapshot_scale", render.snapshot_scale);
+    render.ambient = r.number("ambient", render.ambient);
+    render.light = r.number("light", render.light);
+    r.finish();
+  }
+  if (top.has("physics")) {
+    MapReader r(top.node("physics"), path, "physics");
+    PhysicsSpec& physics = scene.physics;
+    physics.timestep = r.number("timestep", physics.timestep);
+    physics.settle_time = r.number("settle_time", physics.settle_time);
+    physics.position_jitter = r.number("position_jitter", physics.position_jitter);
+    physics.yaw_jitter = r.number("yaw_jitter_deg", physics.yaw_jitter / kDeg) * kDeg;
+    physics.table_friction = r.number("table_friction", physics.table_friction);
+    r.finish();
+  }
+  if (top.has("objects")) {
+    const cv::FileNode objects = top.node("objects");
+    if (!objects.isSeq()) fail(path, "objects", "expected a sequence of object maps");
+    for (size_t i = 0; i < objects.size(); ++i) {
+      const std::string ctx = "objects[" + std::to_string(i) + "]";
+      MapReader r(objects[static_cast<int>(i)], path, ctx);
+      ObjectSpec obj;
+      if (!r.has("kind")) fail(path, join(ctx, "kind"), "missing (one of cup, mug, bottle, can)");
+      obj.kind = r.string("kind", "");
+      obj.name = r.string("name", "");
+      if (!r.has("position")) fail(path, join(ctx, "position"), "missing ([x, y] in metres)");
+      const auto p = r.numbers("position", 2, 2);
+      obj.position = Eigen::Vector2d(p[0], p[1]);
+      obj.yaw = r.number("yaw_deg", 0.0) * kDeg;
+      obj.mass = r.number("mass", 0.0);
+      obj.friction = r.number("friction", 0.0);
+      read_appearance(r, obj.appearance, path, dir);
+      r.finish();
+      scene.objects.push_back(obj);
+    }
+  }
+  top.finish();
+  validate(scene);
+  return scene;
+}
+
+void validate(const Scene& scene) {
+  const std::string& src = scene.source;
+  check_appearance(scene.table, src, "table");
+  check_appearance(scene.background, src, "background");
+  std::set<std::string> names;
+  for (size_t i = 0; i < scene.objects.size(); ++i) {
+    const ObjectSpec& o = scene.objects[i];
+    const std::string ctx = "objects[" + std::to_string(i) + "]";
+    if (!is_object_kind(o.kind)) {
+      std::string known;
+      for (const auto& k : object_kinds()) known += (known.empty() ? "" : ", ") + k;
+      fail(src, join(ctx, "kind"), "unknown kind '" + o.kind + "' (known: " + known + ")");
+    }
+    if (!o.name.empty()) {
+      if (!valid_name(o.name)) fail(src, join(ctx, "name"), "'" + o.name + "': use letters, digits, _ and -");
+      if (!names.insert(o.name).second) fail(src, join(ctx, "name"), "'" + o.name + "' is used twice");
+    }
+    if (!o.position.allFinite() || o.position.norm() > 2.0)
+      fail(src, join(ctx, "position"), "must be finite and within 2 m of the arm base");
+    if (!std::isfinite(o.yaw)) fail(src, join(ctx, "yaw"), "must be finite");
+    if (!(o.mass >= 0 && o.mass < 20)) fail(src, join(ctx, "mass"), "must be in [0, 20) kg (0 = default)");
+    if (!(o.friction >= 0 && o.friction < 5)) fail(src, join(ctx, "friction"), "must be in [0, 5) (0 = default)");
+    check_appearance(o.appearance, src, ctx);
+  }
+  const RigSpec& rig = scene.rig;
+  if (!rig.target.allFinite()) fail(src, "cameras.target", "must be finite");
+  if (!(rig.distance > 0.05 && rig.distance < 10)) fail(src, "cameras.distance", "must be in (0.05, 10) m");
+  if (!(rig.elevation > -M_PI / 2 && rig.elevation < M_PI / 2)) fail(src, "cameras.elevation_deg", "must be in (-90, 90)");
+  if (!std::isfinite(rig.azimuth)) fail(src, "cameras.azimuth_deg", "must be finite");
+  if (!(rig.baseline > 0 && rig.baseline < 2)) fail(src, "cameras.baseline", "must be in (0, 2) m");
+  if (!(rig.vergence >= 0 && rig.vergence < M_PI / 2)) fail(src, "cameras.vergence_deg", "must be in [0, 90)");
+  if (rig.width < 16 || rig.width > 4096) fail(src, "cameras.width", "must be in [16, 4096]");
+  if (rig.height < 16 || rig.height > 4096) fail(src, "cameras.height", "must be in [16, 4096]");
+  if (!(rig.fovy > 1 * kDeg && rig.fovy < 170 * kDeg)) fail(src, "cameras.fovy_deg", "must be in (1, 170)");
+  const RenderSpec& r = scene.render;
+  if (!(r.noise_sigma >= 0 && r.noise_sigma < 100)) fail(src, "render.noise_sigma", "must be in [0, 100)");
+  if (r.snapshot_scale < 1 || r.snapshot_scale > 4) fail(src, "render.snapshot_scale", "must be 1, 2, 3 or 4");
+  if (!(r.ambient >= 0 && r.ambient <= 1)) fail(src, "render.ambient", "must be in [0, 1]");
+  if (!(r.light >= 0 && r.light <= 1)) fail(src, "render.light", "must be in [0, 1]");
+  const PhysicsSpec& p = scene.physics;
+  if (!(p.timestep > 0 && p.timestep <= 0.01)) fail(src, "physics.timestep", "must be in (0, 0.01] s");
+  if (!(p.settle_time >= 0 && p.settle_time <= 10)) fail(src, "physics.settle_time", "must be in [0, 10] s");
+  if (!(p.position_jitter >= 0 && p.position_jitter < 0.1)) fail(src, "physics.position_jitter", "must be in [0, 0.1) m");
+  if (!(p.yaw_jitter >= 0 && p.yaw_jitter <= M_PI)) fail(src, "physics.yaw_jitter_deg", "must be in [0, 180]");
+  if (!(p.table_friction > 0 && p.table_friction < 5)) fail(src, "physics.table_friction", "must be in (0, 5)");
+}
+
+}  // namespace nudge::sim

@@ -1,0 +1,337 @@
+#include "nudge/sim/world.hpp"
+
+#include "nudge/sim/mjcf.hpp"
+#include "nudge/sim/objects.hpp"
+#include "nudge/sim/renderer.hpp"
+
+#include <mujoco/mujoco.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <random>
+
+namespace nudge::sim {
+
+namespace {
+
+constexpr int kPusherGroup = 2;  // geom group of the pusher pad (hidden when !pusher_visible)
+
+mjModel* compile(const std::string& xml, const std::string& source) {
+  auto vfs = std::make_unique<mjVFS>();
+  mj_defaultVFS(vfs.get());
+  const char* name = "nudge_world.xml";
+  if (mj_makeEmptyFileVFS(vfs.get(), name, static_cast<int>(xml.size())) != 0)
+    throw SimError(source + ": cannot stage the model in MuJoCo's virtual file system");
+  const int index = mj_findFileVFS(vfs.get(), name);
+  std::memcpy(vfs->filedata[index], xml.data(), xml.size());
+  char error[1000] = "";
+  mjModel* model = mj_loadXML(name, vfs.get(), error, sizeof(error));
+  mj_deleteVFS(vfs.get());
+  if (!model) throw SimError(source + ": MuJoCo rejected the generated model: " + error);
+  return model;
+}
+
+Eigen::Vector3d vec3(const mjtNum* p) { return Eigen::Vector3d(p[0], p[1], p[2]); }
+
+}  // namespace
+
+double ObjectState::tilt() const {
+  const Eigen::Vector3d z = orientation * Eigen::Vector3d::UnitZ();
+  return std::acos(std::clamp(z.z(), -1.0, 1.0));
+}
+
+struct World::Impl {
+  mjModel* model = nullptr;
+  mjData* data = nullptr;
+  std::unique_ptr<Renderer> renderer;
+  std::vector<int> body;        // object index -> body id
+  std::vector<int> qpos_adr;    // object index -> address of its free joint in qpos
+  std::vector<int> qvel_adr;
+  std::vector<double> height;   // object index -> height
+  std::vector<unsigned char> geom_label;  // geom id -> object index + 1, 0 for the rest
+  int pusher_mocap = -1;
+  int pad_geom = -1;
+  int camera_id[2] = {-1, -1};
+  std::mt19937_64 noise_rng;
+
+  ~Impl() {
+    renderer.reset();
+    if (data) mj_deleteData(data);
+    if (model) mj_deleteModel(model);
+  }
+
+  int object_of_geom(int geom) const {
+    return geom >= 0 && geom < static_cast<int>(geom_label.size()) ? geom_label[geom] - 1 : -1;
+  }
+};
+
+World::World(const Scene& input) : impl_(std::make_unique<Impl>()), scene_(input) {
+  validate(scene_);
+  // Seeded placement jitter: the only randomness in the physics, fixed by the scene's seed.
+  std::mt19937_64 rng(scene_.seed);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  for (size_t i = 0; i < scene_.objects.size(); ++i) {
+    ObjectSpec& o = scene_.objects[i];
+    if (o.name.empty()) o.name = o.kind + std::to_string(i);
+    const double dx = normal(rng), dy = normal(rng), dyaw = normal(rng);
+    o.position += scene_.physics.position_jitter * Eigen::Vector2d(dx, dy);
+    o.yaw += scene_.physics.yaw_jitter * dyaw;
+  }
+  impl_->noise_rng.seed(scene_.seed ^ 0x9e3779b97f4a7c15ULL);
+  rig_ = make_rig(scene_.rig);
+  mjcf_ = build_mjcf(scene_);
+
+  Impl& s = *impl_;
+  s.model = compile(mjcf_, scene_.source);
+  s.data = mj_makeData(s.model);
+  if (!s.data) throw SimError(scene_.source + ": MuJoCo could not allocate mjData");
+  s.geom_label.assign(s.model->ngeom, 0);
+  for (size_t i = 0; i < scene_.objects.size(); ++i) {
+    const std::string name = "obj" + std::to_string(i);
+    const int b = mj_name2id(s.model, mjOBJ_BODY, name.c_str());
+    const int j = mj_name2id(s.model, mjOBJ_JOINT, (name + "_joint").c_str());
+    if (b < 0 || j < 0) throw SimError(scene_.source + ": generated model lacks " + name);
+    s.body.push_back(b);
+    s.qpos_adr.push_back(s.model->jnt_qposadr[j]);
+    s.qvel_adr.push_back(s.model->jnt_dofadr[j]);
+    s.height.push_back(make_object(scene_.objects[i].kind, 8).height);
+    for (int g = 0; g < s.model->ngeom; ++g)
+      if (s.model->geom_bodyid[g] == b) s.geom_label[g] = static_cast<unsigned char>(std::min<size_t>(i + 1, 255));
+  }
+  const int pusher = mj_name2id(s.model, mjOBJ_BODY, "pusher");
+  s.pusher_mocap = pusher >= 0 ? s.model->body_mocapid[pusher] : -1;
+  s.pad_geom = mj_name2id(s.model, mjOBJ_GEOM, "pusher_pad");
+  s.camera_id[0] = mj_name2id(s.model, mjOBJ_CAMERA, "left");
+  s.camera_id[1] = mj_name2id(s.model, mjOBJ_CAMERA, "right");
+  if (s.pusher_mocap < 0 || s.pad_geom < 0 || s.camera_id[0] < 0 || s.camera_id[1] < 0)
+    throw SimError(scene_.source + ": generated model lacks the pusher or the cameras");
+  if (s.model->geom_group[s.pad_geom] != kPusherGroup)
+    throw SimError(scene_.source + ": the pusher pad is not in geom group 2");
+
+  mj_forward(s.model, s.data);
+  step_for(scene_.physics.settle_time);
+  s.data->time = 0;
+}
+
+World::~World() = default;
+
+double World::time() const { return impl_->data->time; }
+double World::timestep() const { return impl_->model->opt.timestep; }
+
+void World::step(int n) {
+  for (int i = 0; i < n; ++i) mj_step(impl_->model, impl_->data);
+}
+
+void World::step_for(double seconds) {
+  if (!(seconds >= 0)) throw std::invalid_argument("World::step_for: seconds must be >= 0");
+  step(static_cast<int>(std::lround(seconds / timestep())));
+}
+
+std::vector<double> World::state() const {
+  const mjModel* m = impl_->model;
+  const mjData* d = impl_->data;
+  std::vector<double> out;
+  out.reserve(1 + m->nq + m->nv + 3 * m->nmocap);
+  out.push_back(d->time);
+  out.insert(out.end(), d->qpos, d->qpos + m->nq);
+  out.insert(out.end(), d->qvel, d->qvel + m->nv);
+  out.insert(out.end(), d->mocap_pos, d->mocap_pos + 3 * m->nmocap);
+  return out;
+}
+
+int World::object_index(const std::string& name) const {
+  for (int i = 0; i < num_objects(); ++i)
+    if (scene_.objects[i].name == name) return i;
+  return -1;
+}
+
+ObjectState World::object(int index) const {
+  if (index < 0 || index >= num_objects())
+    throw std::out_of_range("World::object: no object " + std::to_string(index));
+  const Impl& s = *impl_;
+  const mjtNum* q = s.data->qpos + s.qpos_adr[index];
+  const mjtNum* v = s.data->qvel + s.qvel_adr[index];
+  ObjectState st;
+  st.name = scene_.objects[index].name;
+  st.kind = scene_.objects[index].kind;
+  st.position = vec3(q);
+  st.orientation = Eigen::Quaterniond(q[3], q[4], q[5], q[6]).normalized();
+  st.linear_velocity = vec3(v);
+  // A free joint's angular velocity is in the body frame.
+  st.angular_velocity = st.orientation * vec3(v + 3);
+  st.height = s.height[index];
+  return st;
+}
+
+void World::set_object_pose(int index, const Eigen::Vector3d& position,
+                            const Eigen::Quaterniond& orientation) {
+  if (index < 0 || index >= num_objects())
+    throw std::out_of_range("World::set_object_pose: no object " + std::to_string(index));
+  if (!position.allFinite() || !orientation.coeffs().allFinite() || orientation.norm() < 1e-9)
+    throw std::invalid_argument("World::set_object_pose: pose must be finite");
+  Impl& s = *impl_;
+  const Eigen::Quaterniond q = orientation.normalized();
+  mjtNum* qpos = s.data->qpos + s.qpos_adr[index];
+  for (int i = 0; i < 3; ++i) qpos[i] = position[i];
+  qpos[3] = q.w();
+  qpos[4] = q.x();
+  qpos[5] = q.y();
+  qpos[6] = q.z();
+  for (int i = 0; i < 6; ++i) s.data->qvel[s.qvel_adr[index] + i] = 0;
+  mj_forward(s.model, s.data);
+}
+
+void World::place_object(int index, const Eigen::Vector2d& xy, double yaw) {
+  set_object_pose(index, Eigen::Vector3d(xy.x(), xy.y(), 0.0),
+                  Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ())));
+}
+
+Axis3d World::axis(int index) const {
+  const ObjectState st = object(index);
+  Axis3d a;
+  a.base = st.position;
+  a.direction = st.orientation * Eigen::Vector3d::UnitZ();
+  a.height = st.height;
+  return a;
+}
+
+ImageLine World::axis_in_image(int index, int camera_index) const {
+  return project_axis(camera(camera_index), axis(index));
+}
+
+void World::set_pusher(const Eigen::Vector3d& position, double yaw) {
+  if (!position.allFinite() || !std::isfinite(yaw))
+    throw std::invalid_argument("World::set_pusher: position and yaw must be finite");
+  mjData* d = impl_->data;
+  const int k = impl_->pusher_mocap;
+  for (int i = 0; i < 3; ++i) d->mocap_pos[3 * k + i] = position[i];
+  d->mocap_quat[4 * k + 0] = std::cos(0.5 * yaw);
+  d->mocap_quat[4 * k + 1] = 0;
+  d->mocap_quat[4 * k + 2] = 0;
+  d->mocap_quat[4 * k + 3] = std::sin(0.5 * yaw);
+}
+
+void World::park_pusher() { set_pusher(pusher_park_position(), 0.0); }
+
+Eigen::Vector3d World::pusher_position() const {
+  return vec3(impl_->data->mocap_pos + 3 * impl_->pusher_mocap);
+}
+
+bool World::pusher_in_contact() const {
+  const mjData* d = impl_->data;
+  for (int i = 0; i < d->ncon; ++i) {
+    const mjContact& c = d->contact[i];
+    if (c.geom1 == impl_->pad_geom && impl_->object_of_geom(c.geom2) >= 0) return true;
+    if (c.geom2 == impl_->pad_geom && impl_->object_of_geom(c.geom1) >= 0) return true;
+  }
+  return false;
+}
+
+PushResult World::push(const Eigen::Vector3d& from, const Eigen::Vector3d& to, double speed,
+                       double settle) {
+  if (!from.allFinite() || !to.allFinite())
+    throw std::invalid_argument("World::push: from and to must be finite");
+  if (!(speed > 0 && speed <= 2.0))
+    throw std::invalid_argument("World::push: speed must be in (0, 2] m/s");
+  if (!(settle >= 0)) throw std::invalid_argument("World::push: settle must be >= 0");
+  const Eigen::Vector3d delta = to - from;
+  const double yaw = std::atan2(delta.y(), delta.x());
+  PushResult result;
+  result.start_time = time();
+  set_pusher(from, yaw);
+  mj_forward(impl_->model, impl_->data);
+  if (pusher_in_contact()) {
+    park_pusher();
+    mj_forward(impl_->model, impl_->data);
+    throw SimError("World::push: the pad already touches an object at the start point");
+  }
+  const int steps = std::max(1, static_cast<int>(std::ceil(delta.norm() / (speed * timestep()))));
+  for (int pass = 0; pass < 2; ++pass) {  // out, then back
+    for (int k = 1; k <= steps; ++k) {
+      const double f = static_cast<double>(k) / steps;
+      const Eigen::Vector3d p = pass == 0 ? Eigen::Vector3d(from + f * delta) : Eigen::Vector3d(to - f * delta);
+      set_pusher(p, yaw);
+      step();
+      result.contact = result.contact || pusher_in_contact();
+    }
+  }
+  park_pusher();
+  step_for(settle);
+  result.end_time = time();
+  return result;
+}
+
+cv::Mat World::render(int camera_index) {
+  if (camera_index < 0 || camera_index > 1)
+    throw std::out_of_range("World::render: camera must be 0 (left) or 1 (right)");
+  return colour_image(camera_index, cv::Size(scene_.rig.width, scene_.rig.height));
+}
+
+Renderer& World::renderer() {
+  Impl& s = *impl_;
+  if (!s.renderer) {
+    const int k = scene_.render.snapshot_scale;
+    s.renderer = std::make_unique<Renderer>(s.model, k * scene_.rig.width, k * scene_.rig.height);
+  }
+  return *s.renderer;
+}
+
+cv::Mat World::colour_image(int camera_index, cv::Size size) {
+  Impl& s = *impl_;
+  cv::Mat image = renderer().colour(s.data, s.camera_id[camera_index], scene_.render,
+                                    pusher_visible ? -1 : kPusherGroup, size);
+  if (scene_.render.noise_sigma > 0) {
+    cv::Mat noise(image.size(), CV_32FC3);
+    std::normal_distribution<float> normal(0.0f, static_cast<float>(scene_.render.noise_sigma));
+    for (int y = 0; y < noise.rows; ++y) {
+      float* p = noise.ptr<float>(y);
+      for (int x = 0; x < noise.cols * 3; ++x) p[x] = normal(s.noise_rng);
+    }
+    cv::Mat sum;
+    image.convertTo(sum, CV_32FC3);
+    sum += noise;
+    sum.convertTo(image, CV_8UC3);  // saturating
+  }
+  return image;
+}
+
+cv::Mat World::render_mask(int camera_index) {
+  if (camera_index < 0 || camera_index > 1)
+    throw std::out_of_range("World::render_mask: camera must be 0 (left) or 1 (right)");
+  return renderer().labels(impl_->data, impl_->camera_id[camera_index], impl_->geom_label,
+                           pusher_visible ? -1 : kPusherGroup,
+                           cv::Size(scene_.rig.width, scene_.rig.height));
+}
+
+cv::Mat World::render_snapshot(int camera_index) {
+  if (camera_index < 0 || camera_index > 1)
+    throw std::out_of_range("World::render_snapshot: camera must be 0 (left) or 1 (right)");
+  const int k = scene_.render.snapshot_scale;
+  return colour_image(camera_index, cv::Size(k * scene_.rig.width, k * scene_.rig.height));
+}
+
+cv::Mat World::render_snapshot_mask(int camera_index) {
+  if (camera_index < 0 || camera_index > 1)
+    throw std::out_of_range("World::render_snapshot_mask: camera must be 0 (left) or 1 (right)");
+  const int k = scene_.render.snapshot_scale;
+  return renderer().labels(impl_->data, impl_->camera_id[camera_index], impl_->geom_label,
+                           pusher_visible ? -1 : kPusherGroup,
+                           cv::Size(k * scene_.rig.width, k * scene_.rig.height));
+}
+
+CameraModel World::snapshot_camera(int camera_index) const {
+  return scaled(camera(camera_index), scene_.render.snapshot_scale);
+}
+
+StereoImages World::render_stereo(bool masks) {
+  StereoImages out;
+  out.time = time();
+  for (int c = 0; c < 2; ++c) {
+    out.colour[c] = render(c);
+    if (masks) out.mask[c] = render_mask(c);
+  }
+  return out;
+}
+
+}  // namespace nudge::sim

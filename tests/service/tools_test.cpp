@@ -1,0 +1,117 @@
+// The camera service and the nudge-detect tool run as processes: the camera writes straight into
+// an LCM log (file provider) so stereo pairing can be checked without a network; nudge-detect is
+// run on image files with known axes and on an unreadable one.
+#include <gtest/gtest.h>
+#include <lcm/lcm-cpp.hpp>
+#include <sys/stat.h>
+#include <sys/wait.h>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <regex>
+#include <string>
+
+#include "nudge/bus/image.hpp"
+#include "nudge/symmetry/synthetic.hpp"
+
+namespace syn = nudge::symmetry::synthetic;
+
+namespace {
+
+std::string bin(const std::string& name) { return std::string(NUDGE_BIN_DIR) + "/" + name; }
+
+int run(const std::string& cmd, std::string* out = nullptr) {
+  FILE* pipe = popen(cmd.c_str(), "r");
+  if (!pipe) return -1;
+  std::array<char, 4096> buf{};
+  std::string text;
+  while (fgets(buf.data(), buf.size(), pipe)) text += buf.data();
+  const int status = pclose(pipe);
+  if (out) *out = text;
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+std::string scratch_dir(const std::string& name) {
+  const std::string dir = testing::TempDir() + "/" + name;
+  ::mkdir(dir.c_str(), 0755);
+  return dir;
+}
+
+}  // namespace
+
+TEST(CameraService, StereoPairsShareUtimeAndFrameIds) {
+  const std::string dir = scratch_dir("camera_service");
+  for (int i = 0; i < 4; ++i) {
+    cv::imwrite(dir + "/l" + std::to_string(i) + ".png", cv::Mat(24, 32, CV_8UC3, cv::Scalar(i, 0, 0)));
+    cv::imwrite(dir + "/r" + std::to_string(i) + ".png", cv::Mat(24, 32, CV_8UC3, cv::Scalar(0, i, 0)));
+  }
+  const std::string log_path = dir + "/camera.lcmlog";
+  std::remove(log_path.c_str());
+  const std::string cmd = bin("nudge-camera") + " --left 'images:" + dir + "/l*.png' --right 'images:" + dir +
+                          "/r*.png' --rate 0 --format bgr --lcm-url 'file://" + log_path + "?mode=w' 2>/dev/null";
+  ASSERT_EQ(run(cmd), 0) << cmd;
+  lcm::LogFile log(log_path, "r");
+  ASSERT_TRUE(log.good());
+  std::map<int64_t, std::map<std::string, nudge::image_t>> by_utime;
+  for (const lcm::LogEvent* ev = log.readNextEvent(); ev; ev = log.readNextEvent()) {
+    if (ev->channel.rfind("CAMERA_", 0) != 0) continue;
+    nudge::image_t img;
+    ASSERT_GE(img.decode(ev->data, 0, ev->datalen), 0);
+    by_utime[img.utime][ev->channel] = img;
+  }
+  ASSERT_EQ(by_utime.size(), 4u) << "four captures";
+  int64_t expected_id = 0;
+  for (const auto& [utime, pair] : by_utime) {
+    ASSERT_EQ(pair.size(), 2u) << "left and right share utime " << utime;
+    EXPECT_EQ(pair.at("CAMERA_LEFT").frame_id, expected_id);
+    EXPECT_EQ(pair.at("CAMERA_RIGHT").frame_id, expected_id);
+    EXPECT_EQ(nudge::bus::to_mat(pair.at("CAMERA_LEFT")).at<cv::Vec3b>(0, 0)[0], expected_id);
+    EXPECT_EQ(nudge::bus::to_mat(pair.at("CAMERA_RIGHT")).at<cv::Vec3b>(0, 0)[1], expected_id);
+    ++expected_id;
+  }
+}
+
+TEST(CameraService, BadSourcesAreRefused) {
+  std::string out;
+  EXPECT_NE(run(bin("nudge-camera") + " --source 'images:/nonexistent/*.png' 2>&1", &out), 0);
+  EXPECT_NE(out.find("matches no files"), std::string::npos) << out;
+  EXPECT_EQ(run(bin("nudge-camera") + " --left images:/a 2>&1", &out), 2);
+}
+
+TEST(DetectTool, FindsKnownAxesAndReportsUnreadableFiles) {
+  const std::string dir = scratch_dir("detect_tool");
+  struct Case {
+    double r, theta_deg;
+  };
+  const std::vector<Case> cases = {{30.0, 8.0}, {-45.5, -12.5}};
+  std::string args;
+  for (size_t i = 0; i < cases.size(); ++i) {
+    cv::Mat img(300, 400, CV_8UC3, cv::Scalar(210, 220, 230));
+    syn::draw_shape(img, syn::bottle_profile(200, 36), cases[i].r, cases[i].theta_deg * M_PI / 180, 0,
+                    cv::Scalar(50, 40, 30));
+    const std::string path = dir + "/shape" + std::to_string(i) + ".png";
+    cv::imwrite(path, img);
+    args += " " + path;
+    if (i == 0) args += " " + dir + "/missing.png";
+  }
+  std::string out;
+  const int rc = run(bin("nudge-detect") + " --lines 1 --theta-min -45 --theta-max 45 --draw " + dir +
+                         "/drawn.png" + args + " 2>/dev/null",
+                     &out);
+  EXPECT_EQ(rc, 1) << "a missing file makes the exit code non-zero";
+  const std::regex line_re(R"re(\{"image":"([^"]+)".*?"lines":\[\{"r":([-0-9.e]+),"theta_deg":([-0-9.e]+))re");
+  std::vector<std::pair<double, double>> found;
+  for (std::sregex_iterator it(out.begin(), out.end(), line_re), end; it != end; ++it) {
+    found.emplace_back(std::stod((*it)[2]), std::stod((*it)[3]));
+  }
+  ASSERT_EQ(found.size(), cases.size()) << "the other images still ran:\n" << out;
+  for (size_t i = 0; i < cases.size(); ++i) {
+    EXPECT_NEAR(found[i].first, cases[i].r, 1.0);
+    EXPECT_NEAR(found[i].second, cases[i].theta_deg, 1.0);
+  }
+  EXPECT_TRUE(cv::imread(dir + "/drawn_1.png").data != nullptr) << "--draw numbers files for several images";
+}

@@ -1,0 +1,529 @@
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>  // after Eigen, as OpenCV requires
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+#include "nudge/geometry/plane.hpp"
+#include "nudge/geometry/qt_cluster.hpp"
+#include "nudge/geometry/stereo_rig.hpp"
+#include "nudge/geometry/triangulation.hpp"
+
+using namespace nudge::geometry;
+namespace sym = nudge::symmetry;
+
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+Camera make_camera(double f, double cx, double cy, std::array<double, 5> distortion) {
+  Camera c;
+  c.K << f, 0, cx, 0, f * 1.002, cy, 0, 0, 1;
+  c.distortion = distortion;
+  return c;
+}
+
+// A verged rig like the thesis' (fig. 4.5): 0.25 m baseline, right camera turned 15 deg towards the
+// left one and rolled 1 deg about its optical axis (the mounting bracket's error).
+// Lens distortion of a typical webcam; `strong` is a wide-angle lens.
+enum class Lens { None, Typical, Strong };
+
+StereoRig verged_rig(Lens lens = Lens::Typical) {
+  StereoRig rig;
+  rig.left = make_camera(620, 322.5, 236.0, {-0.15, 0.07, 0.0012, -0.0008, -0.01});
+  rig.right = make_camera(610, 317.0, 243.5, {-0.13, 0.05, -0.0006, 0.0010, 0.0});
+  if (lens == Lens::Strong) {
+    rig.left.distortion = {-0.25, 0.12, 0.0012, -0.0008, -0.02};
+    rig.right.distortion = {-0.22, 0.09, -0.0006, 0.0010, 0.0};
+  }
+  if (lens == Lens::None) rig.left.distortion = rig.right.distortion = {};
+  const Eigen::Matrix3d right_axes_in_left =
+      (Eigen::AngleAxisd(-15 * kDeg, Eigen::Vector3d::UnitY()) * Eigen::AngleAxisd(1 * kDeg, Eigen::Vector3d::UnitZ()))
+          .toRotationMatrix();
+  const Eigen::Vector3d right_centre_in_left(0.25, 0.005, 0.0);
+  rig.R = right_axes_in_left.transpose();
+  rig.T = -rig.R * right_centre_in_left;
+  return rig;
+}
+
+// The table and "up" in the left camera's frame: cameras 0.45 m above the table, pitched 30 deg down.
+struct Table {
+  double pitch = 30 * kDeg, height = 0.45;
+  Eigen::Vector3d up() const { return {0, -std::cos(pitch), -std::sin(pitch)}; }
+  Eigen::Vector3d forward() const { return {0, -std::sin(pitch), std::cos(pitch)}; }
+  Eigen::Vector3d at(double lateral, double distance) const {
+    return lateral * Eigen::Vector3d::UnitX() + distance * forward() - height * up();
+  }
+};
+
+std::vector<cv::Point2d> project(const std::vector<Eigen::Vector3d>& points, const Camera& camera,
+                                 const Eigen::Matrix3d& R, const Eigen::Vector3d& T) {
+  std::vector<cv::Point3d> object;
+  for (const auto& p : points) object.emplace_back(p.x(), p.y(), p.z());
+  cv::Mat rmat, rvec, tvec, K;
+  cv::eigen2cv(R, rmat);
+  cv::Rodrigues(rmat, rvec);
+  cv::eigen2cv(T, tvec);
+  cv::eigen2cv(camera.K, K);
+  std::vector<cv::Point2d> image;
+  cv::projectPoints(object, rvec, tvec, K, std::vector<double>(camera.distortion.begin(), camera.distortion.end()),
+                    image);
+  return image;
+}
+
+// Total-least-squares line through image points, as (R, theta) with theta in (-90, 90] deg; the
+// support segment spans the points (what the detector reports).
+sym::Line fit_line(const std::vector<cv::Point2d>& points, int width, int height) {
+  cv::Point2d mean(0, 0);
+  for (const auto& p : points) mean += p;
+  mean *= 1.0 / points.size();
+  double sxx = 0, syy = 0, sxy = 0;
+  for (const auto& p : points) {
+    sxx += (p.x - mean.x) * (p.x - mean.x);
+    syy += (p.y - mean.y) * (p.y - mean.y);
+    sxy += (p.x - mean.x) * (p.y - mean.y);
+  }
+  const double along = 0.5 * std::atan2(2 * sxy, sxx - syy);  // principal direction of the points
+  Eigen::Vector2d normal(-std::sin(along), std::cos(along));
+  double theta = std::atan2(normal.y(), normal.x());
+  if (theta <= -M_PI / 2) theta += M_PI, normal = -normal;
+  if (theta > M_PI / 2) theta -= M_PI, normal = -normal;
+  sym::Line line;
+  line.theta = theta;
+  line.r = normal.x() * (mean.x - 0.5 * (width - 1)) + normal.y() * (mean.y - 0.5 * (height - 1));
+  line.seg1 = points.front();
+  line.seg2 = points.back();
+  sym::border_endpoints(line.r, line.theta, width, height, &line.end1, &line.end2);
+  return line;
+}
+
+struct StereoAxis {
+  Eigen::Vector3d base, top;  // right camera frame
+  sym::Line left, right;
+};
+
+StereoAxis observe_axis(const StereoRig& rig, const Table& table, double lateral, double distance, double tall) {
+  const Eigen::Vector3d base = table.at(lateral, distance), top = base + tall * table.up();
+  std::vector<Eigen::Vector3d> along;
+  for (int i = 0; i <= 60; ++i) along.push_back(base + (top - base) * (i / 60.0));
+  const auto left_pixels = project(along, rig.left, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero());
+  const auto right_pixels = project(along, rig.right, rig.R, rig.T);
+  for (const auto& p : left_pixels) EXPECT_TRUE(p.inside(cv::Rect2d(0, 0, 639, 479))) << "left view misses the axis";
+  for (const auto& p : right_pixels) EXPECT_TRUE(p.inside(cv::Rect2d(0, 0, 639, 479))) << "right view misses the axis";
+  return {rig.left_to_right(base), rig.left_to_right(top), fit_line(left_pixels, 640, 480),
+          fit_line(right_pixels, 640, 480)};
+}
+
+Plane table_plane_in_right(const StereoRig& rig, const Table& table) {
+  std::vector<Eigen::Vector3d> corners;  // a checkerboard's corners
+  for (int i = 0; i < 7; ++i)
+    for (int j = 0; j < 5; ++j) corners.push_back(rig.left_to_right(table.at(-0.1 + 0.05 * i, 0.45 + 0.05 * j)));
+  const auto plane = fit_plane(corners);
+  EXPECT_TRUE(plane.ok()) << plane.reason();
+  return *plane;
+}
+
+double angle_deg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return std::acos(std::min(1.0, std::fabs(a.normalized().dot(b.normalized())))) / kDeg;
+}
+
+std::string temp_path(const std::string& name) {
+  return (std::filesystem::temp_directory_path() / ("nudge_geometry_test_" + std::to_string(::getpid()) + "_" + name))
+      .string();
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Lens model
+
+TEST(GeometryCamera, ProjectMatchesOpenCvAndNormaliseInvertsIt) {
+  const StereoRig rig = verged_rig();
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> xy(-0.45, 0.45), z(0.4, 2.0);
+  for (int i = 0; i < 200; ++i) {
+    const Eigen::Vector3d p(xy(rng), xy(rng) * 0.75, z(rng));
+    const cv::Point2d reference = project({p}, rig.left, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero())[0];
+    const Eigen::Vector2d pixel = rig.left.project(p);
+    EXPECT_NEAR(pixel.x(), reference.x, 1e-9);
+    EXPECT_NEAR(pixel.y(), reference.y, 1e-9);
+    const auto normalised = rig.left.normalise(pixel);
+    ASSERT_TRUE(normalised.ok()) << normalised.reason();
+    EXPECT_NEAR(normalised->x(), p.x() / p.z(), 1e-10);
+    EXPECT_NEAR(normalised->y(), p.y() / p.z(), 1e-10);
+  }
+}
+
+TEST(GeometryCamera, ImageCornersUndistort) {
+  const StereoRig rig = verged_rig();
+  for (const Eigen::Vector2d& corner : {Eigen::Vector2d(0, 0), Eigen::Vector2d(639, 0), Eigen::Vector2d(0, 479),
+                                       Eigen::Vector2d(639, 479)}) {
+    const auto n = rig.left.normalise(corner);
+    ASSERT_TRUE(n.ok()) << n.reason();
+    EXPECT_NEAR((rig.left.project(Eigen::Vector3d(n->x(), n->y(), 1)) - corner).norm(), 0, 1e-8);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Triangulation
+
+TEST(GeometryTriangulation, LineEndpointsFollowEq41To43) {
+  const auto vertical = line_endpoints(10, 0, 640, 480);
+  ASSERT_TRUE(vertical.ok());
+  EXPECT_NEAR(vertical->first.x(), 329.5, 1e-9);
+  EXPECT_NEAR(vertical->second.x(), 329.5, 1e-9);
+  EXPECT_NEAR(std::fabs(vertical->first.y() - vertical->second.y()), 479, 1e-9);
+  // A tilted line: both ends on the line (eq. 4.1) and on the image border.
+  const double r = 50, theta = 30 * kDeg;
+  const auto tilted = line_endpoints(r, theta, 640, 480);
+  ASSERT_TRUE(tilted.ok());
+  for (const Eigen::Vector2d& p : {tilted->first, tilted->second}) {
+    EXPECT_NEAR(std::cos(theta) * (p.x() - 319.5) + std::sin(theta) * (p.y() - 239.5), r, 1e-9);
+    const double to_border = std::min({p.x(), p.y(), 639 - p.x(), 479 - p.y()});
+    EXPECT_NEAR(to_border, 0, 1e-9);
+  }
+  const auto missing = line_endpoints(1000, 0.1, 640, 480);
+  ASSERT_FALSE(missing.ok());
+  EXPECT_NE(missing.reason().find("misses"), std::string::npos) << missing.reason();
+}
+
+TEST(GeometryTriangulation, RecoversKnownAxesThroughDistortedVergedRig) {
+  const StereoRig rig = verged_rig();
+  const Table table;
+  const Plane plane = table_plane_in_right(rig, table);
+  int checked = 0;
+  for (double lateral : {0.0, 0.08, 0.16}) {
+    for (double distance : {0.5, 0.65, 0.8}) {
+      SCOPED_TRACE("lateral " + std::to_string(lateral) + " distance " + std::to_string(distance));
+      const StereoAxis truth = observe_axis(rig, table, lateral, distance, 0.18);
+      const auto axis = triangulate_axis(rig, truth.left, truth.right);
+      ASSERT_TRUE(axis.ok()) << axis.reason();
+      const auto hit = check_axis(*axis, plane);
+      ASSERT_TRUE(hit.ok()) << hit.reason();
+      EXPECT_LT((hit->point - truth.base).norm(), 0.0005);
+      EXPECT_LT(angle_deg(axis->direction(), truth.top - truth.base), 0.2);
+      EXPECT_LT(hit->tilt_deg, 0.2);
+      ++checked;
+    }
+  }
+  EXPECT_EQ(checked, 9);
+}
+
+TEST(GeometryTriangulation, ThesisEndpointPlaneIsExactWithoutDistortion) {
+  const StereoRig rig = verged_rig(Lens::None);
+  const Table table;
+  const Plane plane = table_plane_in_right(rig, table);
+  TriangulationParams thesis;
+  thesis.plane_samples = 0;
+  const StereoAxis truth = observe_axis(rig, table, 0.1, 0.6, 0.15);
+  const auto axis = triangulate_axis(rig, truth.left, truth.right, thesis);
+  ASSERT_TRUE(axis.ok()) << axis.reason();
+  EXPECT_LT((intersect_axis_plane(*axis, plane).value() - truth.base).norm(), 1e-6);
+  // The segment lies inside both triangles: no deeper than zmax in the right camera.
+  EXPECT_LE(std::max(axis->a.z(), axis->b.z()), thesis.zmax + 1e-9);
+}
+
+TEST(GeometryTriangulation, FittedPlaneCorrectsWhatBorderEndpointsMissUnderStrongDistortion) {
+  // The image of a straight axis is curved; a straight (R, theta) fit drifts from it towards the
+  // border, where the thesis takes its two end points. Sampling the support segment does not.
+  const StereoRig rig = verged_rig(Lens::Strong);
+  const Table table;
+  const Plane plane = table_plane_in_right(rig, table);
+  TriangulationParams thesis;
+  thesis.plane_samples = 0;
+  double worst_fitted = 0, worst_thesis = 0;
+  for (double lateral : {0.0, 0.16}) {
+    for (double distance : {0.5, 0.8}) {
+      const StereoAxis truth = observe_axis(rig, table, lateral, distance, 0.18);
+      const auto fitted = triangulate_axis(rig, truth.left, truth.right);
+      const auto endpoints = triangulate_axis(rig, truth.left, truth.right, thesis);
+      ASSERT_TRUE(fitted.ok() && endpoints.ok());
+      worst_fitted = std::max(worst_fitted, (intersect_axis_plane(*fitted, plane).value() - truth.base).norm());
+      worst_thesis = std::max(worst_thesis, (intersect_axis_plane(*endpoints, plane).value() - truth.base).norm());
+    }
+  }
+  EXPECT_LT(worst_fitted, 0.001);
+  EXPECT_LT(worst_fitted * 5, worst_thesis);
+}
+
+TEST(GeometryTriangulation, TriangleIntersectionOfKnownTriangles) {
+  // Two triangles crossing along the x axis, overlapping on [0, 1] there.
+  const Triangle horizontal{{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}};  // z = 0, covers x in [-1, 1] at y = 0
+  const Triangle vertical{{0, 0, -1}, {3, 0, -1}, {0, 0, 1}};     // y = 0, covers x in [0, 1.5] at z = 0
+  const auto segment = intersect_triangles(horizontal, vertical);
+  ASSERT_TRUE(segment.ok()) << segment.reason();
+  const double lo = std::min(segment->a.x(), segment->b.x()), hi = std::max(segment->a.x(), segment->b.x());
+  EXPECT_NEAR(lo, 0.0, 1e-12);
+  EXPECT_NEAR(hi, 1.0, 1e-12);
+  EXPECT_NEAR(segment->a.y(), 0, 1e-12);
+  EXPECT_NEAR(segment->a.z(), 0, 1e-12);
+
+  const Triangle far_away{{5, 0, -1}, {6, 0, -1}, {5, 0, 1}};  // same plane as `vertical`, beyond x = 1
+  EXPECT_FALSE(intersect_triangles(horizontal, far_away).ok());
+  const Triangle above{{-1, -1, 1}, {1, -1, 1}, {1, 1, 2}};
+  const auto miss = intersect_triangles(horizontal, above);
+  ASSERT_FALSE(miss.ok());
+  EXPECT_NE(miss.reason().find("do not intersect"), std::string::npos) << miss.reason();
+  const Triangle degenerate{{0, 0, 0}, {1, 1, 1}, {2, 2, 2}};
+  EXPECT_NE(intersect_triangles(horizontal, degenerate).reason().find("degenerate"), std::string::npos);
+}
+
+TEST(GeometryTriangulation, DegenerateCasesGiveReasonsNotNaN) {
+  StereoRig rig = verged_rig(Lens::None);
+  const Table table;
+  const StereoAxis truth = observe_axis(rig, table, 0.05, 0.6, 0.15);
+
+  StereoRig same_centre = rig;
+  same_centre.T.setZero();
+  auto axis = triangulate_axis(same_centre, truth.left, truth.right);
+  ASSERT_FALSE(axis.ok());
+  EXPECT_NE(axis.reason().find("camera centres coincide"), std::string::npos) << axis.reason();
+
+  sym::Line off_image = truth.left;
+  off_image.r = 5000;
+  axis = triangulate_axis(rig, off_image, truth.right);
+  ASSERT_FALSE(axis.ok());
+  EXPECT_NE(axis.reason().find("left line"), std::string::npos) << axis.reason();
+  EXPECT_NE(axis.reason().find("misses"), std::string::npos) << axis.reason();
+
+  // A rectified rig: both horizontal lines through the principal point lie in the epipolar plane.
+  StereoRig rectified;
+  rectified.left = rectified.right = make_camera(600, 319.5, 239.5, {});
+  rectified.right.K(1, 1) = 600;
+  rectified.left.K(1, 1) = 600;
+  rectified.T = Eigen::Vector3d(-0.2, 0, 0);
+  sym::Line horizontal;
+  horizontal.theta = 90 * kDeg;
+  axis = triangulate_axis(rectified, horizontal, horizontal);
+  ASSERT_FALSE(axis.ok());
+  EXPECT_NE(axis.reason().find("parallel"), std::string::npos) << axis.reason();
+
+  // Lines whose back-projections only meet behind the cameras or beyond zmax.
+  sym::Line far_left, far_right;
+  far_left.r = -300;   // left camera looks far left...
+  far_right.r = 300;   // ...right camera far right: the planes diverge
+  axis = triangulate_axis(rectified, far_left, far_right);
+  ASSERT_FALSE(axis.ok());
+  EXPECT_FALSE(axis.reason().empty());
+
+  TriangulationParams bad;
+  bad.zmax = std::nan("");
+  EXPECT_FALSE(triangulate_axis(rig, truth.left, truth.right, bad).ok());
+  bad = TriangulationParams{};
+  bad.plane_samples = 2;
+  EXPECT_FALSE(triangulate_axis(rig, truth.left, truth.right, bad).ok());
+}
+
+// ---------------------------------------------------------------------------------------------
+// Table plane and filters
+
+TEST(GeometryPlane, FitsNoisyPointsAndOrientsTowardsCamera) {
+  const Table table;
+  std::mt19937 rng(1);
+  std::normal_distribution<double> noise(0, 0.0005);
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < 50; ++i)
+    points.push_back(table.at(-0.2 + 0.01 * i, 0.4 + 0.05 * (i % 7)) + Eigen::Vector3d(noise(rng), noise(rng), noise(rng)));
+  const auto plane = fit_plane(points);
+  ASSERT_TRUE(plane.ok()) << plane.reason();
+  EXPECT_LT(angle_deg(plane->normal, table.up()), 0.5);
+  EXPECT_GT(plane->normal.dot(table.up()), 0);  // the camera is above the table
+  EXPECT_NEAR(plane->offset, table.height, 0.002);
+  EXPECT_LT(plane->rms_residual, 0.001);
+
+  EXPECT_FALSE(fit_plane({}).ok());
+  const auto collinear = fit_plane({{0, 0, 1}, {0.1, 0, 1}, {0.2, 0, 1}, {0.3, 0, 1}});
+  ASSERT_FALSE(collinear.ok());
+  EXPECT_NE(collinear.reason().find("collinear"), std::string::npos);
+  EXPECT_FALSE(fit_plane({{0, 0, 1}, {0, 1, 1}, {std::nan(""), 0, 1}}).ok());
+}
+
+TEST(GeometryPlane, AxisFiltersGiveReasons) {
+  Plane table;  // z = -0.5 seen from the origin above: normal +z, offset 0.5
+  table.normal = Eigen::Vector3d::UnitZ();
+  table.offset = 0.5;
+  const Segment3 upright{{0.3, 0.2, -0.5}, {0.3, 0.2, -0.3}};
+  auto hit = check_axis(upright, table);
+  ASSERT_TRUE(hit.ok()) << hit.reason();
+  EXPECT_NEAR((hit->point - Eigen::Vector3d(0.3, 0.2, -0.5)).norm(), 0, 1e-12);
+  EXPECT_NEAR(hit->tilt_deg, 0, 1e-9);
+
+  const double lean = std::tan(20 * kDeg) * 0.2;
+  hit = check_axis({{0.3, 0.2, -0.5}, {0.3 + lean, 0.2, -0.3}}, table);
+  ASSERT_FALSE(hit.ok());
+  EXPECT_NE(hit.reason().find("tilted 20.0 deg"), std::string::npos) << hit.reason();
+  AxisFilter loose;
+  loose.max_tilt_deg = 25;
+  EXPECT_TRUE(check_axis({{0.3, 0.2, -0.5}, {0.3 + lean, 0.2, -0.3}}, table, loose).ok());
+
+  hit = check_axis({{3, 0, -0.5}, {3, 0, -0.3}}, table);
+  ASSERT_FALSE(hit.ok());
+  EXPECT_NE(hit.reason().find("from the camera"), std::string::npos) << hit.reason();
+
+  hit = check_axis({{0, 0, -0.4}, {1, 0, -0.4}}, table);  // lying flat
+  ASSERT_FALSE(hit.ok());
+  EXPECT_NE(hit.reason().find("parallel"), std::string::npos) << hit.reason();
+
+  AxisFilter ring;
+  ring.ring_centre = Eigen::Vector3d(0.3, 0.0, -0.5);
+  EXPECT_TRUE(check_axis(upright, table, ring).ok());  // 200 mm from the base
+  ring.ring_centre = Eigen::Vector3d(0.3, 0.15, -0.5);
+  hit = check_axis(upright, table, ring);  // 50 mm from the base
+  ASSERT_FALSE(hit.ok());
+  EXPECT_NE(hit.reason().find("workspace ring"), std::string::npos) << hit.reason();
+
+  EXPECT_FALSE(check_axis(Segment3{}, table).ok());
+}
+
+TEST(GeometryPlane, PlaneFrameRoundTrip) {
+  const Table table;
+  const auto plane = fit_plane({table.at(0, 0.5), table.at(0.2, 0.5), table.at(0, 0.8), table.at(0.3, 0.9)});
+  ASSERT_TRUE(plane.ok());
+  const PlaneFrame frame(*plane);
+  const Eigen::Vector3d p = table.at(0.12, 0.66);
+  EXPECT_NEAR((frame.to_space(frame.to_plane(p)) - p).norm(), 0, 1e-12);
+  EXPECT_NEAR((frame.to_plane(table.at(0.1, 0.5)) - frame.to_plane(table.at(0.0, 0.5))).norm(), 0.1, 1e-12);
+}
+
+// ---------------------------------------------------------------------------------------------
+// QT clustering
+
+TEST(GeometryQt, FindsClustersAndRejectsSmallOnes) {
+  std::mt19937 rng(3);
+  std::normal_distribution<double> jitter(0, 0.002);
+  const std::vector<Eigen::Vector2d> centres = {{0.10, 0.20}, {0.25, 0.22}, {0.18, 0.35}};
+  const std::vector<int> sizes = {30, 20, 12};
+  std::vector<Eigen::Vector2d> points;
+  for (size_t c = 0; c < centres.size(); ++c)
+    for (int i = 0; i < sizes[c]; ++i) points.push_back(centres[c] + Eigen::Vector2d(jitter(rng), jitter(rng)));
+  std::uniform_real_distribution<double> anywhere(-0.5, 0.5);
+  for (int i = 0; i < 10; ++i) points.push_back(Eigen::Vector2d(0.8, 0.8) + Eigen::Vector2d(anywhere(rng), anywhere(rng)) * 0.4);
+  // 72 points: minimum cluster size 8; the scattered points never gather 8 within 10 mm.
+  const std::vector<Cluster> clusters = qt_cluster(points);
+  ASSERT_EQ(clusters.size(), 3u);
+  for (size_t c = 0; c < 3; ++c) {
+    EXPECT_LT((clusters[c].centroid - centres[c]).norm(), 0.0015) << "cluster " << c;
+    EXPECT_GE(clusters[c].size(), sizes[c] - 2);
+    EXPECT_LE(clusters[c].size(), sizes[c]);
+    for (int i : clusters[c].members) EXPECT_LE((points[i] - clusters[c].centroid).norm(), 0.02);
+  }
+  QtParams one;
+  one.max_clusters = 1;
+  EXPECT_EQ(qt_cluster(points, one).size(), 1u);
+}
+
+TEST(GeometryQt, ExactSmallSets) {
+  // Points on a line 6 mm apart: seeds in the middle reach both neighbours (12 mm apart from each
+  // other, but each within 10 mm of the seed), so clusters of 3 form.
+  std::vector<Eigen::Vector2d> points;
+  for (int i = 0; i < 6; ++i) points.push_back({0.006 * i, 0});
+  QtParams params;
+  params.min_fraction = 0;
+  const auto clusters = qt_cluster(points, params);
+  ASSERT_EQ(clusters.size(), 2u);
+  EXPECT_EQ(clusters[0].members, (std::vector<int>{0, 1, 2}));  // seeds 1-4 tie: lowest seed index first
+  EXPECT_NEAR(clusters[0].centroid.x(), 0.006, 1e-12);
+  EXPECT_EQ(clusters[1].members, (std::vector<int>{3, 4, 5}));
+  EXPECT_NEAR(clusters[1].centroid.x(), 0.024, 1e-12);
+
+  EXPECT_TRUE(qt_cluster({}).empty());
+  params.min_fraction = 0.5;  // 3 of 6 points: still enough
+  EXPECT_EQ(qt_cluster(points, params).size(), 2u);
+  params.min_fraction = 0.51;
+  EXPECT_TRUE(qt_cluster(points, params).empty());
+  // Thesis default: at least 1/9 of all points. A lone point among 9 is a cluster, among 10 it is not.
+  std::vector<Eigen::Vector2d> ten(9, Eigen::Vector2d(0, 0));
+  ten.push_back({1, 1});
+  const auto default_clusters = qt_cluster(ten);
+  ASSERT_EQ(default_clusters.size(), 1u);
+  EXPECT_EQ(default_clusters[0].size(), 9);
+  ten.pop_back();
+  ten.push_back({1, 1});
+  ten.erase(ten.begin());  // 8 at the origin, 1 far away: 9 points, min size 1
+  EXPECT_EQ(qt_cluster(ten).size(), 2u);
+}
+
+TEST(GeometryQt, InvalidParams) {
+  QtParams bad;
+  bad.radius = 0;
+  EXPECT_THROW(qt_cluster({{0, 0}}, bad), std::invalid_argument);
+  bad = QtParams{};
+  bad.min_fraction = 2;
+  EXPECT_THROW(qt_cluster({{0, 0}}, bad), std::invalid_argument);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Rig file
+
+TEST(GeometryRig, YamlRoundTrip) {
+  const StereoRig rig = verged_rig();
+  const std::string path = temp_path("rig.yaml");
+  save_rig(rig, path);
+  const StereoRig back = load_rig(path);
+  EXPECT_EQ(back.left.width, 640);
+  EXPECT_EQ(back.right.height, 480);
+  EXPECT_LT((back.left.K - rig.left.K).norm(), 1e-12);
+  EXPECT_LT((back.right.K - rig.right.K).norm(), 1e-12);
+  for (int i = 0; i < 5; ++i) {
+    EXPECT_DOUBLE_EQ(back.left.distortion[i], rig.left.distortion[i]);
+    EXPECT_DOUBLE_EQ(back.right.distortion[i], rig.right.distortion[i]);
+  }
+  EXPECT_LT((back.R - rig.R).norm(), 1e-12);
+  EXPECT_LT((back.T - rig.T).norm(), 1e-12);
+  std::filesystem::remove(path);
+}
+
+TEST(GeometryRig, MissingOrBadFieldNamesFieldAndFile) {
+  const std::string path = temp_path("partial.yaml");
+  save_rig(verged_rig(), path);
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  in.close();
+  const std::string full = text.str();
+
+  // Drop the T matrix (its block runs to the end of the file).
+  const std::string without_t = full.substr(0, full.find("\nT:")) + "\n";
+  {
+    std::ofstream(path) << without_t;
+  }
+  try {
+    load_rig(path);
+    FAIL() << "missing T accepted";
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(path), std::string::npos) << what;
+    EXPECT_NE(what.find("'T'"), std::string::npos) << what;
+    EXPECT_NE(what.find("missing"), std::string::npos) << what;
+  }
+
+  // Rename a nested field.
+  std::string renamed = full;
+  renamed.replace(renamed.find("camera_matrix"), 13, "camera_matrixx");
+  {
+    std::ofstream(path) << renamed;
+  }
+  try {
+    load_rig(path);
+    FAIL() << "missing left.camera_matrix accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("left.camera_matrix"), std::string::npos) << e.what();
+  }
+
+  EXPECT_THROW(load_rig(temp_path("does_not_exist.yaml")), std::runtime_error);
+  {
+    std::ofstream(path) << "%YAML:1.0\n---\nleft: [ unterminated\n";
+  }
+  EXPECT_THROW(load_rig(path), std::runtime_error);
+  StereoRig bad = verged_rig();
+  bad.R(0, 0) = 2;
+  EXPECT_THROW(save_rig(bad, path), std::invalid_argument);
+  std::filesystem::remove(path);
+}
