@@ -116,7 +116,12 @@ class Detector {
  private:
   struct Scratch {  // per-thread working memory, kept between frames to avoid allocation
     std::vector<int32_t> xq, row, sorted, starts, fill, pairs, hist, stamp;
+    std::vector<int16_t> sorted16, pairs16;
   };
+  template <typename Bin>
+  void add_votes(const Bin* bins, int votes, int k, int layer, size_t hist_size, Scratch& s) const;
+  template <typename Bin>
+  void add_votes_once(const Bin* bins, int votes, int32_t row_id, Scratch& s) const;
   void vote_thetas(const EdgeSet& edges, const std::vector<int>& thetas, size_t first, size_t step,
                    Scratch& scratch);
   void add_support(const EdgeSet& edges, Line* line) const;
