@@ -327,3 +327,22 @@ TEST(GeneralizedSymmetry, PeaksOnTheAxisOfAMirrorSymmetricShape) {
   EXPECT_GT(on_axis, 2 * cv::sum(g.magnitude.col(25))[0]);
   EXPECT_THROW(generalized_symmetry(cv::Mat(), GstParams{}), std::invalid_argument);
 }
+
+TEST(SymmetryGeometry, MapLineBetweenImageSizes) {
+  // Detect in a half-size copy, map back: the line matches detection at full size.
+  cv::Mat full(480, 640, CV_8UC1, cv::Scalar(220));
+  syn::draw_shape(full, syn::bottle_profile(300, 50), 37.0, 6.0 * kDeg, 0, cv::Scalar(40));
+  cv::Mat half;
+  cv::resize(full, half, {320, 240}, 0, 0, cv::INTER_AREA);
+  Params p = synthetic_params();
+  p.num_lines = 1;
+  p.theta_min_deg = -45;
+  p.theta_max_deg = 45;
+  const Result small = Detector(p).detect(half);
+  ASSERT_EQ(small.lines.size(), 1u);
+  const Line mapped = map_line(small.lines[0], half.size(), full.size());
+  EXPECT_LT(angle_diff_deg(mapped.theta, 6.0 * kDeg), 0.5);
+  EXPECT_NEAR(mapped.r, 37.0, 1.0);
+  // The support segment scales with the image.
+  EXPECT_NEAR(cv::norm(mapped.seg1 - mapped.seg2), 2 * cv::norm(small.lines[0].seg1 - small.lines[0].seg2), 2.0);
+}

@@ -154,6 +154,27 @@ void border_endpoints(double r, double theta, int width, int height, cv::Point2d
   *p2 = pivot + t1 * dir;
 }
 
+Line map_line(const Line& line, cv::Size from, cv::Size to) {
+  const double sx = static_cast<double>(to.width) / from.width, sy = static_cast<double>(to.height) / from.height;
+  auto map_point = [&](cv::Point2d p) { return cv::Point2d((p.x + 0.5) * sx - 0.5, (p.y + 0.5) * sy - 0.5); };
+  const cv::Point2d c_from(0.5 * (from.width - 1), 0.5 * (from.height - 1));
+  const cv::Point2d n(std::cos(line.theta), std::sin(line.theta));
+  const cv::Point2d d(-n.y, n.x);
+  // Map two points of the line, then re-derive (R, theta) about the new centre.
+  const cv::Point2d a = map_point(c_from + line.r * n), b = map_point(c_from + line.r * n + 100.0 * d);
+  Line out = line;
+  double theta = std::atan2(b.x - a.x, -(b.y - a.y));  // normal of the mapped direction
+  if (theta > M_PI / 2) theta -= M_PI;
+  if (theta <= -M_PI / 2) theta += M_PI;
+  const cv::Point2d c_to(0.5 * (to.width - 1), 0.5 * (to.height - 1));
+  out.theta = theta;
+  out.r = (a - c_to).dot(cv::Point2d(std::cos(theta), std::sin(theta)));
+  border_endpoints(out.r, out.theta, to.width, to.height, &out.end1, &out.end2);
+  out.seg1 = map_point(line.seg1);
+  out.seg2 = map_point(line.seg2);
+  return out;
+}
+
 Detector::Detector(Params params, EdgeParams edge_params)
     : params_(std::move(params)), edge_params_(edge_params) {
   validate(params_);

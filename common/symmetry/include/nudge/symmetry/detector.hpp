@@ -93,6 +93,11 @@ std::vector<int> theta_bins_in_range(double theta_min_deg, double theta_max_deg)
 EdgeSet detect_edges(const cv::Mat& image, const EdgeParams& params, cv::Mat* edge_image = nullptr);
 EdgeSet edges_from_mask(const cv::Mat& mask);  // non-zero pixels of an 8-bit mask
 
+// The same line in an image of another size (a resized copy of the same view): pixel centres
+// map as x_to = (x_from + 0.5) * to.width / from.width - 0.5, and likewise in y. Meant for
+// isotropic resizing; border endpoints and the support segment are mapped too.
+Line map_line(const Line& line, cv::Size from, cv::Size to);
+
 // Where the line meets the border of a w x h image.
 void border_endpoints(double r, double theta, int width, int height, cv::Point2d* p1, cv::Point2d* p2);
 
