@@ -6,13 +6,7 @@
 namespace nudge::segmentation {
 
 namespace {
-cv::Mat to_bgr(const cv::Mat& image) {
-  cv::Mat bgr;
-  if (image.channels() == 1) cv::cvtColor(image, bgr, cv::COLOR_GRAY2BGR);
-  else if (image.channels() == 4) cv::cvtColor(image, bgr, cv::COLOR_BGRA2BGR);
-  else bgr = image.clone();
-  return bgr;
-}
+using symmetry::to_bgr;
 
 std::vector<cv::Point> fixed_point(const std::vector<cv::Point2d>& points, int shift) {
   std::vector<cv::Point> out;

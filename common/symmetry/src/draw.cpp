@@ -4,7 +4,6 @@
 
 namespace nudge::symmetry {
 
-namespace {
 cv::Mat to_bgr(const cv::Mat& image) {
   cv::Mat bgr;
   if (image.channels() == 1) cv::cvtColor(image, bgr, cv::COLOR_GRAY2BGR);
@@ -12,6 +11,8 @@ cv::Mat to_bgr(const cv::Mat& image) {
   else bgr = image.clone();
   return bgr;
 }
+
+namespace {
 const cv::Scalar kColours[] = {{0, 0, 255}, {0, 200, 0}, {255, 80, 0}, {0, 200, 255}, {255, 0, 255}, {255, 255, 0}};
 }  // namespace
 

@@ -143,6 +143,9 @@ class Detector {
 // Uses the same rotation table and quantisation as Detector::vote, so accumulators must be equal.
 Accumulator reference_vote(const EdgeSet& edges, const Params& params);
 
+// A 3-channel BGR copy of a grey, BGR or BGRA image, to draw on.
+cv::Mat to_bgr(const cv::Mat& image);
+
 // Visualisations (fig. 3.6-3.8): lines over the edges; the accumulator as an image.
 cv::Mat draw_lines(const cv::Mat& background, const std::vector<Line>& lines);
 cv::Mat accumulator_image(const Accumulator& acc, int skew_index = 0);
