@@ -3,9 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <string>
 #include <unistd.h>
@@ -76,6 +78,21 @@ TEST(SimScene, LoadsTheShippedScenes) {
   EXPECT_NO_THROW(load_scene(scene_path("single_cup.yaml")));
 }
 
+TEST(SimScene, EveryShippedSceneBuildsAndRenders) {
+  int scenes = 0;
+  for (const auto& entry :
+       std::filesystem::directory_iterator(std::string(NUDGE_SOURCE_DIR) + "/common/sim/scenes")) {
+    if (entry.path().extension() != ".yaml") continue;
+    ++scenes;
+    SCOPED_TRACE(entry.path().string());
+    World world(load_scene(entry.path().string()));
+    const cv::Mat mask = world.render_mask(1);
+    for (int i = 0; i < world.num_objects(); ++i)
+      EXPECT_GT(cv::countNonZero(mask == i + 1), 300) << world.object(i).name << " not visible";
+  }
+  EXPECT_GE(scenes, 3);
+}
+
 TEST(SimScene, ErrorsNameTheFileAndTheField) {
   std::string path;
   std::string msg = load_error("%YAML:1.0\nobjects:\n  - { kind: teapot, position: [0.2, 0] }\n", &path);
@@ -94,6 +111,25 @@ TEST(SimScene, ErrorsNameTheFileAndTheField) {
 
   msg = load_error("%YAML:1.0\nbackground: { type: image, file: no_such_file.png }\n");
   EXPECT_NE(msg.find("background.file"), std::string::npos) << msg;
+
+  msg = load_error("%YAML:1.0\nobjects:\n  - { kind: cup, position: [0.2, 0], fill: 1.5 }\n");
+  EXPECT_NE(msg.find("objects[0].fill"), std::string::npos) << msg;
+
+  msg = load_error("%YAML:1.0\nobjects:\n  - { kind: cup, position: [0.2, 0] }\n"
+                   "  - { kind: bottle, position: [0.25, 0.02] }\n");
+  EXPECT_NE(msg.find("objects[1].position: overlaps objects[0]"), std::string::npos) << msg;
+
+  msg = load_error("%YAML:1.0\nobjects:\n  - { kind: cup, position: [3.0, 0] }\n");
+  EXPECT_NE(msg.find("objects[0].position: must be on the table"), std::string::npos) << msg;
+
+  msg = load_error("%YAML:1.0\nphysics: { impratio: 0.5 }\n");
+  EXPECT_NE(msg.find("physics.impratio"), std::string::npos) << msg;
+
+  msg = load_error("%YAML:1.0\nrender: { shadows: maybe }\n");
+  EXPECT_NE(msg.find("render.shadows"), std::string::npos) << msg;
+
+  msg = load_error("%YAML:1.0\nobjects: [1, 2\n");  // not YAML
+  EXPECT_NE(msg.find("not a valid scene file"), std::string::npos) << msg;
 
   msg = load_error("%YAML:1.0\ntable: { colour: [1.5, 0, 0] }\n");
   EXPECT_NE(msg.find("table.colour"), std::string::npos) << msg;
@@ -282,35 +318,130 @@ TEST(SimRender, IntrinsicsAndPosesMatchTheRenderer) {
   const ObjectModel bottle = make_object("bottle");
   const Axis3d axis = world.axis(0);
   for (int c = 0; c < 2; ++c) {
+    for (int hires = 0; hires < 2; ++hires) {  // the 640x480 view and the 1280x960 still
+      const CameraModel cam = hires ? world.snapshot_camera(c) : world.camera(c);
+      const cv::Mat mask = hires ? world.render_snapshot_mask(c) : world.render_mask(c);
+      ASSERT_EQ(mask.cols, hires ? 1280 : 640);
+      ASSERT_EQ(mask.rows, hires ? 960 : 480);
+      // Extremes of the projected outline: circles of the profile's vertices.
+      double top = 1e9, left = 1e9, right = -1e9;
+      for (const auto& p : bottle.profile) {
+        for (int k = 0; k < 360; ++k) {
+          const double a = k * kDeg;
+          const Eigen::Vector3d X =
+              axis.base + Eigen::Vector3d(p.x() * std::cos(a), p.x() * std::sin(a), p.y());
+          const Eigen::Vector2d u = cam.project(X);
+          top = std::min(top, u.y());
+          left = std::min(left, u.x());
+          right = std::max(right, u.x());
+        }
+      }
+      int mask_top = mask.rows, mask_left = mask.cols, mask_right = -1;
+      for (int y = 0; y < mask.rows; ++y)
+        for (int x = 0; x < mask.cols; ++x)
+          if (mask.at<uchar>(y, x) == 1) {
+            mask_top = std::min(mask_top, y);
+            mask_left = std::min(mask_left, x);
+            mask_right = std::max(mask_right, x);
+          }
+      // A pixel is drawn when the outline covers its centre (the mesh is a 48-gon, a hair
+      // inside the circles): extremes agree within about a pixel, the middle more closely.
+      const double tol = hires ? 1.5 : 1.25;
+      EXPECT_NEAR(mask_top, top, tol) << "camera " << c << " hires " << hires;
+      EXPECT_NEAR(mask_left, left, tol) << "camera " << c << " hires " << hires;
+      EXPECT_NEAR(mask_right, right, tol) << "camera " << c << " hires " << hires;
+      EXPECT_NEAR(0.5 * (mask_left + mask_right), 0.5 * (left + right), 0.75)
+          << "camera " << c << " hires " << hires;
+    }
+  }
+  const cv::Mat still = world.render_snapshot(1);
+  EXPECT_EQ(still.size(), cv::Size(1280, 960));
+  EXPECT_EQ(still.type(), CV_8UC3);
+}
+
+TEST(SimCamera, DistortionRoundTrip) {
+  RigSpec spec;
+  spec.distortion = {-0.25, 0.1, 0.001, -0.002, 0.0};
+  const CameraModel cam = make_rig(spec).cameras[1];
+  ASSERT_TRUE(cam.distorted());
+  for (const Eigen::Vector3d& X : {Eigen::Vector3d(0.25, 0, 0.06), Eigen::Vector3d(0.1, 0.3, 0.0),
+                                  Eigen::Vector3d(0.4, -0.25, 0.2)}) {
+    const Eigen::Vector2d pixel = cam.project(X);
+    const Eigen::Vector3d c = cam.to_camera(X);
+    const Eigen::Vector2d n = cam.undistort(pixel);
+    EXPECT_NEAR(n.x(), c.x() / c.z(), 1e-9);
+    EXPECT_NEAR(n.y(), c.y() / c.z(), 1e-9);
+  }
+  // Barrel distortion: the pinhole image that covers the corners is larger than the image.
+  const PinholeCanvas canvas = pinhole_canvas(cam);
+  EXPECT_GT(canvas.width, 640);
+  EXPECT_GT(canvas.height, 480);
+  CameraModel ideal = cam;
+  ideal.distortion = {};
+  EXPECT_EQ(pinhole_canvas(ideal).width, 640);
+}
+
+// With lens distortion the renderer warps a larger pinhole image: silhouettes still land where
+// the distorted camera model projects them, and the corners are filled.
+TEST(SimRender, DistortedCamerasMatchTheirModel) {
+  Scene scene = one_object("bottle", 0.22, -0.12);
+  scene.rig.distortion = {-0.25, 0.08, 0.0, 0.0, 0.0};
+  World world(scene);
+  const ObjectModel bottle = make_object("bottle");
+  const Axis3d axis = world.axis(0);
+  for (int c = 0; c < 2; ++c) {
     const CameraModel& cam = world.camera(c);
     const cv::Mat mask = world.render_mask(c);
-    // Extremes of the projected outline: circles of the profile's vertices.
-    double top = 1e9, left = 1e9, right = -1e9;
-    for (const auto& p : bottle.profile) {
+    const cv::Mat image = world.render(c);
+    ASSERT_EQ(image.size(), cv::Size(640, 480));
+    for (const cv::Point corner : {cv::Point(0, 0), cv::Point(639, 0), cv::Point(0, 479), cv::Point(639, 479)}) {
+      const cv::Vec3b px = image.at<cv::Vec3b>(corner);
+      EXPECT_GT(px[0] + px[1] + px[2], 60) << "corner " << corner << " camera " << c;
+    }
+    double left = 1e9, right = -1e9;
+    for (const auto& p : bottle.profile)
       for (int k = 0; k < 360; ++k) {
         const double a = k * kDeg;
-        const Eigen::Vector3d X = axis.base + Eigen::Vector3d(p.x() * std::cos(a), p.x() * std::sin(a), p.y());
-        const Eigen::Vector2d u = cam.project(X);
-        top = std::min(top, u.y());
+        const Eigen::Vector2d u = cam.project(
+            axis.base + Eigen::Vector3d(p.x() * std::cos(a), p.x() * std::sin(a), p.y()));
         left = std::min(left, u.x());
         right = std::max(right, u.x());
       }
-    }
-    int mask_top = mask.rows, mask_left = mask.cols, mask_right = -1;
+    int mask_left = mask.cols, mask_right = -1;
     for (int y = 0; y < mask.rows; ++y)
       for (int x = 0; x < mask.cols; ++x)
         if (mask.at<uchar>(y, x) == 1) {
-          mask_top = std::min(mask_top, y);
           mask_left = std::min(mask_left, x);
           mask_right = std::max(mask_right, x);
         }
-    // A pixel is drawn when the outline covers its centre (the mesh is a 48-gon, a hair inside
-    // the circles): extremes agree within about a pixel, the silhouette's middle more closely.
-    EXPECT_NEAR(mask_top, top, 1.25) << "camera " << c;
-    EXPECT_NEAR(mask_left, left, 1.25) << "camera " << c;
-    EXPECT_NEAR(mask_right, right, 1.25) << "camera " << c;
-    EXPECT_NEAR(0.5 * (mask_left + mask_right), 0.5 * (left + right), 0.75) << "camera " << c;
+    EXPECT_NEAR(mask_left, left, 1.5) << "camera " << c;
+    EXPECT_NEAR(mask_right, right, 1.5) << "camera " << c;
   }
+  EXPECT_EQ(world.render_snapshot(0).size(), cv::Size(1280, 960));
+}
+
+TEST(SimRender, ImageTexturesFromPngFiles) {
+  // A 64x64 two-colour stripe texture next to a scene file that refers to it relatively.
+  const std::string dir = "/tmp/nudge_sim_test_tex_" + std::to_string(::getpid());
+  std::filesystem::create_directories(dir);
+  cv::Mat stripes(64, 64, CV_8UC3, cv::Scalar(40, 40, 200));
+  for (int x = 0; x < 64; x += 16) stripes.colRange(x, x + 8).setTo(cv::Scalar(230, 230, 230));
+  ASSERT_TRUE(cv::imwrite(dir + "/stripes.png", stripes));
+  std::ofstream(dir + "/scene.yaml")
+      << "%YAML:1.0\ntable: { type: image, file: stripes.png, repeat: 8 }\n"
+         "objects:\n  - { kind: bottle, position: [0.25, 0], type: image, file: stripes.png }\n";
+  const Scene scene = load_scene(dir + "/scene.yaml");
+  EXPECT_EQ(scene.table.file, dir + "/stripes.png");
+  World world(scene);
+  const cv::Mat image = world.render(0);
+  const cv::Mat mask = world.render_mask(0);
+  // Both colours of the texture show on the table (reddish and whitish pixels).
+  cv::Mat channels[3];
+  cv::split(image, channels);
+  const cv::Mat table = mask == 0;
+  EXPECT_GT(cv::countNonZero((channels[2] > channels[0] + 60) & table), 5000);
+  EXPECT_GT(cv::countNonZero((channels[0] > 150) & table), 5000);
+  std::filesystem::remove_all(dir);
 }
 
 TEST(SimRender, PusherCanBeHiddenAndNoiseIsSeeded) {
@@ -352,6 +483,27 @@ TEST(SimPhysics, DeterministicForSceneAndSeed) {
   double diff = 0;
   for (size_t i = 0; i < first.size(); ++i) diff += std::fabs(first[i] - third[i]);
   EXPECT_GT(diff, 1e-4);
+}
+
+TEST(SimPhysics, RestoredStateReplaysExactly) {
+  World world(load_scene(scene_path("three_objects.yaml")));
+  world.set_pusher(Eigen::Vector3d(0.22, 0.05, 0.03), M_PI / 2);
+  world.step(50);
+  const std::vector<double> saved = world.state();
+  auto run = [&world]() {
+    for (int k = 0; k < 300; ++k) {
+      world.set_pusher(Eigen::Vector3d(0.22, 0.05 + 1e-4 * k, 0.03), M_PI / 2);
+      world.step();
+    }
+    return world.state();
+  };
+  const std::vector<double> first = run();
+  world.set_state(saved);
+  EXPECT_EQ(world.state(), saved);
+  const std::vector<double> second = run();
+  EXPECT_EQ(first, second);
+  EXPECT_NE(first, saved);
+  EXPECT_THROW(world.set_state(std::vector<double>(3, 0.0)), std::invalid_argument);
 }
 
 TEST(SimPhysics, ObjectsLeftAloneStayStill) {
@@ -419,6 +571,21 @@ TEST(SimPhysics, HighPushTipsATallEmptyBottle) {
   EXPECT_GT(high.tilt, 60 * kDeg);
 }
 
+// Thesis ch. 6: a nudge perpendicular to the camera's line of sight moves the object across the
+// image: its ground-truth symmetry line shifts in R while staying upright (theta nearly constant).
+TEST(SimPhysics, NudgeAcrossTheViewShiftsTheSymmetryLine) {
+  World world(one_object("cup"));
+  const ImageLine before = world.axis_in_image(0, 1);
+  const double touch = radius_at("cup", 0.02) + pusher_pad_half_size().x();
+  world.push(Eigen::Vector3d(0.25, -touch - 0.03, 0.02), Eigen::Vector3d(0.25, -touch + 0.03, 0.02));
+  const ImageLine after = world.axis_in_image(0, 1);
+  ASSERT_TRUE(before.valid && after.valid);
+  std::printf("nudge: R %.1f -> %.1f px, theta %.2f -> %.2f deg\n", before.r, after.r,
+              before.theta / kDeg, after.theta / kDeg);
+  EXPECT_GT(std::fabs(after.r - before.r), 20);  // ~3 cm at ~0.7 m: ~25 px
+  EXPECT_LT(std::fabs(after.theta - before.theta), 3 * kDeg);
+}
+
 TEST(SimPhysics, PlacedObjectsSettleWhereTheyArePut) {
   World world(one_object("mug"));
   world.place_object(0, Eigen::Vector2d(0.3, 0.05), 0.5);
@@ -429,6 +596,31 @@ TEST(SimPhysics, PlacedObjectsSettleWhereTheyArePut) {
   EXPECT_LT(st.tilt(), 0.5 * kDeg);
   const Eigen::Vector3d handle = st.orientation * Eigen::Vector3d::UnitX();
   EXPECT_NEAR(std::atan2(handle.y(), handle.x()), 0.5, 1e-3);
+}
+
+TEST(SimObjects, WaterFillAddsMassLowDown) {
+  // combine(): two point-like halves 2 cm apart -> com midway, inertia m d^2 / 4 about it.
+  MassProperties a, b;
+  a.mass = b.mass = 0.5;
+  a.com = Eigen::Vector3d(0, 0, 0.01);
+  b.com = Eigen::Vector3d(0, 0, -0.01);
+  const MassProperties ab = combine(a, b);
+  EXPECT_NEAR(ab.com.norm(), 0, 1e-12);
+  EXPECT_NEAR(ab.inertia(0, 0), 1.0 * 0.02 * 0.02 / 4, 1e-12);
+  EXPECT_NEAR(ab.inertia(2, 2), 0, 1e-12);
+
+  Scene scene = one_object("bottle");
+  scene.objects[0].fill = 0.5;
+  scene.objects.push_back(one_object("bottle", 0.25, 0.15).objects[0]);  // empty, for comparison
+  World world(scene);
+  const ObjectModel bottle = make_object("bottle");
+  const double water = kWaterDensity * M_PI * std::pow(bottle.liquid_radius, 2) * 0.5 * bottle.liquid_height;
+  const ObjectState full = world.object(0), empty = world.object(1);
+  EXPECT_NEAR(full.mass, bottle.default_mass + water, 1e-9);
+  EXPECT_NEAR(empty.mass, bottle.default_mass, 1e-9);
+  EXPECT_LT(full.centre_of_mass.z(), empty.centre_of_mass.z() - 0.03);
+  world.step_for(2.0);
+  EXPECT_LT((world.object(0).position - full.position).norm(), 1e-4);
 }
 
 TEST(SimPhysics, PushStartingInsideAnObjectIsRefused) {

@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -11,11 +12,63 @@ using Eigen::Matrix3d;
 using Eigen::Vector2d;
 using Eigen::Vector3d;
 
+bool CameraModel::distorted() const {
+  for (double d : distortion)
+    if (d != 0) return true;
+  return false;
+}
+
+Vector2d CameraModel::distort(const Vector2d& n) const {
+  const double k1 = distortion[0], k2 = distortion[1], p1 = distortion[2], p2 = distortion[3],
+               k3 = distortion[4];
+  const double x = n.x(), y = n.y(), r2 = x * x + y * y;
+  const double radial = 1 + r2 * (k1 + r2 * (k2 + r2 * k3));
+  return Vector2d(x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x * x),
+                  y * radial + p1 * (r2 + 2 * y * y) + 2 * p2 * x * y);
+}
+
+Vector2d CameraModel::undistort(const Vector2d& pixel) const {
+  const Vector2d d((pixel.x() - K(0, 2)) / K(0, 0), (pixel.y() - K(1, 2)) / K(1, 1));
+  if (!distorted()) return d;
+  // Fixed-point iteration n <- n + (d - distort(n)), as OpenCV's undistortPoints, then polished.
+  Vector2d n = d;
+  for (int i = 0; i < 50; ++i) {
+    const Vector2d step = d - distort(n);
+    n += step;
+    if (step.norm() < 1e-12) break;
+  }
+  return n;
+}
+
 Vector2d CameraModel::project(const Vector3d& world, double* depth) const {
   const Vector3d c = to_camera(world);
   if (depth) *depth = c.z();
-  const Vector3d p = K * c;
-  return Vector2d(p.x() / p.z(), p.y() / p.z());
+  const Vector2d n = distort(Vector2d(c.x() / c.z(), c.y() / c.z()));
+  return Vector2d(K(0, 0) * n.x() + K(0, 2), K(1, 1) * n.y() + K(1, 2));
+}
+
+PinholeCanvas pinhole_canvas(const CameraModel& camera) {
+  PinholeCanvas canvas{camera.width, camera.height};
+  if (!camera.distorted()) return canvas;
+  // The undistorted positions of the border pixels bound the pinhole image needed.
+  double ex = 0, ey = 0;
+  auto visit = [&](double u, double v) {
+    const Vector2d n = camera.undistort(Vector2d(u, v));
+    ex = std::max(ex, std::fabs(camera.K(0, 0) * n.x()));
+    ey = std::max(ey, std::fabs(camera.K(1, 1) * n.y()));
+  };
+  for (int u = 0; u < camera.width; ++u) {
+    visit(u, 0);
+    visit(u, camera.height - 1);
+  }
+  for (int v = 0; v < camera.height; ++v) {
+    visit(0, v);
+    visit(camera.width - 1, v);
+  }
+  // Even sizes keep the centre at (size - 1) / 2; 2 px margin for interpolation.
+  canvas.width = std::max(camera.width, 2 * static_cast<int>(std::ceil(ex + 2)));
+  canvas.height = std::max(camera.height, 2 * static_cast<int>(std::ceil(ey + 2)));
+  return canvas;
 }
 
 Matrix3d StereoRig::R_right_left() const {
@@ -57,6 +110,7 @@ StereoRig make_rig(const RigSpec& spec) {
     cam.height = spec.height;
     cam.fovy = spec.fovy;
     cam.K = K;
+    cam.distortion = spec.distortion;
     cam.R.row(0) = rgt.transpose();
     cam.R.row(1) = down.transpose();
     cam.R.row(2) = fwd.transpose();

@@ -12,9 +12,6 @@ namespace nudge::sim {
 
 namespace {
 
-// Table top extent (world frame) and the backdrop wall behind it (at its -x edge).
-constexpr double kTableXMin = -0.6, kTableXMax = 1.1, kTableHalfY = 1.0;
-
 class Xml {
  public:
   Xml() {
@@ -97,6 +94,16 @@ std::string build_mjcf(const Scene& scene) {
   const RigSpec& rs = scene.rig;
   const StereoRig rig = make_rig(rs);
   const int samples = scene.render.antialias ? 4 : 0;
+  // The offscreen buffer holds the largest image drawn: a high-resolution still, or the larger
+  // pinhole image a distorted camera is warped from.
+  PinholeCanvas canvas = pinhole_canvas(scaled(rig.cameras[0], scene.render.snapshot_scale));
+  const PinholeCanvas small = pinhole_canvas(rig.cameras[0]);
+  canvas.width = std::max(canvas.width, small.width);
+  canvas.height = std::max(canvas.height, small.height);
+  if (canvas.width > 8192 || canvas.height > 8192)
+    throw SceneError(scene.source + ": cameras.distortion: too strong to render (needs a " +
+                     std::to_string(canvas.width) + "x" + std::to_string(canvas.height) +
+                     " pinhole image)");
 
   Xml assets, bodies;
   add_material(assets, "table_mat", scene.table, false);
@@ -114,12 +121,17 @@ std::string build_mjcf(const Scene& scene) {
     }
     const double mass = spec.mass > 0 ? spec.mass : model.default_mass;
     const double friction = spec.friction > 0 ? spec.friction : model.default_friction;
-    const MassProperties props = shell_mass_properties(parts, mass);
+    MassProperties props = shell_mass_properties(parts, mass);
+    if (spec.fill > 0) {
+      const double h = spec.fill * model.liquid_height, r = model.liquid_radius;
+      props = combine(props, cylinder_mass_properties(r, model.liquid_bottom, h,
+                                                      kWaterDensity * M_PI * r * r * h));
+    }
     const Eigen::Matrix3d& I = props.inertia;
     bodies << "    <body name=\"" << id << "\" pos=\"" << spec.position.x() << ' '
            << spec.position.y() << " 0\" euler=\"0 0 " << spec.yaw << "\">\n"
            << "      <freejoint name=\"" << id << "_joint\"/>\n"
-           << "      <inertial pos=\"" << vec(props.com) << "\" mass=\"" << mass
+           << "      <inertial pos=\"" << vec(props.com) << "\" mass=\"" << props.mass
            << "\" fullinertia=\"" << I(0, 0) << ' ' << I(1, 1) << ' ' << I(2, 2) << ' ' << I(0, 1)
            << ' ' << I(0, 2) << ' ' << I(1, 2) << "\"/>\n";
     for (size_t k = 0; k < model.parts.size(); ++k) {
@@ -145,8 +157,7 @@ std::string build_mjcf(const Scene& scene) {
     << "  <size njmax=\"2000\" nconmax=\"500\"/>\n"
     << "  <statistic extent=\"2\" center=\"" << vec(table_centre) << "\"/>\n"
     << "  <visual>\n"
-    << "    <global offwidth=\"" << rs.width * scene.render.snapshot_scale << "\" offheight=\""
-    << rs.height * scene.render.snapshot_scale << "\"/>\n"
+    << "    <global offwidth=\"" << canvas.width << "\" offheight=\"" << canvas.height << "\"/>\n"
     << "    <quality offsamples=\"" << samples << "\" shadowsize=\"2048\"/>\n"
     << "    <headlight ambient=\"" << ambient << ' ' << ambient << ' ' << ambient
     << "\" diffuse=\"0.25 0.25 0.25\" specular=\"0.1 0.1 0.1\"/>\n"

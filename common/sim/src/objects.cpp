@@ -21,12 +21,14 @@ void orient_outwards(Mesh& mesh) {
 }
 
 // A closed tube of radius `tube_r` swept along `centre` (open curve), with flat end caps.
-Mesh sweep_tube(const std::vector<Vector3d>& centre, double tube_r, int sides) {
+// Texture coordinates: 1 unit per `v_unit` metres along the tube and around it.
+Mesh sweep_tube(const std::vector<Vector3d>& centre, double tube_r, int sides, double v_unit) {
   Mesh mesh;
   const int n = static_cast<int>(centre.size());
   std::vector<double> arc(n, 0.0);
   for (int i = 1; i < n; ++i) arc[i] = arc[i - 1] + (centre[i] - centre[i - 1]).norm();
-  const double end_v = arc[n - 1] / (2 * M_PI * tube_r);
+  const double end_v = arc[n - 1] / v_unit;
+  const double around = 2 * M_PI * tube_r / v_unit;
   for (int i = 0; i < n; ++i) {
     const Vector3d tangent =
         (centre[std::min(i + 1, n - 1)] - centre[std::max(i - 1, 0)]).normalized();
@@ -37,8 +39,8 @@ Mesh sweep_tube(const std::vector<Vector3d>& centre, double tube_r, int sides) {
       const double b = 2 * M_PI * j / sides;
       const Vector3d p = centre[i] + tube_r * (std::cos(b) * normal + std::sin(b) * binormal);
       mesh.vertices.push_back(p.cast<float>());
-      mesh.texcoords.emplace_back(static_cast<float>(j) / sides,
-                                  static_cast<float>(arc[i] / (2 * M_PI * tube_r)));
+      mesh.texcoords.emplace_back(static_cast<float>(around * j / sides),
+                                  static_cast<float>(arc[i] / v_unit));
     }
   }
   const int ring = sides + 1;
@@ -92,7 +94,8 @@ std::vector<Vector2d> can_profile() {
 }
 
 ObjectModel from_profile(const std::string& kind, const std::vector<Vector2d>& profile,
-                         int segments, double mass, double friction) {
+                         int segments, double mass, double friction, double liquid_radius,
+                         double liquid_bottom, double liquid_height) {
   ObjectModel model;
   model.kind = kind;
   model.profile = profile;
@@ -104,6 +107,9 @@ ObjectModel from_profile(const std::string& kind, const std::vector<Vector2d>& p
   }
   model.default_mass = mass;
   model.default_friction = friction;
+  model.liquid_radius = liquid_radius;
+  model.liquid_bottom = liquid_bottom;
+  model.liquid_height = liquid_height;
   return model;
 }
 
@@ -176,6 +182,29 @@ MassProperties shell_mass_properties(const std::vector<const Mesh*>& meshes, dou
   return props;
 }
 
+MassProperties cylinder_mass_properties(double radius, double z0, double height, double mass) {
+  MassProperties props;
+  props.mass = mass;
+  props.com = Vector3d(0, 0, z0 + 0.5 * height);
+  const double side = mass * (3 * radius * radius + height * height) / 12.0;
+  props.inertia = Eigen::Vector3d(side, side, 0.5 * mass * radius * radius).asDiagonal();
+  return props;
+}
+
+MassProperties combine(const MassProperties& a, const MassProperties& b) {
+  MassProperties out;
+  out.mass = a.mass + b.mass;
+  if (!(out.mass > 0)) return out;
+  out.com = (a.mass * a.com + b.mass * b.com) / out.mass;
+  auto shifted = [&out](const MassProperties& p) {  // parallel axis theorem to the joint com
+    const Vector3d d = p.com - out.com;
+    return Eigen::Matrix3d(p.inertia + p.mass * (d.squaredNorm() * Eigen::Matrix3d::Identity() -
+                                                 d * d.transpose()));
+  };
+  out.inertia = shifted(a) + shifted(b);
+  return out;
+}
+
 Mesh revolve(const std::vector<Vector2d>& profile, int segments) {
   if (profile.size() < 3) throw std::invalid_argument("revolve: profile needs >= 3 points");
   if (segments < 3) throw std::invalid_argument("revolve: segments must be >= 3");
@@ -225,11 +254,13 @@ bool is_object_kind(const std::string& kind) {
 }
 
 ObjectModel make_object(const std::string& kind, int segments) {
-  if (kind == "cup") return from_profile(kind, cup_profile(), segments, 0.25, 0.5);
-  if (kind == "bottle") return from_profile(kind, bottle_profile(), segments, 0.04, 0.45);
-  if (kind == "can") return from_profile(kind, can_profile(), segments, 0.02, 0.4);
+  // Liquid space: an inscribed cylinder (the cup's tapered inside is averaged; the bottle's
+  // shoulder and neck are left out).
+  if (kind == "cup") return from_profile(kind, cup_profile(), segments, 0.25, 0.5, 0.031, 0.006, 0.080);
+  if (kind == "bottle") return from_profile(kind, bottle_profile(), segments, 0.04, 0.45, 0.0335, 0.002, 0.125);
+  if (kind == "can") return from_profile(kind, can_profile(), segments, 0.02, 0.4, 0.032, 0.004, 0.110);
   if (kind == "mug") {
-    ObjectModel model = from_profile(kind, mug_profile(), segments, 0.35, 0.5);
+    ObjectModel model = from_profile(kind, mug_profile(), segments, 0.35, 0.5, 0.0365, 0.008, 0.085);
     // Handle: an elliptical arc on the +x side, its ends buried 4 mm in the wall.
     const double wall = 0.041, zc = 0.050, rx = 0.030, rz = 0.027, tube = 0.0055;
     std::vector<Vector3d> centre;
@@ -238,7 +269,7 @@ ObjectModel make_object(const std::string& kind, int segments) {
       const double a = -M_PI / 2 + M_PI * k / steps;
       centre.emplace_back(wall - 0.004 + rx * std::cos(a), 0.0, zc + rz * std::sin(a));
     }
-    Mesh handle = sweep_tube(centre, tube, 16);
+    Mesh handle = sweep_tube(centre, tube, 16, 2 * M_PI * model.max_radius);
     orient_outwards(handle);
     model.parts.push_back(std::move(handle));
     return model;

@@ -97,7 +97,12 @@ Renderer::~Renderer() {
                                         width_, height_);
   if (impl_->gl_made) mjr_freeContext(&impl_->gl);
   if (impl_->scene_made) mjv_freeScene(&impl_->scene);
-  if (impl_->context) OSMesaDestroyContext(impl_->context);
+  if (impl_->context) {
+    // Release the context before destroying it. (OSMesa itself keeps ~100 bytes per buffer it
+    // has seen until exit; nothing here can free them.)
+    OSMesaMakeCurrent(nullptr, nullptr, 0, 0, 0);
+    OSMesaDestroyContext(impl_->context);
+  }
 }
 
 cv::Size Renderer::checked(cv::Size size) const {

@@ -6,6 +6,7 @@
 
 #include <cctype>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -127,7 +128,9 @@ std::string directory_of(const std::string& path) {
 
 std::string resolve(const std::string& file, const std::string& dir) {
   if (file.empty() || file[0] == '/') return file;
-  return dir + "/" + file;
+  std::error_code ec;
+  const auto full = std::filesystem::absolute(std::filesystem::path(dir) / file, ec);
+  return ec ? dir + "/" + file : full.lexically_normal().string();
 }
 
 // Appearance keys may sit in their own map (table, background) or inline in an object's map.
@@ -163,6 +166,8 @@ void check_appearance(const Appearance& a, const std::string& source, const std:
   if (!(a.reflectance >= 0 && a.reflectance <= 1)) fail(source, join(ctx, "reflectance"), "must be in [0, 1]");
   if (a.kind == Appearance::Kind::Image) {
     if (a.file.empty()) fail(source, join(ctx, "file"), "type image needs a PNG file");
+    if (a.file.find_first_of("\"<>&") != std::string::npos)
+      fail(source, join(ctx, "file"), "'" + a.file + "': the characters \" < > & are not allowed");
     const auto dot = a.file.find_last_of('.');
     if (dot == std::string::npos || a.file.substr(dot) != ".png")
       fail(source, join(ctx, "file"), "'" + a.file + "' must be a .png file");
@@ -197,7 +202,13 @@ Scene load_scene(const std::string& path) {
   try {
     if (!fs.open(path, cv::FileStorage::READ)) throw SceneError(path + ": cannot open scene file");
   } catch (const cv::Exception& e) {
-    throw SceneError(path + ": not a valid scene file: " + e.msg);
+    // OpenCV's parser puts "<file>(<line>): <what>" in the "function" part of its message.
+    std::string detail = e.msg;
+    const auto at = detail.find("in function '");
+    if (at != std::string::npos) detail = detail.substr(at + 13);
+    while (!detail.empty() && (detail.back() == '\n' || detail.back() == '\'' || detail.back() == ' '))
+      detail.pop_back();
+    throw SceneError(path + ": not a valid scene file: " + detail);
   }
   Scene scene = default_scene();
   scene.source = path;
@@ -231,6 +242,10 @@ Scene load_scene(const std::string& path) {
     rig.width = r.integer("width", rig.width);
     rig.height = r.integer("height", rig.height);
     rig.fovy = r.number("fovy_deg", rig.fovy / kDeg) * kDeg;
+    if (r.has("distortion")) {
+      const auto d = r.numbers("distortion", 5, 5);
+      for (int i = 0; i < 5; ++i) rig.distortion[i] = d[i];
+    }
     r.finish();
   }
   if (top.has("render")) {
@@ -253,6 +268,9 @@ Scene load_scene(const std::string& path) {
     physics.position_jitter = r.number("position_jitter", physics.position_jitter);
     physics.yaw_jitter = r.number("yaw_jitter_deg", physics.yaw_jitter / kDeg) * kDeg;
     physics.table_friction = r.number("table_friction", physics.table_friction);
+    physics.elliptic_cone = r.boolean("elliptic_cone", physics.elliptic_cone);
+    physics.impratio = r.number("impratio", physics.impratio);
+    physics.noslip_iterations = r.integer("noslip_iterations", physics.noslip_iterations);
     r.finish();
   }
   if (top.has("objects")) {
@@ -271,6 +289,7 @@ Scene load_scene(const std::string& path) {
       obj.yaw = r.number("yaw_deg", 0.0) * kDeg;
       obj.mass = r.number("mass", 0.0);
       obj.friction = r.number("friction", 0.0);
+      obj.fill = r.number("fill", 0.0);
       read_appearance(r, obj.appearance, path, dir);
       r.finish();
       scene.objects.push_back(obj);
@@ -285,6 +304,7 @@ void validate(const Scene& scene) {
   const std::string& src = scene.source;
   check_appearance(scene.table, src, "table");
   check_appearance(scene.background, src, "background");
+  if (scene.objects.size() > 254) fail(src, "objects", "at most 254 objects (mask labels are 8-bit)");
   std::set<std::string> names;
   for (size_t i = 0; i < scene.objects.size(); ++i) {
     const ObjectSpec& o = scene.objects[i];
@@ -298,13 +318,33 @@ void validate(const Scene& scene) {
       if (!valid_name(o.name)) fail(src, join(ctx, "name"), "'" + o.name + "': use letters, digits, _ and -");
       if (!names.insert(o.name).second) fail(src, join(ctx, "name"), "'" + o.name + "' is used twice");
     }
-    if (!o.position.allFinite() || o.position.norm() > 2.0)
-      fail(src, join(ctx, "position"), "must be finite and within 2 m of the arm base");
+    if (!o.position.allFinite() || o.position.x() <= kTableXMin + 0.05 ||
+        o.position.x() >= kTableXMax - 0.05 || std::fabs(o.position.y()) >= kTableHalfY - 0.05)
+    {
+      std::ostringstream what;
+      what << "must be on the table (x in (" << kTableXMin + 0.05 << ", " << kTableXMax - 0.05
+           << "), |y| < " << kTableHalfY - 0.05 << " m)";
+      fail(src, join(ctx, "position"), what.str());
+    }
     if (!std::isfinite(o.yaw)) fail(src, join(ctx, "yaw"), "must be finite");
     if (!(o.mass >= 0 && o.mass < 20)) fail(src, join(ctx, "mass"), "must be in [0, 20) kg (0 = default)");
     if (!(o.friction >= 0 && o.friction < 5)) fail(src, join(ctx, "friction"), "must be in [0, 5) (0 = default)");
+    if (!(o.fill >= 0 && o.fill <= 1)) fail(src, join(ctx, "fill"), "must be in [0, 1]");
     check_appearance(o.appearance, src, ctx);
   }
+  // Objects must not start inside each other (footprints: widest radius; a mug's handle may
+  // still touch a neighbour).
+  for (size_t i = 0; i < scene.objects.size(); ++i)
+    for (size_t j = 0; j < i; ++j) {
+      const ObjectSpec& a = scene.objects[i];
+      const ObjectSpec& b = scene.objects[j];
+      const double gap = (a.position - b.position).norm() - make_object(a.kind, 8).max_radius -
+                         make_object(b.kind, 8).max_radius;
+      if (gap < 0)
+        fail(src, "objects[" + std::to_string(i) + "].position",
+             "overlaps objects[" + std::to_string(j) + "] by " +
+                 std::to_string(static_cast<int>(std::ceil(-gap * 1000))) + " mm");
+    }
   const RigSpec& rig = scene.rig;
   if (!rig.target.allFinite()) fail(src, "cameras.target", "must be finite");
   if (!(rig.distance > 0.05 && rig.distance < 10)) fail(src, "cameras.distance", "must be in (0.05, 10) m");
@@ -315,6 +355,8 @@ void validate(const Scene& scene) {
   if (rig.width < 16 || rig.width > 4096) fail(src, "cameras.width", "must be in [16, 4096]");
   if (rig.height < 16 || rig.height > 4096) fail(src, "cameras.height", "must be in [16, 4096]");
   if (!(rig.fovy > 1 * kDeg && rig.fovy < 170 * kDeg)) fail(src, "cameras.fovy_deg", "must be in (1, 170)");
+  for (double d : rig.distortion)
+    if (!(std::fabs(d) <= 2)) fail(src, "cameras.distortion", "coefficients must be in [-2, 2]");
   const RenderSpec& r = scene.render;
   if (!(r.noise_sigma >= 0 && r.noise_sigma < 100)) fail(src, "render.noise_sigma", "must be in [0, 100)");
   if (r.snapshot_scale < 1 || r.snapshot_scale > 4) fail(src, "render.snapshot_scale", "must be 1, 2, 3 or 4");
@@ -326,6 +368,8 @@ void validate(const Scene& scene) {
   if (!(p.position_jitter >= 0 && p.position_jitter < 0.1)) fail(src, "physics.position_jitter", "must be in [0, 0.1) m");
   if (!(p.yaw_jitter >= 0 && p.yaw_jitter <= M_PI)) fail(src, "physics.yaw_jitter_deg", "must be in [0, 180]");
   if (!(p.table_friction > 0 && p.table_friction < 5)) fail(src, "physics.table_friction", "must be in (0, 5)");
+  if (!(p.impratio >= 1 && p.impratio <= 1000)) fail(src, "physics.impratio", "must be in [1, 1000]");
+  if (p.noslip_iterations < 0 || p.noslip_iterations > 1000) fail(src, "physics.noslip_iterations", "must be in [0, 1000]");
 }
 
 }  // namespace nudge::sim

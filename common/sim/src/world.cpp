@@ -5,6 +5,7 @@
 #include "nudge/sim/renderer.hpp"
 
 #include <mujoco/mujoco.h>
+#include <opencv2/imgproc.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -21,10 +22,11 @@ mjModel* compile(const std::string& xml, const std::string& source) {
   auto vfs = std::make_unique<mjVFS>();
   mj_defaultVFS(vfs.get());
   const char* name = "nudge_world.xml";
-  if (mj_makeEmptyFileVFS(vfs.get(), name, static_cast<int>(xml.size())) != 0)
+  // Staged with its terminating NUL, whether the parser goes by the size or by the terminator.
+  if (mj_makeEmptyFileVFS(vfs.get(), name, static_cast<int>(xml.size() + 1)) != 0)
     throw SimError(source + ": cannot stage the model in MuJoCo's virtual file system");
   const int index = mj_findFileVFS(vfs.get(), name);
-  std::memcpy(vfs->filedata[index], xml.data(), xml.size());
+  std::memcpy(vfs->filedata[index], xml.c_str(), xml.size() + 1);
   char error[1000] = "";
   mjModel* model = mj_loadXML(name, vfs.get(), error, sizeof(error));
   mj_deleteVFS(vfs.get());
@@ -54,6 +56,13 @@ struct World::Impl {
   int pad_geom = -1;
   int camera_id[2] = {-1, -1};
   std::mt19937_64 noise_rng;
+  // Distortion warps, [0] for the rig's size, [1] for snapshots (built on first use).
+  struct Warp {
+    cv::Size size;          // the pinhole image rendered
+    double fovy_deg = 0;    // its vertical field of view
+    cv::Mat map_x, map_y;   // distorted pixel -> pinhole pixel
+  };
+  Warp warp[2];
 
   ~Impl() {
     renderer.reset();
@@ -97,7 +106,7 @@ World::World(const Scene& input) : impl_(std::make_unique<Impl>()), scene_(input
     s.qvel_adr.push_back(s.model->jnt_dofadr[j]);
     s.height.push_back(make_object(scene_.objects[i].kind, 8).height);
     for (int g = 0; g < s.model->ngeom; ++g)
-      if (s.model->geom_bodyid[g] == b) s.geom_label[g] = static_cast<unsigned char>(std::min<size_t>(i + 1, 255));
+      if (s.model->geom_bodyid[g] == b) s.geom_label[g] = static_cast<unsigned char>(i + 1);
   }
   const int pusher = mj_name2id(s.model, mjOBJ_BODY, "pusher");
   s.pusher_mocap = pusher >= 0 ? s.model->body_mocapid[pusher] : -1;
@@ -132,12 +141,41 @@ std::vector<double> World::state() const {
   const mjModel* m = impl_->model;
   const mjData* d = impl_->data;
   std::vector<double> out;
-  out.reserve(1 + m->nq + m->nv + 3 * m->nmocap);
+  out.reserve(1 + m->nq + 2 * m->nv + 7 * m->nmocap + m->na);
   out.push_back(d->time);
   out.insert(out.end(), d->qpos, d->qpos + m->nq);
   out.insert(out.end(), d->qvel, d->qvel + m->nv);
   out.insert(out.end(), d->mocap_pos, d->mocap_pos + 3 * m->nmocap);
+  out.insert(out.end(), d->mocap_quat, d->mocap_quat + 4 * m->nmocap);
+  out.insert(out.end(), d->act, d->act + m->na);
+  // The constraint solver starts from the last accelerations: part of the state for exact replay.
+  out.insert(out.end(), d->qacc_warmstart, d->qacc_warmstart + m->nv);
   return out;
+}
+
+void World::set_state(const std::vector<double>& state) {
+  const mjModel* m = impl_->model;
+  mjData* d = impl_->data;
+  const size_t size = 1 + m->nq + 2 * m->nv + 7 * m->nmocap + m->na;
+  if (state.size() != size)
+    throw std::invalid_argument("World::set_state: expected " + std::to_string(size) +
+                                " values, got " + std::to_string(state.size()));
+  for (double v : state)
+    if (!std::isfinite(v)) throw std::invalid_argument("World::set_state: non-finite value");
+  const double* p = state.data();
+  d->time = *p++;
+  std::copy(p, p + m->nq, d->qpos);
+  p += m->nq;
+  std::copy(p, p + m->nv, d->qvel);
+  p += m->nv;
+  std::copy(p, p + 3 * m->nmocap, d->mocap_pos);
+  p += 3 * m->nmocap;
+  std::copy(p, p + 4 * m->nmocap, d->mocap_quat);
+  p += 4 * m->nmocap;
+  std::copy(p, p + m->na, d->act);
+  p += m->na;
+  mj_forward(m, d);  // positions of bodies, contacts: for rendering and queries
+  std::copy(p, p + m->nv, d->qacc_warmstart);
 }
 
 int World::object_index(const std::string& name) const {
@@ -161,6 +199,9 @@ ObjectState World::object(int index) const {
   // A free joint's angular velocity is in the body frame.
   st.angular_velocity = st.orientation * vec3(v + 3);
   st.height = s.height[index];
+  st.mass = s.model->body_mass[s.body[index]];
+  // From the pose, so it is right even before the next mj_forward.
+  st.centre_of_mass = st.position + st.orientation * vec3(s.model->body_ipos + 3 * s.body[index]);
   return st;
 }
 
@@ -262,26 +303,68 @@ PushResult World::push(const Eigen::Vector3d& from, const Eigen::Vector3d& to, d
   return result;
 }
 
-cv::Mat World::render(int camera_index) {
+cv::Mat World::render(int camera_index) { return draw(camera_index, false, false); }
+
+cv::Mat World::render_mask(int camera_index) { return draw(camera_index, false, true); }
+
+cv::Mat World::render_snapshot(int camera_index) { return draw(camera_index, true, false); }
+
+cv::Mat World::render_snapshot_mask(int camera_index) { return draw(camera_index, true, true); }
+
+CameraModel World::snapshot_camera(int camera_index) const {
+  return scaled(camera(camera_index), scene_.render.snapshot_scale);
+}
+
+cv::Mat World::draw(int camera_index, bool snapshot, bool labels) {
   if (camera_index < 0 || camera_index > 1)
     throw std::out_of_range("World::render: camera must be 0 (left) or 1 (right)");
-  return colour_image(camera_index, cv::Size(scene_.rig.width, scene_.rig.height));
-}
-
-Renderer& World::renderer() {
   Impl& s = *impl_;
-  if (!s.renderer) {
-    const int k = scene_.render.snapshot_scale;
-    s.renderer = std::make_unique<Renderer>(s.model, k * scene_.rig.width, k * scene_.rig.height);
+  if (!s.renderer)
+    s.renderer = std::make_unique<Renderer>(s.model, s.model->vis.global.offwidth,
+                                            s.model->vis.global.offheight);
+  const CameraModel cam = snapshot ? snapshot_camera(camera_index) : camera(camera_index);
+  const int id = s.camera_id[camera_index];
+  const int hidden = pusher_visible ? -1 : kPusherGroup;
+
+  // A distorted camera: render a larger ideal pinhole image with the same focal length, then
+  // warp it. Both cameras share intrinsics, so one warp per image size serves both.
+  Impl::Warp* warp = nullptr;
+  if (cam.distorted()) {
+    warp = &s.warp[snapshot ? 1 : 0];
+    if (warp->map_x.empty()) {
+      const PinholeCanvas canvas = pinhole_canvas(cam);
+      warp->size = cv::Size(canvas.width, canvas.height);
+      warp->map_x.create(cam.height, cam.width, CV_32F);
+      warp->map_y.create(cam.height, cam.width, CV_32F);
+      const double cx = 0.5 * (canvas.width - 1), cy = 0.5 * (canvas.height - 1);
+      for (int v = 0; v < cam.height; ++v)
+        for (int u = 0; u < cam.width; ++u) {
+          const Eigen::Vector2d n = cam.undistort(Eigen::Vector2d(u, v));
+          warp->map_x.at<float>(v, u) = static_cast<float>(cam.K(0, 0) * n.x() + cx);
+          warp->map_y.at<float>(v, u) = static_cast<float>(cam.K(1, 1) * n.y() + cy);
+        }
+      warp->fovy_deg = 2 * std::atan(0.5 * canvas.height / cam.K(1, 1)) * 180.0 / M_PI;
+    }
   }
-  return *s.renderer;
-}
-
-cv::Mat World::colour_image(int camera_index, cv::Size size) {
-  Impl& s = *impl_;
-  cv::Mat image = renderer().colour(s.data, s.camera_id[camera_index], scene_.render,
-                                    pusher_visible ? -1 : kPusherGroup, size);
-  if (scene_.render.noise_sigma > 0) {
+  const cv::Size size = warp ? warp->size : cv::Size(cam.width, cam.height);
+  const mjtNum fovy = s.model->cam_fovy[id];
+  if (warp) s.model->cam_fovy[id] = warp->fovy_deg;
+  cv::Mat image;
+  try {
+    image = labels ? s.renderer->labels(s.data, id, s.geom_label, hidden, size)
+                   : s.renderer->colour(s.data, id, scene_.render, hidden, size);
+  } catch (...) {
+    s.model->cam_fovy[id] = fovy;
+    throw;
+  }
+  s.model->cam_fovy[id] = fovy;
+  if (warp) {
+    cv::Mat warped;
+    cv::remap(image, warped, warp->map_x, warp->map_y,
+              labels ? cv::INTER_NEAREST : cv::INTER_LINEAR, cv::BORDER_CONSTANT);
+    image = warped;
+  }
+  if (!labels && scene_.render.noise_sigma > 0) {
     cv::Mat noise(image.size(), CV_32FC3);
     std::normal_distribution<float> normal(0.0f, static_cast<float>(scene_.render.noise_sigma));
     for (int y = 0; y < noise.rows; ++y) {
@@ -294,34 +377,6 @@ cv::Mat World::colour_image(int camera_index, cv::Size size) {
     sum.convertTo(image, CV_8UC3);  // saturating
   }
   return image;
-}
-
-cv::Mat World::render_mask(int camera_index) {
-  if (camera_index < 0 || camera_index > 1)
-    throw std::out_of_range("World::render_mask: camera must be 0 (left) or 1 (right)");
-  return renderer().labels(impl_->data, impl_->camera_id[camera_index], impl_->geom_label,
-                           pusher_visible ? -1 : kPusherGroup,
-                           cv::Size(scene_.rig.width, scene_.rig.height));
-}
-
-cv::Mat World::render_snapshot(int camera_index) {
-  if (camera_index < 0 || camera_index > 1)
-    throw std::out_of_range("World::render_snapshot: camera must be 0 (left) or 1 (right)");
-  const int k = scene_.render.snapshot_scale;
-  return colour_image(camera_index, cv::Size(k * scene_.rig.width, k * scene_.rig.height));
-}
-
-cv::Mat World::render_snapshot_mask(int camera_index) {
-  if (camera_index < 0 || camera_index > 1)
-    throw std::out_of_range("World::render_snapshot_mask: camera must be 0 (left) or 1 (right)");
-  const int k = scene_.render.snapshot_scale;
-  return renderer().labels(impl_->data, impl_->camera_id[camera_index], impl_->geom_label,
-                           pusher_visible ? -1 : kPusherGroup,
-                           cv::Size(k * scene_.rig.width, k * scene_.rig.height));
-}
-
-CameraModel World::snapshot_camera(int camera_index) const {
-  return scaled(camera(camera_index), scene_.render.snapshot_scale);
 }
 
 StereoImages World::render_stereo(bool masks) {

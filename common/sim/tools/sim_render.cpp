@@ -46,6 +46,9 @@ int main(int argc, char** argv) {
     const double first_ms = watch.lap_ms();
     for (int i = 1; i < repeat; ++i) world.render_stereo(false);
     const double pair_ms = repeat > 1 ? watch.lap_ms() / (repeat - 1) : first_ms;
+    cv::Mat still[2];
+    for (int c = 0; c < 2; ++c) still[c] = world.render_snapshot(c);
+    const double still_ms = watch.lap_ms();
     double mask_ms = 0;
     if (masks) {
       for (int i = 0; i < repeat; ++i) world.render_mask(0);
@@ -54,6 +57,7 @@ int main(int argc, char** argv) {
     const char* names[2] = {"left", "right"};
     for (int c = 0; c < 2; ++c) {
       cv::imwrite(out + "/" + names[c] + ".png", first.colour[c]);
+      cv::imwrite(out + "/" + names[c] + "_still.png", still[c]);
       if (masks) {
         cv::Mat scaled;
         first.mask[c].convertTo(scaled, CV_8U, 255.0 / std::max(1, world.num_objects()));
@@ -84,7 +88,7 @@ int main(int argc, char** argv) {
     std::printf("first stereo pair (incl. GL context%s) %.1f ms; stereo pair %.1f ms (%.1f per camera)",
                 masks ? " and masks" : "", first_ms, pair_ms, pair_ms / 2);
     if (masks) std::printf("; mask %.1f ms", mask_ms);
-    std::printf("\n");
+    std::printf("\nhigh-resolution still pair %dx%d %.1f ms\n", still[0].cols, still[0].rows, still_ms);
     for (int i = 0; i < world.num_objects(); ++i) {
       const auto st = world.object(i);
       for (int c = 0; c < 2; ++c) {

@@ -1,9 +1,10 @@
 #pragma once
-// Pinhole cameras of the simulated stereo rig and ground-truth projection of symmetry axes.
+// Cameras of the simulated stereo rig and ground-truth projection of symmetry axes.
 //
 // Camera frame: OpenCV's (x right, y down, z forward). Pose is world -> camera:
 // X_cam = R * X_world + t. Intrinsics K = [f 0 cx; 0 f cy; 0 0 1] with pixel indices from 0 at
-// pixel centres, so the principal point is the image centre ((w-1)/2, (h-1)/2). No distortion.
+// pixel centres, so the principal point is the image centre ((w-1)/2, (h-1)/2). Optional lens
+// distortion in OpenCV's model (k1, k2, p1, p2, k3), zero by default.
 #include "nudge/sim/scene.hpp"
 
 #include <Eigen/Core>
@@ -20,13 +21,27 @@ struct CameraModel {
   Eigen::Matrix3d K = Eigen::Matrix3d::Identity();
   Eigen::Matrix3d R = Eigen::Matrix3d::Identity();  // world -> camera rotation
   Eigen::Vector3d t = Eigen::Vector3d::Zero();      // world -> camera translation
+  std::array<double, 5> distortion{{0, 0, 0, 0, 0}};  // k1 k2 p1 p2 k3
 
+  bool distorted() const;
   Eigen::Vector3d centre() const { return -R.transpose() * t; }  // in the world frame
   Eigen::Vector3d forward() const { return R.row(2).transpose(); }  // optical axis, world frame
   Eigen::Vector3d to_camera(const Eigen::Vector3d& world) const { return R * world + t; }
-  // Pixel coordinates of a world point; z (depth) <= 0 means behind the camera.
+  // Pixel coordinates of a world point, distortion included; z (depth) <= 0: behind the camera.
   Eigen::Vector2d project(const Eigen::Vector3d& world, double* depth = nullptr) const;
+  // Normalised image coordinates (x/z, y/z) -> distorted normalised coordinates.
+  Eigen::Vector2d distort(const Eigen::Vector2d& normalised) const;
+  // Pixel -> undistorted normalised coordinates (iterative inverse of distort()).
+  Eigen::Vector2d undistort(const Eigen::Vector2d& pixel) const;
 };
+
+// Size of the ideal pinhole image (same f, principal point at its centre) that covers every pixel
+// of `camera`'s distorted image, with a small margin; the camera's own size without distortion.
+// Rendering draws this image and warps it.
+struct PinholeCanvas {
+  int width = 0, height = 0;
+};
+PinholeCanvas pinhole_canvas(const CameraModel& camera);
 
 // The two cameras of a verged stereo rig, index 0 = left, 1 = right.
 struct StereoRig {

@@ -31,6 +31,12 @@ struct MassProperties {
 
 // Mass properties of a thin shell of total mass `mass` spread uniformly over the meshes' area.
 MassProperties shell_mass_properties(const std::vector<const Mesh*>& meshes, double mass);
+// A solid upright cylinder (axis z) of `radius`, from height z0 to z0 + height.
+MassProperties cylinder_mass_properties(double radius, double z0, double height, double mass);
+// Two bodies rigidly joined.
+MassProperties combine(const MassProperties& a, const MassProperties& b);
+
+constexpr double kWaterDensity = 1000.0;  // kg/m^3
 
 struct ObjectModel {
   std::string kind;
@@ -41,6 +47,8 @@ struct ObjectModel {
   double max_radius = 0;      // m, widest point of the body of revolution (handle excluded)
   double default_mass = 0;    // kg
   double default_friction = 0.5;
+  // The space a liquid can fill, as a cylinder: radius, bottom and height (fill = 1).
+  double liquid_radius = 0, liquid_bottom = 0, liquid_height = 0;
 
   // Outer radius of the body of revolution at height z (largest r where the profile crosses z;
   // handle excluded); 0 outside [0, height]. Where a pad at that height first touches the object.

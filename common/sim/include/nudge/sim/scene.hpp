@@ -8,6 +8,7 @@
 // x from the arm base towards the workspace and the cameras, y to the left seen from the arm.
 #include <Eigen/Core>
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <stdexcept>
@@ -15,6 +16,10 @@
 #include <vector>
 
 namespace nudge::sim {
+
+// The table top drawn (world frame, metres); its plane z = 0 is infinite for collisions. The
+// backdrop wall stands along its far edge x = kTableXMin.
+constexpr double kTableXMin = -0.6, kTableXMax = 1.1, kTableHalfY = 1.0;
 
 // Any error in a scene: the message names the file (or "scene") and the offending field.
 class SceneError : public std::runtime_error {
@@ -43,6 +48,7 @@ struct ObjectSpec {
   Appearance appearance;
   double mass = 0.0;               // kg; 0 = the library's default for the kind
   double friction = 0.0;           // sliding friction; 0 = the library's default
+  double fill = 0.0;               // fraction of the liquid space filled with water (rigid: no sloshing)
 };
 
 // A verged stereo pair (thesis ch. 4.3). The rig's centre looks at `target` from `distance`,
@@ -59,6 +65,9 @@ struct RigSpec {
   int width = 640;
   int height = 480;
   double fovy = 45.0 * M_PI / 180.0;  // vertical field of view
+  // Lens distortion of both cameras, OpenCV's model and order (k1, k2, p1, p2, k3) on normalised
+  // coordinates; all zero = an ideal pinhole. Rendered by warping a larger pinhole image.
+  std::array<double, 5> distortion{{0, 0, 0, 0, 0}};
 };
 
 struct RenderSpec {

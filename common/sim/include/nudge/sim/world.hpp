@@ -20,8 +20,6 @@
 
 namespace nudge::sim {
 
-class Renderer;
-
 // Failures of MuJoCo (model compilation, rendering context) and misuse of the pusher.
 class SimError : public std::runtime_error {
  public:
@@ -36,6 +34,8 @@ struct ObjectState {
   Eigen::Vector3d linear_velocity = Eigen::Vector3d::Zero();   // of the body origin
   Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();  // world frame
   double height = 0;  // along the symmetry axis
+  double mass = 0;    // kg, contents included
+  Eigen::Vector3d centre_of_mass = Eigen::Vector3d::Zero();  // world frame
   double tilt() const;  // angle between the symmetry axis and the world z axis, radians
 };
 
@@ -69,8 +69,13 @@ class World {
   double timestep() const;
   void step(int n = 1);
   void step_for(double seconds);  // whole steps, rounded to the nearest
-  // Generalised positions and velocities of the whole world (for determinism checks, logging).
+  // The whole dynamic state: time, generalised positions and velocities, the pusher's position
+  // and orientation, the solver's warm start (for determinism checks, logging, and rewinding
+  // with set_state()).
   std::vector<double> state() const;
+  // Restores a state() of a World built from the same scene; stepping on from it reproduces the
+  // original run exactly. Throws std::invalid_argument if the size does not match.
+  void set_state(const std::vector<double>& state);
 
   // ---- objects and ground truth
   int num_objects() const { return static_cast<int>(scene_.objects.size()); }
@@ -97,23 +102,22 @@ class World {
   // settles for `settle` s. The pad faces the direction of motion.
   PushResult push(const Eigen::Vector3d& from, const Eigen::Vector3d& to, double speed = 0.05,
                   double settle = 1.0);
-  // True when the pad currently touches one of the objects.
+  // True when the pad touches one of the objects (contacts as of the last step).
   bool pusher_in_contact() const;
 
   // ---- rendering (OSMesa context created on first use)
   cv::Mat render(int camera);       // BGR, rig width x height
-  cv::Mat render_mask(int camera);  // CV_8U, object index + 1 (255 caps), 0 elsewhere
+  cv::Mat render_mask(int camera);  // CV_8U, object index + 1, 0 elsewhere
   StereoImages render_stereo(bool masks = false);
   // High-resolution still (scene.render.snapshot_scale x the rig size, e.g. 1280x960) and the
   // camera model that goes with it.
   cv::Mat render_snapshot(int camera);
   cv::Mat render_snapshot_mask(int camera);
   CameraModel snapshot_camera(int camera) const;
-  bool pusher_visible = true;       // draw the pusher pad in colour images
+  bool pusher_visible = true;       // draw the pusher pad (colour images and masks)
 
  private:
-  Renderer& renderer();
-  cv::Mat colour_image(int camera, cv::Size size);
+  cv::Mat draw(int camera, bool snapshot, bool labels);
   struct Impl;
   std::unique_ptr<Impl> impl_;
   Scene scene_;
