@@ -16,6 +16,7 @@
 
 #include "nudge/flags.hpp"
 #include "nudge/geometry/stereo_rig.hpp"
+#include "nudge/geometry/workspace.hpp"
 #include "nudge/log.hpp"
 
 using namespace nudge;
@@ -23,7 +24,7 @@ using namespace nudge;
 namespace {
 
 struct Options {
-  std::string board, left_glob, right_glob, out;
+  std::string board, left_glob, right_glob, out, table_left, table_right;
   double square = 0;
 };
 
@@ -60,7 +61,8 @@ cv::Mat read_grey(const std::string& path) {
 // reprojection error on the opencv-doc pairs (0.25 against 0.44 px).
 std::vector<cv::Point2f> find_corners(const cv::Mat& grey, const BoardSize& board) {
   std::vector<cv::Point2f> corners;
-  if (!cv::findChessboardCornersSB(grey, cv::Size(board.columns, board.rows), corners, cv::CALIB_CB_ACCURACY)) return {};
+  const cv::Size size(board.columns, board.rows);
+  if (!cv::findChessboardCornersSB(grey, size, corners, cv::CALIB_CB_ACCURACY)) return {};
   return corners;
 }
 
@@ -123,9 +125,13 @@ geometry::Camera to_camera(const cv::Mat& K, const cv::Mat& distortion, cv::Size
   return camera;
 }
 
-// Each camera alone first (a good start), then both together refining everything: the stereo
-// RMS is over both images of every pair.
-double calibrate(const Views& views, const BoardSize& board, double square, const std::string& out) {
+struct Calibration {
+  geometry::StereoRig rig;
+  double rms = 0;  // px, over both images of every pair
+};
+
+// Each camera alone first (a good start), then both together refining everything.
+Calibration calibrate(const Views& views, const BoardSize& board, double square) {
   const std::vector<std::vector<cv::Point3f>> objects(views.left.size(), board_points(board, square));
   cv::Mat K_left, K_right, d_left, d_right, R, T, E, F;
   std::vector<cv::Mat> rvecs, tvecs;
@@ -137,14 +143,33 @@ double calibrate(const Views& views, const BoardSize& board, double square, cons
       objects, views.left, views.right, K_left, d_left, K_right, d_right, views.left_size, R, T, E, F,
       cv::CALIB_USE_INTRINSIC_GUESS,
       cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 100, 1e-6));
-  geometry::StereoRig rig;
-  rig.left = to_camera(K_left, d_left, views.left_size);
-  rig.right = to_camera(K_right, d_right, views.right_size);
-  cv::cv2eigen(R, rig.R);
-  cv::cv2eigen(T, rig.T);
-  geometry::save_rig(rig, out);
-  log::info() << "wrote " << out << " from " << views.left.size() << " pairs; baseline " << rig.T.norm() << " m";
-  return rms;
+  Calibration result;
+  result.rms = rms;
+  result.rig.left = to_camera(K_left, d_left, views.left_size);
+  result.rig.right = to_camera(K_right, d_right, views.right_size);
+  cv::cv2eigen(R, result.rig.R);
+  cv::cv2eigen(T, result.rig.T);
+  return result;
+}
+
+std::vector<Eigen::Vector2d> to_eigen(const std::vector<cv::Point2f>& points) {
+  std::vector<Eigen::Vector2d> out;
+  for (const auto& p : points) out.emplace_back(p.x, p.y);
+  return out;
+}
+
+// The table plane from one pair showing the board lying on the table (thesis sec. 4.3.5).
+geometry::Plane table_plane(const geometry::StereoRig& rig, const Options& opt, const BoardSize& board) {
+  const cv::Mat left = read_grey(opt.table_left), right = read_grey(opt.table_right);
+  const auto left_corners = find_corners(left, board), right_corners = find_corners(right, board);
+  if (left_corners.empty() || right_corners.empty())
+    throw std::runtime_error("table pair (" + opt.table_left + ", " + opt.table_right + "): no board found in " +
+                             (left_corners.empty() ? opt.table_left : opt.table_right));
+  const auto plane = geometry::table_from_corners(rig, to_eigen(left_corners), to_eigen(right_corners));
+  if (!plane) throw std::runtime_error("table pair: " + plane.reason());
+  log::info() << "table plane: normal (" << plane->normal.transpose() << "), " << plane->offset
+              << " m from the right camera, rms residual " << plane->rms_residual * 1000 << " mm";
+  return *plane;
 }
 
 }  // namespace
@@ -157,12 +182,16 @@ int main(int argc, char** argv) {
               "Stereo calibration from chessboard image pairs (OpenCV). Left and right images pair up in\n"
               "sorted order; pairs where either image lacks the board are skipped with a warning.\n"
               "Writes the rig file (both intrinsics with distortion k1 k2 p1 p2 k3, R, T, image sizes;\n"
-              "x_right = R x_left + T, metres) and prints `rms_px=<value>` on the last line.");
+              "x_right = R x_left + T, metres) and prints `rms_px=<value>` on the last line.\n"
+              "With --table-left/--table-right (the board lying on the table) it also writes table_plane,\n"
+              "fitted to the triangulated corners, in the right camera's frame.");
   flags.add_string("board", &opt.board, "inner corners COLSxROWS, e.g. 9x6");
   flags.add_double("square", &opt.square, "side of a chessboard square, metres");
   flags.add_string("left", &opt.left_glob, "left images, a shell pattern (quote it)");
   flags.add_string("right", &opt.right_glob, "right images, a shell pattern (quote it)");
   flags.add_string("out", &opt.out, "calibration file to write (YAML)");
+  flags.add_string("table-left", &opt.table_left, "left image of the board lying on the table: adds table_plane");
+  flags.add_string("table-right", &opt.table_right, "right image of the same board (with --table-left)");
   BoardSize board;
   try {
     if (!flags.parse(argc, argv)) return 0;
@@ -170,14 +199,21 @@ int main(int argc, char** argv) {
       if (!flags.given(name)) throw FlagError(std::string("--") + name + " is required");
     board = parse_board(opt.board);
     if (!(opt.square > 0)) throw FlagError("--square must be a positive length in metres");
+    if (opt.table_left.empty() != opt.table_right.empty())
+      throw FlagError("--table-left and --table-right go together");
   } catch (const std::exception& e) {
     std::cerr << "nudge-calibrate: " << e.what() << "\n";
     return 2;
   }
   try {
     const Views views = collect_views(expand(opt.left_glob, "left"), expand(opt.right_glob, "right"), board);
-    const double rms = calibrate(views, board, opt.square, opt.out);
-    std::cout << "rms_px=" << rms << std::endl;
+    const Calibration calibration = calibrate(views, board, opt.square);
+    geometry::Workspace workspace;
+    if (!opt.table_left.empty()) workspace.table = table_plane(calibration.rig, opt, board);
+    geometry::save_rig(calibration.rig, workspace, opt.out);
+    log::info() << "wrote " << opt.out << " from " << views.left.size() << " pairs; baseline "
+                << calibration.rig.T.norm() << " m";
+    std::cout << "rms_px=" << calibration.rms << std::endl;
   } catch (const std::exception& e) {
     log::error() << e.what();
     return 1;

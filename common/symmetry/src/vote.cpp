@@ -5,12 +5,14 @@
 // work per vote:
 //  * Rotation is integer fixed-point (quantise.hpp) in a loop the compiler vectorises; rows are
 //    built with one counting sort.
-//  * Pairs are checked sixteen at a time without branches (AVX-512: one compare mask per pixel and
-//    block of partners), and the R bins of the valid pairs are compress-stored into a buffer. The
-//    plain loop's unpredictable "is dx inside [Dmin, Dmax]" branch is what makes it slow.
-//  * The buffer is histogrammed into four interleaved copies of the accumulator row, so that
-//    consecutive increments of one bin do not wait on each other; the copies are summed once per
-//    theta.
+//  * Pairs are checked 16 or 32 at a time without branches (AVX-512: one compare mask per pixel and
+//    block of partners, 16-bit lanes when coordinates fit, two pixels per step on short rows), and
+//    the R bins of the valid pairs are compress-stored into a buffer. The plain loop's
+//    unpredictable "is dx inside [Dmin, Dmax]" branch is what makes it slow. Without AVX-512 a
+//    branch-free scalar loop does the same.
+//  * The buffer, filled by many rows, is histogrammed into four interleaved copies of the
+//    accumulator row, so that consecutive increments of one bin do not wait on each other; the
+//    copies are summed once per theta.
 // The accumulator is bit-identical to reference_vote() (tests compare them).
 #include <algorithm>
 #include <cstring>
@@ -166,7 +168,7 @@ int skew_margin(const std::vector<double>& skew_deg) {
 
 // Histograms pair bins into the four interleaved copies of the accumulator row.
 template <typename Bin>
-void Detector::add_votes(const Bin* bins, int votes, int, int, size_t hist_size, Scratch& s) const {
+void Detector::add_votes(const Bin* bins, int votes, size_t hist_size, Scratch& s) const {
   int32_t* h = s.hist.data();
   int q = 0;
   for (; q + 4 <= votes; q += 4) {
@@ -283,14 +285,14 @@ void Detector::vote_thetas(const EdgeSet& edges, const std::vector<int>& thetas,
         // stores that wrote them would stall on store-to-load forwarding.
         if (narrow) {
           if (pending + need > s.pairs16.size()) {
-            add_votes(s.pairs16.data(), static_cast<int>(pending), k, layer, hist_size, s);
+            add_votes(s.pairs16.data(), static_cast<int>(pending), hist_size, s);
             pending = 0;
             if (need > s.pairs16.size()) s.pairs16.resize(std::max(need, size_t{16384}));
           }
           pending += row_pair_bins16(s.sorted16.data() + s.starts[r], count, rule, s.pairs16.data() + pending);
         } else {
           if (pending + need > s.pairs.size()) {
-            add_votes(s.pairs.data(), static_cast<int>(pending), k, layer, hist_size, s);
+            add_votes(s.pairs.data(), static_cast<int>(pending), hist_size, s);
             pending = 0;
             if (need > s.pairs.size()) s.pairs.resize(std::max(need, size_t{16384}));
           }
@@ -302,8 +304,8 @@ void Detector::vote_thetas(const EdgeSet& edges, const std::vector<int>& thetas,
           pending = 0;
         }
       }
-      if (narrow) add_votes(s.pairs16.data(), static_cast<int>(pending), k, layer, hist_size, s);
-      else add_votes(s.pairs.data(), static_cast<int>(pending), k, layer, hist_size, s);
+      if (narrow) add_votes(s.pairs16.data(), static_cast<int>(pending), hist_size, s);
+      else add_votes(s.pairs.data(), static_cast<int>(pending), hist_size, s);
       pending = 0;
       // Sum the copies into the accumulator row and clear them for the next theta.
       int32_t* out = acc_.votes[layer].ptr<int32_t>(k);

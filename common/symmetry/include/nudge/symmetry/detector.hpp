@@ -124,7 +124,7 @@ class Detector {
     std::vector<int16_t> sorted16, pairs16;
   };
   template <typename Bin>
-  void add_votes(const Bin* bins, int votes, int k, int layer, size_t hist_size, Scratch& s) const;
+  void add_votes(const Bin* bins, int votes, size_t hist_size, Scratch& s) const;
   template <typename Bin>
   void add_votes_once(const Bin* bins, int votes, int32_t row_id, Scratch& s) const;
   void vote_thetas(const EdgeSet& edges, const std::vector<int>& thetas, size_t first, size_t step,

@@ -1,0 +1,102 @@
+#pragma once
+// From stereo symmetry lines to object locations on the table (thesis sec. 4.3.4 and 6.2):
+// every left x right pairing of lines is triangulated; axes that stand upright on the table are
+// kept; over many stereo frames their table intersections are QT-clustered, and the cluster
+// centroids are the "interesting locations" the robot may nudge.
+#include <Eigen/Core>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "nudge/geometry/plane.hpp"
+#include "nudge/geometry/qt_cluster.hpp"
+#include "nudge/geometry/stereo_rig.hpp"
+#include "nudge/geometry/triangulation.hpp"
+
+namespace nudge::geometry {
+
+// One left x right pairing that gave a valid axis.
+struct PairedAxis {
+  int left_index = 0, right_index = 0;  // into the lines passed in
+  Segment3 axis;                        // right camera frame
+  std::optional<TableHit> hit;          // set when a table plane was given
+};
+
+struct PairingResult {
+  int pairings = 0;                     // pairings tried
+  std::vector<PairedAxis> axes;         // the valid ones, in pairing order (left-major)
+  std::vector<std::string> rejections;  // "left 1 x right 2: <reason>" for every other pairing
+};
+
+// Triangulates each of the first `max_lines` left lines (all when <= 0) with each of the first
+// `max_lines` right lines. With a table, an axis is valid only if it passes `filter`; without one,
+// if it triangulates. Lines with non-finite numbers are rejected with a reason, never a NaN axis.
+PairingResult triangulate_pairings(const StereoRig& rig, const std::vector<symmetry::Line>& left,
+                                   const std::vector<symmetry::Line>& right, const Plane* table,
+                                   const AxisFilter& filter = {}, const TriangulationParams& params = {},
+                                   int max_lines = 0);
+
+bool is_finite(const symmetry::Line& line);  // r, theta and the stored end points
+
+// A frame on the table for everything downstream of triangulation (arm, planner): z along the
+// table normal (up, towards the cameras), origin where `origin_hint` (the arm base, in the right
+// camera's frame) meets the table along the normal, else below the right camera; x the right
+// camera's x axis projected onto the table, y = z x x.
+class TableFrame {
+ public:
+  explicit TableFrame(const Plane& table, const std::optional<Eigen::Vector3d>& origin_hint = std::nullopt);
+  Eigen::Vector3d to_table(const Eigen::Vector3d& camera_point) const;
+  Eigen::Vector3d to_camera(const Eigen::Vector3d& table_point) const;
+  const Eigen::Vector3d& origin() const { return origin_; }  // right camera frame
+
+ private:
+  Eigen::Vector3d origin_;
+  Eigen::Matrix3d axes_;  // rows: x, y, z of the table frame in the right camera's frame
+};
+
+struct LocationParams {
+  int frames = 25;           // stereo pairs gathered per request (thesis: 25)
+  int lines_per_image = 3;   // top lines per image: 9 pairings per stereo pair (thesis: 3)
+  double max_tilt_deg = 10;  // from the table normal (thesis ch. 6: 10 deg)
+  double max_range_m = 1.2;  // from the right camera
+  double ring_inner_m = 0.150, ring_outer_m = 0.350;  // arm workspace ring (thesis: 150-350 mm)
+  QtParams qt;               // radius 10 mm, clusters of at least 1/9 of all intersects
+};
+
+// Throws std::invalid_argument naming the offending parameter.
+void validate(const LocationParams& params);
+
+struct Location {
+  Eigen::Vector3d position;  // cluster centroid on the table, right camera frame
+  int support = 0;           // intersects in the cluster
+};
+
+// Gathers table intersects over `frames` stereo pairs, then clusters them. Without an arm base the
+// workspace ring cannot be applied and every upright axis on the table counts.
+class LocationFinder {
+ public:
+  LocationFinder(const StereoRig& rig, const Plane& table, const std::optional<Eigen::Vector3d>& arm_base,
+                 LocationParams params = {}, TriangulationParams triangulation = {});
+
+  // Adds one stereo pair's lines (strongest first); returns how many intersects it contributed.
+  int add_frame(const std::vector<symmetry::Line>& left, const std::vector<symmetry::Line>& right);
+  bool complete() const { return frames_ >= params_.frames; }
+  int frames() const { return frames_; }
+  int intersects() const { return static_cast<int>(points_.size()); }
+  // QT clusters of the intersects gathered so far, largest first.
+  std::vector<Location> locations() const;
+  void reset();
+
+ private:
+  StereoRig rig_;
+  Plane table_;
+  LocationParams params_;
+  TriangulationParams triangulation_;
+  AxisFilter filter_;
+  PlaneFrame plane_frame_;
+  int frames_ = 0;
+  std::vector<Eigen::Vector3d> points_;  // right camera frame
+};
+
+}  // namespace nudge::geometry

@@ -1,0 +1,132 @@
+#include "nudge/geometry/interesting_locations.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace nudge::geometry {
+
+bool is_finite(const symmetry::Line& l) {
+  return std::isfinite(l.r) && std::isfinite(l.theta) && std::isfinite(l.end1.x) && std::isfinite(l.end1.y) &&
+         std::isfinite(l.end2.x) && std::isfinite(l.end2.y) && std::isfinite(l.seg1.x) && std::isfinite(l.seg1.y) &&
+         std::isfinite(l.seg2.x) && std::isfinite(l.seg2.y);
+}
+
+namespace {
+
+std::string pairing_name(int left, int right) {
+  return "left " + std::to_string(left) + " x right " + std::to_string(right);
+}
+
+int lines_used(size_t available, int max_lines) {
+  const int n = static_cast<int>(available);
+  return max_lines > 0 && max_lines < n ? max_lines : n;
+}
+
+// One pairing: the axis, and its table hit when there is a table. Fails with the first reason.
+Outcome<PairedAxis> pair_lines(const StereoRig& rig, const symmetry::Line& left, const symmetry::Line& right,
+                               const Plane* table, const AxisFilter& filter, const TriangulationParams& params) {
+  using Result = Outcome<PairedAxis>;
+  if (!is_finite(left) || !is_finite(right))
+    return Result::failure(std::string(is_finite(left) ? "right" : "left") + " line has non-finite values");
+  const auto axis = triangulate_axis(rig, left, right, params);
+  if (!axis) return Result::failure(axis.reason());
+  PairedAxis paired;
+  paired.axis = *axis;
+  if (table) {
+    const auto hit = check_axis(*axis, *table, filter);
+    if (!hit) return Result::failure(hit.reason());
+    paired.hit = *hit;
+  }
+  return Result::success(paired);
+}
+
+}  // namespace
+
+PairingResult triangulate_pairings(const StereoRig& rig, const std::vector<symmetry::Line>& left,
+                                   const std::vector<symmetry::Line>& right, const Plane* table,
+                                   const AxisFilter& filter, const TriangulationParams& params, int max_lines) {
+  PairingResult result;
+  const int num_left = lines_used(left.size(), max_lines), num_right = lines_used(right.size(), max_lines);
+  for (int i = 0; i < num_left; ++i) {
+    for (int j = 0; j < num_right; ++j) {
+      ++result.pairings;
+      auto paired = pair_lines(rig, left[i], right[j], table, filter, params);
+      if (!paired) {
+        result.rejections.push_back(pairing_name(i, j) + ": " + paired.reason());
+        continue;
+      }
+      PairedAxis axis = *paired;
+      axis.left_index = i;
+      axis.right_index = j;
+      result.axes.push_back(axis);
+    }
+  }
+  return result;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Table frame
+
+TableFrame::TableFrame(const Plane& table, const std::optional<Eigen::Vector3d>& origin_hint) {
+  const PlaneFrame plane(table);
+  origin_ = origin_hint ? Eigen::Vector3d(*origin_hint - table.signed_distance(*origin_hint) * table.normal)
+                        : plane.origin;
+  axes_.row(0) = plane.x_axis.transpose();
+  axes_.row(1) = plane.y_axis.transpose();
+  axes_.row(2) = table.normal.transpose();
+}
+
+Eigen::Vector3d TableFrame::to_table(const Eigen::Vector3d& p) const { return axes_ * (p - origin_); }
+Eigen::Vector3d TableFrame::to_camera(const Eigen::Vector3d& q) const { return axes_.transpose() * q + origin_; }
+
+// ---------------------------------------------------------------------------------------------
+// Interesting locations
+
+void validate(const LocationParams& p) {
+  if (p.frames < 1) throw std::invalid_argument("location parameter frames must be >= 1");
+  if (p.lines_per_image < 1) throw std::invalid_argument("location parameter lines_per_image must be >= 1");
+  if (!(p.max_tilt_deg >= 0 && p.max_tilt_deg <= 90))
+    throw std::invalid_argument("location parameter max_tilt_deg must be in [0, 90]");
+  if (!(p.max_range_m > 0)) throw std::invalid_argument("location parameter max_range_m must be > 0");
+  if (!(p.ring_inner_m >= 0 && p.ring_outer_m > p.ring_inner_m))
+    throw std::invalid_argument("location parameters need 0 <= ring_inner_m < ring_outer_m");
+  if (!(p.qt.radius > 0) || !(p.qt.min_fraction >= 0 && p.qt.min_fraction <= 1))
+    throw std::invalid_argument("location QT parameters need radius > 0 and min_fraction in [0, 1]");
+}
+
+LocationFinder::LocationFinder(const StereoRig& rig, const Plane& table, const std::optional<Eigen::Vector3d>& arm_base,
+                               LocationParams params, TriangulationParams triangulation)
+    : rig_(rig), table_(table), params_(params), triangulation_(triangulation), plane_frame_(table) {
+  validate(params_);
+  filter_.max_tilt_deg = params_.max_tilt_deg;
+  filter_.max_range_m = params_.max_range_m;
+  filter_.ring_inner_m = params_.ring_inner_m;
+  filter_.ring_outer_m = params_.ring_outer_m;
+  // The ring lies on the table around the base's foot, whatever the base's height.
+  if (arm_base) filter_.ring_centre = TableFrame(table, arm_base).origin();
+}
+
+int LocationFinder::add_frame(const std::vector<symmetry::Line>& left, const std::vector<symmetry::Line>& right) {
+  const PairingResult result =
+      triangulate_pairings(rig_, left, right, &table_, filter_, triangulation_, params_.lines_per_image);
+  for (const PairedAxis& axis : result.axes) points_.push_back(axis.hit->point);
+  ++frames_;
+  return static_cast<int>(result.axes.size());
+}
+
+std::vector<Location> LocationFinder::locations() const {
+  std::vector<Eigen::Vector2d> on_table;
+  on_table.reserve(points_.size());
+  for (const auto& p : points_) on_table.push_back(plane_frame_.to_plane(p));
+  std::vector<Location> out;
+  for (const Cluster& c : qt_cluster(on_table, params_.qt))
+    out.push_back({plane_frame_.to_space(c.centroid), c.size()});
+  return out;
+}
+
+void LocationFinder::reset() {
+  frames_ = 0;
+  points_.clear();
+}
+
+}  // namespace nudge::geometry

@@ -1,0 +1,251 @@
+// triangulation: stereo symmetry lines -> 3D symmetry axes (thesis sec. 4.3) and, on request,
+// candidate object locations on the table (sec. 6.2).
+//   SYMMETRY_LEFT + SYMMETRY_RIGHT (paired by utime) -> AXES (axes_t), every stereo pair
+//   CANDIDATES_REQUEST (candidates_request_t) -> gather N pairs -> CANDIDATES (candidates_t), once
+// With a table plane, positions are in the table frame (z up along the table normal, origin at the
+// arm base's foot on the table, else below the right camera; x = the right camera's x projected
+// onto the table). Without one, AXES are in the right camera's frame with NaN table points.
+// The table plane and arm base come from --table-plane / --arm-base, else from the calibration
+// file's optional `table_plane` / `arm_base` fields (see nudge/geometry/workspace.hpp).
+#include <cmath>
+#include <limits>
+#include <optional>
+
+#include "nudge/axes_t.hpp"
+#include "nudge/bus/service.hpp"
+#include "nudge/bus/symmetry_convert.hpp"
+#include "nudge/candidates_request_t.hpp"
+#include "nudge/candidates_t.hpp"
+#include "nudge/geometry/interesting_locations.hpp"
+#include "nudge/geometry/stereo_pairing.hpp"
+#include "nudge/geometry/workspace.hpp"
+#include "nudge/log.hpp"
+#include "nudge/symmetry_lines_t.hpp"
+
+using namespace nudge;
+namespace geo = nudge::geometry;
+
+namespace {
+
+struct Options {
+  std::string calibration, left_channel = "SYMMETRY_LEFT", right_channel = "SYMMETRY_RIGHT";
+  std::vector<double> table_plane, arm_base;
+  int lines = 0, buffer = 16;
+  geo::AxisFilter filter;             // AXES: thesis ch. 4 (15 deg, within reach)
+  geo::TriangulationParams triangulation;
+  geo::LocationParams locations;      // CANDIDATES: thesis ch. 6
+};
+
+// n . p + d = 0 from --table-plane NX NY NZ D (right camera frame).
+geo::Plane plane_from_flag(const std::vector<double>& v) {
+  try {
+    return geo::plane_from_coefficients(Eigen::Vector4d(v[0], v[1], v[2], v[3]));
+  } catch (const std::invalid_argument& e) {
+    throw FlagError(std::string("--table-plane: ") + e.what());
+  }
+}
+
+// The table and arm base from the flags, else from the calibration file's optional fields.
+geo::Workspace workspace_of(const Options& opt) {
+  geo::Workspace workspace = geo::load_workspace(opt.calibration);
+  if (!opt.table_plane.empty()) workspace.table = plane_from_flag(opt.table_plane);
+  if (!opt.arm_base.empty()) workspace.arm_base = Eigen::Vector3d(opt.arm_base[0], opt.arm_base[1], opt.arm_base[2]);
+  return workspace;
+}
+
+void copy3(const Eigen::Vector3d& v, double out[3]) {
+  for (int i = 0; i < 3; ++i) out[i] = v(i);
+}
+
+class Triangulation {
+ public:
+  Triangulation(bus::Service& service, const Options& opt)
+      : service_(service), opt_(opt), rig_(geo::load_rig(opt.calibration)), pairer_(opt.buffer) {
+    const geo::Workspace workspace = workspace_of(opt);
+    table_ = workspace.table;
+    arm_base_ = workspace.arm_base;
+    if (table_) frame_.emplace(*table_, arm_base_);
+    log::info() << "rig " << opt.calibration << ": baseline " << rig_.T.norm() << " m; "
+                << (table_ ? "table frame output" : "no table plane: AXES in the right camera frame, no candidates")
+                << (table_ && !arm_base_ ? "; no arm base: candidates without the workspace ring" : "");
+  }
+
+  void subscribe() {
+    auto& subs = service_.subscriptions();
+    subs.subscribe<symmetry_lines_t>(opt_.left_channel, [this](const symmetry_lines_t& m, const std::string& ch) {
+      on_lines(geo::Side::Left, m, ch);
+    });
+    subs.subscribe<symmetry_lines_t>(opt_.right_channel, [this](const symmetry_lines_t& m, const std::string& ch) {
+      on_lines(geo::Side::Right, m, ch);
+    });
+    subs.subscribe<candidates_request_t>("CANDIDATES_REQUEST",
+                                         [this](const candidates_request_t& m, const std::string&) { on_request(m); });
+  }
+
+ private:
+  using Lines = std::vector<symmetry::Line>;
+
+  // Checks the message against the calibration; throws (counted and skipped by the bus) if unusable.
+  Lines lines_of(const symmetry_lines_t& msg, const std::string& channel, const geo::Camera& camera) {
+    if (msg.width != camera.width || msg.height != camera.height)
+      throw std::runtime_error("utime " + std::to_string(msg.utime) + ": image " + std::to_string(msg.width) +
+                               "x" + std::to_string(msg.height) + " but the calibration is for " +
+                               std::to_string(camera.width) + "x" + std::to_string(camera.height));
+    Lines lines;
+    for (const auto& l : msg.lines) lines.push_back(bus::from_message(l));
+    for (size_t i = 0; i < lines.size(); ++i) {
+      if (geo::is_finite(lines[i])) continue;
+      ++service_.counters().errors;  // the rest of the message is still usable
+      log::error() << channel << " utime " << msg.utime << ": line " << i
+                   << " has non-finite values; its pairings are skipped";
+    }
+    return lines;
+  }
+
+  void on_lines(geo::Side side, const symmetry_lines_t& msg, const std::string& channel) {
+    Lines lines = lines_of(msg, channel, side == geo::Side::Left ? rig_.left : rig_.right);
+    const int64_t dropped_before = pairer_.dropped();
+    auto pair = pairer_.add(side, msg.utime, std::move(lines));
+    if (pairer_.dropped() > dropped_before)
+      log::warn() << "dropped " << pairer_.dropped() - dropped_before << " unmatched symmetry message(s) ("
+                  << pairer_.dropped() << " so far)";
+    if (!pair) return;
+    ++pairs_;
+    publish_axes(pair->utime, pair->left, pair->right);
+    if (finder_) gather(pair->utime, pair->left, pair->right);
+    service_.set_status("pairs " + std::to_string(pairs_) + ", unmatched " + std::to_string(pairer_.dropped()));
+  }
+
+  void publish_axes(int64_t utime, const Lines& left, const Lines& right) {
+    const geo::PairingResult result = geo::triangulate_pairings(rig_, left, right, table_ ? &*table_ : nullptr,
+                                                                opt_.filter, opt_.triangulation, opt_.lines);
+    for (const auto& why : result.rejections) log::debug() << "utime " << utime << ": " << why;
+    axes_t msg;
+    msg.utime = utime;
+    msg.num_pairings = result.pairings;
+    for (const geo::PairedAxis& a : result.axes) msg.axes.push_back(to_message(a));
+    msg.num_axes = static_cast<int32_t>(msg.axes.size());
+    service_.publish("AXES", msg);
+    log::debug() << "utime " << utime << ": " << msg.num_axes << " of " << msg.num_pairings << " pairings valid";
+  }
+
+  axis3d_t to_message(const geo::PairedAxis& a) const {
+    axis3d_t m;
+    m.left_index = a.left_index;
+    m.right_index = a.right_index;
+    if (!frame_) {
+      copy3(a.axis.a, m.point_a);
+      copy3(a.axis.b, m.point_b);
+      copy3(Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN()), m.table_point);
+      m.angle_to_normal = std::numeric_limits<double>::quiet_NaN();
+      return m;
+    }
+    copy3(frame_->to_table(a.axis.a), m.point_a);
+    copy3(frame_->to_table(a.axis.b), m.point_b);
+    copy3(frame_->to_table(a.hit->point), m.table_point);
+    m.angle_to_normal = a.hit->tilt_deg * M_PI / 180.0;
+    return m;
+  }
+
+  void on_request(const candidates_request_t& request) {
+    if (!table_) {
+      throw std::runtime_error("candidate locations need the table plane (--table-plane); request ignored");
+    }
+    geo::LocationParams params = opt_.locations;
+    if (request.frames > 0) params.frames = request.frames;
+    if (request.lines_per_image > 0) params.lines_per_image = request.lines_per_image;
+    if (finder_) log::warn() << "a new candidates request replaces the one in progress";
+    finder_.emplace(rig_, *table_, arm_base_, params, opt_.triangulation);
+    log::info() << "candidates requested: gathering " << params.frames << " stereo pairs, " << params.lines_per_image
+                << " lines per image";
+  }
+
+  void gather(int64_t utime, const Lines& left, const Lines& right) {
+    finder_->add_frame(left, right);
+    if (!finder_->complete()) return;
+    candidates_t msg;
+    msg.utime = utime;
+    msg.frames_used = finder_->frames();
+    msg.intersects = finder_->intersects();
+    for (const geo::Location& loc : finder_->locations()) {
+      const Eigen::Vector3d p = frame_->to_table(loc.position);
+      msg.position.push_back({p.x(), p.y(), p.z()});
+      msg.cluster_size.push_back(loc.support);
+    }
+    msg.num_candidates = static_cast<int32_t>(msg.position.size());
+    service_.publish("CANDIDATES", msg);
+    log::info() << "candidates: " << msg.num_candidates << " locations from " << msg.intersects << " intersects over "
+                << msg.frames_used << " stereo pairs";
+    finder_.reset();
+  }
+
+  bus::Service& service_;
+  const Options& opt_;
+  geo::StereoRig rig_;
+  std::optional<geo::Plane> table_;
+  std::optional<Eigen::Vector3d> arm_base_;
+  std::optional<geo::TableFrame> frame_;
+  geo::StereoPairer<Lines> pairer_;
+  std::optional<geo::LocationFinder> finder_;
+  int64_t pairs_ = 0;
+};
+
+void add_flags(Flags& f, Options& o) {
+  f.add_string("calibration", &o.calibration, "stereo rig file (nudge-calibrate's YAML); required");
+  f.add_doubles("table-plane", &o.table_plane, 4,
+                "table plane NX NY NZ D (n.p + D = 0, right camera frame, m); default: the file's table_plane");
+  f.add_doubles("arm-base", &o.arm_base, 3,
+                "arm base X Y Z (right camera frame, m; centre of the workspace ring); default: the file's arm_base");
+  f.add_string("left-channel", &o.left_channel, "left symmetry lines");
+  f.add_string("right-channel", &o.right_channel, "right symmetry lines");
+  f.add_int("lines", &o.lines, "AXES: strongest lines per image to pair (0: all)");
+  f.add_int("buffer", &o.buffer, "unmatched messages kept per side while waiting for the partner");
+  f.add_double("max-tilt", &o.filter.max_tilt_deg, "AXES: max angle from the table normal, degrees");
+  f.add_double("max-range", &o.filter.max_range_m, "max distance of a table point from the right camera, m");
+  f.add_double("zmax", &o.triangulation.zmax, "depth of the back-projected triangles, m");
+  f.add_int("plane-samples", &o.triangulation.plane_samples, "samples fitted per line (0: thesis end points)");
+  f.add_int("candidate-frames", &o.locations.frames, "CANDIDATES: stereo pairs gathered per request");
+  f.add_int("candidate-lines", &o.locations.lines_per_image, "CANDIDATES: strongest lines per image");
+  f.add_double("candidate-tilt", &o.locations.max_tilt_deg, "CANDIDATES: max angle from the table normal, degrees");
+  f.add_double("ring-inner", &o.locations.ring_inner_m, "CANDIDATES: workspace ring inner radius, m");
+  f.add_double("ring-outer", &o.locations.ring_outer_m, "CANDIDATES: workspace ring outer radius, m");
+  f.add_double("cluster-radius", &o.locations.qt.radius, "CANDIDATES: QT cluster radius, m");
+  f.add_double("cluster-min-fraction", &o.locations.qt.min_fraction, "CANDIDATES: smallest cluster, fraction of all");
+}
+
+void check(const Options& o) {
+  if (o.calibration.empty()) throw FlagError("--calibration FILE is required");
+  if (o.buffer < 1) throw FlagError("--buffer must be >= 1");
+  if (o.lines < 0) throw FlagError("--lines must be >= 0");
+  if (!(o.filter.max_tilt_deg >= 0 && o.filter.max_tilt_deg <= 90)) throw FlagError("--max-tilt must be in [0, 90]");
+  if (!(o.filter.max_range_m > 0)) throw FlagError("--max-range must be > 0");
+  if (!(o.triangulation.zmax > 0)) throw FlagError("--zmax must be > 0");
+  if (o.triangulation.plane_samples < 0) throw FlagError("--plane-samples must be >= 0");
+  if (!o.table_plane.empty()) plane_from_flag(o.table_plane);
+  geo::LocationParams locations = o.locations;
+  locations.max_range_m = o.filter.max_range_m;
+  try {
+    geo::validate(locations);
+  } catch (const std::invalid_argument& e) {
+    throw FlagError(e.what());
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return bus::guarded_main("triangulation", [&] {
+    bus::Service service("triangulation",
+                         "Stereo triangulation of symmetry lines into 3D axes (thesis sec. 4.3) and candidate\n"
+                         "object locations on request (sec. 6.2).");
+    Options opt;
+    add_flags(service.flags(), opt);
+    if (!service.parse(argc, argv)) return 0;
+    check(opt);
+    opt.locations.max_range_m = opt.filter.max_range_m;
+    Triangulation triangulation(service, opt);  // loads the rig: a bad file ends here, naming the field
+    service.start();
+    triangulation.subscribe();
+    return service.run();
+  });
+}
