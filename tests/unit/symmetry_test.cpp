@@ -346,3 +346,11 @@ TEST(SymmetryGeometry, MapLineBetweenImageSizes) {
   // The support segment scales with the image.
   EXPECT_NEAR(cv::norm(mapped.seg1 - mapped.seg2), 2 * cv::norm(small.lines[0].seg1 - small.lines[0].seg2), 2.0);
 }
+
+TEST(SymmetryEdges, DetectionLeavesTheCallersImageUntouched) {
+  cv::Mat img = blank();
+  syn::draw_shape(img, syn::bottle_profile(150, 28), 0, 0, 0, cv::Scalar(40));
+  const cv::Mat copy = img.clone();
+  detect_edges(img, EdgeParams{2.0, 30, 90, false});
+  EXPECT_EQ(cv::norm(img, copy, cv::NORM_INF), 0);
+}

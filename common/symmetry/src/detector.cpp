@@ -125,7 +125,11 @@ EdgeSet detect_edges(const cv::Mat& image, const EdgeParams& params, cv::Mat* ed
   } else {
     grey = image;
   }
-  if (params.blur_sigma > 0) cv::GaussianBlur(grey, grey, cv::Size(0, 0), params.blur_sigma);
+  if (params.blur_sigma > 0) {
+    cv::Mat blurred;  // a new buffer: `grey` may share the caller's pixels
+    cv::GaussianBlur(grey, blurred, cv::Size(0, 0), params.blur_sigma);
+    grey = blurred;
+  }
   double low = params.canny_low, high = params.canny_high;
   if (params.auto_canny) auto_thresholds(grey, &low, &high);
   cv::Mat edges;
