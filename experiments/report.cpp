@@ -100,7 +100,8 @@ cv::Mat plot(const std::vector<Series>& series, const std::string& title, const 
   cv::putText(img, y_label, {5, area.y - 8}, cv::FONT_HERSHEY_SIMPLEX, 0.45, black);
   int legend_y = area.y + 18;
   for (const auto& s : series) {
-    for (size_t i = 0; i + 1 < s.x.size(); ++i) cv::line(img, px(s.x[i], s.y[i]), px(s.x[i + 1], s.y[i + 1]), s.colour, 2, cv::LINE_AA);
+    if (s.lines)
+      for (size_t i = 0; i + 1 < s.x.size(); ++i) cv::line(img, px(s.x[i], s.y[i]), px(s.x[i + 1], s.y[i + 1]), s.colour, 2, cv::LINE_AA);
     if (s.points)
       for (size_t i = 0; i < s.x.size(); ++i) cv::circle(img, px(s.x[i], s.y[i]), 3, s.colour, cv::FILLED, cv::LINE_AA);
     cv::line(img, {area.x + 10, legend_y - 4}, {area.x + 30, legend_y - 4}, s.colour, 2);

@@ -25,7 +25,8 @@ struct Series {
   std::string label;
   std::vector<double> x, y;
   cv::Scalar colour{200, 80, 0};
-  bool points = true;  // markers; lines are always drawn
+  bool points = true;  // markers
+  bool lines = true;   // join consecutive points
 };
 // A line plot with axes, ticks and a legend.
 cv::Mat plot(const std::vector<Series>& series, const std::string& title, const std::string& x_label,
