@@ -7,6 +7,8 @@
 
 #include "nudge/symmetry/detector.hpp"
 #include "nudge/symmetry/gst.hpp"
+#include "nudge/symmetry/loy_eklundh.hpp"
+#include "nudge/symmetry/photo.hpp"
 #include "nudge/symmetry/synthetic.hpp"
 
 using namespace nudge::symmetry;
@@ -353,4 +355,61 @@ TEST(SymmetryEdges, DetectionLeavesTheCallersImageUntouched) {
   const cv::Mat copy = img.clone();
   detect_edges(img, EdgeParams{2.0, 30, 90, false});
   EXPECT_EQ(cv::norm(img, copy, cv::NORM_INF), 0);
+}
+
+namespace {
+// A cluttered scene made exactly mirror-symmetric about the line (r, theta): each pixel on the
+// negative side shows its mirror image on the positive side.
+cv::Mat mirror_scene(double r, double theta, uint32_t seed) {
+  const cv::Mat base = syn::indoor_scene(seed, 400, 300, 4);
+  const cv::Point2d n(std::cos(theta), std::sin(theta)), c(199.5, 149.5);
+  cv::Mat map_x(base.size(), CV_32F), map_y(base.size(), CV_32F);
+  for (int y = 0; y < base.rows; ++y)
+    for (int x = 0; x < base.cols; ++x) {
+      const cv::Point2d p(x, y);
+      const double side = (p - c).dot(n) - r;
+      const cv::Point2d q = side >= 0 ? p : p - 2 * side * n;
+      map_x.at<float>(y, x) = static_cast<float>(q.x);
+      map_y.at<float>(y, x) = static_cast<float>(q.y);
+    }
+  cv::Mat out;
+  cv::remap(base, out, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_REFLECT);
+  return out;
+}
+}  // namespace
+
+TEST(LoyEklundh, FindsTheMirrorAxisOfASymmetricTexturedScene) {
+  for (const auto& [r, theta_deg] : std::vector<std::pair<double, double>>{{15, 20}, {-30, -35}}) {
+    const auto lines = loy_eklundh(mirror_scene(r, theta_deg * kDeg, 5));
+    ASSERT_FALSE(lines.empty());
+    EXPECT_LT(angle_diff_deg(lines[0].theta, theta_deg * kDeg), 2.0) << theta_deg;
+    EXPECT_LT(r_diff(lines[0], r, theta_deg * kDeg), 3.0) << r;
+  }
+  EXPECT_THROW(loy_eklundh(cv::Mat()), std::invalid_argument);
+}
+
+TEST(PhotoDetection, LargeImagesAreDetectedAtWorkingSizeAndMappedBack) {
+  cv::Mat img(960, 1280, CV_8UC3, cv::Scalar(200, 210, 220));
+  syn::draw_shape(img, syn::bottle_profile(600, 100), -150.0, 4.0 * kDeg, 0, cv::Scalar(40, 50, 60));
+  PhotoOptions options;
+  options.params.num_lines = 1;
+  options.params.theta_min_deg = -45;
+  options.params.theta_max_deg = 45;
+  const PhotoDetection found = detect_photo(img, options);
+  EXPECT_EQ(found.working_image.cols, 480);
+  ASSERT_EQ(found.in_image.lines.size(), 1u);
+  EXPECT_LT(angle_diff_deg(found.in_image.lines[0].theta, 4.0 * kDeg), 1.0);
+  EXPECT_NEAR(found.in_image.lines[0].r, -150.0, 3.0);
+  EXPECT_EQ(found.in_image.width, 1280);
+}
+
+TEST(PhotoDetection, CompetitionRule) {
+  Line l;
+  l.theta = 0;
+  l.seg1 = {100, 50};
+  l.seg2 = {100, 250};
+  EXPECT_TRUE(competition_match(l, {102, 40}, {102, 240}));
+  EXPECT_FALSE(competition_match(l, {150, 40}, {150, 240}));   // centre too far
+  EXPECT_FALSE(competition_match(l, {100, 50}, {180, 250}));   // angle over 10 deg
+  EXPECT_FALSE(competition_match(l, {100, 240}, {100, 260}));  // short truth: its centre is too far
 }

@@ -11,6 +11,7 @@
 #include "nudge/json.hpp"
 #include "nudge/log.hpp"
 #include "nudge/symmetry/detector.hpp"
+#include "nudge/symmetry/photo.hpp"
 #include "nudge/timing.hpp"
 
 using namespace nudge;
@@ -19,13 +20,9 @@ namespace sym = nudge::symmetry;
 namespace {
 
 struct Options {
-  sym::Params params;
-  sym::EdgeParams edge;
-  std::vector<double> canny;
+  sym::PhotoOptions photo;
   std::string draw, accumulator, voters, edges_out, skew;
   int voters_line = 1;
-  int max_side = 480;
-  double blur = -1, dmin = -1, dmax = -1;
 };
 
 // "out.png" -> "out_3.png" when several images are processed.
@@ -35,23 +32,6 @@ std::string numbered(const std::string& path, size_t index, size_t count) {
   const std::string stem = dot == std::string::npos ? path : path.substr(0, dot);
   const std::string ext = dot == std::string::npos ? ".png" : path.substr(dot);
   return stem + "_" + std::to_string(index + 1) + ext;
-}
-
-// Defaults that scale with the photograph (the thesis' 25/250 px and blur 1 at 640x480).
-void fill_image_defaults(const cv::Mat& image, const Options& opt, sym::Params* p, sym::EdgeParams* e) {
-  const double short_side = std::min(image.cols, image.rows), long_side = std::max(image.cols, image.rows);
-  *p = opt.params;
-  *e = opt.edge;
-  p->dmin = opt.dmin >= 0 ? opt.dmin : std::max(5.0, 0.05 * short_side);
-  p->dmax = opt.dmax >= 0 ? opt.dmax : 0.5 * long_side;
-  e->blur_sigma = opt.blur >= 0 ? opt.blur : std::max(1.0, short_side / 480.0);
-  if (opt.canny.size() == 2) {
-    e->canny_low = opt.canny[0];
-    e->canny_high = opt.canny[1];
-    e->auto_canny = false;
-  } else {
-    e->auto_canny = true;
-  }
 }
 
 void write_image(const std::string& path, const cv::Mat& image) {
@@ -92,41 +72,21 @@ bool process(const std::string& path, size_t index, size_t count, const Options&
     log::error() << path << ": cannot read the image (missing, unreadable or not an image)";
     return false;
   }
-  // Large photographs are detected at a working size (symmetry of whole objects is a coarse-scale
-  // property, and the cost grows with the square of the edge count); lines are mapped back.
-  cv::Mat work = image;
-  const int long_side = std::max(image.cols, image.rows);
-  if (opt.max_side > 0 && long_side > opt.max_side) {
-    const double f = static_cast<double>(opt.max_side) / long_side;
-    cv::resize(image, work, cv::Size(), f, f, cv::INTER_AREA);
-  }
-  sym::Params p;
-  sym::EdgeParams e;
-  fill_image_defaults(work, opt, &p, &e);
-  sym::Detector detector(p, e);
-  Stopwatch watch;
-  cv::Mat edge_image;
-  const sym::EdgeSet edges = sym::detect_edges(work, e, &edge_image);
-  const double edges_ms = watch.elapsed_ms();
-  sym::Result result = detector.detect(edges);
-  result.ms.edges_ms = edges_ms;
-  sym::Result reported = result;
-  if (work.size() != image.size()) {
-    reported.width = image.cols;
-    reported.height = image.rows;
-    for (auto& l : reported.lines) l = sym::map_line(l, work.size(), image.size());
-  }
-  std::cout << json_for(path, reported, p, e) << std::endl;
-
+  const sym::PhotoDetection found = sym::detect_photo(image, opt.photo);
+  std::cout << json_for(path, found.in_image, found.params, found.edge_params) << std::endl;
   // Pictures are drawn at the working size, where the edges live.
-  if (!opt.draw.empty()) write_image(numbered(opt.draw, index, count), sym::draw_lines(edge_image, result.lines));
-  if (!opt.edges_out.empty()) write_image(numbered(opt.edges_out, index, count), edge_image);
-  if (!opt.accumulator.empty())
-    write_image(numbered(opt.accumulator, index, count), sym::accumulator_image(detector.last_accumulator()));
-  if (!opt.voters.empty() && opt.voters_line >= 1 && opt.voters_line <= static_cast<int>(result.lines.size())) {
-    const sym::Line& line = result.lines[opt.voters_line - 1];
+  const auto& lines = found.at_working_size.lines;
+  if (!opt.draw.empty()) write_image(numbered(opt.draw, index, count), sym::draw_lines(found.edge_image, lines));
+  if (!opt.edges_out.empty()) write_image(numbered(opt.edges_out, index, count), found.edge_image);
+  if (!opt.accumulator.empty()) {
+    sym::Detector detector(found.params, found.edge_params);
+    write_image(numbered(opt.accumulator, index, count), sym::accumulator_image(detector.vote(found.edges)));
+  }
+  if (!opt.voters.empty() && opt.voters_line >= 1 && opt.voters_line <= static_cast<int>(lines.size())) {
+    const sym::Line& line = lines[opt.voters_line - 1];
+    sym::Detector detector(found.params, found.edge_params);
     write_image(numbered(opt.voters, index, count),
-                sym::draw_voting_pairs(edge_image, detector.voting_pairs(edges, line), line));
+                sym::draw_voting_pairs(found.edge_image, detector.voting_pairs(found.edges, line), line));
   }
   return true;
 }
@@ -144,22 +104,22 @@ int main(int argc, char** argv) {
               "Defaults scale with the image: dmin 5% of the short side, dmax 50% of the long side,\n"
               "blur sigma max(1, short side / 480), Canny thresholds from the image's gradients.");
   flags.set_positional("IMAGE...", "image files");
-  flags.add_int("lines", &opt.params.num_lines, "symmetry lines per image (Nlines)");
-  flags.add_double("dmin", &opt.dmin, "minimum pairing distance, px (default: scaled)");
-  flags.add_double("dmax", &opt.dmax, "maximum pairing distance, px; 0 = none (default: scaled)");
-  flags.add_double("theta-min", &opt.params.theta_min_deg, "orientation limit, degrees");
-  flags.add_double("theta-max", &opt.params.theta_max_deg, "orientation limit, degrees (min > max wraps)");
-  flags.add_doubles("canny", &opt.canny, 2, "Canny thresholds LOW HIGH (default: from the image)");
-  flags.add_double("blur", &opt.blur, "Gaussian blur sigma before Canny; 0 = none (default: scaled)");
-  flags.add_double("min-peak-ratio", &opt.params.min_peak_ratio, "drop peaks below this fraction of the top");
-  flags.add_int("suppress-r", &opt.params.suppress_r, "non-maximum suppression half-size in R, px");
-  flags.add_int("suppress-theta", &opt.params.suppress_theta, "non-maximum suppression half-size, deg");
-  flags.add_bool("once-per-row", &opt.params.once_per_row, "a row of Rot increments a bin at most once");
-  flags.add_int("max-row-pixels", &opt.params.max_row_pixels, "skip rows of Rot with more pixels (0: off)");
-  flags.add_bool("anti-alias", &opt.params.anti_alias, "3x3 Gaussian vote kernel");
+  flags.add_int("lines", &opt.photo.params.num_lines, "symmetry lines per image (Nlines)");
+  flags.add_double("dmin", &opt.photo.dmin, "minimum pairing distance, px (default: scaled)");
+  flags.add_double("dmax", &opt.photo.dmax, "maximum pairing distance, px; 0 = none (default: scaled)");
+  flags.add_double("theta-min", &opt.photo.params.theta_min_deg, "orientation limit, degrees");
+  flags.add_double("theta-max", &opt.photo.params.theta_max_deg, "orientation limit, degrees (min > max wraps)");
+  flags.add_doubles("canny", &opt.photo.canny, 2, "Canny thresholds LOW HIGH (default: from the image)");
+  flags.add_double("blur", &opt.photo.blur, "Gaussian blur sigma before Canny; 0 = none (default: scaled)");
+  flags.add_double("min-peak-ratio", &opt.photo.params.min_peak_ratio, "drop peaks below this fraction of the top");
+  flags.add_int("suppress-r", &opt.photo.params.suppress_r, "non-maximum suppression half-size in R, px");
+  flags.add_int("suppress-theta", &opt.photo.params.suppress_theta, "non-maximum suppression half-size, deg");
+  flags.add_bool("once-per-row", &opt.photo.params.once_per_row, "a row of Rot increments a bin at most once");
+  flags.add_int("max-row-pixels", &opt.photo.params.max_row_pixels, "skip rows of Rot with more pixels (0: off)");
+  flags.add_bool("anti-alias", &opt.photo.params.anti_alias, "3x3 Gaussian vote kernel");
   flags.add_string("skew", &opt.skew, "skew angles to try, degrees, comma-separated (e.g. -20,-10,10,20)");
-  flags.add_int("threads", &opt.params.threads, "threads across angles");
-  flags.add_int("max-side", &opt.max_side, "detect on a copy scaled to this long side, px (0: full size)");
+  flags.add_int("threads", &opt.photo.params.threads, "threads across angles");
+  flags.add_int("max-side", &opt.photo.max_side, "detect on a copy scaled to this long side, px (0: full size)");
   flags.add_string("draw", &opt.draw, "write the edges with the detected lines to this PNG");
   flags.add_string("edges", &opt.edges_out, "write the Canny edge image to this PNG");
   flags.add_string("accumulator", &opt.accumulator, "write the Hough accumulator (theta across, R down)");
@@ -169,13 +129,14 @@ int main(int argc, char** argv) {
     if (!flags.parse(argc, argv)) return 0;
     std::stringstream ss(opt.skew);
     for (std::string item; std::getline(ss, item, ',');)
-      if (!item.empty()) opt.params.skew_deg.push_back(parse_double(item, "--skew"));
-    sym::Params check = opt.params;
-    check.dmin = std::max(0.0, opt.dmin);
-    check.dmax = opt.dmax >= 0 ? opt.dmax : 0;
+      if (!item.empty()) opt.photo.params.skew_deg.push_back(parse_double(item, "--skew"));
+    sym::Params check = opt.photo.params;
+    check.dmin = std::max(0.0, opt.photo.dmin);
+    check.dmax = opt.photo.dmax >= 0 ? opt.photo.dmax : 0;
     sym::validate(check);
-    if (opt.canny.size() == 2) sym::validate(sym::EdgeParams{0, opt.canny[0], opt.canny[1], false});
-    if (opt.blur > 50) throw FlagError("--blur must be in [0, 50]");
+    if (opt.photo.canny.size() == 2) sym::validate(sym::EdgeParams{0, opt.photo.canny[0], opt.photo.canny[1], false});
+    if (opt.photo.blur > 50) throw FlagError("--blur must be in [0, 50]");
+    if (opt.photo.max_side < 0) throw FlagError("--max-side must be >= 0");
   } catch (const std::exception& e) {
     std::cerr << "nudge-detect: " << e.what() << "\n";
     return 2;

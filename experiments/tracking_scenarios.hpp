@@ -1,0 +1,61 @@
+#pragma once
+// The ten tracking test videos of thesis sec. 5.3, re-staged in the simulated world with exact
+// ground truth. Objects are moved kinematically (World::set_object_pose, no physics) one frame
+// at a time at 25 Hz; each video starts with a few still frames so that the tracker's automatic
+// start sees a sharp jump in motion, as in the thesis' hand-held videos.
+//
+//   for (const Scenario& s : tracking_scenarios()) {
+//     const Video v = render_video(s, /*camera=*/0);
+//     for (const VideoFrame& f : v.frames) ... f.image (BGR 640x480), f.truth (R, theta of the target)
+//   }
+#include <opencv2/core.hpp>
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "nudge/sim/world.hpp"
+
+namespace nudge::experiments {
+
+struct Scenario {
+  std::string name;          // short id, e.g. "light_bottle_turning"
+  std::string description;   // one line: what moves and what makes it hard
+  std::string thesis_video;  // the thesis video it re-stages ("1".."10", or "-" for ours)
+  sim::Scene scene;
+  int target = 0;            // index of the tracked object
+  int frames = 0;            // total frames
+  int still_frames = 6;      // frames before anything moves
+  // Sets the pose of every moving object for frame k (0 .. frames - 1).
+  std::function<void(sim::World& world, int k)> pose;
+};
+
+struct VideoFrame {
+  cv::Mat image;             // BGR, the rig's size (640x480)
+  sim::ImageLine truth;      // the target's axis in this camera
+  bool target_moving = false;// the target's pose differs from the previous frame's
+};
+
+struct Video {
+  std::vector<VideoFrame> frames;
+  cv::Rect first_box;        // bounding box of the target's mask in frame 0
+  double render_ms = 0;      // total rendering time
+};
+
+// The ten scenarios (thesis videos 1-9 re-staged, plus one of ours), in a fixed order.
+std::vector<Scenario> tracking_scenarios();
+
+// Renders a scenario from camera `camera` (0 = left). max_frames > 0 shortens the video.
+Video render_video(const Scenario& scenario, int camera = 0, int max_frames = 0);
+
+// Difference between an estimated line and the true one, (R px, theta rad), with the estimate
+// taken in whichever of its two forms (R, theta) / (-R, theta +- pi) lies nearer the truth.
+struct LineError {
+  double r = 0, theta = 0;
+};
+LineError line_error(double r, double theta, const sim::ImageLine& truth);
+
+// Distance (px) from an image point to the true line.
+double distance_to_line(const cv::Point2d& p, const sim::ImageLine& truth, int width, int height);
+
+}  // namespace nudge::experiments
