@@ -1,0 +1,36 @@
+#pragma once
+// Where the arm stands in the world (table) frame, and pose_t conversions.
+//
+// The robot library works in the arm's BASE frame (DH frame 0: origin at the shoulder, z up along
+// joint 1). Everything on the bus is in the WORLD frame of docs/sim.md: origin on the arm base's
+// vertical axis at table-top height, z up, metres. The base therefore sits on the world z axis,
+// `height` above the table top, turned by `yaw` about z (0: base x along world x).
+#include <Eigen/Geometry>
+
+#include "nudge/pose_t.hpp"
+
+namespace nudge::arm {
+
+struct BaseFrame {
+  double height = 0.33;  // shoulder above the table top, metres (docs/robot.md, SafetyConfig)
+  double yaw = 0.0;      // radians about the world z axis
+
+  Eigen::Isometry3d world_from_base() const;
+  Eigen::Isometry3d to_base(const Eigen::Isometry3d& world_pose) const;
+  Eigen::Isometry3d to_world(const Eigen::Isometry3d& base_pose) const;
+  Eigen::Vector3d point_to_base(const Eigen::Vector3d& world_point) const;
+  Eigen::Vector3d direction_to_base(const Eigen::Vector3d& world_direction) const;
+  // The table plane z = 0 of the world, in the base frame.
+  double table_z() const { return -height; }
+};
+
+pose_t to_message(const Eigen::Isometry3d& pose);
+
+// The pose a pose_t describes. False when a number is not finite or the quaternion (w, x, y, z)
+// is not of unit length (within 1e-3; it is then normalised exactly).
+bool from_message(const pose_t& message, Eigen::Isometry3d* pose);
+
+// Whether every number of the pose_t is zero (a sender that left the field unset).
+bool is_unset(const pose_t& message);
+
+}  // namespace nudge::arm
