@@ -4,7 +4,13 @@
 #include <cmath>
 #include <stdexcept>
 
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <utility>
 
 #include "nudge/timing.hpp"
 
@@ -30,6 +36,49 @@ sim::ObjectSpec object(const std::string& kind, const std::string& name, double 
 sim::ObjectSpec checkered(sim::ObjectSpec o, const Vector3d& colour2, double repeat) {
   o.appearance.kind = sim::Appearance::Kind::Checker;
   o.appearance.colour2 = colour2;
+  o.appearance.repeat = repeat;
+  return o;
+}
+
+// Textures made here (deterministic) and written once per process to a temporary directory:
+// a printed label (text, logo blocks) and multi-coloured patches. Unlike a checker, neither is
+// mirror-symmetric about horizontal lines.
+std::string texture_file(const std::string& name) {
+  static std::string dir;
+  if (dir.empty()) {
+    const std::filesystem::path d =
+        std::filesystem::temp_directory_path() / "nudge_exp_textures";
+    std::filesystem::create_directories(d);
+    cv::RNG rng(20080601);
+    cv::Mat label(512, 512, CV_8UC3, cv::Scalar(170, 70, 30));  // BGR: blue bottle
+    cv::rectangle(label, {0, 170}, {511, 350}, cv::Scalar(235, 245, 250), cv::FILLED);
+    for (int i = 0; i < 14; ++i) {
+      const cv::Point p(rng.uniform(0, 480), rng.uniform(180, 330));
+      cv::rectangle(label, p, p + cv::Point(rng.uniform(8, 40), rng.uniform(6, 20)),
+                    cv::Scalar(rng.uniform(0, 255), rng.uniform(0, 255), rng.uniform(0, 255)), cv::FILLED);
+    }
+    cv::putText(label, "NUDGE", {40, 260}, cv::FONT_HERSHEY_DUPLEX, 2.6, cv::Scalar(30, 30, 200), 6);
+    cv::putText(label, "fresh 500 ml", {150, 320}, cv::FONT_HERSHEY_SIMPLEX, 1.2, cv::Scalar(40, 40, 40), 2);
+    cv::circle(label, {420, 90}, 40, cv::Scalar(40, 200, 240), cv::FILLED);
+    cv::Mat patches(256, 256, CV_8UC3, cv::Scalar(30, 200, 230));  // yellow
+    const cv::Scalar colours[] = {{30, 30, 200}, {40, 160, 40}, {200, 90, 30}, {240, 240, 240}, {30, 120, 240}};
+    for (int i = 0; i < 40; ++i) {
+      const cv::Point p(rng.uniform(-20, 250), rng.uniform(-20, 250));
+      cv::rectangle(patches, p, p + cv::Point(rng.uniform(15, 70), rng.uniform(15, 70)), colours[i % 5], cv::FILLED);
+    }
+    for (const auto& [file, image] : {std::pair<std::string, cv::Mat>{"label.png", label}, {"patches.png", patches}}) {
+      const std::filesystem::path tmp = d / (std::to_string(::getpid()) + "_" + file);
+      if (!cv::imwrite(tmp.string(), image)) throw std::runtime_error("cannot write " + tmp.string());
+      std::filesystem::rename(tmp, d / file);
+    }
+    dir = d.string();
+  }
+  return dir + "/" + name;
+}
+
+sim::ObjectSpec textured(sim::ObjectSpec o, const std::string& texture, double repeat) {
+  o.appearance.kind = sim::Appearance::Kind::Image;
+  o.appearance.file = texture_file(texture);
   o.appearance.repeat = repeat;
   return o;
 }
@@ -120,17 +169,17 @@ Scenario textured_bottle_scale() {
   Scenario sc;
   sc.name = "textured_bottle_scale";
   sc.thesis_video = "5, 6";
-  sc.description = "checkered bottle slid from the back of the table towards the camera and back "
-                   "(image height about 120 -> 240 px), weaving sideways, tilting 40 deg away at the end";
+  sc.description = "bottle with a printed label slid diagonally from the back of the table towards the camera and "
+                   "back (large scale change), tilting 40 deg away at the end";
   sc.scene = base_scene();
-  sc.scene.objects = {checkered(object("bottle", "textured_bottle", -0.1, 0.0, Vector3d(0.15, 0.3, 0.7)),
-                                Vector3d(0.95, 0.95, 0.9), 6),
+  sc.scene.objects = {textured(object("bottle", "textured_bottle", -0.12, -0.16, Vector3d(1, 1, 1)), "label.png", 1),
                       object("cup", "white_cup", 0.1, 0.22, Vector3d(0.95, 0.95, 0.95))};
   sc.frames = 146;
   sc.pose = [sc](sim::World& w, int k) {
     const double s = progress(sc, k);
+    // Diagonally towards the camera and back along another diagonal.
     const double x = s < 0.5 ? -0.12 + 0.47 * ease(2 * s) : 0.35 - 0.37 * ease(2 * s - 1);
-    const double y = 0.07 * std::sin(2 * M_PI * s);
+    const double y = s < 0.5 ? -0.16 + 0.28 * ease(2 * s) : 0.12 - 0.1 * ease(2 * s - 1);
     const Vector3d base(x, y, 0);
     const double tilt = 40.0 * std::clamp((s - 0.75) / 0.25, 0.0, 1.0);
     w.set_object_pose(0, base, about(tilt_axis(w, base), -tilt * kDeg));
@@ -142,11 +191,10 @@ Scenario multicolour_mug() {
   Scenario sc;
   sc.name = "multicolour_mug";
   sc.thesis_video = "7";
-  sc.description = "red/yellow checkered mug slid along an arc while turning its handle, with a "
+  sc.description = "mug with multi-coloured patches slid along an arc while turning its handle, with a "
                    "5-frame jump half way (the thesis' capture lag); a white bottle stands by";
   sc.scene = base_scene();
-  sim::ObjectSpec mug = checkered(object("mug", "multicolour_mug", 0.15, -0.1, Vector3d(0.8, 0.1, 0.1)),
-                                  Vector3d(0.95, 0.9, 0.2), 4);
+  sim::ObjectSpec mug = textured(object("mug", "multicolour_mug", 0.15, -0.1, Vector3d(1, 1, 1)), "patches.png", 2);
   sc.scene.objects = {mug, object("bottle", "white_bottle", 0.1, 0.2, Vector3d(0.92, 0.92, 0.95))};
   sc.frames = 126;
   sc.pose = [sc](sim::World& w, int k) {
@@ -156,7 +204,7 @@ Scenario multicolour_mug() {
     Scenario longer = sc;
     longer.frames = sc.frames + 5;
     const double s = progress(longer, kk);
-    const double phi = (-120.0 + 220.0 * s) * kDeg;
+    const double phi = (-120.0 + 180.0 * s) * kDeg;
     pose_base(w, 0, 0.25 + 0.1 * std::cos(phi), 0.12 * std::sin(phi),
               about(Vector3d::UnitZ(), (30.0 + 200.0 * s) * kDeg));
   };
@@ -197,15 +245,19 @@ Scenario crossing() {
   Scenario sc;
   sc.name = "crossing";
   sc.thesis_video = "9";
-  sc.description = "a yellow bottle and a blue cup slid in opposite directions; their symmetry "
-                   "lines cross in the middle (the cup passes in front)";
+  sc.description = "a blue cup (the target) and, starting 12 frames later, a yellow bottle behind it "
+                   "slid in opposite directions; their symmetry lines cross";
   sc.scene = base_scene();
   sc.scene.objects = {object("bottle", "yellow_bottle", 0.16, -0.18, Vector3d(0.9, 0.85, 0.45)),
                       object("cup", "blue_cup", 0.33, 0.18, Vector3d(0.2, 0.35, 0.8))};
+  sc.target = 1;
   sc.frames = 116;
   sc.pose = [sc](sim::World& w, int k) {
+    // The cup starts first (the tracker starts on it), the bottle 12 frames later; both end together.
     const double s = progress(sc, k);
-    pose_base(w, 0, 0.16, -0.18 + 0.36 * s);
+    Scenario later = sc;
+    later.still_frames = sc.still_frames + 12;
+    pose_base(w, 0, 0.16, -0.18 + 0.36 * progress(later, k));
     pose_base(w, 1, 0.33, 0.18 - 0.36 * s);
   };
   return sc;
@@ -270,7 +322,7 @@ Scenario cluttered_swing() {
   Scenario sc;
   sc.name = "cluttered_swing";
   sc.thesis_video = "-";
-  sc.description = "ours: white cup carried over five cluttered objects (checkered table and wall, "
+  sc.description = "ours: white cup carried in front of four cluttered objects (checkered table and wall, "
                    "shadows, noise sigma 2), bobbing and rocking +-25 deg";
   sc.scene = base_scene(2.0);
   sc.scene.table.kind = sim::Appearance::Kind::Checker;
@@ -287,14 +339,14 @@ Scenario cluttered_swing() {
   sim::ObjectSpec can = object("can", "silver_can", 0.30, -0.10, Vector3d(0.75, 0.75, 0.78));
   can.appearance.specular = 0.9;
   can.appearance.shininess = 0.8;
-  sc.scene.objects = {object("cup", "white_cup", 0.08, 0.25, Vector3d(0.95, 0.95, 0.95)), mug,
+  sc.scene.objects = {object("cup", "white_cup", 0.45, 0.25, Vector3d(0.95, 0.95, 0.95)), mug,
                       checkered(object("bottle", "striped_bottle", 0.22, 0.0, Vector3d(0.1, 0.5, 0.2)),
                                 Vector3d(0.9, 0.9, 0.9), 6),
                       can, object("bottle", "water_bottle", 0.18, -0.20, Vector3d(0.92, 0.92, 0.95))};
   sc.frames = 126;
   sc.pose = [sc](sim::World& w, int k) {
     const double s = progress(sc, k);
-    const Vector3d c(0.27, 0.2 - 0.4 * s, 0.27 + 0.03 * std::sin(3 * M_PI * s));
+    const Vector3d c(0.40, 0.2 - 0.4 * s, 0.10 + 0.03 * std::sin(3 * M_PI * s));
     pose_centre(w, 0, c, about(view_axis(w, c), 25.0 * std::sin(2 * M_PI * s) * kDeg));
   };
   return sc;
@@ -330,7 +382,8 @@ Video render_video(const Scenario& scenario, int camera, int max_frames) {
     last_q = st.orientation;
     if (k == 0) {
       const cv::Mat mask = world.render_mask(camera);
-      video.first_box = cv::boundingRect(mask == scenario.target + 1);
+      video.first_mask = mask == scenario.target + 1;
+      video.first_box = cv::boundingRect(video.first_mask);
       if (video.first_box.area() == 0) throw std::runtime_error(scenario.name + ": target not visible in frame 0");
     }
     video.frames.push_back(std::move(f));

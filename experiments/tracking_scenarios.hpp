@@ -39,6 +39,7 @@ struct VideoFrame {
 struct Video {
   std::vector<VideoFrame> frames;
   cv::Rect first_box;        // bounding box of the target's mask in frame 0
+  cv::Mat first_mask;        // CV_8U 255 on the target's pixels in frame 0
   double render_ms = 0;      // total rendering time
 };
 

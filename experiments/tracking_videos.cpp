@@ -66,6 +66,7 @@ VideoResult run_video(const Scenario& sc, int camera, int max_frames, const std:
   std::vector<double> r_abs, t_abs;
   double total_ms = 0;
   const int snap_frame = res.motion_start + (last_moving - res.motion_start) * 2 / 3;
+  std::vector<cv::Mat> previews;
   for (int k = 0; k < res.frames; ++k) {
     const VideoFrame& f = video.frames[k];
     Stopwatch w;
@@ -99,12 +100,24 @@ VideoResult run_video(const Scenario& sc, int camera, int max_frames, const std:
       cv::putText(img, sc.name + " #" + std::to_string(k), {8, 22}, cv::FONT_HERSHEY_SIMPLEX, 0.6,
                   cv::Scalar(0, 0, 0), 2);
       if (k == snap_frame) res.snapshot = img;
-      if (!preview.empty() && k % 10 == 0) {
-        char buf[32];
-        std::snprintf(buf, sizeof buf, "_%03d.png", k);
-        cv::imwrite(preview + "/" + sc.name + buf, img);
+      if (!preview.empty() && k % 8 == 0) {
+        cv::Mat small;
+        cv::resize(img, small, {320, 240}, 0, 0, cv::INTER_AREA);
+        previews.push_back(small);
       }
     }
+  }
+  if (!previews.empty()) {  // a contact sheet, four frames a row
+    while (previews.size() % 4 != 0) previews.push_back(cv::Mat(240, 320, CV_8UC3, cv::Scalar::all(255)));
+    std::vector<cv::Mat> rows;
+    for (size_t i = 0; i < previews.size(); i += 4) {
+      cv::Mat row;
+      cv::hconcat(std::vector<cv::Mat>(previews.begin() + i, previews.begin() + i + 4), row);
+      rows.push_back(row);
+    }
+    cv::Mat sheet;
+    cv::vconcat(rows, sheet);
+    cv::imwrite(preview + "/" + sc.name + ".png", sheet);
   }
   res.ms_per_frame = total_ms / std::max(1, res.frames);
   if (!r_abs.empty()) {
@@ -221,7 +234,7 @@ int main(int argc, char** argv) {
   flags.add_int("frames", &frames, "shorten every video to this many frames (0 = full length)");
   flags.add_int("camera", &camera, "camera of the stereo rig (0 left, 1 right)");
   flags.add_string("only", &only, "run only the video of this name (results are not written)");
-  flags.add_string("preview", &preview, "write every 10th annotated frame to this directory");
+  flags.add_string("preview", &preview, "write a contact sheet of every 8th annotated frame per video to this directory");
   try {
     if (!flags.parse(argc, argv)) return 0;
     if (camera < 0 || camera > 1) throw FlagError("--camera: must be 0 or 1");

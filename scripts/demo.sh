@@ -1,9 +1,13 @@
 #!/usr/bin/env bash
-# The main job: camera -> symmetry -> monitor as separate processes over LCM, on a stereo image
-# sequence; the whole run is recorded to an LCM log under out/ and the detections are drawn
-# into out/demo/.
-#   scripts/demo.sh                       # the shipped synthetic sequence
-#   scripts/demo.sh 'images:/data/left/*.png' 'images:/data/right/*.png'
+# The main job: the simulated lab seen by the stereo pair, processed by the services as separate
+# processes over LCM: world (MuJoCo physics) -> camera (--source sim: renders every state) ->
+# symmetry -> monitor (draws the lines and the true axes into out/demo/, prints how well the
+# detected lines match the ground truth). The whole run is recorded to an LCM log under out/.
+#   scripts/demo.sh                       # the simulated world (NUDGE_DEMO_SCENE, default three_objects.yaml)
+#   scripts/demo.sh 'images:/data/left/*.png' 'images:/data/right/*.png'   # recorded stereo data
+#   scripts/demo.sh synthetic             # the synthetic image sequence (generated into out/scenes)
+# NUDGE_DEMO_SECONDS (4) and NUDGE_DEMO_RATE (10 Hz) set the simulated run; NUDGE_DEMO_FRAMES (20)
+# the length of the synthetic sequence.
 # By default the processes share a private network namespace (when run as root), so no
 # traffic leaves it; NUDGE_HOST_NETWORK=1 uses this host's network instead (to watch with
 # scripts/spy.sh).
@@ -14,19 +18,11 @@ nudge_build
 
 out="$NUDGE_ROOT/out"
 mkdir -p "$out/demo"
-frames=${NUDGE_DEMO_FRAMES:-20}
-if [ $# -ge 2 ]; then
-  left=$1; right=$2
-else
-  if [ ! -f "$out/scenes/frame_$(printf %03d $((frames - 1))).png" ]; then
-    "$NUDGE_BUILD_DIR/bin/nudge-synth-scenes" --out "$out/scenes" --count "$frames" --seed 1 >/dev/null
-  fi
-  left="images:$out/scenes/*.png"; right="images:$out/scenes/*.png"
-  nudge_log "no sources given: using the synthetic sequence in out/scenes"
-fi
+rm -f "$out/demo"/*.png
 log="$out/demo-$(date +%Y%m%d-%H%M%S).lcmlog"
 
-run_pipeline() {
+# Recorded (or synthetic) stereo images: camera -> symmetry -> monitor.
+run_images_pipeline() {
   local bin=$1 left=$2 right=$3 log=$4 out=$5 frames=$6
   local url="udpm://239.255.76.67:7667?ttl=0&recv_buf_size=16777216"
   lcm-logger --lcm-url="$url" -q "$log" & local logger=$!
@@ -41,12 +37,75 @@ run_pipeline() {
   wait $sym $logger 2>/dev/null || true
   return $status
 }
-export -f run_pipeline
-nudge_log "camera -> symmetry -> monitor over LCM, $frames stereo frames; recording $log"
-if nudge_in_private_network bash -c 'run_pipeline "$@"' demo "$NUDGE_BUILD_DIR/bin" "$left" "$right" "$log" "$out" "$frames"; then
-  nudge_log "done: detections drawn in out/demo/, LCM log $log ($(du -h "$log" | cut -f1))"
+
+# The simulated world: world -> camera (sim) -> symmetry -> monitor (with the ground truth).
+run_sim_pipeline() {
+  local bin=$1 scene=$2 log=$3 out=$4 seconds=$5 rate=$6 calibration=$7
+  local frames=$((seconds * rate + 1))  # the state at t = 0, then one per period
+  local url="udpm://239.255.76.67:7667?ttl=0&recv_buf_size=16777216"
+  rm -f "$out/demo"/*.log  # the start-up check below reads the services' fresh logs
+  lcm-logger --lcm-url="$url" -q "$log" & local logger=$!
+  # Upright objects: +-25 deg about vertical. The backdrop's foot is a long straight edge: the
+  # thesis' rule that a row of Rot votes for a bin at most once keeps it from outvoting objects.
+  "$bin/nudge-symmetry" --lcm-url "$url" --lines 5 --theta-min -25 --theta-max 25 --once-per-row \
+    2>"$out/demo/symmetry.log" & local sym=$!
+  "$bin/nudge-monitor" --lcm-url "$url" --truth --draw-dir "$out/demo" --expect-frames "$frames" --timeout 120 \
+    2>"$out/demo/monitor.log" & local mon=$!
+  "$bin/nudge-camera" --lcm-url "$url" --source sim --scene "$scene" --snapshots 2>"$out/demo/camera.log" & local cam=$!
+  # 3D axes (AXES, recorded in the log) when the triangulation service is built, with the rig and
+  # table found by the camera-arm calibration in simulation (nudge-exp-calibration-sim).
+  local tri=
+  if [ -x "$bin/nudge-triangulation" ] && [ -f "$calibration" ]; then
+    "$bin/nudge-triangulation" --lcm-url "$url" --calibration "$calibration" 2>"$out/demo/triangulation.log" & tri=$!
+  fi
+  # Every subscriber listens before the first state: wait until each has started (the camera
+  # builds its World first), at most 30 s.
+  for _ in $(seq 300); do
+    [ "$(grep -l "started:" "$out/demo/symmetry.log" "$out/demo/monitor.log" "$out/demo/camera.log" 2>/dev/null | wc -l)" -eq 3 ] && break
+    sleep 0.1
+  done
+  sleep 0.2
+  "$bin/nudge-world" --lcm-url "$url" --scene "$scene" --realtime-factor 1 --rate "$rate" --duration "$seconds" \
+    2>"$out/demo/world.log"
+  local status=0
+  wait $mon || status=$?
+  kill -INT $sym $cam $tri $logger 2>/dev/null || true
+  wait $sym $cam $tri $logger 2>/dev/null || true
+  grep -hE "truth |lines for" "$out/demo/monitor.log" | sed 's/^.* I monitor: /  /' >&2 || true
+  if [ -n "$tri" ]; then
+    grep -hE "stopping:" "$out/demo/triangulation.log" | sed 's/^.* I triangulation: stopping: /  triangulation (AXES in the log): /' >&2 || true
+  fi
+  return $status
+}
+export -f run_images_pipeline run_sim_pipeline
+
+if [ $# -ge 2 ] || [ "${1:-}" = synthetic ]; then
+  frames=${NUDGE_DEMO_FRAMES:-20}
+  if [ $# -ge 2 ]; then
+    left=$1; right=$2
+  else
+    if [ ! -f "$out/scenes/frame_$(printf %03d $((frames - 1))).png" ]; then
+      "$NUDGE_BUILD_DIR/bin/nudge-synth-scenes" --out "$out/scenes" --count "$frames" --seed 1 >/dev/null
+    fi
+    left="images:$out/scenes/*.png"; right="images:$out/scenes/*.png"
+    nudge_log "using the synthetic sequence in out/scenes"
+  fi
+  nudge_log "camera -> symmetry -> monitor over LCM, $frames stereo frames; recording $log"
+  pipeline=(run_images_pipeline "$NUDGE_BUILD_DIR/bin" "$left" "$right" "$log" "$out" "$frames")
+  drawn="detections drawn in out/demo/"
+else
+  scene=${NUDGE_DEMO_SCENE:-$NUDGE_ROOT/common/sim/scenes/three_objects.yaml}
+  seconds=${NUDGE_DEMO_SECONDS:-4}
+  rate=${NUDGE_DEMO_RATE:-10}
+  nudge_log "world ($(basename "$scene"), ${seconds} s in real time) -> camera (sim, $rate Hz) -> symmetry -> monitor over LCM; recording $log"
+  pipeline=(run_sim_pipeline "$NUDGE_BUILD_DIR/bin" "$scene" "$log" "$out" "$seconds" "$rate"
+            "$NUDGE_ROOT/docs/results/calibration_sim.yaml")
+  drawn="detections drawn in out/demo/ (true axes dashed white)"
+fi
+if nudge_in_private_network bash -c '"$@"' demo "${pipeline[@]}"; then
+  nudge_log "done: $drawn, LCM log $log ($(du -h "$log" | cut -f1))"
   nudge_log "replay it with: scripts/replay.sh $log"
 else
-  nudge_log "the pipeline did not deliver lines for every frame"
+  nudge_log "the pipeline did not deliver lines for every frame (logs in out/demo/)"
   exit 1
 fi

@@ -1,5 +1,6 @@
 // camera: publishes frames from image files, a video or a capture device on CAMERA_* channels.
 // Stereo: --left SRC --right SRC publish CAMERA_LEFT / CAMERA_RIGHT with one shared utime per pair.
+// Simulation: --source sim --scene FILE renders the world service's SIM_STATE (sim_backend.cpp).
 #include <sstream>
 #include <thread>
 
@@ -8,6 +9,7 @@
 #include "nudge/camera/source.hpp"
 #include "nudge/log.hpp"
 #include "nudge/timing.hpp"
+#include "sim_backend.hpp"
 
 using namespace nudge;
 
@@ -24,7 +26,8 @@ int main(int argc, char** argv) {
   return bus::guarded_main("camera", [&] {
     bus::Service service("camera",
                          "Publishes camera frames. Sources: images:GLOB, video:PATH, device:N.\n"
-                         "Mono: --source SRC [--channel CAMERA]. Stereo: --left SRC --right SRC.");
+                         "Mono: --source SRC [--channel CAMERA]. Stereo: --left SRC --right SRC.\n"
+                         "Simulation: --source sim --scene FILE renders every SIM_STATE as a stereo pair.");
     std::string source_spec, left_spec, right_spec, channel = "CAMERA", format = "gray";
     double rate = 25.0;
     bool loop = false;
@@ -39,9 +42,25 @@ int main(int argc, char** argv) {
     f.add_double("rate", &rate, "frames per second; 0 = as fast as possible");
     f.add_bool("loop", &loop, "start again at the end of a file source");
     f.add_int("count", &count, "stop after this many frames (pairs); 0 = no limit");
+    camera_service::SimOptions sim;
+    f.add_string("scene", &sim.scene_file, "--source sim: the world service's scene file");
+    f.add_double("noise", &sim.noise_sigma, "--source sim: Gaussian pixel noise sigma (-1: the scene's)");
+    f.add_bool("snapshots", &sim.snapshots,
+               "--source sim: answer CAMERA_SNAPSHOT_REQUEST with 1280x960 stills on SNAPSHOT_LEFT/RIGHT");
     if (!service.parse(argc, argv)) return 0;
     if (rate < 0) throw FlagError("--rate must be >= 0");
+    if (count < 0) throw FlagError("--count must be >= 0");
     const int8_t pixel_format = bus::format_from_name(format);
+    if (source_spec == "sim") {
+      // Frames follow the simulated clock (one pair per SIM_STATE): --rate and --loop do not apply.
+      if (!left_spec.empty() || !right_spec.empty()) throw FlagError("--source sim renders both cameras itself: no --left/--right");
+      if (sim.scene_file.empty()) throw FlagError("--source sim needs --scene FILE");
+      sim.pixel_format = pixel_format;
+      sim.jpeg_quality = jpeg_quality;
+      sim.count = count;
+      return camera_service::run_sim_camera(service, sim);
+    }
+    if (!sim.scene_file.empty() || sim.snapshots) throw FlagError("--scene and --snapshots need --source sim");
 
     std::vector<Stream> streams;
     if (!left_spec.empty() || !right_spec.empty()) {

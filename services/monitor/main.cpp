@@ -1,8 +1,11 @@
 // monitor: shows what the pipeline detects. Prints one line per SYMMETRY_* message, optionally
 // draws the lines over the matching CAMERA_* frame (paired by utime) into PNG files, and can
-// check that every frame got its lines (--expect-frames, for tests and the demo).
+// check that every frame got its lines (--expect-frames, for tests and the demo). In simulation
+// (--truth) it compares the lines with the true axes in SIM_STATE and prints a summary at exit.
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
+#include <cmath>
 #include <cstdio>
 #include <map>
 #include <set>
@@ -13,6 +16,7 @@
 #include "nudge/bus/service.hpp"
 #include "nudge/bus/symmetry_convert.hpp"
 #include "nudge/log.hpp"
+#include "nudge/sim_state_t.hpp"
 #include "nudge/timing.hpp"
 
 using namespace nudge;
@@ -21,6 +25,30 @@ namespace {
 
 std::string camera_channel_for(const std::string& symmetry_channel) {
   return "CAMERA" + symmetry_channel.substr(std::string("SYMMETRY").size());
+}
+
+constexpr double kDeg = M_PI / 180.0;
+
+// How well one object's true axis was found in one camera: the detected line nearest to it
+// (|dR| in px + |dtheta| in degrees) in every frame that had a state.
+struct TruthStats {
+  int frames = 0, found = 0;        // found: nearest line within the tolerance
+  double sum_r = 0, sum_theta = 0;  // over the found frames, px and rad
+};
+
+// The true (R, theta) of an object in the camera of a SYMMETRY_LEFT / _RIGHT channel; false for
+// other channels and for axes that do not project (NaN).
+bool true_line(const object_state_t& o, const std::string& channel, double* r, double* theta) {
+  if (channel == "SYMMETRY_LEFT") {
+    *r = o.r_left;
+    *theta = o.theta_left;
+  } else if (channel == "SYMMETRY_RIGHT") {
+    *r = o.r_right;
+    *theta = o.theta_right;
+  } else {
+    return false;
+  }
+  return std::isfinite(*r) && std::isfinite(*theta);
 }
 
 }  // namespace
@@ -36,7 +64,12 @@ int main(int argc, char** argv) {
     f.add_string("draw-dir", &draw_dir, "write frames with their lines here (needs the CAMERA_* images)");
     f.add_int("expect-frames", &expect_frames, "exit 0 once this many frames per channel got lines, else 1");
     f.add_double("timeout", &timeout_s, "give up after this many seconds (0: never)");
+    bool truth = false;
+    std::vector<double> tolerance = {3.0, 2.0};
+    f.add_bool("truth", &truth, "simulation: compare lines with SIM_STATE's true axes, draw those dashed, summarise");
+    f.add_doubles("truth-tolerance", &tolerance, 2, "a true axis counts as found within R px and theta deg");
     if (!service.parse(argc, argv)) return 0;
+    if (!(tolerance[0] > 0 && tolerance[1] > 0)) throw FlagError("--truth-tolerance must be > 0");
     std::vector<std::string> list;
     std::stringstream ss(channels);
     for (std::string c; std::getline(ss, c, ',');)
@@ -47,6 +80,14 @@ int main(int argc, char** argv) {
 
     std::map<std::string, std::map<int64_t, cv::Mat>> frames;  // camera channel -> utime -> image
     std::map<std::string, std::set<int64_t>> seen;
+    std::map<int64_t, sim_state_t> states;                            // utime -> state (recent ones)
+    std::map<std::string, std::map<std::string, TruthStats>> stats;  // channel -> object -> stats
+    if (truth) {
+      service.subscriptions().subscribe<sim_state_t>("SIM_STATE", [&](const sim_state_t& msg, const std::string&) {
+        states[msg.utime] = msg;
+        while (states.size() > 200) states.erase(states.begin());  // keep memory bounded
+      });
+    }
     for (const auto& channel : list) {
       const std::string cam = camera_channel_for(channel);
       if (!draw_dir.empty()) {
@@ -64,14 +105,50 @@ int main(int argc, char** argv) {
              << (msg.ms_edges + msg.ms_vote + msg.ms_peaks) << " ms;";
         for (const auto& l : msg.lines) line << " (r " << l.r << ", theta " << l.theta * 180.0 / M_PI << " deg)";
         log::info() << line.str();
+        const auto state = truth ? states.find(msg.utime) : states.end();
+        if (state != states.end()) {
+          for (const auto& o : state->second.objects) {
+            double r = 0, theta = 0;
+            if (!true_line(o, ch, &r, &theta)) continue;
+            TruthStats& st = stats[ch][o.name];
+            ++st.frames;
+            double best = INFINITY, best_r = 0, best_theta = 0;
+            for (const auto& l : msg.lines) {
+              const double dr = std::abs(l.r - r), dtheta = std::abs(l.theta - theta);
+              if (dr + dtheta / kDeg < best) {
+                best = dr + dtheta / kDeg;
+                best_r = dr;
+                best_theta = dtheta;
+              }
+            }
+            if (best_r <= tolerance[0] && best_theta <= tolerance[1] * kDeg) {
+              ++st.found;
+              st.sum_r += best_r;
+              st.sum_theta += best_theta;
+            }
+          }
+        }
         if (draw_dir.empty()) return;
         const auto it = frames[cam].find(msg.utime);
         if (it == frames[cam].end()) return;
         std::vector<symmetry::Line> lines;
         for (const auto& l : msg.lines) lines.push_back(bus::from_message(l));
+        cv::Mat drawn = symmetry::draw_lines(it->second, lines);
+        if (state != states.end()) {  // the true axes, dashed white (the detections use colours)
+          for (const auto& o : state->second.objects) {
+            double r = 0, theta = 0;
+            if (!true_line(o, ch, &r, &theta)) continue;
+            cv::Point2d a, b;
+            symmetry::border_endpoints(r, theta, drawn.cols, drawn.rows, &a, &b);
+            const double length = cv::norm(b - a);
+            for (double s = 0; s + 6 < length; s += 12)
+              cv::line(drawn, a + (b - a) * (s / length), a + (b - a) * ((s + 6) / length), cv::Scalar(255, 255, 255), 1,
+                       cv::LINE_AA);
+          }
+        }
         char name[64];
         std::snprintf(name, sizeof name, "/%s_%06lld.png", ch.c_str(), static_cast<long long>(msg.frame_id));
-        cv::imwrite(draw_dir + name, symmetry::draw_lines(it->second, lines));
+        cv::imwrite(draw_dir + name, drawn);
       });
     }
     const int64_t deadline = timeout_s > 0 ? wall_utime() + static_cast<int64_t>(timeout_s * 1e6) : 0;
@@ -85,6 +162,16 @@ int main(int argc, char** argv) {
       if (deadline && wall_utime() > deadline) service.request_stop();
       return 20;
     });
+    for (const auto& [channel, objects] : stats) {
+      for (const auto& [object, st] : objects) {
+        std::ostringstream line;
+        line << "truth " << channel << " " << object << ": found in " << st.found << "/" << st.frames
+             << " frames (within " << tolerance[0] << " px, " << tolerance[1] << " deg)";
+        if (st.found > 0)
+          line << ", mean error " << st.sum_r / st.found << " px, " << st.sum_theta / st.found / kDeg << " deg";
+        log::info() << line.str();
+      }
+    }
     if (expect_frames > 0) {
       for (const auto& c : list) log::info() << c << ": lines for " << seen[c].size() << " frames";
       return complete ? 0 : 1;

@@ -93,6 +93,19 @@ std::vector<Vector2d> can_profile() {
           {0.0280, 0.120}, {0, 0.120}};
 }
 
+// A colour marker: a sleeve on a pendulum arm (thesis sec. 5.4, fig. 5.7), an 85 mm long, 24 mm
+// thick ellipsoid. Its image centroid lies on the projection of its axis, which the pendulum
+// experiment uses as ground truth.
+std::vector<Vector2d> marker_profile() {
+  std::vector<Vector2d> p;
+  const int n = 16;
+  for (int i = 0; i <= n; ++i) {
+    const double phi = M_PI * i / n;
+    p.emplace_back(i == 0 || i == n ? 0.0 : 0.012 * std::sin(phi), 0.0425 * (1 - std::cos(phi)));
+  }
+  return p;
+}
+
 ObjectModel from_profile(const std::string& kind, const std::vector<Vector2d>& profile,
                          int segments, double mass, double friction, double liquid_radius,
                          double liquid_bottom, double liquid_height) {
@@ -246,7 +259,7 @@ Mesh revolve(const std::vector<Vector2d>& profile, int segments) {
   return mesh;
 }
 
-std::vector<std::string> object_kinds() { return {"bottle", "can", "cup", "mug"}; }
+std::vector<std::string> object_kinds() { return {"bottle", "can", "cup", "marker", "mug"}; }
 
 bool is_object_kind(const std::string& kind) {
   const auto kinds = object_kinds();
@@ -259,6 +272,7 @@ ObjectModel make_object(const std::string& kind, int segments) {
   if (kind == "cup") return from_profile(kind, cup_profile(), segments, 0.25, 0.5, 0.031, 0.006, 0.080);
   if (kind == "bottle") return from_profile(kind, bottle_profile(), segments, 0.04, 0.45, 0.0335, 0.002, 0.125);
   if (kind == "can") return from_profile(kind, can_profile(), segments, 0.02, 0.4, 0.032, 0.004, 0.110);
+  if (kind == "marker") return from_profile(kind, marker_profile(), segments, 0.005, 0.5, 0.0, 0.0, 0.0);
   if (kind == "mug") {
     ObjectModel model = from_profile(kind, mug_profile(), segments, 0.35, 0.5, 0.0365, 0.008, 0.085);
     // Handle: an elliptical arc on the +x side, its ends buried 4 mm in the wall.

@@ -280,7 +280,7 @@ Scene load_scene(const std::string& path) {
       const std::string ctx = "objects[" + std::to_string(i) + "]";
       MapReader r(objects[static_cast<int>(i)], path, ctx);
       ObjectSpec obj;
-      if (!r.has("kind")) fail(path, join(ctx, "kind"), "missing (one of cup, mug, bottle, can)");
+      if (!r.has("kind")) fail(path, join(ctx, "kind"), "missing (one of cup, mug, bottle, can, marker)");
       obj.kind = r.string("kind", "");
       obj.name = r.string("name", "");
       if (!r.has("position")) fail(path, join(ctx, "position"), "missing ([x, y] in metres)");

@@ -1,0 +1,59 @@
+#include "nudge/sim/state_sync.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace nudge::sim {
+
+std::optional<double> pad_yaw_from_tool(const Eigen::Quaterniond& tool_orientation) {
+  if (!tool_orientation.coeffs().allFinite() || tool_orientation.norm() < 1e-9) return std::nullopt;
+  const Eigen::Vector3d x = tool_orientation.normalized() * Eigen::Vector3d::UnitX();
+  if (std::hypot(x.x(), x.y()) < 1e-3) return std::nullopt;
+  return std::atan2(x.y(), x.x());
+}
+
+Eigen::Quaterniond yaw_rotation(double yaw) {
+  return Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()));
+}
+
+double yaw_of(const Eigen::Quaterniond& rotation) {
+  const Eigen::Vector3d x = rotation.normalized() * Eigen::Vector3d::UnitX();
+  return std::atan2(x.y(), x.x());
+}
+
+PoseSnapshot snapshot_poses(const World& world, double pusher_yaw) {
+  PoseSnapshot out;
+  for (int i = 0; i < world.num_objects(); ++i) {
+    const ObjectState st = world.object(i);
+    out.objects.push_back({st.name, st.position, st.orientation});
+  }
+  out.pusher_position = world.pusher_position();
+  out.pusher_yaw = pusher_yaw;
+  return out;
+}
+
+void apply_poses(World& world, const PoseSnapshot& poses) {
+  if (static_cast<int>(poses.objects.size()) != world.num_objects())
+    throw std::invalid_argument("the state has " + std::to_string(poses.objects.size()) + " objects, the scene " +
+                                std::to_string(world.num_objects()) + " (is it the same scene?)");
+  for (const ObjectPose& o : poses.objects) {
+    if (!o.position.allFinite() || !o.orientation.coeffs().allFinite() || o.orientation.norm() < 1e-9)
+      throw std::invalid_argument("object '" + o.name + "': pose is not finite");
+  }
+  if (!poses.pusher_position.allFinite() || !std::isfinite(poses.pusher_yaw))
+    throw std::invalid_argument("pusher: pose is not finite");
+  // Checked before anything moves, so a bad state leaves the world as it was.
+  std::vector<int> index;
+  for (const ObjectPose& o : poses.objects) {
+    index.push_back(world.object_index(o.name));
+    if (index.back() < 0) throw std::invalid_argument("object '" + o.name + "' is not in the scene");
+  }
+  // The pusher first: set_object_pose() recomputes the derived positions of every body (the
+  // mocap pusher included); with no objects, set_state() of the current state does it.
+  world.set_pusher(poses.pusher_position, poses.pusher_yaw);
+  for (size_t k = 0; k < index.size(); ++k)
+    world.set_object_pose(index[k], poses.objects[k].position, poses.objects[k].orientation);
+  if (index.empty()) world.set_state(world.state());
+}
+
+}  // namespace nudge::sim

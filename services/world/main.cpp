@@ -1,0 +1,299 @@
+// world: the simulated lab (MuJoCo physics of the table, the objects and the arm's pusher pad).
+// Publishes SIM_STATE at --rate in simulated time, answers SIM_TRUTH_REQUEST with SIM_TRUTH
+// (state + both cameras' object masks), and puts the pusher at the arm's tool point from
+// ARM_STATE. All logic runs on simulated time; see docs/sim.md, "The world service".
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <stdexcept>
+#include <string>
+
+#include "nudge/arm_state_t.hpp"
+#include "nudge/bus/image.hpp"
+#include "nudge/bus/service.hpp"
+#include "nudge/log.hpp"
+#include "nudge/sim/state_sync.hpp"
+#include "nudge/sim/world.hpp"
+#include "nudge/sim_state_t.hpp"
+#include "nudge/sim_truth_request_t.hpp"
+#include "nudge/sim_truth_t.hpp"
+#include "nudge/timing.hpp"
+
+using namespace nudge;
+
+namespace {
+
+constexpr const char* kStateChannel = "SIM_STATE";
+constexpr const char* kTruthChannel = "SIM_TRUTH";
+constexpr const char* kTruthRequestChannel = "SIM_TRUTH_REQUEST";
+constexpr const char* kArmStateChannel = "ARM_STATE";
+// Utimes from here on are wall-clock stamps (2001 onwards), not simulated time since a start.
+constexpr int64_t kWallClockUtime = 1000000000LL * 1000000LL;
+// The longest simulated time a log may span (a day).
+constexpr double kMaxLogSeconds = 86400.0;
+
+pose_t to_pose(const Eigen::Vector3d& p, const Eigen::Quaterniond& q) {
+  pose_t pose;
+  for (int i = 0; i < 3; ++i) pose.position[i] = p[i];
+  pose.orientation[0] = q.w();
+  pose.orientation[1] = q.x();
+  pose.orientation[2] = q.y();
+  pose.orientation[3] = q.z();
+  return pose;
+}
+
+// The world's physics, its pusher (driven by the arm) and what it publishes, on simulated time.
+class Simulation {
+ public:
+  Simulation(bus::Service& service, const sim::Scene& scene, double rate)
+      : service_(service), world_(scene) {
+    const double period = 1.0 / rate;
+    steps_per_state_ = std::max<int64_t>(1, std::llround(period / world_.timestep()));
+    if (std::abs(steps_per_state_ * world_.timestep() - period) > 1e-9)
+      log::warn() << "--rate " << rate << " Hz is not a whole number of " << world_.timestep() * 1e3
+                  << " ms physics steps: publishing every " << steps_per_state_ << " steps ("
+                  << 1.0 / (steps_per_state_ * world_.timestep()) << " Hz)";
+    world_.park_pusher();
+  }
+
+  double time() const { return static_cast<double>(step_) * world_.timestep(); }
+  double timestep() const { return world_.timestep(); }
+  int64_t utime() const { return std::llround(time() * 1e6); }
+
+  // One physics step with the pusher where the arm last put it; publishes SIM_STATE on the
+  // rate's boundaries.
+  void step() {
+    world_.step();
+    ++step_;
+    if (step_ % steps_per_state_ == 0) service_.publish(kStateChannel, state_message());
+  }
+  // Simulated time never goes past this (--duration).
+  void set_end_time(double seconds) { end_time_ = seconds; }
+  bool finished() const { return time() + 0.5 * world_.timestep() >= end_time_; }
+  // Steps until simulated time reaches `seconds` (never backwards, never past the end time).
+  void advance_to(double seconds) {
+    seconds = std::min(seconds, end_time_);
+    while (time() + 0.5 * world_.timestep() < seconds && !service_.stop_requested()) step();
+  }
+  // Steps up to the next SIM_STATE boundary (at most that many steps).
+  void advance_to_next_state() {
+    do step();
+    while (step_ % steps_per_state_ != 0 && !finished());
+  }
+
+  // The arm's contract: the tool point is the pad centre; the pad faces the horizontal direction
+  // of the tool's x axis (the previous yaw is kept while that axis points straight up or down).
+  void on_arm_state(const arm_state_t& msg) {
+    const Eigen::Vector3d p(msg.end_effector.position[0], msg.end_effector.position[1], msg.end_effector.position[2]);
+    const Eigen::Quaterniond q(msg.end_effector.orientation[0], msg.end_effector.orientation[1],
+                               msg.end_effector.orientation[2], msg.end_effector.orientation[3]);
+    if (!p.allFinite() || !q.coeffs().allFinite() || std::abs(q.norm() - 1.0) > 1e-3)
+      throw std::invalid_argument("end_effector: position must be finite and orientation a unit quaternion");
+    if (!std::isfinite(msg.gripper)) throw std::invalid_argument("gripper: not finite");
+    for (double j : msg.joints)
+      if (!std::isfinite(j)) throw std::invalid_argument("joints: not finite");
+    if (const auto yaw = sim::pad_yaw_from_tool(q)) pusher_yaw_ = *yaw;
+    world_.set_pusher(p, pusher_yaw_);
+    arm_ = msg;
+  }
+
+  void on_truth_request() {
+    // After a step MuJoCo's body positions are those from before its integration: restoring the
+    // state recomputes them from the poses the state message reports (and changes nothing else).
+    world_.set_state(world_.state());
+    sim_truth_t truth;
+    truth.state = state_message();
+    truth.utime = truth.state.utime;
+    truth.mask_left = bus::to_message(world_.render_mask(0), image_t::FORMAT_GRAY8, truth.utime, step_, "left");
+    truth.mask_right = bus::to_message(world_.render_mask(1), image_t::FORMAT_GRAY8, truth.utime, step_, "right");
+    service_.publish(kTruthChannel, truth);
+  }
+
+  sim_state_t state_message() const {
+    sim_state_t msg;
+    msg.utime = utime();
+    msg.step = step_;
+    for (int i = 0; i < 6; ++i) msg.joints[i] = arm_ ? arm_->joints[i] : 0.0;
+    msg.gripper = arm_ ? arm_->gripper : 0.0;
+    msg.num_objects = world_.num_objects();
+    for (int i = 0; i < world_.num_objects(); ++i) {
+      const sim::ObjectState st = world_.object(i);
+      const sim::Axis3d axis = world_.axis(i);
+      object_state_t o;
+      o.name = st.name;
+      o.pose = to_pose(st.position, st.orientation);
+      for (int k = 0; k < 3; ++k) {
+        o.axis_point[k] = axis.base[k];
+        o.axis_direction[k] = axis.direction[k];
+      }
+      const sim::ImageLine left = world_.axis_in_image(i, 0), right = world_.axis_in_image(i, 1);
+      const float nan = std::nanf("");
+      o.r_left = left.valid ? static_cast<float>(left.r) : nan;
+      o.theta_left = left.valid ? static_cast<float>(left.theta) : nan;
+      o.r_right = right.valid ? static_cast<float>(right.r) : nan;
+      o.theta_right = right.valid ? static_cast<float>(right.theta) : nan;
+      msg.objects.push_back(o);
+    }
+    msg.pusher = to_pose(world_.pusher_position(), sim::yaw_rotation(pusher_yaw_));
+    return msg;
+  }
+
+ private:
+  bus::Service& service_;
+  sim::World world_;
+  int64_t step_ = 0;
+  int64_t steps_per_state_ = 1;
+  double end_time_ = std::numeric_limits<double>::infinity();
+  double pusher_yaw_ = 0;
+  std::optional<arm_state_t> arm_;
+};
+
+// The world's inputs. Live, a message takes effect at the next physics step. From a log (the
+// file provider hands messages over as fast as they are read, stamped with the wall clock), a
+// message takes effect at simulated time = its utime minus an origin, the same way every run.
+// By default the origin is 0 when the first input message's utime looks like simulated time (an
+// arm on --clock sim stamps ARM_STATE with SIM_STATE's utime), else that first utime (wall-clock
+// stamps: the log replays as if the world had run in real time while it was recorded).
+// Bad messages are reported naming the channel, counted and skipped.
+class Inputs {
+ public:
+  Inputs(bus::Service& service, Simulation& sim, bool from_log, std::optional<int64_t> log_origin)
+      : sim_(sim), from_log_(from_log), log_origin_(log_origin) {
+    service.subscriptions().subscribe<arm_state_t>(kArmStateChannel, [this](const arm_state_t& msg, const std::string&) {
+      catch_up(msg.utime);
+      sim_.on_arm_state(msg);  // throws on a bad pose: counted, skipped
+    });
+    service.subscriptions().subscribe<sim_truth_request_t>(
+        kTruthRequestChannel, [this](const sim_truth_request_t& msg, const std::string&) {
+          catch_up(msg.utime);
+          sim_.on_truth_request();
+        });
+  }
+
+ private:
+  void catch_up(int64_t utime) {
+    if (!from_log_) return;
+    if (!log_origin_) log_origin_ = utime < kWallClockUtime ? 0 : utime;
+    const double seconds = 1e-6 * static_cast<double>(utime - *log_origin_);
+    // A stamp on another clock (wall-clock time after simulated time) would run the physics for
+    // years: refused (counted, skipped) instead.
+    if (seconds > kMaxLogSeconds)
+      throw std::invalid_argument("utime " + std::to_string(utime) + " is " + std::to_string(seconds) +
+                                  " s after the log's origin: not on the same clock");
+    sim_.advance_to(seconds);
+  }
+
+  Simulation& sim_;
+  bool from_log_;
+  std::optional<int64_t> log_origin_;
+};
+
+// Paces simulated time against the wall clock: sim time runs `factor` times as fast as wall time.
+// When the machine cannot keep up it falls behind, never skips physics steps, and re-anchors so
+// that it does not rush to catch up afterwards (it simply runs slower than asked).
+class Pacer {
+ public:
+  explicit Pacer(double factor) : factor_(factor) {}
+  // The simulated time physics should have reached now.
+  double target(double sim_time) {
+    const int64_t now = wall_utime();
+    if (!anchored_) {
+      anchor_wall_ = now;
+      anchor_sim_ = sim_time;
+      anchored_ = true;
+    }
+    double t = anchor_sim_ + factor_ * 1e-6 * static_cast<double>(now - anchor_wall_);
+    if (t - sim_time > kMaxLag) {
+      ++slips_;
+      anchor_wall_ = now;
+      anchor_sim_ = sim_time;
+      t = sim_time;
+    }
+    return t;
+  }
+  // Milliseconds of wall time until simulated time `due` is reached.
+  int wait_ms(double due, double sim_target) const {
+    return static_cast<int>(std::clamp(std::ceil(1e3 * (due - sim_target) / factor_), 0.0, 20.0));
+  }
+  int64_t slips() const { return slips_; }
+
+ private:
+  static constexpr double kMaxLag = 0.1;  // s of simulated time
+  double factor_;
+  bool anchored_ = false;
+  int64_t anchor_wall_ = 0;
+  double anchor_sim_ = 0;
+  int64_t slips_ = 0;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return bus::guarded_main("world", [&] {
+    bus::Service service("world",
+                         "The simulated world: MuJoCo physics of a scene (docs/sim.md). Publishes SIM_STATE,\n"
+                         "answers SIM_TRUTH_REQUEST on SIM_TRUTH, puts the pusher at ARM_STATE's tool point.");
+    std::string scene_file;
+    int seed = -1;
+    double realtime_factor = 1.0, rate = 25.0, duration = 0.0;
+    auto& f = service.flags();
+    f.add_string("scene", &scene_file, "scene file (YAML, docs/sim.md)");
+    f.add_int("seed", &seed, "seed for placement jitter and noise (-1: the scene's)");
+    f.add_double("realtime-factor", &realtime_factor,
+                 "simulated seconds per wall-clock second (1: real time, 0: as fast as possible)");
+    f.add_double("rate", &rate, "SIM_STATE messages per simulated second");
+    f.add_double("duration", &duration, "stop after this many simulated seconds (0: run until stopped)");
+    double log_origin_s = -1;
+    f.add_double("log-origin", &log_origin_s,
+                 "input from a log: the utime (s) that is simulated time 0 (-1: automatic, docs/sim.md)");
+    if (!service.parse(argc, argv)) return 0;
+    if (scene_file.empty()) throw FlagError("--scene FILE is required");
+    if (!(realtime_factor >= 0 && std::isfinite(realtime_factor))) throw FlagError("--realtime-factor must be >= 0");
+    if (!(rate > 0 && std::isfinite(rate))) throw FlagError("--rate must be > 0");
+    if (!(duration >= 0 && std::isfinite(duration))) throw FlagError("--duration must be >= 0");
+    if (seed < -1) throw FlagError("--seed must be >= 0 (or -1 for the scene's)");
+    if (!(log_origin_s >= 0 || log_origin_s == -1)) throw FlagError("--log-origin must be >= 0 (or -1)");
+    const int64_t log_origin = log_origin_s >= 0 ? std::llround(log_origin_s * 1e6) : -1;
+    sim::Scene scene;
+    try {
+      scene = sim::load_scene(scene_file);  // errors name the file and the field
+    } catch (const sim::SceneError& e) {
+      throw FlagError(e.what());
+    }
+    if (seed >= 0) scene.seed = static_cast<uint64_t>(seed);
+
+    service.start();
+    Simulation sim(service, scene, rate);
+    if (duration > 0) sim.set_end_time(duration);
+    const bool from_log = service.input_is_log();
+    Inputs inputs(service, sim, from_log, log_origin >= 0 ? std::optional<int64_t>(log_origin) : std::nullopt);
+    log::info() << scene_file << ": " << scene.objects.size() << " objects, seed " << scene.seed << ", "
+                << (from_log ? "input events applied at their log time"
+                             : realtime_factor > 0 ? "realtime factor " + std::to_string(realtime_factor)
+                                                   : std::string("as fast as possible"));
+    service.publish(kStateChannel, sim.state_message());  // the state at t = 0
+
+    Pacer pacer(realtime_factor);
+    const int rc = service.run([&]() -> int {
+      if (sim.finished()) {
+        service.request_stop();
+        return 0;
+      }
+      if (from_log) return 0;  // input events drive the clock (Inputs::catch_up)
+      if (realtime_factor == 0) {
+        // As fast as possible, looking for input between every published state.
+        sim.advance_to_next_state();
+        return 0;
+      }
+      const double target = pacer.target(sim.time());
+      sim.advance_to(target);
+      service.set_status("t " + std::to_string(sim.time()) + " s, slowed " + std::to_string(pacer.slips()) + "x");
+      return pacer.wait_ms(sim.time() + sim.timestep(), target);
+    }, 20);
+    // A log's events are all applied: simulate on to --duration, as fast as possible.
+    if (from_log && rc == 0 && duration > 0) sim.advance_to(duration);
+    log::info() << "simulated " << sim.time() << " s";
+    return rc;
+  });
+}

@@ -1,0 +1,360 @@
+// Service tests of the simulated world and the camera's sim backend, each a pure function from
+// log to log (LCM file provider):
+//  - nudge-world runs ~1 s of simulated time as fast as it can; nudge-camera --source sim renders
+//    that log: one stereo pair per SIM_STATE sharing its utime, and the fast symmetry detector
+//    finds the upright bottle where the SIM_STATE's ground truth says (2 px, 1 deg); a state of
+//    another scene is counted and skipped; a snapshot request gets a 1280x960 pair;
+//  - ARM_STATE drives the pusher (the arm's contract) and pushes a cup; SIM_TRUTH_REQUEST gets
+//    masks; a bad message is counted and skipped; the same input gives the same output; input
+//    stamped in simulated time acts at that time;
+//  - bad scenes and flags are usage errors (exit 2) naming the file and field.
+#include <gtest/gtest.h>
+#include <lcm/lcm-cpp.hpp>
+#include <sys/wait.h>
+
+#include <Eigen/Geometry>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "nudge/arm_state_t.hpp"
+#include "nudge/bus/image.hpp"
+#include "nudge/heartbeat_t.hpp"
+#include "nudge/image_t.hpp"
+#include "nudge/sim_state_t.hpp"
+#include "nudge/sim_truth_request_t.hpp"
+#include "nudge/sim_truth_t.hpp"
+#include "nudge/snapshot_request_t.hpp"
+#include "nudge/symmetry/detector.hpp"
+
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+const std::string kBin = NUDGE_BIN_DIR;
+
+struct Event {
+  int64_t timestamp;
+  std::string channel;
+  std::vector<uint8_t> data;
+};
+
+std::vector<Event> read_log(const std::string& path) {
+  lcm::LogFile log(path, "r");
+  EXPECT_TRUE(log.good()) << path;
+  std::vector<Event> events;
+  for (const lcm::LogEvent* ev = log.readNextEvent(); ev; ev = log.readNextEvent()) {
+    const auto* p = static_cast<const uint8_t*>(ev->data);
+    events.push_back({ev->timestamp, ev->channel, std::vector<uint8_t>(p, p + ev->datalen)});
+  }
+  return events;
+}
+
+void write_log(const std::string& path, const std::vector<Event>& events) {
+  lcm::LogFile log(path, "w");
+  ASSERT_TRUE(log.good()) << path;
+  for (const Event& e : events) {
+    lcm::LogEvent ev{};
+    ev.timestamp = e.timestamp;
+    ev.channel = e.channel;
+    ev.datalen = static_cast<int32_t>(e.data.size());
+    ev.data = const_cast<uint8_t*>(e.data.data());
+    ASSERT_EQ(log.writeEvent(&ev), 0);
+  }
+}
+
+template <typename Msg>
+std::vector<uint8_t> encode(const Msg& msg) {
+  std::vector<uint8_t> bytes(msg.getEncodedSize());
+  msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  return bytes;
+}
+
+template <typename Msg>
+Msg decode(const Event& e) {
+  Msg msg;
+  EXPECT_GE(msg.decode(e.data.data(), 0, static_cast<int>(e.data.size())), 0) << e.channel;
+  return msg;
+}
+
+int run(const std::string& cmd) {
+  const int status = std::system(cmd.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+std::string write_scene(const std::string& name, const std::string& objects) {
+  const std::string path = testing::TempDir() + "/" + name + ".yaml";
+  std::ofstream(path) << "%YAML:1.0\n---\nseed: 3\n"
+                      << "table: { type: plain, colour: [0.72, 0.58, 0.42] }\n"
+                      << "background: { type: plain, colour: [0.3, 0.4, 0.6] }\n"
+                      << "objects:\n"
+                      << objects;
+  return path;
+}
+
+int64_t last_heartbeat_errors(const std::vector<Event>& events) {
+  int64_t errors = -1;
+  for (const Event& e : events)
+    if (e.channel == "HEARTBEAT") errors = decode<nudge::heartbeat_t>(e).errors;
+  return errors;
+}
+
+}  // namespace
+
+TEST(WorldCamera, EveryStateBecomesAStereoPairWhoseBottleAxisTheDetectorFinds) {
+  const std::string dir = testing::TempDir();
+  const std::string scene = write_scene(
+      "world_camera_bottle", "  - { kind: bottle, name: bottle, position: [0.25, 0.02], colour: [0.15, 0.3, 0.7] }\n"
+                             "  - { kind: cup, name: cup, position: [0.20, -0.15], colour: [0.9, 0.2, 0.2] }\n");
+  const std::string world_log = dir + "/world_out.lcmlog", camera_in = dir + "/camera_in.lcmlog",
+                    camera_log = dir + "/camera_out.lcmlog";
+  std::remove(world_log.c_str());
+  std::remove(camera_log.c_str());
+  ASSERT_EQ(run(kBin + "/nudge-world --scene " + scene + " --realtime-factor 0 --duration 1.0 --lcm-in memq://" +
+                " --lcm-out 'file://" + world_log + "?mode=w'"),
+            0);
+
+  // The states, and a snapshot request after the 10th one.
+  std::map<int64_t, nudge::sim_state_t> states;
+  std::vector<Event> world_events = read_log(world_log), camera_input;
+  for (const Event& e : world_events) {
+    camera_input.push_back(e);
+    if (e.channel != "SIM_STATE") continue;
+    const auto state = decode<nudge::sim_state_t>(e);
+    states[state.utime] = state;
+    if (states.size() == 10) {
+      nudge::snapshot_request_t request;
+      request.utime = e.timestamp;
+      camera_input.push_back({e.timestamp + 1, "CAMERA_SNAPSHOT_REQUEST", encode(request)});
+    }
+    if (states.size() == 5) {  // a state of another scene: reported, counted, no frames
+      nudge::sim_state_t other = state;
+      other.utime = 999;
+      other.objects[0].name = "teapot";
+      camera_input.push_back({e.timestamp + 2, "SIM_STATE", encode(other)});
+    }
+  }
+  ASSERT_EQ(states.size(), 26u) << "25 Hz over 1 s of simulated time, plus the state at t = 0";
+  EXPECT_EQ(states.begin()->first, 0);
+  EXPECT_EQ(states.rbegin()->first, 1000000);
+  write_log(camera_in, camera_input);
+
+  ASSERT_EQ(run(kBin + "/nudge-camera --source sim --scene " + scene + " --snapshots --format png" +
+                " --lcm-in 'file://" + camera_in + "?speed=0' --lcm-out 'file://" + camera_log + "?mode=w'"),
+            0);
+  std::map<int64_t, cv::Mat> left, right;
+  std::vector<nudge::image_t> snapshots;
+  for (const Event& e : read_log(camera_log)) {
+    if (e.channel == "CAMERA_LEFT" || e.channel == "CAMERA_RIGHT") {
+      const auto img = decode<nudge::image_t>(e);
+      (e.channel == "CAMERA_LEFT" ? left : right)[img.utime] = nudge::bus::to_mat(img);
+    } else if (e.channel == "SNAPSHOT_LEFT" || e.channel == "SNAPSHOT_RIGHT") {
+      snapshots.push_back(decode<nudge::image_t>(e));
+    }
+  }
+  EXPECT_EQ(last_heartbeat_errors(read_log(camera_log)), 1) << "the other scene's state is counted";
+  ASSERT_EQ(left.size(), states.size()) << "a left frame for every state (and none for the bad one)";
+  ASSERT_EQ(right.size(), states.size()) << "a right frame for every state";
+  for (const auto& [utime, state] : states) {
+    ASSERT_TRUE(left.count(utime) && right.count(utime)) << "left and right share the state's utime " << utime;
+    EXPECT_EQ(left[utime].cols, 640);
+    EXPECT_EQ(left[utime].rows, 480);
+  }
+  ASSERT_EQ(snapshots.size(), 2u) << "one still pair for the one request";
+  for (const auto& s : snapshots) {
+    EXPECT_EQ(s.width, 1280);
+    EXPECT_EQ(s.height, 960);
+    EXPECT_EQ(s.utime, std::next(states.begin(), 9)->first) << "the still shows the latest state";
+  }
+
+  // Thesis parameters for upright objects in 640x480 frames.
+  nudge::symmetry::Params params;
+  params.dmin = 25;
+  params.dmax = 250;
+  params.theta_min_deg = -25;
+  params.theta_max_deg = 25;
+  params.num_lines = 5;
+  // The backdrop's foot is a long straight edge across the image: every pair of its pixels votes
+  // for a line perpendicular to it. The thesis' rule against straight lines (§3.2.3) stops that.
+  params.once_per_row = true;
+  nudge::symmetry::EdgeParams edges;
+  edges.blur_sigma = 1.0;
+  nudge::symmetry::Detector detector(params, edges);
+  for (const int64_t utime : {int64_t{0}, int64_t{520000}, int64_t{1000000}}) {
+    const nudge::sim_state_t& state = states.at(utime);
+    const auto bottle = std::find_if(state.objects.begin(), state.objects.end(),
+                                     [](const nudge::object_state_t& o) { return o.name == "bottle"; });
+    ASSERT_NE(bottle, state.objects.end());
+    for (int cam = 0; cam < 2; ++cam) {
+      const double r = cam == 0 ? bottle->r_left : bottle->r_right;
+      const double theta = cam == 0 ? bottle->theta_left : bottle->theta_right;
+      const auto result = detector.detect(cam == 0 ? left.at(utime) : right.at(utime));
+      double best_r = 1e9, best_theta = 1e9;
+      for (const auto& line : result.lines) {
+        if (std::abs(line.r - r) + std::abs(line.theta - theta) / kDeg < std::abs(best_r - r) + std::abs(best_theta - theta) / kDeg) {
+          best_r = line.r;
+          best_theta = line.theta;
+        }
+      }
+      EXPECT_NEAR(best_r, r, 2.0) << "camera " << cam << " utime " << utime;
+      EXPECT_NEAR(best_theta, theta, 1.0 * kDeg) << "camera " << cam << " utime " << utime;
+    }
+  }
+}
+
+TEST(World, ArmStateDrivesThePusherTruthIsAnsweredAndTheRunIsDeterministic) {
+  const std::string dir = testing::TempDir();
+  const std::string scene = write_scene("world_push", "  - { kind: cup, name: cup, position: [0.25, 0.0] }\n");
+  const std::string in = dir + "/world_push_in.lcmlog";
+  // Events at log time T0 + t act at simulated time t.
+  const int64_t t0 = 1700000000000000;
+  std::vector<Event> input;
+  nudge::sim_truth_request_t request;
+  request.utime = t0;
+  input.push_back({t0, "SIM_TRUTH_REQUEST", encode(request)});
+  // The tool's x axis along +y: the pad sweeps 9 cm along +y, 2 cm above the table, from 10 cm
+  // before the cup's axis to 1 cm before it (the cup's base radius is ~3 cm), at 4.5 cm/s.
+  const Eigen::Quaterniond tool(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()));
+  nudge::arm_state_t arm{};
+  for (int k = 0; k <= 200; ++k) {
+    arm.utime = t0 + 500000 + 10000 * k;
+    arm.end_effector.position[0] = 0.25;
+    arm.end_effector.position[1] = -0.10 + 0.09 * k / 200.0;
+    arm.end_effector.position[2] = 0.02;
+    arm.end_effector.orientation[0] = tool.w();
+    arm.end_effector.orientation[1] = tool.x();
+    arm.end_effector.orientation[2] = tool.y();
+    arm.end_effector.orientation[3] = tool.z();
+    arm.joints[0] = 0.1 * k;
+    arm.gripper = 0.03;
+    input.push_back({arm.utime, "ARM_STATE", encode(arm)});
+  }
+  nudge::arm_state_t bad = arm;  // refused: not a pose
+  bad.end_effector.position[2] = std::nan("");
+  input.push_back({t0 + 2600000, "ARM_STATE", encode(bad)});
+  request.utime = t0 + 3000000;
+  input.push_back({t0 + 3000000, "SIM_TRUTH_REQUEST", encode(request)});
+  write_log(in, input);
+
+  std::vector<std::vector<Event>> runs;
+  for (int r = 0; r < 2; ++r) {
+    const std::string out = dir + "/world_push_out" + std::to_string(r) + ".lcmlog";
+    std::remove(out.c_str());
+    ASSERT_EQ(run(kBin + "/nudge-world --scene " + scene + " --duration 3.6 --lcm-in 'file://" + in +
+                  "?speed=0' --lcm-out 'file://" + out + "?mode=w'"),
+              0);
+    runs.push_back(read_log(out));
+  }
+  EXPECT_EQ(last_heartbeat_errors(runs[0]), 1) << "the NaN pose is counted";
+
+  std::map<int64_t, nudge::sim_state_t> states;
+  std::vector<nudge::sim_truth_t> truths;
+  for (const Event& e : runs[0]) {
+    if (e.channel == "SIM_STATE") {
+      const auto s = decode<nudge::sim_state_t>(e);
+      states[s.utime] = s;
+    }
+    if (e.channel == "SIM_TRUTH") truths.push_back(decode<nudge::sim_truth_t>(e));
+  }
+  ASSERT_EQ(states.size(), 3.6 * 25 + 1);
+  // Parked (behind the backdrop) until the first ARM_STATE at t = 0.5 s.
+  EXPECT_LT(states.at(480000).pusher.position[0], -0.6);
+  EXPECT_DOUBLE_EQ(states.at(480000).joints[0], 0.0);
+  // Then at the tool point, facing along the tool's x axis, with the arm's joints and gripper.
+  const auto& later = states.at(1000000);
+  EXPECT_NEAR(later.pusher.position[0], 0.25, 1e-9);
+  EXPECT_NEAR(later.pusher.position[2], 0.02, 1e-9);
+  const Eigen::Quaterniond pad(later.pusher.orientation[0], later.pusher.orientation[1], later.pusher.orientation[2],
+                               later.pusher.orientation[3]);
+  EXPECT_NEAR(pad.angularDistance(tool), 0.0, 1e-9);
+  EXPECT_DOUBLE_EQ(later.gripper, 0.03);
+  // It stays at the last good pose: the NaN one is skipped.
+  const auto& end = states.at(3600000);
+  EXPECT_NEAR(end.pusher.position[1], -0.01, 1e-9);
+  EXPECT_NEAR(end.joints[0], 20.0, 1e-9);
+  // The cup was pushed along +y and stays upright.
+  const auto& cup_before = states.at(0).objects.at(0).pose.position;
+  const auto& cup_after = end.objects.at(0).pose.position;
+  EXPECT_GT(cup_after[1] - cup_before[1], 0.015);
+  EXPECT_LT(std::abs(cup_after[0] - cup_before[0]), 0.01);
+  EXPECT_GT(end.objects.at(0).axis_direction[2], std::cos(5 * kDeg));
+
+  // Truth at t = 0 and t = 3 s: the state and masks with the cup's label.
+  ASSERT_EQ(truths.size(), 2u);
+  EXPECT_EQ(truths[0].utime, 0);
+  EXPECT_EQ(truths[1].utime, 3000000);
+  for (const auto& t : truths) {
+    EXPECT_EQ(t.state.utime, t.utime);
+    for (const auto* mask : {&t.mask_left, &t.mask_right}) {
+      const cv::Mat m = nudge::bus::to_mat(*mask);
+      EXPECT_EQ(m.cols, 640);
+      EXPECT_GT(cv::countNonZero(m == 1), 1000) << "the cup covers thousands of pixels";
+    }
+  }
+
+  // Deterministic: the same scene, seed and input give the same states and truth, bit for bit.
+  std::vector<const Event*> a, b;
+  for (const Event& e : runs[0])
+    if (e.channel != "HEARTBEAT") a.push_back(&e);
+  for (const Event& e : runs[1])
+    if (e.channel != "HEARTBEAT") b.push_back(&e);
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) {
+    ASSERT_EQ(a[i]->channel, b[i]->channel) << i;
+    ASSERT_TRUE(a[i]->data == b[i]->data) << "message " << i << " on " << a[i]->channel << " differs";
+  }
+}
+
+TEST(World, BadSceneOrFlagsExitWithAUsageErrorNamingTheProblem) {
+  const std::string scene = write_scene("world_bad", "  - { kind: teapot, position: [0.25, 0.0] }\n");
+  const std::string err = testing::TempDir() + "/world_bad.err";
+  EXPECT_EQ(run(kBin + "/nudge-world --scene " + scene + " --lcm-in memq:// 2>" + err), 2);
+  std::ifstream f(err);
+  const std::string text((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find(scene + ": objects[0].kind: unknown kind 'teapot'"), std::string::npos) << text;
+  EXPECT_EQ(run(kBin + "/nudge-world --lcm-in memq:// 2>/dev/null"), 2) << "no --scene";
+  EXPECT_EQ(run(kBin + "/nudge-world --scene " + scene + " --rate 0 2>/dev/null"), 2);
+  EXPECT_EQ(run(kBin + "/nudge-camera --source sim --lcm-in memq:// 2>/dev/null"), 2) << "no --scene";
+  EXPECT_EQ(run(kBin + "/nudge-camera --source sim --scene " + scene + " --lcm-in memq:// 2>/dev/null"), 2);
+}
+
+TEST(World, InputStampedInSimulatedTimeActsAtThatTimeAndOtherClocksAreRefused) {
+  const std::string dir = testing::TempDir();
+  const std::string scene = write_scene("world_sim_clock", "  - { kind: cup, name: cup, position: [0.25, 0.0] }\n");
+  const std::string in = dir + "/world_sim_clock_in.lcmlog", out = dir + "/world_sim_clock_out.lcmlog";
+  std::remove(out.c_str());
+  // An arm on --clock sim stamps ARM_STATE with SIM_STATE's utime: the first one at t = 0.5 s.
+  nudge::arm_state_t arm{};
+  arm.end_effector.position[0] = 0.25;
+  arm.end_effector.position[1] = -0.2;
+  arm.end_effector.position[2] = 0.05;
+  arm.end_effector.orientation[0] = 1;
+  std::vector<Event> input;
+  for (int k = 0; k < 10; ++k) {
+    arm.utime = 500000 + 10000 * k;
+    input.push_back({1700000000000000 + k, "ARM_STATE", encode(arm)});
+  }
+  nudge::sim_truth_request_t wall_clock;  // a wall-clock stamp among simulated ones: refused
+  wall_clock.utime = 1700000000000000;
+  input.push_back({1700000000000100, "SIM_TRUTH_REQUEST", encode(wall_clock)});
+  write_log(in, input);
+  ASSERT_EQ(run(kBin + "/nudge-world --scene " + scene + " --duration 1 --lcm-in 'file://" + in +
+                "?speed=0' --lcm-out 'file://" + out + "?mode=w' 2>/dev/null"),
+            0);
+  const auto events = read_log(out);
+  std::map<int64_t, nudge::sim_state_t> states;
+  for (const Event& e : events) {
+    EXPECT_NE(e.channel, "SIM_TRUTH") << "the wall-clock request is not answered";
+    if (e.channel == "SIM_STATE") {
+      const auto s = decode<nudge::sim_state_t>(e);
+      states[s.utime] = s;
+    }
+  }
+  ASSERT_EQ(states.size(), 26u);
+  EXPECT_LT(states.at(480000).pusher.position[0], -0.6) << "parked before t = 0.5 s";
+  EXPECT_NEAR(states.at(520000).pusher.position[1], -0.2, 1e-12) << "at the tool point from t = 0.5 s";
+  EXPECT_EQ(last_heartbeat_errors(events), 1);
+}
