@@ -11,6 +11,7 @@
 #include <string>
 
 #include "nudge/bus/image.hpp"
+#include "nudge/contours_t.hpp"
 #include "nudge/heartbeat_t.hpp"
 #include "nudge/symmetry/detector.hpp"
 #include "nudge/symmetry/synthetic.hpp"
@@ -108,6 +109,39 @@ TEST(SymmetryService, LogInLogOutMatchesTheKnownAxesAndSkipsBadMessages) {
     EXPECT_NEAR(msg.lines[0].r, t.r, 1.0) << "utime " << utime;
     EXPECT_NEAR(msg.lines[0].theta, t.theta, 1.0 * kDeg) << "utime " << utime;
   }
+}
+
+TEST(SymmetryService, ContoursOfTheTopLinesOnRequest) {
+  const std::string dir = testing::TempDir();
+  const std::string in = dir + "/contours_in.lcmlog", out = dir + "/contours_out.lcmlog";
+  std::remove(out.c_str());
+  const auto truth = write_input_log(in);
+  const std::string cmd = std::string(NUDGE_BIN_DIR) + "/nudge-symmetry --inputs CAMERA --lines 1 --dmin 10 --dmax 0" +
+                          " --theta-min -30 --theta-max 30 --contours 1 --lcm-in 'file://" + in + "?speed=0'" +
+                          " --lcm-out 'file://" + out + "?mode=w' 2>/dev/null";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+  lcm::LogFile log(out, "r");
+  int frames = 0;
+  for (const lcm::LogEvent* ev = log.readNextEvent(); ev; ev = log.readNextEvent()) {
+    if (ev->channel != "CONTOURS") continue;
+    nudge::contours_t msg;
+    ASSERT_GE(msg.decode(ev->data, 0, ev->datalen), 0);
+    ++frames;
+    ASSERT_EQ(msg.num_contours, 1);
+    const auto& c = msg.contours[0];
+    EXPECT_GT(c.num_left, 100);
+    EXPECT_GT(c.num_right, 100);
+    // Every contour point lies within the bottle's half-width (30 px) of the true axis.
+    const Truth& t = truth.at(msg.utime);
+    const double cx = 159.5, cy = 119.5;
+    for (const auto* side : {&c.left, &c.right}) {
+      for (const auto& p : *side) {
+        const double offset = (p[0] - cx) * std::cos(t.theta) + (p[1] - cy) * std::sin(t.theta) - t.r;
+        EXPECT_LE(std::fabs(offset), 33.0);
+      }
+    }
+  }
+  EXPECT_EQ(frames, static_cast<int>(truth.size()));
 }
 
 TEST(SymmetryService, BadFlagsAreRefusedWithAUsageError) {
