@@ -42,7 +42,7 @@ struct Appearance {
 
 struct ObjectSpec {
   std::string name;                // unique; defaults to "<kind><index>"
-  std::string kind;                // a kind of the object library: cup, mug, bottle, can
+  std::string kind;                // a kind of the object library: cup, mug, bottle, can, marker
   Eigen::Vector2d position{0.25, 0.0};  // of the base centre on the table, world x y
   double yaw = 0.0;                // about the world z axis (turns a mug's handle)
   Appearance appearance;
