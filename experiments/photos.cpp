@@ -100,7 +100,8 @@ int main(int argc, char** argv) {
     if (images == 0) throw std::runtime_error("no readable images in " + annotations);
     JsonWriter j;
     j.begin_object();
-    j.field("machine", machine_description()).field("date", today()).field("annotations", annotations);
+    j.field("machine", machine_description()).field("date", today());
+    j.field("annotations", annotations.substr(annotations.rfind('/') + 1));
     j.field("images", images);
     j.key("fast").begin_object().field("top_line_hits", fast_hits).field("hit_rate", double(fast_hits) / images);
     j.field("median_ms", median(fast_ms)).end_object();

@@ -80,6 +80,10 @@ void write_results(const std::vector<SceneTiming>& results, double seconds) {
   j.field("machine", machine_description()).field("date", today());
   j.field("image", "640x480 stereo, shadows off").field("frame_rate_hz", 1.0 / kFramePeriod);
   j.field("seconds_simulated", seconds);
+  // Headline figures: the most demanding scene (the last, most objects), world and camera on one core.
+  const SceneTiming& worst = results.back();
+  j.field("headline_scene", worst.scene).field("realtime_factor", worst.one_core_factor());
+  j.field("render_ms_per_frame", worst.render_ms_per_frame).field("physics_steps_per_s", worst.physics_steps_per_s);
   j.key("scenes").begin_array();
   for (const auto& t : results) {
     j.begin_object();
