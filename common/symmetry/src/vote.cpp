@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cstring>
 #include <thread>
+#include <type_traits>
 
 #if defined(__AVX512F__)
 #pragma GCC diagnostic push
@@ -239,7 +240,7 @@ void Detector::vote_thetas(const EdgeSet& edges, const std::vector<int>& thetas,
   s.row.resize(n);
   s.sorted.resize(n);
   s.starts.resize(num_rows + 1);
-  s.fill.resize(num_rows);
+  s.fill.resize(4 * static_cast<size_t>(num_rows));
   s.hist.assign(kCopies * hist_size, 0);
   s.stamp.assign(hist_size, -1);
   std::vector<double> tan_skew;
@@ -252,7 +253,9 @@ void Detector::vote_thetas(const EdgeSet& edges, const std::vector<int>& thetas,
   for (size_t ti = first; ti < thetas.size(); ti += step) {
     const int k = thetas[ti];
     const ThetaTable t = detail::theta_table(k);
-    // Rotate (vectorised) and count the pixels of each row of Rot.
+    // Rotate (vectorised), then a counting sort into rows of Rot with four interleaved sets of
+    // counters: edge pixels come in runs along edges that fall into the same row, and one shared
+    // counter per row would make every pixel wait for the previous one's increment.
     int32_t* xq = s.xq.data();
     int32_t* row = s.row.data();
     const int32_t* u = u2_.data();
@@ -261,16 +264,32 @@ void Detector::vote_thetas(const EdgeSet& edges, const std::vector<int>& thetas,
       xq[i] = detail::rotated_xq(u[i], v[i], t);
       row[i] = detail::rotated_row(u[i], v[i], t) + layout.row_max;
     }
-    std::fill(s.starts.begin(), s.starts.end(), 0);
-    for (size_t i = 0; i < n; ++i) ++s.starts[row[i] + 1];
-    for (int r = 0; r < num_rows; ++r) s.starts[r + 1] += s.starts[r];
-    std::copy(s.starts.begin(), s.starts.end() - 1, s.fill.begin());
-    int32_t* fill = s.fill.data();
-    if (narrow) {
-      for (size_t i = 0; i < n; ++i) s.sorted16[fill[row[i]]++] = static_cast<int16_t>(xq[i]);
-    } else {
-      for (size_t i = 0; i < n; ++i) s.sorted[fill[row[i]]++] = xq[i];
+    constexpr int kLanes = 4;
+    int32_t* counts = s.fill.data();  // kLanes x num_rows, lane-major
+    std::fill(s.fill.begin(), s.fill.end(), 0);
+    size_t i = 0;
+    for (; i + kLanes <= n; i += kLanes)
+      for (int l = 0; l < kLanes; ++l) ++counts[l * num_rows + row[i + l]];
+    for (; i < n; ++i) ++counts[row[i]];
+    int32_t running = 0;
+    for (int r = 0; r < num_rows; ++r) {
+      s.starts[r] = running;
+      for (int l = 0; l < kLanes; ++l) {
+        const int32_t c = counts[l * num_rows + r];
+        counts[l * num_rows + r] = running;  // becomes this lane's next free slot in row r
+        running += c;
+      }
     }
+    s.starts[num_rows] = running;
+    auto scatter = [&](auto* out) {
+      using Value = std::remove_pointer_t<decltype(out)>;
+      size_t j = 0;
+      for (; j + kLanes <= n; j += kLanes)
+        for (int l = 0; l < kLanes; ++l) out[counts[l * num_rows + row[j + l]]++] = static_cast<Value>(xq[j + l]);
+      for (; j < n; ++j) out[counts[row[j]]++] = static_cast<Value>(xq[j]);
+    };
+    if (narrow) scatter(s.sorted16.data());
+    else scatter(s.sorted.data());
 
     for (int layer = 0; layer < num_layers; ++layer) {
       const double tan_phi = layer == 0 ? 0.0 : tan_skew[layer - 1];
