@@ -31,13 +31,22 @@ nudge_install_packages() {
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 }
 
-# Configures once, then builds what changed.
+# Configures once, then builds what changed. Fails (with the compiler's messages) if the build does.
 nudge_build() {
   if [ ! -f "$NUDGE_BUILD_DIR/CMakeCache.txt" ]; then
     cmake -S "$NUDGE_ROOT" -B "$NUDGE_BUILD_DIR" -DCMAKE_BUILD_TYPE=Release >/dev/null
   fi
-  cmake --build "$NUDGE_BUILD_DIR" -j "$NUDGE_JOBS" -- --no-print-directory 2>&1 | grep -vE '^\[ *[0-9]+%\]|^Consolidate compiler|^Scanning' || true
-  [ "${PIPESTATUS[0]}" -eq 0 ]
+  nudge_log "building in $NUDGE_BUILD_DIR (the first build takes several minutes)"
+  local log
+  log=$(mktemp)
+  if ! cmake --build "$NUDGE_BUILD_DIR" -j "$NUDGE_JOBS" >"$log" 2>&1; then
+    grep -vE '^\[ *[0-9]+%\]' "$log" >&2
+    rm -f "$log"
+    nudge_log "build failed"
+    return 1
+  fi
+  grep -E 'warning:|error:' "$log" >&2 || true
+  rm -f "$log"
 }
 
 # Runs "$@" where LCM multicast stays private: inside a new network namespace with only
