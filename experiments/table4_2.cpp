@@ -7,6 +7,7 @@
 //   nudge-exp-table4_2 [--repeats 3]
 // Writes docs/results/table4_2.{json,md} and table4_2_topview.png.
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include <cmath>
 #include <cstdlib>
@@ -105,6 +106,8 @@ struct Trial {
   int valid_axes = 0;
   double ms = 0;  // detection in both images + triangulation
   Eigen::Vector3d truth_world, hit_world;
+  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> axes_world;  // every valid axis
+  double height = 0;  // the object's, along its axis
 };
 
 Trial run_trial(const ObjectCase& object, int location, int repeats) {
@@ -149,6 +152,11 @@ Trial run_trial(const ObjectCase& object, int location, int repeats) {
   const sim::CameraModel& right_cam = world.camera(1);
   t.truth_world = world.object(0).position;
   const Eigen::Vector3d truth_cam = right_cam.to_camera(t.truth_world);
+  t.height = world.object(0).height;
+  for (const auto& axis : pairing.axes) {
+    t.axes_world.emplace_back(right_cam.R.transpose() * (axis.axis.a - right_cam.t),
+                              right_cam.R.transpose() * (axis.axis.b - right_cam.t));
+  }
   double best = 1e300;
   for (const auto& axis : pairing.axes) {
     if (!axis.hit) continue;
@@ -161,6 +169,42 @@ Trial run_trial(const ObjectCase& object, int location, int repeats) {
   t.failed = best == 1e300;
   t.error_mm = t.failed ? 0 : 1000 * best;
   return t;
+}
+
+// Fig. 4.8-like 3D picture: the table with the true axes (green) and the triangulated ones (red),
+// seen obliquely, drawn with a simple perspective projection.
+cv::Mat plot_axes_3d(const std::vector<Trial>& trials) {
+  const cv::Size size(720, 540);
+  cv::Mat img(size, CV_8UC3, cv::Scalar(255, 255, 255));
+  // A virtual camera looking at the workspace from the side and above.
+  const Eigen::Vector3d eye(0.75, -0.55, 0.45), target(0.255, 0.0, 0.05);
+  const Eigen::Vector3d forward = (target - eye).normalized();
+  const Eigen::Vector3d right = forward.cross(Eigen::Vector3d::UnitZ()).normalized();
+  const Eigen::Vector3d down = forward.cross(right);
+  const double f = 950;
+  auto project = [&](const Eigen::Vector3d& p) {
+    const Eigen::Vector3d d = p - eye;
+    const double z = d.dot(forward);
+    return cv::Point(static_cast<int>(size.width / 2 + f * d.dot(right) / z),
+                     static_cast<int>(size.height / 2 + f * d.dot(down) / z));
+  };
+  for (double x = 0.15; x <= 0.36; x += 0.03) cv::line(img, project({x, -0.14, 0}), project({x, 0.14, 0}), cv::Scalar(225, 225, 225));
+  for (double y = -0.14; y <= 0.141; y += 0.03) cv::line(img, project({0.15, y, 0}), project({0.36, y, 0}), cv::Scalar(225, 225, 225));
+  for (const auto& t : trials) {
+    const Eigen::Vector3d top = t.truth_world + Eigen::Vector3d(0, 0, std::max(0.1, t.height));
+    cv::line(img, project(t.truth_world), project(top), cv::Scalar(0, 160, 0), 3, cv::LINE_AA);
+    for (const auto& [a, b] : t.axes_world) {
+      // Clip the (2 m deep) triangulated segment to the object's height above the table.
+      const Eigen::Vector3d dir = (b - a).normalized();
+      if (std::fabs(dir.z()) < 1e-6) continue;
+      const Eigen::Vector3d at0 = a + dir * ((0 - a.z()) / dir.z());
+      const Eigen::Vector3d at_top = a + dir * ((top.z() - a.z()) / dir.z());
+      cv::line(img, project(at0), project(at_top), cv::Scalar(0, 0, 220), 1, cv::LINE_AA);
+    }
+  }
+  cv::putText(img, "Table 4.2 in 3D: true axes (green), triangulated axes (red); grid 30 mm", {12, 24},
+              cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+  return img;
 }
 
 double stddev(const std::vector<double>& v) {
@@ -247,7 +291,7 @@ int main(int argc, char** argv) {
        << "| failures | " << failures << " / " << trials.size() << " | 1 / 24 |\n"
        << "| valid axes per stereo pair | " << mean(valid) << " | ≈ 1.5 |\n"
        << "| stereo pairs per second (Canny, detection ×2, 25 triangulations) | " << 1000.0 / mean(times)
-       << " | 5 |\n\n![top view](table4_2_topview.png)\n";
+       << " | 5 |\n\n![3D view](table4_2_3d.png)\n\n![top view](table4_2_topview.png)\n";
     write_result("table4_2.md", md.str());
 
     // Where each intersection lies relative to its object's true position (the origin).
@@ -259,6 +303,7 @@ int main(int argc, char** argv) {
       offsets.y.push_back(1000 * (t.hit_world.x() - t.truth_world.x()));
     }
     Series frame{"", {-8, 8}, {-8, 8}, {255, 255, 255}, false, false};  // fixes a square +-8 mm view
+    write_png("table4_2_3d.png", plot_axes_3d(trials));
     write_png("table4_2_topview.png", plot({frame, origin, offsets}, "Table 4.2: intersections around the truth, top view",
                                            "y error (mm)", "x error (mm)", {560, 560}));
   } catch (const std::exception& e) {
