@@ -13,8 +13,10 @@
 #include "nudge/symmetry/detector.hpp"
 #include "nudge/symmetry/photo.hpp"
 #include "nudge/timing.hpp"
+#include "../common/photo_tool.hpp"
 
 using namespace nudge;
+using nudge::tools::numbered;
 namespace sym = nudge::symmetry;
 
 namespace {
@@ -24,15 +26,6 @@ struct Options {
   std::string draw, accumulator, voters, edges_out, skew;
   int voters_line = 1;
 };
-
-// "out.png" -> "out_3.png" when several images are processed.
-std::string numbered(const std::string& path, size_t index, size_t count) {
-  if (count <= 1) return path;
-  const auto dot = path.rfind('.');
-  const std::string stem = dot == std::string::npos ? path : path.substr(0, dot);
-  const std::string ext = dot == std::string::npos ? ".png" : path.substr(dot);
-  return stem + "_" + std::to_string(index + 1) + ext;
-}
 
 void write_image(const std::string& path, const cv::Mat& image) {
   if (!cv::imwrite(path, image)) throw std::runtime_error("cannot write " + path);
@@ -74,10 +67,11 @@ bool process(const std::string& path, size_t index, size_t count, const Options&
   }
   const sym::PhotoDetection found = sym::detect_photo(image, opt.photo);
   std::cout << json_for(path, found.in_image, found.params, found.edge_params) << std::endl;
-  // Pictures are drawn at the working size, where the edges live.
-  const auto& lines = found.at_working_size.lines;
-  if (!opt.draw.empty()) write_image(numbered(opt.draw, index, count), sym::draw_lines(found.edge_image, lines));
-  if (!opt.edges_out.empty()) write_image(numbered(opt.edges_out, index, count), found.edge_image);
+  // Lines and edges are drawn at the photograph's size (edges scaled up from the working size).
+  const cv::Mat edges_full = tools::at_size(found.edge_image, image.size());
+  if (!opt.draw.empty()) write_image(numbered(opt.draw, index, count), sym::draw_lines(edges_full, found.in_image.lines));
+  if (!opt.edges_out.empty()) write_image(numbered(opt.edges_out, index, count), edges_full);
+  const auto& lines = found.at_working_size.lines;  // the voters live at the working size
   if (!opt.accumulator.empty()) {
     sym::Detector detector(found.params, found.edge_params);
     write_image(numbered(opt.accumulator, index, count), sym::accumulator_image(detector.vote(found.edges)));
@@ -104,22 +98,10 @@ int main(int argc, char** argv) {
               "Defaults scale with the image: dmin 5% of the short side, dmax 50% of the long side,\n"
               "blur sigma max(1, short side / 480), Canny thresholds from the image's gradients.");
   flags.set_positional("IMAGE...", "image files");
-  flags.add_int("lines", &opt.photo.params.num_lines, "symmetry lines per image (Nlines)");
-  flags.add_double("dmin", &opt.photo.dmin, "minimum pairing distance, px (default: scaled)");
-  flags.add_double("dmax", &opt.photo.dmax, "maximum pairing distance, px; 0 = none (default: scaled)");
-  flags.add_double("theta-min", &opt.photo.params.theta_min_deg, "orientation limit, degrees");
-  flags.add_double("theta-max", &opt.photo.params.theta_max_deg, "orientation limit, degrees (min > max wraps)");
-  flags.add_doubles("canny", &opt.photo.canny, 2, "Canny thresholds LOW HIGH (default: from the image)");
-  flags.add_double("blur", &opt.photo.blur, "Gaussian blur sigma before Canny; 0 = none (default: scaled)");
-  flags.add_double("min-peak-ratio", &opt.photo.params.min_peak_ratio, "drop peaks below this fraction of the top");
-  flags.add_int("suppress-r", &opt.photo.params.suppress_r, "non-maximum suppression half-size in R, px");
-  flags.add_int("suppress-theta", &opt.photo.params.suppress_theta, "non-maximum suppression half-size, deg");
-  flags.add_bool("once-per-row", &opt.photo.params.once_per_row, "a row of Rot increments a bin at most once");
-  flags.add_int("max-row-pixels", &opt.photo.params.max_row_pixels, "skip rows of Rot with more pixels (0: off)");
+  tools::add_photo_flags(flags, &opt.photo);
   flags.add_bool("anti-alias", &opt.photo.params.anti_alias, "3x3 Gaussian vote kernel");
   flags.add_string("skew", &opt.skew, "skew angles to try, degrees, comma-separated (e.g. -20,-10,10,20)");
   flags.add_int("threads", &opt.photo.params.threads, "threads across angles");
-  flags.add_int("max-side", &opt.photo.max_side, "detect on a copy scaled to this long side, px (0: full size)");
   flags.add_string("draw", &opt.draw, "write the edges with the detected lines to this PNG");
   flags.add_string("edges", &opt.edges_out, "write the Canny edge image to this PNG");
   flags.add_string("accumulator", &opt.accumulator, "write the Hough accumulator (theta across, R down)");
@@ -130,13 +112,7 @@ int main(int argc, char** argv) {
     std::stringstream ss(opt.skew);
     for (std::string item; std::getline(ss, item, ',');)
       if (!item.empty()) opt.photo.params.skew_deg.push_back(parse_double(item, "--skew"));
-    sym::Params check = opt.photo.params;
-    check.dmin = std::max(0.0, opt.photo.dmin);
-    check.dmax = opt.photo.dmax >= 0 ? opt.photo.dmax : 0;
-    sym::validate(check);
-    if (opt.photo.canny.size() == 2) sym::validate(sym::EdgeParams{0, opt.photo.canny[0], opt.photo.canny[1], false});
-    if (opt.photo.blur > 50) throw FlagError("--blur must be in [0, 50]");
-    if (opt.photo.max_side < 0) throw FlagError("--max-side must be >= 0");
+    tools::validate_photo_options(opt.photo);
   } catch (const std::exception& e) {
     std::cerr << "nudge-detect: " << e.what() << "\n";
     return 2;
@@ -145,15 +121,7 @@ int main(int argc, char** argv) {
     std::cerr << flags.help();
     return 2;
   }
-  bool all_ok = true;
-  const auto& images = flags.positional();
-  for (size_t i = 0; i < images.size(); ++i) {
-    try {
-      all_ok &= process(images[i], i, images.size(), opt);
-    } catch (const std::exception& e) {
-      log::error() << images[i] << ": " << e.what();
-      all_ok = false;
-    }
-  }
-  return all_ok ? 0 : 1;
+  return tools::run_on_images(flags.positional(), [&](const std::string& path, size_t index, size_t count) {
+    return process(path, index, count, opt);
+  });
 }

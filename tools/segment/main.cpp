@@ -13,46 +13,36 @@
 #include "nudge/segmentation/segment.hpp"
 #include "nudge/symmetry/detector.hpp"
 #include "nudge/timing.hpp"
+#include "../common/photo_tool.hpp"
 
 using namespace nudge;
 namespace sym = nudge::symmetry;
 namespace seg = nudge::segmentation;
+using nudge::tools::numbered;
 
 namespace {
 
 struct Options {
-  sym::Params params;
+  sym::PhotoOptions photo;
   seg::SegmentParams segment;
-  std::vector<double> canny;
   std::string draw;
-  double blur = -1, dmin = -1, dmax = -1, max_width = -1;
+  double max_width = -1;
 };
 
-// "out.png" -> "out_3.png" when several images are processed.
-std::string numbered(const std::string& path, size_t index, size_t count) {
-  if (count <= 1) return path;
-  const auto dot = path.rfind('.');
-  const std::string stem = dot == std::string::npos ? path : path.substr(0, dot);
-  const std::string ext = dot == std::string::npos ? ".png" : path.substr(dot);
-  return stem + "_" + std::to_string(index + 1) + ext;
+// MAXw follows Dmax ("usually set to Dmax", sec. 4.2.2), at the working size.
+seg::SegmentParams segment_params(const Options& opt, const sym::PhotoDetection& found) {
+  seg::SegmentParams s = opt.segment;
+  const double long_side = std::max(found.working_image.cols, found.working_image.rows);
+  s.max_width = opt.max_width > 0 ? opt.max_width : found.params.dmax > 0 ? found.params.dmax : long_side;
+  return s;
 }
 
-// Defaults that scale with the photograph, as nudge-detect's (the thesis' 25/250 px and blur 1 at
-// 640x480); MAXw follows Dmax ("usually set to Dmax", sec. 4.2.2).
-void fill_image_defaults(const cv::Mat& image, const Options& opt, sym::Params* p, sym::EdgeParams* e,
-                         seg::SegmentParams* s) {
-  const double short_side = std::min(image.cols, image.rows), long_side = std::max(image.cols, image.rows);
-  *p = opt.params;
-  p->dmin = opt.dmin >= 0 ? opt.dmin : std::max(5.0, 0.05 * short_side);
-  p->dmax = opt.dmax >= 0 ? opt.dmax : 0.5 * long_side;
-  e->blur_sigma = opt.blur >= 0 ? opt.blur : std::max(1.0, short_side / 480.0);
-  e->auto_canny = opt.canny.size() != 2;
-  if (!e->auto_canny) {
-    e->canny_low = opt.canny[0];
-    e->canny_high = opt.canny[1];
-  }
-  *s = opt.segment;
-  s->max_width = opt.max_width > 0 ? opt.max_width : p->dmax > 0 ? p->dmax : long_side;
+// Contour points from the working size back to the photograph's pixels.
+std::vector<cv::Point2d> to_image(const std::vector<cv::Point2d>& points, cv::Size from, cv::Size to) {
+  std::vector<cv::Point2d> out;
+  for (const auto& p : points)
+    out.emplace_back((p.x + 0.5) * to.width / from.width - 0.5, (p.y + 0.5) * to.height / from.height - 0.5);
+  return out;
 }
 
 const cv::Scalar kColours[] = {{0, 0, 255}, {0, 200, 0}, {255, 80, 0}, {255, 0, 255}, {0, 160, 255}, {255, 255, 0}};
@@ -105,24 +95,24 @@ bool process(const std::string& path, size_t index, size_t count, const Options&
     log::error() << path << ": cannot read the image (missing, unreadable or not an image)";
     return false;
   }
-  sym::Params p;
-  sym::EdgeParams e;
-  seg::SegmentParams s;
-  fill_image_defaults(image, opt, &p, &e, &s);
+  const sym::PhotoDetection detected = sym::detect_photo(image, opt.photo);
+  const seg::SegmentParams s = segment_params(opt, detected);
   Stopwatch watch;
-  cv::Mat edge_image;
-  const sym::EdgeSet edges = sym::detect_edges(image, e, &edge_image);
-  const double edges_ms = watch.lap_ms();
-  const sym::Result result = sym::Detector(p, e).detect(edges);
-  watch.restart();
   const seg::Segmenter segmenter(s);
-  std::vector<Segmented> found;
-  for (const sym::Line& line : result.lines) found.push_back({line, segmenter.segment(edges, line)});
+  std::vector<Segmented> at_work;
+  for (const sym::Line& line : detected.at_working_size.lines) at_work.push_back({line, segmenter.segment(detected.edges, line)});
   const double segment_ms = watch.elapsed_ms();
-  std::cout << json_for(path, result, found, edges_ms, segment_ms, s) << std::endl;
+  // Report in the photograph's coordinates.
+  std::vector<Segmented> found = at_work;
+  for (size_t i = 0; i < found.size(); ++i) {
+    found[i].line = detected.in_image.lines[i];
+    found[i].contour.left = to_image(at_work[i].contour.left, detected.working_image.size(), image.size());
+    found[i].contour.right = to_image(at_work[i].contour.right, detected.working_image.size(), image.size());
+  }
+  std::cout << json_for(path, detected.in_image, found, detected.in_image.ms.edges_ms, segment_ms, s) << std::endl;
 
-  if (!opt.draw.empty()) {
-    cv::Mat picture = edge_image;
+  if (!opt.draw.empty()) {  // at the photograph's size, over the edges scaled up from the working size
+    cv::Mat picture = tools::at_size(detected.edge_image, image.size());
     for (size_t i = 0; i < found.size(); ++i)
       picture = seg::draw_contour(picture, found[i].contour, found[i].line, kColours[i % std::size(kColours)]);
     const std::string out = numbered(opt.draw, index, count);
@@ -137,31 +127,20 @@ int main(int argc, char** argv) {
   log::set_component("segment");
   cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);  // we report bad files ourselves
   Options opt;
-  opt.params.num_lines = 3;
+  opt.photo.params.num_lines = 3;
   Flags flags("nudge-segment",
               "Segments object contours about their symmetry lines (Li 2008, sec. 4.2) and prints one JSON\n"
               "object per image: {image, width, height, edges, contours: [{line: {r, theta_deg, votes},\n"
               "score, cells, left: [[x, y]...], right: [[x, y]...]}], ms}. Contour sides run along the line.\n"
               "Detection defaults scale with the image as nudge-detect's; MAXw defaults to Dmax.");
   flags.set_positional("IMAGE...", "image files");
-  flags.add_int("lines", &opt.params.num_lines, "symmetry lines per image to segment (strongest first)");
-  flags.add_double("dmin", &opt.dmin, "minimum pairing distance, px (default: scaled)");
-  flags.add_double("dmax", &opt.dmax, "maximum pairing distance, px; 0 = none (default: scaled)");
-  flags.add_double("theta-min", &opt.params.theta_min_deg, "orientation limit, degrees");
-  flags.add_double("theta-max", &opt.params.theta_max_deg, "orientation limit, degrees (min > max wraps)");
-  flags.add_doubles("canny", &opt.canny, 2, "Canny thresholds LOW HIGH (default: from the image)");
-  flags.add_double("blur", &opt.blur, "Gaussian blur sigma before Canny; 0 = none (default: scaled)");
+  tools::add_photo_flags(flags, &opt.photo);
   flags.add_double("max-width", &opt.max_width, "MAXw: widest edge pair in the SEPT, px (default: Dmax)");
   flags.add_double("max-mid", &opt.segment.max_mid, "MAXmid: largest midpoint deviation, px");
   flags.add_string("draw", &opt.draw, "write the edge image with the lines and contours to this PNG");
   try {
     if (!flags.parse(argc, argv)) return 0;
-    sym::Params check = opt.params;
-    check.dmin = std::max(0.0, opt.dmin);
-    check.dmax = opt.dmax >= 0 ? opt.dmax : 0;
-    sym::validate(check);
-    if (opt.canny.size() == 2) sym::validate(sym::EdgeParams{0, opt.canny[0], opt.canny[1], false});
-    if (opt.blur > 50) throw FlagError("--blur must be in [0, 50]");
+    tools::validate_photo_options(opt.photo);
     seg::SegmentParams seg_check = opt.segment;
     if (opt.max_width > 0) seg_check.max_width = opt.max_width;
     seg::validate(seg_check);
@@ -173,15 +152,7 @@ int main(int argc, char** argv) {
     std::cerr << flags.help();
     return 2;
   }
-  bool all_ok = true;
-  const auto& images = flags.positional();
-  for (size_t i = 0; i < images.size(); ++i) {
-    try {
-      all_ok &= process(images[i], i, images.size(), opt);
-    } catch (const std::exception& e) {
-      log::error() << images[i] << ": " << e.what();
-      all_ok = false;
-    }
-  }
-  return all_ok ? 0 : 1;
+  return tools::run_on_images(flags.positional(), [&](const std::string& path, size_t index, size_t count) {
+    return process(path, index, count, opt);
+  });
 }
