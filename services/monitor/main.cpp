@@ -70,10 +70,7 @@ int main(int argc, char** argv) {
     f.add_doubles("truth-tolerance", &tolerance, 2, "a true axis counts as found within R px and theta deg");
     if (!service.parse(argc, argv)) return 0;
     if (!(tolerance[0] > 0 && tolerance[1] > 0)) throw FlagError("--truth-tolerance must be > 0");
-    std::vector<std::string> list;
-    std::stringstream ss(channels);
-    for (std::string c; std::getline(ss, c, ',');)
-      if (!c.empty()) list.push_back(c);
+    const std::vector<std::string> list = split_list(channels);
     if (list.empty()) throw FlagError("--channels is empty");
     if (!draw_dir.empty()) ::mkdir(draw_dir.c_str(), 0755);
     service.start();

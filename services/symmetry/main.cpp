@@ -17,14 +17,6 @@ using namespace nudge;
 
 namespace {
 
-std::vector<std::string> split(const std::string& list) {
-  std::vector<std::string> out;
-  std::stringstream ss(list);
-  for (std::string item; std::getline(ss, item, ',');)
-    if (!item.empty()) out.push_back(item);
-  return out;
-}
-
 // CAMERA_LEFT -> SYMMETRY_LEFT (or CONTOURS_LEFT); other names get the prefix.
 std::string output_channel(const std::string& input, const std::string& kind) {
   const std::string prefix = "CAMERA";
@@ -100,7 +92,7 @@ int main(int argc, char** argv) {
     if (params.dmax > 0) segment_params.max_width = params.dmax;  // thesis: MAXw is usually Dmax
     const segmentation::Segmenter segmenter(segment_params);
     service.start();
-    for (const auto& channel : split(inputs)) {
+    for (const auto& channel : split_list(inputs)) {
       const std::string out = output_channel(channel, "SYMMETRY");
       const std::string contours_out = output_channel(channel, "CONTOURS");
       service.subscriptions().subscribe<image_t>(channel, [&, out, contours_out](const image_t& msg, const std::string&) {

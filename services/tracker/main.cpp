@@ -20,14 +20,6 @@ using namespace nudge;
 
 namespace {
 
-std::vector<std::string> split(const std::string& list) {
-  std::vector<std::string> out;
-  std::stringstream ss(list);
-  for (std::string item; std::getline(ss, item, ',');)
-    if (!item.empty()) out.push_back(item);
-  return out;
-}
-
 std::string default_output(const std::string& input) {
   const std::string prefix = "CAMERA";
   if (input.rfind(prefix, 0) == 0) return "TRACK" + input.substr(prefix.size());
@@ -114,8 +106,8 @@ int main(int argc, char** argv) {
     f.add_bool("no-mask", &no_mask, "do not send the block motion mask in track_t");
     if (!service.parse(argc, argv)) return 0;
     const bool send_mask = !no_mask;
-    const std::vector<std::string> in_channels = split(inputs);
-    std::vector<std::string> out_channels = split(outputs);
+    const std::vector<std::string> in_channels = split_list(inputs);
+    std::vector<std::string> out_channels = split_list(outputs);
     if (in_channels.empty()) throw FlagError("--inputs names no channel");
     if (!out_channels.empty() && out_channels.size() != in_channels.size())
       throw FlagError("--outputs must name one channel per input");

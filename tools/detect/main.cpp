@@ -109,9 +109,7 @@ int main(int argc, char** argv) {
   flags.add_int("voters-line", &opt.voters_line, "which line (1 = strongest) --voters shows");
   try {
     if (!flags.parse(argc, argv)) return 0;
-    std::stringstream ss(opt.skew);
-    for (std::string item; std::getline(ss, item, ',');)
-      if (!item.empty()) opt.photo.params.skew_deg.push_back(parse_double(item, "--skew"));
+    for (const auto& item : split_list(opt.skew)) opt.photo.params.skew_deg.push_back(parse_double(item, "--skew"));
     tools::validate_photo_options(opt.photo);
   } catch (const std::exception& e) {
     std::cerr << "nudge-detect: " << e.what() << "\n";

@@ -29,6 +29,14 @@ int parse_int(const std::string& text, const std::string& what) {
   return static_cast<int>(value);
 }
 
+std::vector<std::string> split_list(const std::string& list, char separator) {
+  std::vector<std::string> items;
+  std::stringstream ss(list);
+  for (std::string item; std::getline(ss, item, separator);)
+    if (!item.empty()) items.push_back(item);
+  return items;
+}
+
 Flags::Flags(std::string program, std::string summary)
     : program_(std::move(program)), summary_(std::move(summary)) {}
 

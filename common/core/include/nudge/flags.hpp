@@ -52,6 +52,9 @@ class Flags {
   std::map<std::string, bool> given_;
 };
 
+// "a,b,,c" -> {"a", "b", "c"}: the items of a comma-separated flag value, empty ones dropped.
+std::vector<std::string> split_list(const std::string& list, char separator = ',');
+
 // Strict numeric parsing: the whole string must be a finite number.
 double parse_double(const std::string& text, const std::string& what);
 int parse_int(const std::string& text, const std::string& what);
