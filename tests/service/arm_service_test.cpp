@@ -18,8 +18,11 @@
 #include "nudge/robot/motions.hpp"
 #include "nudge/robot/puma260.hpp"
 #include "nudge/sim_state_t.hpp"
+#include "lcm_log.hpp"
 
 namespace {
+
+using nudge::test::encode;
 
 using nudge::arm_command_t;
 using nudge::arm_state_t;
@@ -35,13 +38,6 @@ constexpr int kMoving = arm_state_t::MOTION_MOVING, kDone = arm_state_t::MOTION_
 // Per-process names: several build trees may run their tests at the same time.
 std::string temp_path(const std::string& name) {
   return testing::TempDir() + "/" + std::to_string(getpid()) + "_" + name;
-}
-
-template <typename Msg>
-std::vector<uint8_t> encode(const Msg& msg) {
-  std::vector<uint8_t> bytes(msg.getEncodedSize());
-  msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
-  return bytes;
 }
 
 // An input log under construction: events must be added in time order.

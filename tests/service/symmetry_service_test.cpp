@@ -16,32 +16,20 @@
 #include "nudge/symmetry/detector.hpp"
 #include "nudge/symmetry/synthetic.hpp"
 #include "nudge/symmetry_lines_t.hpp"
+#include "lcm_log.hpp"
 
 namespace syn = nudge::symmetry::synthetic;
 
 namespace {
+
+using nudge::test::encode;
+using nudge::test::write_event;
 
 constexpr double kDeg = M_PI / 180.0;
 
 struct Truth {
   double r, theta;
 };
-
-void write_event(lcm::LogFile& log, int64_t utime, const std::string& channel, const std::vector<uint8_t>& bytes) {
-  lcm::LogEvent ev{};
-  ev.timestamp = utime;
-  ev.channel = channel;
-  ev.datalen = static_cast<int32_t>(bytes.size());
-  ev.data = const_cast<uint8_t*>(bytes.data());
-  ASSERT_EQ(log.writeEvent(&ev), 0);
-}
-
-template <typename Msg>
-std::vector<uint8_t> encode(const Msg& msg) {
-  std::vector<uint8_t> bytes(msg.getEncodedSize());
-  msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
-  return bytes;
-}
 
 // Frames with one upright bottle each, at known axes.
 std::map<int64_t, Truth> write_input_log(const std::string& path) {

@@ -17,10 +17,14 @@
 #include "nudge/symmetry/synthetic.hpp"
 #include "nudge/track_t.hpp"
 #include "nudge/tracker_command_t.hpp"
+#include "lcm_log.hpp"
 
 namespace syn = nudge::symmetry::synthetic;
 
 namespace {
+
+using nudge::test::encode;
+using nudge::test::write_event;
 
 constexpr double kDeg = M_PI / 180.0;
 constexpr int64_t kStart = 1000000, kPeriod = 40000;  // 25 fps
@@ -50,22 +54,6 @@ cv::Mat frame(int i) {
   for (int k = 0; k < 4; ++k)
     syn::draw_shape(img, syn::bottle_profile(220, 40 * shades[k]), t.r, t.theta, 0, cv::Scalar(40 + 25 * k));
   return img;
-}
-
-template <typename Msg>
-std::vector<uint8_t> encode(const Msg& msg) {
-  std::vector<uint8_t> bytes(msg.getEncodedSize());
-  msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
-  return bytes;
-}
-
-void write_event(lcm::LogFile& log, int64_t utime, const std::string& channel, const std::vector<uint8_t>& bytes) {
-  lcm::LogEvent ev{};
-  ev.timestamp = utime;
-  ev.channel = channel;
-  ev.datalen = static_cast<int32_t>(bytes.size());
-  ev.data = const_cast<uint8_t*>(bytes.data());
-  ASSERT_EQ(log.writeEvent(&ev), 0);
 }
 
 void write_input_log(const std::string& path) {

@@ -28,11 +28,15 @@
 #include "nudge/geometry/workspace.hpp"
 #include "nudge/heartbeat_t.hpp"
 #include "nudge/symmetry_lines_t.hpp"
+#include "lcm_log.hpp"
 
 namespace geo = nudge::geometry;
 namespace sym = nudge::symmetry;
 
 namespace {
+
+using nudge::test::encode;
+using nudge::test::write_event;
 
 constexpr double kDeg = M_PI / 180.0;
 constexpr int kWidth = 640, kHeight = 480;
@@ -122,22 +126,6 @@ Object observe(const geo::StereoRig& rig, const std::string& name, double latera
 std::array<double, 4> table_plane_in_right(const geo::StereoRig& rig) {
   const Eigen::Vector3d n = rig.R * table_up(), p = rig.left_to_right(table_at(0, 0.6));
   return {n.x(), n.y(), n.z(), -n.dot(p)};
-}
-
-void write_event(lcm::LogFile& log, int64_t utime, const std::string& channel, const std::vector<uint8_t>& bytes) {
-  lcm::LogEvent ev{};
-  ev.timestamp = utime;
-  ev.channel = channel;
-  ev.datalen = static_cast<int32_t>(bytes.size());
-  ev.data = const_cast<uint8_t*>(bytes.data());
-  ASSERT_EQ(log.writeEvent(&ev), 0);
-}
-
-template <typename Msg>
-std::vector<uint8_t> encode(const Msg& msg) {
-  std::vector<uint8_t> bytes(msg.getEncodedSize());
-  msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
-  return bytes;
 }
 
 nudge::symmetry_lines_t lines_message(const std::vector<sym::Line>& lines, int64_t utime, const std::string& camera) {

@@ -30,8 +30,11 @@
 #include "nudge/sim_truth_t.hpp"
 #include "nudge/snapshot_request_t.hpp"
 #include "nudge/symmetry/detector.hpp"
+#include "lcm_log.hpp"
 
 namespace {
+
+using nudge::test::encode;
 
 constexpr double kDeg = M_PI / 180.0;
 const std::string kBin = NUDGE_BIN_DIR;
@@ -64,13 +67,6 @@ void write_log(const std::string& path, const std::vector<Event>& events) {
     ev.data = const_cast<uint8_t*>(e.data.data());
     ASSERT_EQ(log.writeEvent(&ev), 0);
   }
-}
-
-template <typename Msg>
-std::vector<uint8_t> encode(const Msg& msg) {
-  std::vector<uint8_t> bytes(msg.getEncodedSize());
-  msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
-  return bytes;
 }
 
 template <typename Msg>
