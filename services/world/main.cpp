@@ -1,7 +1,8 @@
 // world: the simulated lab (MuJoCo physics of the table, the objects and the arm's pusher pad).
 // Publishes SIM_STATE at --rate in simulated time, answers SIM_TRUTH_REQUEST with SIM_TRUTH
-// (state + both cameras' object masks), and puts the pusher at the arm's tool point from
-// ARM_STATE. All logic runs on simulated time; see docs/sim.md, "The world service".
+// (state + both cameras' object masks), and puts the pusher (or, with --tool gripper, the
+// gripper, its opening from ARM_STATE.gripper) at the arm's tool point from ARM_STATE. All logic
+// runs on simulated time; see docs/sim.md, "The world service".
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -46,8 +47,8 @@ pose_t to_pose(const Eigen::Vector3d& p, const Eigen::Quaterniond& q) {
 // The world's physics, its pusher (driven by the arm) and what it publishes, on simulated time.
 class Simulation {
  public:
-  Simulation(bus::Service& service, const sim::Scene& scene, double rate)
-      : service_(service), world_(scene) {
+  Simulation(bus::Service& service, const sim::Scene& scene, double rate, bool gripper)
+      : service_(service), world_(scene), gripper_(gripper) {
     const double period = 1.0 / rate;
     steps_per_state_ = std::max<int64_t>(1, std::llround(period / world_.timestep()));
     if (std::abs(steps_per_state_ * world_.timestep() - period) > 1e-9)
@@ -82,8 +83,10 @@ class Simulation {
     while (step_ % steps_per_state_ != 0 && !finished());
   }
 
-  // The arm's contract: the tool point is the pad centre; the pad faces the horizontal direction
-  // of the tool's x axis (the previous yaw is kept while that axis points straight up or down).
+  // The arm's contract: the tool point is the pad centre (the gripper's centre with --tool
+  // gripper); the pad faces the horizontal direction of the tool's x axis (the previous yaw is kept
+  // while that axis points straight up or down); the gripper's fingers close across it, towards
+  // the opening ARM_STATE.gripper.
   void on_arm_state(const arm_state_t& msg) {
     const Eigen::Vector3d p(msg.end_effector.position[0], msg.end_effector.position[1], msg.end_effector.position[2]);
     const Eigen::Quaterniond q(msg.end_effector.orientation[0], msg.end_effector.orientation[1],
@@ -94,7 +97,10 @@ class Simulation {
     for (double j : msg.joints)
       if (!std::isfinite(j)) throw std::invalid_argument("joints: not finite");
     if (const auto yaw = sim::pad_yaw_from_tool(q)) pusher_yaw_ = *yaw;
-    world_.set_pusher(p, pusher_yaw_);
+    if (gripper_)
+      world_.set_end_effector(p, pusher_yaw_, msg.gripper);
+    else
+      world_.set_pusher(p, pusher_yaw_);
     arm_ = msg;
   }
 
@@ -146,6 +152,7 @@ class Simulation {
   int64_t steps_per_state_ = 1;
   double end_time_ = std::numeric_limits<double>::infinity();
   double pusher_yaw_ = 0;
+  bool gripper_ = false;  // the arm's tool is the gripper (else the pad)
   std::optional<arm_state_t> arm_;
 };
 
@@ -233,7 +240,8 @@ int main(int argc, char** argv) {
   return bus::guarded_main("world", [&] {
     bus::Service service("world",
                          "The simulated world: MuJoCo physics of a scene (docs/sim.md). Publishes SIM_STATE,\n"
-                         "answers SIM_TRUTH_REQUEST on SIM_TRUTH, puts the pusher at ARM_STATE's tool point.");
+                         "answers SIM_TRUTH_REQUEST on SIM_TRUTH, puts the pusher (--tool gripper: the gripper)\n"
+                         "at ARM_STATE's tool point.");
     std::string scene_file;
     int seed = -1;
     double realtime_factor = 1.0, rate = 25.0, duration = 0.0;
@@ -244,6 +252,8 @@ int main(int argc, char** argv) {
                  "simulated seconds per wall-clock second (1: real time, 0: as fast as possible)");
     f.add_double("rate", &rate, "SIM_STATE messages per simulated second");
     f.add_double("duration", &duration, "stop after this many simulated seconds (0: run until stopped)");
+    std::string tool = "pad";
+    f.add_string("tool", &tool, "the arm's tool: pad (pushes) or gripper (grasps; fingers follow ARM_STATE.gripper)");
     double log_origin_s = -1;
     f.add_double("log-origin", &log_origin_s,
                  "input from a log: the utime (s) that is simulated time 0 (-1: automatic, docs/sim.md)");
@@ -253,6 +263,7 @@ int main(int argc, char** argv) {
     if (!(rate > 0 && std::isfinite(rate))) throw FlagError("--rate must be > 0");
     if (!(duration >= 0 && std::isfinite(duration))) throw FlagError("--duration must be >= 0");
     if (seed < -1) throw FlagError("--seed must be >= 0 (or -1 for the scene's)");
+    if (tool != "pad" && tool != "gripper") throw FlagError("--tool must be pad or gripper, not '" + tool + "'");
     if (!(log_origin_s >= 0 || log_origin_s == -1)) throw FlagError("--log-origin must be >= 0 (or -1)");
     const int64_t log_origin = log_origin_s >= 0 ? std::llround(log_origin_s * 1e6) : -1;
     sim::Scene scene;
@@ -264,7 +275,7 @@ int main(int argc, char** argv) {
     if (seed >= 0) scene.seed = static_cast<uint64_t>(seed);
 
     service.start();
-    Simulation sim(service, scene, rate);
+    Simulation sim(service, scene, rate, tool == "gripper");
     if (duration > 0) sim.set_end_time(duration);
     const bool from_log = service.input_is_log();
     Inputs inputs(service, sim, from_log, log_origin >= 0 ? std::optional<int64_t>(log_origin) : std::nullopt);

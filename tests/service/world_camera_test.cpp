@@ -304,6 +304,55 @@ TEST(World, ArmStateDrivesThePusherTruthIsAnsweredAndTheRunIsDeterministic) {
   }
 }
 
+// With --tool gripper the arm's tool point carries the gripper and ARM_STATE.gripper is its
+// opening: descend open around a bottle, close, lift 5 cm; the bottle goes up with the fingers,
+// the same way every run.
+TEST(World, WithTheGripperToolArmStateGraspsAndLiftsABottle) {
+  const std::string dir = testing::TempDir();
+  const std::string scene = write_scene("world_grip", "  - { kind: bottle, name: bottle, position: [0.25, 0.0] }\n");
+  const std::string in = dir + "/world_grip_in.lcmlog";
+  std::vector<Event> input;
+  nudge::arm_state_t arm{};
+  arm.end_effector.orientation[0] = 1;  // tool x axis along world x: the fingers close along y
+  for (int k = 0; k <= 300; ++k) {  // 100 Hz from t = 0.5 s, stamped in simulated time
+    const double t = 0.01 * k;
+    arm.utime = 500000 + 10000 * k;
+    arm.end_effector.position[0] = 0.25;
+    arm.end_effector.position[1] = 0.0;
+    // 0-1 s: down from 0.25 to 0.06 m, open; 1-2 s: close; 2-3 s: up 5 cm.
+    arm.end_effector.position[2] = t < 1 ? 0.25 - 0.19 * t : t < 2 ? 0.06 : 0.06 + 0.05 * (t - 2);
+    arm.gripper = t < 1 ? 0.10 : t < 2 ? 0.10 * (2 - t) : 0.0;
+    input.push_back({arm.utime, "ARM_STATE", encode(arm)});
+  }
+  write_log(in, input);
+  std::vector<std::vector<uint8_t>> outputs[2];  // SIM_STATE messages of two runs
+  for (int r = 0; r < 2; ++r) {
+    const std::string out = dir + "/world_grip_out" + std::to_string(r) + ".lcmlog";
+    std::remove(out.c_str());
+    ASSERT_EQ(run(kBin + "/nudge-world --scene " + scene + " --tool gripper --duration 4 --lcm-in 'file://" + in +
+                  "?speed=0' --lcm-out 'file://" + out + "?mode=w'"),
+              0);
+    for (const Event& e : read_log(out))
+      if (e.channel == "SIM_STATE") outputs[r].push_back(e.data);
+  }
+  EXPECT_EQ(outputs[0], outputs[1]) << "deterministic";
+  std::map<int64_t, nudge::sim_state_t> states;
+  for (const auto& data : outputs[0]) {
+    const auto s = decode<nudge::sim_state_t>(Event{0, "SIM_STATE", data});
+    states[s.utime] = s;
+  }
+  ASSERT_EQ(states.size(), 4 * 25 + 1);
+  const auto& before = states.at(0).objects.at(0).pose.position;
+  const auto& closed = states.at(2480000).objects.at(0).pose.position;
+  const auto& lifted = states.at(4000000);
+  EXPECT_NEAR(closed[2], before[2], 1e-3) << "still on the table after closing";
+  EXPECT_NEAR(lifted.objects.at(0).pose.position[2] - before[2], 0.05, 0.005) << "lifted with the fingers";
+  EXPECT_NEAR(lifted.objects.at(0).pose.position[0], before[0], 0.005);
+  EXPECT_GT(lifted.objects.at(0).axis_direction[2], std::cos(3 * kDeg));
+  EXPECT_DOUBLE_EQ(lifted.gripper, 0.0);
+  EXPECT_EQ(run(kBin + "/nudge-world --scene " + scene + " --tool spoon --duration 1 2>/dev/null"), 2);
+}
+
 TEST(World, BadSceneOrFlagsExitWithAUsageErrorNamingTheProblem) {
   const std::string scene = write_scene("world_bad", "  - { kind: teapot, position: [0.25, 0.0] }\n");
   const std::string err = testing::TempDir() + "/world_bad.err";

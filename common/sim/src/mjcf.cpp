@@ -89,6 +89,57 @@ const Eigen::Vector3d& pusher_pad_half_size() {
   return half;
 }
 
+const GripperGeometry& gripper_geometry() {
+  static const GripperGeometry g;
+  return g;
+}
+
+// A centred vertical cylinder of radius r touches a face through the apex (0, a) whose normal
+// makes the angle alpha with the closing axis when r = a cos(alpha).
+double GripperGeometry::apex_for_opening(double opening) const {
+  return 0.5 * opening / std::cos(groove_half_angle);
+}
+
+double GripperGeometry::opening_for_apex(double apex) const {
+  return 2.0 * apex * std::cos(groove_half_angle);
+}
+
+namespace {
+
+// One finger: a body on a slide joint along `side` * tool y, its groove's apex at the body
+// origin, two rows of two faces opening towards the tool point.
+void add_finger(Xml& x, const std::string& name, int side) {
+  const GripperGeometry& g = gripper_geometry();
+  const double a = g.groove_half_angle, ca = std::cos(a), sa = std::sin(a);
+  const double range = g.apex_for_opening(g.max_opening + 0.01);
+  x << "      <body name=\"" << name << "\">\n"
+    << "        <joint name=\"" << name << "_slide\" type=\"slide\" axis=\"0 " << side
+    << " 0\" limited=\"true\" range=\"0 " << range << "\" damping=\"" << g.damping << "\"/>\n"
+    << "        <inertial pos=\"0 0 0\" mass=\"" << g.finger_mass << "\" diaginertia=\"2e-5 2e-5 2e-5\"/>\n";
+  int k = 0;
+  for (int row = -1; row <= 1; row += 2) {
+    for (int end = -1; end <= 1; end += 2) {
+      // Along the face from the apex (towards the tool point and to one side), and its outward normal.
+      const Eigen::Vector3d along(end * ca, -side * sa, 0), normal(end * sa, side * ca, 0);
+      const Eigen::Vector3d centre =
+          g.face_half_length * along + g.face_half_thickness * normal + Eigen::Vector3d(0, 0, row * g.row_offset);
+      x << "        <geom name=\"" << name << "_" << k++ << "\" type=\"box\" size=\"" << g.face_half_length
+        << ' ' << g.face_half_thickness << ' ' << g.face_half_height << "\" pos=\"" << vec(centre)
+        << "\" euler=\"0 0 " << std::atan2(along.y(), along.x()) << "\" rgba=\"0.2 0.2 0.22 1\" group=\"2\""
+        << " contype=\"2\" conaffinity=\"0\" condim=\"3\" friction=\"" << g.friction
+        << " 0.005 0.0001\" solmix=\"10\" solref=\"0.01 1\" solimp=\"0.95 0.99 0.001\"/>\n";
+    }
+  }
+  // The finger's stem up to the palm (the arm's flange, 0.15 m above the tool point): drawn,
+  // never colliding.
+  x << "        <geom name=\"" << name << "_stem\" type=\"box\" size=\"0.008 " << g.face_half_thickness
+    << " 0.07\" pos=\"0 " << side * (g.face_half_thickness + 0.002) << " 0.085\" rgba=\"0.5 0.5 0.52 1\""
+    << " group=\"2\" contype=\"0\" conaffinity=\"0\"/>\n"
+    << "      </body>\n";
+}
+
+}  // namespace
+
 std::string build_mjcf(const Scene& scene) {
   validate(scene);
   const RigSpec& rs = scene.rig;
@@ -189,9 +240,31 @@ std::string build_mjcf(const Scene& scene) {
   x << "    <body name=\"pusher\" mocap=\"true\" pos=\"" << vec(pusher_park_position()) << "\">\n"
     << "      <geom name=\"pusher_pad\" type=\"box\" size=\"" << vec(pad) << "\""
     << " rgba=\"0.95 0.8 0.25 1\" group=\"2\" contype=\"2\" conaffinity=\"2\" condim=\"3\""
-    << " friction=\"0.8 0.005 0.0001\" solmix=\"10\" solref=\"0.03 1\" solimp=\"0.6 0.9 0.01\"/>\n"
-    << "    </body>\n"
+    << " friction=\"0.8 0.005 0.0001\" solmix=\"10\" solref=\"0.03 1\" solimp=\"0.6 0.9 0.01\"/>\n";
+  const GripperGeometry& g = gripper_geometry();
+  const double range = g.apex_for_opening(g.max_opening + 0.01);
+  // The gripper's hand: a dynamic body welded to the mocap body (a mocap body has no velocity, so
+  // friction could not carry a held object along with fingers attached to it directly).
+  x << "    </body>\n"
+    << "    <body name=\"hand\" pos=\"" << vec(pusher_park_position()) << "\">\n"
+    << "      <freejoint name=\"hand_joint\"/>\n"
+    << "      <inertial pos=\"0 0 0.1\" mass=\"" << g.hand_mass << "\" diaginertia=\"2e-4 2e-4 2e-4\"/>\n"
+    << "      <geom name=\"hand_palm\" type=\"box\" size=\"0.015 " << 0.5 * g.max_opening + 0.012
+    << " 0.006\" pos=\"0 0 0.161\" rgba=\"0.5 0.5 0.52 1\" group=\"2\" contype=\"0\" conaffinity=\"0\"/>\n";
+  add_finger(x, "finger_left", 1);
+  add_finger(x, "finger_right", -1);
+  x << "    </body>\n"
     << bodies.str() << "  </worldbody>\n"
+    << "  <equality>\n"
+    << "    <weld name=\"hand_weld\" body1=\"pusher\" body2=\"hand\" relpose=\"0 0 0 1 0 0 0\""
+    << " solref=\"" << g.weld_timeconst << " 1\"/>\n"
+    << "  </equality>\n"
+    << "  <actuator>\n";
+  for (const char* finger : {"finger_left", "finger_right"})
+    x << "    <position name=\"" << finger << "_act\" joint=\"" << finger << "_slide\" kp=\"" << g.kp
+      << "\" ctrllimited=\"true\" ctrlrange=\"0 " << range << "\" forcelimited=\"true\" forcerange=\""
+      << -g.max_force << ' ' << g.max_force << "\"/>\n";
+  x << "  </actuator>\n"
     << "</mujoco>\n";
   return x.str();
 }

@@ -17,6 +17,8 @@ namespace nudge::sim {
 namespace {
 
 constexpr int kPusherGroup = 2;  // geom group of the pusher pad (hidden when !pusher_visible)
+constexpr double kMaxGripperJump = 0.02;  // m: a larger move of the tool point snaps the hand
+constexpr int kUnusedToolGroup = 3;  // the tool not in use: never drawn (mjv hides groups 3-5)
 
 mjModel* compile(const std::string& xml, const std::string& source) {
   auto vfs = std::make_unique<mjVFS>();
@@ -54,6 +56,13 @@ struct World::Impl {
   std::vector<unsigned char> geom_label;  // geom id -> object index + 1, 0 for the rest
   int pusher_mocap = -1;
   int pad_geom = -1;
+  std::vector<int> finger_geoms;     // the fingers' colliding faces
+  std::vector<int> finger_visuals;   // the fingers' other geoms (stems)
+  int finger_body[2] = {-1, -1};     // left, right
+  int finger_qpos[2] = {-1, -1};     // their slide joints
+  int hand_qpos = -1, hand_qvel = -1;  // the hand's free joint
+  int finger_act[2] = {-1, -1};
+  bool gripper = false;              // the tool in use: the gripper (else the pad)
   int camera_id[2] = {-1, -1};
   std::mt19937_64 noise_rng;
   // Distortion warps, [0] for the rig's size, [1] for snapshots (built on first use).
@@ -72,6 +81,35 @@ struct World::Impl {
 
   int object_of_geom(int geom) const {
     return geom >= 0 && geom < static_cast<int>(geom_label.size()) ? geom_label[geom] - 1 : -1;
+  }
+  bool is_tool_geom(int geom) const {
+    return geom == pad_geom || std::find(finger_geoms.begin(), finger_geoms.end(), geom) != finger_geoms.end();
+  }
+  // Puts the hand exactly on the tool point, at rest (the weld then holds it there).
+  void snap_hand() {
+    const int k = pusher_mocap;
+    for (int i = 0; i < 3; ++i) data->qpos[hand_qpos + i] = data->mocap_pos[3 * k + i];
+    for (int i = 0; i < 4; ++i) data->qpos[hand_qpos + 3 + i] = data->mocap_quat[4 * k + i];
+    for (int i = 0; i < 6; ++i) data->qvel[hand_qvel + i] = 0;
+  }
+  void place_tool(const Eigen::Vector3d& position, double yaw) {
+    const int k = pusher_mocap;
+    for (int i = 0; i < 3; ++i) data->mocap_pos[3 * k + i] = position[i];
+    data->mocap_quat[4 * k + 0] = std::cos(0.5 * yaw);
+    data->mocap_quat[4 * k + 1] = 0;
+    data->mocap_quat[4 * k + 2] = 0;
+    data->mocap_quat[4 * k + 3] = std::sin(0.5 * yaw);
+  }
+  // Collision bits and drawing group of the two tools for the one in use.
+  void apply_tool() {
+    auto set = [this](int g, int contype, int conaffinity, int group) {
+      model->geom_contype[g] = contype;
+      model->geom_conaffinity[g] = conaffinity;
+      model->geom_group[g] = group;
+    };
+    set(pad_geom, gripper ? 0 : 2, gripper ? 0 : 2, gripper ? kUnusedToolGroup : kPusherGroup);
+    for (int g : finger_geoms) set(g, gripper ? 2 : 0, 0, gripper ? kPusherGroup : kUnusedToolGroup);
+    for (int g : finger_visuals) set(g, 0, 0, gripper ? kPusherGroup : kUnusedToolGroup);
   }
 };
 
@@ -117,6 +155,34 @@ World::World(const Scene& input) : impl_(std::make_unique<Impl>()), scene_(input
     throw SimError(scene_.source + ": generated model lacks the pusher or the cameras");
   if (s.model->geom_group[s.pad_geom] != kPusherGroup)
     throw SimError(scene_.source + ": the pusher pad is not in geom group 2");
+  const int hand = mj_name2id(s.model, mjOBJ_BODY, "hand");
+  const int hand_joint = mj_name2id(s.model, mjOBJ_JOINT, "hand_joint");
+  if (hand < 0 || hand_joint < 0) throw SimError(scene_.source + ": generated model lacks the gripper's hand");
+  s.hand_qpos = s.model->jnt_qposadr[hand_joint];
+  s.hand_qvel = s.model->jnt_dofadr[hand_joint];
+  std::vector<int> gripper_bodies{hand};
+  const char* fingers[2] = {"finger_left", "finger_right"};
+  for (int f = 0; f < 2; ++f) {
+    const std::string name = fingers[f];
+    const int b = mj_name2id(s.model, mjOBJ_BODY, name.c_str());
+    const int j = mj_name2id(s.model, mjOBJ_JOINT, (name + "_slide").c_str());
+    s.finger_act[f] = mj_name2id(s.model, mjOBJ_ACTUATOR, (name + "_act").c_str());
+    if (b < 0 || j < 0 || s.finger_act[f] < 0)
+      throw SimError(scene_.source + ": generated model lacks the gripper's " + name);
+    s.finger_body[f] = b;
+    s.finger_qpos[f] = s.model->jnt_qposadr[j];
+    gripper_bodies.push_back(b);
+  }
+  for (int g = 0; g < s.model->ngeom; ++g)
+    if (std::count(gripper_bodies.begin(), gripper_bodies.end(), s.model->geom_bodyid[g]))
+      (s.model->geom_contype[g] ? s.finger_geoms : s.finger_visuals).push_back(g);
+  s.apply_tool();
+  // The gripper starts open.
+  const double open = gripper_geometry().apex_for_opening(gripper_geometry().max_opening);
+  for (int f = 0; f < 2; ++f) {
+    s.data->ctrl[s.finger_act[f]] = open;
+    s.data->qpos[s.finger_qpos[f]] = open;
+  }
 
   mj_forward(s.model, s.data);
   step_for(scene_.physics.settle_time);
@@ -141,7 +207,7 @@ std::vector<double> World::state() const {
   const mjModel* m = impl_->model;
   const mjData* d = impl_->data;
   std::vector<double> out;
-  out.reserve(1 + m->nq + 2 * m->nv + 7 * m->nmocap + m->na);
+  out.reserve(2 + m->nq + 2 * m->nv + 7 * m->nmocap + m->na + m->nu);
   out.push_back(d->time);
   out.insert(out.end(), d->qpos, d->qpos + m->nq);
   out.insert(out.end(), d->qvel, d->qvel + m->nv);
@@ -150,13 +216,15 @@ std::vector<double> World::state() const {
   out.insert(out.end(), d->act, d->act + m->na);
   // The constraint solver starts from the last accelerations: part of the state for exact replay.
   out.insert(out.end(), d->qacc_warmstart, d->qacc_warmstart + m->nv);
+  out.insert(out.end(), d->ctrl, d->ctrl + m->nu);  // the fingers' commanded positions
+  out.push_back(impl_->gripper ? 1.0 : 0.0);         // the tool in use
   return out;
 }
 
 void World::set_state(const std::vector<double>& state) {
   const mjModel* m = impl_->model;
   mjData* d = impl_->data;
-  const size_t size = 1 + m->nq + 2 * m->nv + 7 * m->nmocap + m->na;
+  const size_t size = 2 + m->nq + 2 * m->nv + 7 * m->nmocap + m->na + m->nu;
   if (state.size() != size)
     throw std::invalid_argument("World::set_state: expected " + std::to_string(size) +
                                 " values, got " + std::to_string(state.size()));
@@ -164,6 +232,7 @@ void World::set_state(const std::vector<double>& state) {
     if (!std::isfinite(v)) throw std::invalid_argument("World::set_state: non-finite value");
   const double* p = state.data();
   d->time = *p++;
+  const double* qpos = p;
   std::copy(p, p + m->nq, d->qpos);
   p += m->nq;
   std::copy(p, p + m->nv, d->qvel);
@@ -174,8 +243,17 @@ void World::set_state(const std::vector<double>& state) {
   p += 4 * m->nmocap;
   std::copy(p, p + m->na, d->act);
   p += m->na;
+  const double* warmstart = p;
+  p += m->nv;
+  std::copy(p, p + m->nu, d->ctrl);
+  p += m->nu;
+  impl_->gripper = *p != 0;
+  impl_->apply_tool();
   mj_forward(m, d);  // positions of bodies, contacts: for rendering and queries
-  std::copy(p, p + m->nv, d->qacc_warmstart);
+  // mj_forward renormalises the free joints' quaternions in qpos in place, which can change their
+  // last bits (and, through contacts, the whole future): put back the exact state.
+  std::copy(qpos, qpos + m->nq, d->qpos);
+  std::copy(warmstart, warmstart + m->nv, d->qacc_warmstart);
 }
 
 int World::object_index(const std::string& name) const {
@@ -244,13 +322,60 @@ ImageLine World::axis_in_image(int index, int camera_index) const {
 void World::set_pusher(const Eigen::Vector3d& position, double yaw) {
   if (!position.allFinite() || !std::isfinite(yaw))
     throw std::invalid_argument("World::set_pusher: position and yaw must be finite");
-  mjData* d = impl_->data;
-  const int k = impl_->pusher_mocap;
-  for (int i = 0; i < 3; ++i) d->mocap_pos[3 * k + i] = position[i];
-  d->mocap_quat[4 * k + 0] = std::cos(0.5 * yaw);
-  d->mocap_quat[4 * k + 1] = 0;
-  d->mocap_quat[4 * k + 2] = 0;
-  d->mocap_quat[4 * k + 3] = std::sin(0.5 * yaw);
+  use_gripper(false);
+  impl_->place_tool(position, yaw);
+  impl_->snap_hand();  // the gripper, not in use, rides along
+}
+
+void World::use_gripper(bool gripper) {
+  if (impl_->gripper == gripper) return;
+  impl_->gripper = gripper;
+  impl_->apply_tool();
+}
+
+void World::set_end_effector(const Eigen::Vector3d& position, double yaw, double opening) {
+  if (!position.allFinite() || !std::isfinite(yaw) || !std::isfinite(opening))
+    throw std::invalid_argument("World::set_end_effector: position, yaw and opening must be finite");
+  Impl& s = *impl_;
+  // The hand follows the tool point through a soft weld; it is put there directly when the
+  // gripper comes into use and after a jump (a new motion starting elsewhere).
+  const double jump = (position - vec3(s.data->qpos + s.hand_qpos)).norm();
+  const bool snap = !s.gripper || jump > kMaxGripperJump;
+  use_gripper(true);
+  s.place_tool(position, yaw);
+  if (snap) s.snap_hand();
+  const GripperGeometry& g = gripper_geometry();
+  const double apex = g.apex_for_opening(std::clamp(opening, 0.0, g.max_opening));
+  for (int f = 0; f < 2; ++f) s.data->ctrl[s.finger_act[f]] = apex;
+}
+
+bool World::gripper_in_use() const { return impl_->gripper; }
+
+double World::gripper_opening() const {
+  const mjtNum* q = impl_->data->qpos;
+  return gripper_geometry().opening_for_apex(0.5 * (q[impl_->finger_qpos[0]] + q[impl_->finger_qpos[1]]));
+}
+
+double World::gripper_commanded_opening() const {
+  const mjtNum* c = impl_->data->ctrl;
+  return gripper_geometry().opening_for_apex(0.5 * (c[impl_->finger_act[0]] + c[impl_->finger_act[1]]));
+}
+
+bool World::gripper_holds(int index) const {
+  if (index < 0 || index >= num_objects())
+    throw std::out_of_range("World::gripper_holds: no object " + std::to_string(index));
+  const Impl& s = *impl_;
+  if (!s.gripper) return false;
+  bool touched[2] = {false, false};
+  for (int i = 0; i < s.data->ncon; ++i) {
+    const mjContact& c = s.data->contact[i];
+    for (const auto& [tool, other] : {std::pair(c.geom1, c.geom2), std::pair(c.geom2, c.geom1)}) {
+      if (s.object_of_geom(other) != index) continue;
+      for (int f = 0; f < 2; ++f)
+        if (s.model->geom_bodyid[tool] == s.finger_body[f]) touched[f] = true;
+    }
+  }
+  return touched[0] && touched[1];
 }
 
 void World::park_pusher() { set_pusher(pusher_park_position(), 0.0); }
@@ -263,8 +388,8 @@ bool World::pusher_in_contact() const {
   const mjData* d = impl_->data;
   for (int i = 0; i < d->ncon; ++i) {
     const mjContact& c = d->contact[i];
-    if (c.geom1 == impl_->pad_geom && impl_->object_of_geom(c.geom2) >= 0) return true;
-    if (c.geom2 == impl_->pad_geom && impl_->object_of_geom(c.geom1) >= 0) return true;
+    if (impl_->is_tool_geom(c.geom1) && impl_->object_of_geom(c.geom2) >= 0) return true;
+    if (impl_->is_tool_geom(c.geom2) && impl_->object_of_geom(c.geom1) >= 0) return true;
   }
   return false;
 }

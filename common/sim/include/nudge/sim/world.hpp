@@ -70,8 +70,8 @@ class World {
   void step(int n = 1);
   void step_for(double seconds);  // whole steps, rounded to the nearest
   // The whole dynamic state: time, generalised positions and velocities, the pusher's position
-  // and orientation, the solver's warm start (for determinism checks, logging, and rewinding
-  // with set_state()).
+  // and orientation, the solver's warm start, the fingers' commanded positions and the tool in
+  // use (for determinism checks, logging, and rewinding with set_state()).
   std::vector<double> state() const;
   // Restores a state() of a World built from the same scene; stepping on from it reproduces the
   // original run exactly. Throws std::invalid_argument if the size does not match.
@@ -102,8 +102,25 @@ class World {
   // settles for `settle` s. The pad faces the direction of motion.
   PushResult push(const Eigen::Vector3d& from, const Eigen::Vector3d& to, double speed = 0.05,
                   double settle = 1.0);
-  // True when the pad touches one of the objects (contacts as of the last step).
+  // True when the tool in use (the pad, or the gripper's fingers) touches one of the objects
+  // (contacts as of the last step).
   bool pusher_in_contact() const;
+
+  // ---- the gripper (two fingers with V-grooved pads on the same tool point as the pad)
+  // Only one tool is in use at a time: set_pusher()/park_pusher()/push() use the pad (the fingers
+  // then neither collide nor show), set_end_effector() uses the gripper (the pad then neither
+  // collides nor shows). Places the tool point (the gripper's centre) at `position`, the fingers
+  // closing along the horizontal direction yaw + 90 deg (the tool's y axis; its x axis, the push
+  // direction, is `yaw`), and commands the opening (m, clamped to [0, max_opening]: the diameter
+  // of the centred vertical cylinder both grooves touch). The fingers are dynamic: position
+  // actuators drive them towards the opening and they stop on what they grip, which is then held
+  // by contact and friction only. Moves the tool point instantly: the caller steps physics.
+  void set_end_effector(const Eigen::Vector3d& position, double yaw, double opening);
+  bool gripper_in_use() const;
+  double gripper_opening() const;           // the fingers' actual opening now, m
+  double gripper_commanded_opening() const;  // m
+  // True when both fingers touch object `index` (contacts as of the last step).
+  bool gripper_holds(int index) const;
 
   // ---- rendering (OSMesa context created on first use)
   cv::Mat render(int camera);       // BGR, rig width x height
@@ -114,10 +131,11 @@ class World {
   cv::Mat render_snapshot(int camera);
   cv::Mat render_snapshot_mask(int camera);
   CameraModel snapshot_camera(int camera) const;
-  bool pusher_visible = true;       // draw the pusher pad (colour images and masks)
+  bool pusher_visible = true;       // draw the pusher pad / gripper (colour images and masks)
 
  private:
   cv::Mat draw(int camera, bool snapshot, bool labels);
+  void use_gripper(bool gripper);
   struct Impl;
   std::unique_ptr<Impl> impl_;
   Scene scene_;
