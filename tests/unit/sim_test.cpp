@@ -444,6 +444,25 @@ TEST(SimRender, ImageTexturesFromPngFiles) {
   std::filesystem::remove_all(dir);
 }
 
+TEST(SimRender, TransparentObjectsShowWhatIsBehindThem) {
+  // A white bottle in front of a red wall: opaque, its pixels are white; clear, they are pinkish.
+  auto mean_colour_of_object = [](double opacity) {
+    Scene scene = one_object("bottle", 0.45, 0.0);
+    scene.background.colour = Eigen::Vector3d(0.9, 0.1, 0.1);
+    scene.objects[0].appearance.opacity = opacity;
+    World world(scene);
+    const cv::Mat image = world.render(0);
+    const cv::Mat mask = world.render_mask(0) == 1;
+    EXPECT_GT(cv::countNonZero(mask), 500);
+    return cv::mean(image, mask);  // BGR
+  };
+  const cv::Scalar opaque = mean_colour_of_object(1.0), clear = mean_colour_of_object(0.25);
+  EXPECT_NEAR(opaque[2] - opaque[0], 0, 30) << "an opaque white bottle is grey-white";
+  EXPECT_GT(clear[2] - clear[0], opaque[2] - opaque[0] + 20) << "a clear one lets the wall's red through";
+  EXPECT_NE(load_error("%YAML:1.0\nobjects:\n  - { kind: cup, position: [0.25, 0], opacity: 0 }\n").find("opacity"),
+            std::string::npos);
+}
+
 TEST(SimRender, PusherCanBeHiddenAndNoiseIsSeeded) {
   Scene scene = one_object("cup");
   scene.render.noise_sigma = 3;

@@ -37,7 +37,6 @@ std::string vec(const Eigen::Vector3d& v) {
   return s.str();
 }
 
-std::string rgba(const Eigen::Vector3d& c) { return vec(c) + " 1"; }
 
 // A texture + material pair for an appearance. Returns the material name.
 std::string add_material(Xml& assets, const std::string& name, const Appearance& a, bool mesh) {
@@ -55,10 +54,10 @@ std::string add_material(Xml& assets, const std::string& name, const Appearance&
   }
   assets << "    <material name=\"" << name << "\"";
   if (textured) {
-    assets << " texture=\"" << tex << "\" rgba=\"1 1 1 1\"";
+    assets << " texture=\"" << tex << "\" rgba=\"1 1 1 " << a.opacity << "\"";
     if (!mesh) assets << " texrepeat=\"" << a.repeat << ' ' << a.repeat << "\" texuniform=\"false\"";
   } else {
-    assets << " rgba=\"" << rgba(a.colour) << "\"";
+    assets << " rgba=\"" << vec(a.colour) << ' ' << a.opacity << "\"";
   }
   assets << " specular=\"" << a.specular << "\" shininess=\"" << a.shininess
          << "\" reflectance=\"" << a.reflectance << "\"/>\n";

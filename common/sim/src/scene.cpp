@@ -153,6 +153,7 @@ void read_appearance(MapReader& r, Appearance& a, const std::string& source, con
   a.specular = r.number("specular", a.specular);
   a.shininess = r.number("shininess", a.shininess);
   a.reflectance = r.number("reflectance", a.reflectance);
+  a.opacity = r.number("opacity", a.opacity);
 }
 
 void check_appearance(const Appearance& a, const std::string& source, const std::string& ctx) {
@@ -164,6 +165,7 @@ void check_appearance(const Appearance& a, const std::string& source, const std:
   if (!(a.specular >= 0 && a.specular <= 1)) fail(source, join(ctx, "specular"), "must be in [0, 1]");
   if (!(a.shininess >= 0 && a.shininess <= 1)) fail(source, join(ctx, "shininess"), "must be in [0, 1]");
   if (!(a.reflectance >= 0 && a.reflectance <= 1)) fail(source, join(ctx, "reflectance"), "must be in [0, 1]");
+  if (!(a.opacity >= 0.05 && a.opacity <= 1)) fail(source, join(ctx, "opacity"), "must be in [0.05, 1]");
   if (a.kind == Appearance::Kind::Image) {
     if (a.file.empty()) fail(source, join(ctx, "file"), "type image needs a PNG file");
     if (a.file.find_first_of("\"<>&") != std::string::npos)

@@ -38,6 +38,7 @@ struct Appearance {
   double specular = 0.3;
   double shininess = 0.3;
   double reflectance = 0.0;                // only drawn when Render::reflections is on
+  double opacity = 1.0;                    // 1 = opaque; less: transparent (glass, clear plastic)
 };
 
 struct ObjectSpec {
