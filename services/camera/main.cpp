@@ -45,6 +45,8 @@ int main(int argc, char** argv) {
     camera_service::SimOptions sim;
     f.add_string("scene", &sim.scene_file, "--source sim: the world service's scene file");
     f.add_double("noise", &sim.noise_sigma, "--source sim: Gaussian pixel noise sigma (-1: the scene's)");
+    f.add_int("motion-blur", &sim.motion_blur,
+              "--source sim: renders averaged over the interval since the last state (0: sharp)");
     f.add_bool("snapshots", &sim.snapshots,
                "--source sim: answer CAMERA_SNAPSHOT_REQUEST with 1280x960 stills on SNAPSHOT_LEFT/RIGHT");
     if (!service.parse(argc, argv)) return 0;
@@ -55,6 +57,7 @@ int main(int argc, char** argv) {
       // Frames follow the simulated clock (one pair per SIM_STATE): --rate and --loop do not apply.
       if (!left_spec.empty() || !right_spec.empty()) throw FlagError("--source sim renders both cameras itself: no --left/--right");
       if (sim.scene_file.empty()) throw FlagError("--source sim needs --scene FILE");
+      if (sim.motion_blur < 0 || sim.motion_blur > 32) throw FlagError("--motion-blur must be in [0, 32]");
       sim.pixel_format = pixel_format;
       sim.jpeg_quality = jpeg_quality;
       sim.count = count;

@@ -3,6 +3,8 @@
 // drawn and published on CAMERA_LEFT / CAMERA_RIGHT with the state's (simulated) utime.
 #include "sim_backend.hpp"
 
+#include <opencv2/imgproc.hpp>
+
 #include <optional>
 
 #include "nudge/bus/image.hpp"
@@ -50,6 +52,9 @@ int run_sim_camera(bus::Service& service, const SimOptions& options) {
     throw FlagError(e.what());  // a usage error: exit code 2, the message names file and field
   }
   if (options.noise_sigma >= 0) scene.render.noise_sigma = options.noise_sigma;
+  const bool blur = options.motion_blur > 1;
+  const double noise_sigma = scene.render.noise_sigma;
+  if (blur) scene.render.noise_sigma = 0;  // noise goes on the blurred frame, not on every sub-render
   sim::World world(scene);
   log::info() << "rendering SIM_STATE of " << options.scene_file << " (" << scene.rig.width << "x"
               << scene.rig.height << ", noise " << scene.render.noise_sigma << ")";
@@ -57,14 +62,38 @@ int run_sim_camera(bus::Service& service, const SimOptions& options) {
 
   int64_t frame_id = 0, snapshot_id = 0;
   std::optional<int64_t> last_state_utime;
+  std::optional<sim::PoseSnapshot> previous;
+  // One camera's frame: sharp, or the mean of renders spread over the interval since the last
+  // state (motion blur), with the sensor noise added once, seeded by scene seed and frame.
+  auto render = [&](int camera, const sim::PoseSnapshot& poses) {
+    if (!blur || !previous) return world.render(camera);
+    cv::Mat sum = cv::Mat::zeros(scene.rig.height, scene.rig.width, CV_32FC3);
+    for (int k = 1; k <= options.motion_blur; ++k) {
+      sim::apply_poses(world, sim::interpolate_poses(*previous, poses, static_cast<double>(k) / options.motion_blur));
+      cv::accumulate(world.render(camera), sum);
+    }
+    sum /= options.motion_blur;
+    if (noise_sigma > 0) {
+      cv::Mat noise(sum.size(), CV_32FC3);
+      cv::RNG rng(scene.seed * 1000003u + static_cast<uint64_t>(frame_id) * 2 + camera);
+      rng.fill(noise, cv::RNG::NORMAL, 0, noise_sigma);
+      sum += noise;
+    }
+    cv::Mat out;
+    sum.convertTo(out, CV_8UC3);
+    return out;
+  };
   service.subscriptions().subscribe<sim_state_t>(kStateChannel, [&](const sim_state_t& state, const std::string&) {
-    sim::apply_poses(world, poses_of(state));  // throws naming the object: counted, skipped
+    const sim::PoseSnapshot poses = poses_of(state);
+    sim::apply_poses(world, poses);  // throws naming the object: counted, skipped
     last_state_utime = state.utime;
     // Both frames come from one set of poses and share the state's utime (a stereo pair).
     for (int c = 0; c < 2; ++c) {
-      service.publish(kChannels[c], bus::to_message(world.render(c), options.pixel_format, state.utime, frame_id,
+      service.publish(kChannels[c], bus::to_message(render(c, poses), options.pixel_format, state.utime, frame_id,
                                                     kCameraNames[c], options.jpeg_quality));
     }
+    previous = poses;
+    if (blur) sim::apply_poses(world, poses);  // snapshots show the state itself
     ++frame_id;
     if (options.count > 0 && frame_id >= options.count) service.request_stop();
   });

@@ -14,6 +14,8 @@ struct SimOptions {
   int8_t pixel_format = 0;  // image_t::FORMAT_* of the published frames
   int jpeg_quality = 90;
   int count = 0;            // stop after this many stereo pairs; 0 = no limit
+  int motion_blur = 0;      // > 1: average this many renders across the interval since the last
+                            // state (the shutter open for the whole frame); 0 or 1: sharp
 };
 
 // Loads the scene (SceneError names the file and field), starts the service and renders one

@@ -201,6 +201,50 @@ TEST(WorldCamera, EveryStateBecomesAStereoPairWhoseBottleAxisTheDetectorFinds) {
   }
 }
 
+TEST(WorldCamera, MotionBlurSmearsAnObjectThatMovedDuringTheFrame) {
+  const std::string dir = testing::TempDir();
+  const std::string scene = write_scene(
+      "world_camera_blur", "  - { kind: bottle, name: bottle, position: [0.25, 0.0], colour: [0.15, 0.3, 0.7] }\n");
+  const std::string world_log = dir + "/blur_world.lcmlog", camera_in = dir + "/blur_in.lcmlog";
+  std::remove(world_log.c_str());
+  ASSERT_EQ(run(kBin + "/nudge-world --scene " + scene + " --realtime-factor 0 --duration 0.04 --lcm-in memq://" +
+                " --lcm-out 'file://" + world_log + "?mode=w'"),
+            0);
+  // Two states: the bottle, then the same bottle 6 cm to the side one frame later.
+  std::vector<Event> input;
+  for (const Event& e : read_log(world_log)) {
+    if (e.channel != "SIM_STATE" || !input.empty()) continue;
+    auto state = decode<nudge::sim_state_t>(e);
+    input.push_back({e.timestamp, "SIM_STATE", encode(state)});
+    state.utime += 40000;
+    state.objects[0].pose.position[1] += 0.06;
+    input.push_back({e.timestamp + 40000, "SIM_STATE", encode(state)});
+  }
+  ASSERT_EQ(input.size(), 2u);
+  write_log(camera_in, input);
+  auto left_frames = [&](const std::string& flags) {
+    const std::string out = dir + "/blur_out.lcmlog";
+    std::remove(out.c_str());
+    EXPECT_EQ(run(kBin + "/nudge-camera --source sim --scene " + scene + " --noise 0 --format png " + flags +
+                  " --lcm-in 'file://" + camera_in + "?speed=0' --lcm-out 'file://" + out + "?mode=w'"),
+              0);
+    std::vector<cv::Mat> frames;
+    for (const Event& e : read_log(out))
+      if (e.channel == "CAMERA_LEFT") frames.push_back(nudge::bus::to_mat(decode<nudge::image_t>(e)));
+    return frames;
+  };
+  const auto sharp = left_frames(""), blurred = left_frames("--motion-blur 6");
+  ASSERT_EQ(sharp.size(), 2u);
+  ASSERT_EQ(blurred.size(), 2u);
+  EXPECT_EQ(cv::norm(blurred[0], sharp[0], cv::NORM_INF), 0) << "nothing moved before the first frame";
+  // The blurred second frame lies between the two sharp ones: the bottle smeared along its path.
+  cv::Mat midway;
+  cv::addWeighted(sharp[0], 0.5, sharp[1], 0.5, 0, midway);
+  EXPECT_GT(cv::norm(blurred[1], sharp[1], cv::NORM_L1), 1e5);
+  EXPECT_GT(cv::norm(blurred[1], sharp[0], cv::NORM_L1), 1e5);
+  EXPECT_LT(cv::norm(blurred[1], midway, cv::NORM_L1), cv::norm(sharp[1], midway, cv::NORM_L1));
+}
+
 TEST(World, ArmStateDrivesThePusherTruthIsAnsweredAndTheRunIsDeterministic) {
   const std::string dir = testing::TempDir();
   const std::string scene = write_scene("world_push", "  - { kind: cup, name: cup, position: [0.25, 0.0] }\n");

@@ -88,3 +88,20 @@ TEST(SimStateSync, AStateThatDoesNotMatchTheSceneIsRefusedAndChangesNothing) {
   poses.pusher_yaw = std::nan("");
   EXPECT_THROW(sim::apply_poses(world, poses), std::invalid_argument);
 }
+
+TEST(SimStateSync, InterpolatedPosesForMotionBlur) {
+  nudge::sim::PoseSnapshot a, b;
+  a.objects.push_back({"cup", Eigen::Vector3d(0, 0, 0), Eigen::Quaterniond::Identity()});
+  b.objects.push_back({"cup", Eigen::Vector3d(0.1, 0.2, 0), Eigen::Quaterniond(Eigen::AngleAxisd(1.0, Eigen::Vector3d::UnitZ()))});
+  a.pusher_yaw = 3.0;
+  b.pusher_yaw = -3.0;  // the short way round crosses +-pi
+  const auto half = nudge::sim::interpolate_poses(a, b, 0.5);
+  EXPECT_NEAR(half.objects[0].position.x(), 0.05, 1e-12);
+  EXPECT_NEAR(half.objects[0].position.y(), 0.1, 1e-12);
+  EXPECT_NEAR(Eigen::AngleAxisd(half.objects[0].orientation).angle(), 0.5, 1e-9);
+  EXPECT_NEAR(std::remainder(half.pusher_yaw - M_PI, 2 * M_PI), 0.0, 1e-9);
+  const auto end = nudge::sim::interpolate_poses(a, b, 1.0);
+  EXPECT_NEAR((end.objects[0].position - b.objects[0].position).norm(), 0.0, 1e-12);
+  b.objects[0].name = "mug";  // different objects: nothing to interpolate
+  EXPECT_EQ(nudge::sim::interpolate_poses(a, b, 0.5).objects[0].name, "mug");
+}

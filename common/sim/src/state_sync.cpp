@@ -56,4 +56,18 @@ void apply_poses(World& world, const PoseSnapshot& poses) {
   if (index.empty()) world.set_state(world.state());
 }
 
+PoseSnapshot interpolate_poses(const PoseSnapshot& from, const PoseSnapshot& to, double t) {
+  if (from.objects.size() != to.objects.size()) return to;
+  PoseSnapshot out = to;
+  for (size_t i = 0; i < to.objects.size(); ++i) {
+    if (from.objects[i].name != to.objects[i].name) return to;
+    out.objects[i].position = (1 - t) * from.objects[i].position + t * to.objects[i].position;
+    out.objects[i].orientation = from.objects[i].orientation.slerp(t, to.objects[i].orientation);
+  }
+  out.pusher_position = (1 - t) * from.pusher_position + t * to.pusher_position;
+  const double turn = std::remainder(to.pusher_yaw - from.pusher_yaw, 2 * M_PI);
+  out.pusher_yaw = from.pusher_yaw + t * turn;
+  return out;
+}
+
 }  // namespace nudge::sim

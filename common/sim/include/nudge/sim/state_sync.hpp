@@ -42,6 +42,12 @@ double yaw_of(const Eigen::Quaterniond& rotation);
 // not report it).
 PoseSnapshot snapshot_poses(const World& world, double pusher_yaw);
 
+// The poses a fraction t (0..1) of the way from `from` to `to`: positions linearly, orientations
+// by spherical interpolation, the pusher's yaw the short way round. For motion blur: the camera
+// renders several instants of one exposure. Objects are matched by position in the list and must
+// carry the same names; otherwise `to` is returned unchanged.
+PoseSnapshot interpolate_poses(const PoseSnapshot& from, const PoseSnapshot& to, double t);
+
 // Teleports every object of `world` (matched by name) and the pusher to `poses` and updates the
 // derived positions, so that the next render shows them. Throws std::invalid_argument naming the
 // object when a name is unknown, a pose is not finite, or the object counts differ.
