@@ -6,16 +6,20 @@
 //    fitted with Ceres to theta(t) = A e^(-alpha t) cos(omega (t - t0)) + B, R(t) = L theta(t) + L0;
 //    the mean absolute residuals show how well the marker lines follow a damped pendulum.
 //  - Symmetry detection without the Kalman filter (Table 5.3): block motion masks the edges as in
-//    the tracker, the fast symmetry detector (Nlines 3, theta within +-30 deg of vertical) gives
-//    its strongest line; error against the marker ground truth; frames within 5 of a turning point
-//    ignored.
+//    the tracker, the fast symmetry detector (Nlines 3) gives its strongest line within angle
+//    limits around the previous estimate (thesis sec. 5.4: the tracker's detection with the
+//    filter switched off), bounded to +-30 deg of vertical; the previous estimate is the last
+//    detection made while the bottle clearly moved (see --steady); the first detection searches
+//    +-30 deg of vertical. Error against the marker ground truth; frames within 5 of a turning
+//    point ignored. NUDGE_TRACE=1 prints every frame's detection to stderr.
 //  - Colour centroid (sec. 5.4.3): hue-saturation histogram (45 x 8) of the bottle, back-projection,
 //    motion mask, threshold, largest 8-connected blob, distance of its centroid to the true line.
-//   nudge-exp-pendulum [--frames 1000] [--only white|red|edge|mixed]
+//   nudge-exp-pendulum [--frames 1000] [--only white|red|edge|mixed] [--half-width 5]
 // Writes docs/results/pendulum.{json,md} and pendulum_<background>.png.
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <sstream>
@@ -44,7 +48,13 @@ namespace {
 
 constexpr double kFps = 25.0;
 constexpr int kTurningMargin = 5;  // frames ignored on each side of a turning point (thesis)
-constexpr double kDetectHalfRangeDeg = 30.0;
+constexpr double kDetectHalfRangeDeg = 30.0;  // the first detection: theta within +-30 deg of vertical
+// Later detections: theta within +- this of the previous frame's detection (0: always the fixed
+// range above). Set by --half-width.
+double g_half_width_deg = 5.0;
+// Only detections made while at least this fraction of the typical (slowly decaying maximum)
+// number of moving blocks moves re-centre the limits. Set by --steady.
+double g_steady_fraction = 0.6;
 
 // The rig (metres, world frame). The swing plane is x = kPivot.x(): face-on to the cameras.
 const Eigen::Vector3d kPivot(-0.25, 0.0, 1.20);
@@ -254,6 +264,7 @@ struct FrameRecord {
   sim::ImageLine gt_line;      // the marker line
   sim::ImageLine exact;        // the bottle's projected axis
   bool detected = false;       // a symmetry line (frames >= 1)
+  double det_votes = 0;
   double det_r = 0, det_theta = 0;
   bool colour = false;
   cv::Point2d centroid;
@@ -302,10 +313,9 @@ BackgroundResult run_background(const std::string& name, int frames) {
   world.park_pusher();
   const Swing swing;
   trk::TrackerParams tp;  // the tracker's motion, edge and detector settings
-  sym::Params dp = tp.detector;
-  dp.theta_min_deg = -kDetectHalfRangeDeg;
-  dp.theta_max_deg = kDetectHalfRangeDeg;
-  sym::Detector detector(dp, tp.edges);
+  bool have_previous = false;  // a previous detection centres the angle limits
+  double previous_theta_deg = 0;
+  double moving_typical = 0;  // slowly decaying maximum of the moving-block count
   cv::Mat hist, prev_grey;
   std::vector<FrameRecord> rec(frames);
   const int w = world.camera(0).width, h = world.camera(0).height;
@@ -342,14 +352,41 @@ BackgroundResult run_background(const std::string& name, int frames) {
       sym::detect_edges(grey.clone(), tp.edges, &edge_image);
       const sym::EdgeSet edges = sym::edges_from_mask(trk::mask_edges(edge_image, imask));
       if (!edges.points.empty()) {
+        sym::Params dp = tp.detector;
+        dp.theta_min_deg = -kDetectHalfRangeDeg;
+        dp.theta_max_deg = kDetectHalfRangeDeg;
+        if (have_previous && g_half_width_deg > 0) {
+          // Around the previous detection, within the rig's range (the swing never leaves it): a
+          // wrong line at a turning point cannot drag later searches to a horizontal "symmetry".
+          const double lo = std::max(-kDetectHalfRangeDeg, previous_theta_deg - g_half_width_deg);
+          const double hi = std::min(kDetectHalfRangeDeg, previous_theta_deg + g_half_width_deg);
+          if (lo < hi) {
+            dp.theta_min_deg = lo;
+            dp.theta_max_deg = hi;
+          }
+        }
+        sym::Detector detector(dp, tp.edges);
         const sym::Result r = detector.detect(edges);
         if (!r.lines.empty()) {
           f.detected = true;
           f.det_r = r.lines[0].r;
           f.det_theta = r.lines[0].theta;
+          f.det_votes = r.lines[0].votes;
+          // The limits follow detections made with the bottle clearly moving: near a turning
+          // point the bottle hardly moves, few of its edges survive the motion mask, and a
+          // background line may win; centring the next search on it would keep it.
+          if (motion.moving_blocks >= g_steady_fraction * moving_typical) {
+            have_previous = true;
+            previous_theta_deg = f.det_theta * 180.0 / M_PI;
+          }
         }
       }
       detect_ms += dw.elapsed_ms();
+      moving_typical = std::max(0.98 * moving_typical, static_cast<double>(motion.moving_blocks));
+      if (std::getenv("NUDGE_TRACE"))  // per-frame trace for debugging (stderr)
+        std::cerr << name << " #" << k << " edges " << edges.points.size() << " exact " << f.exact.r << "/"
+                  << f.exact.theta * 180 / M_PI << (f.detected ? " det " : " none ") << f.det_r << "/"
+                  << f.det_theta * 180 / M_PI << " moving " << motion.moving_blocks << " votes " << f.det_votes << "\n";
       cv::Mat back;
       cv::calcBackProject(&hsv, 1, kHistChannels, hist, back, kHistRanges);
       back &= value_mask(hsv);
@@ -475,6 +512,7 @@ void write_results(const std::vector<BackgroundResult>& rs, int frames) {
   j.begin_object();
   j.field("machine", machine_description()).field("date", today()).field("frames", frames);
   j.field("turning_margin_frames", kTurningMargin).field("detect_half_range_deg", kDetectHalfRangeDeg);
+  j.field("detect_half_width_around_previous_deg", g_half_width_deg).field("steady_fraction", g_steady_fraction);
   j.key("true_swing").begin_object();
   j.field("A_rad", s.A).field("alpha_per_s", s.alpha).field("omega_rad_per_s", s.omega).field("t0_s", s.t0);
   j.field("B_rad", s.B).end_object();
@@ -515,8 +553,13 @@ void write_results(const std::vector<BackgroundResult>& rs, int frames) {
      << "**Ground truth** = the line through the two markers' colour centroids (HSV filter, largest blob), "
         "fitted with Ceres to θ(t) = A·e^(−αt)·cos(ω(t − t0)) + B, R(t) = L·θ(t) + L0 (A, α, ω, t0, B, L, L0 "
         "free). **Detection** without the Kalman filter: block motion masks the Canny edges as in the tracker; "
-        "the fast symmetry detector (Dmin 25, Dmax 250, Nlines 3, θ within ±" << kDetectHalfRangeDeg
-     << "° of vertical) gives its strongest line. Frames within " << kTurningMargin
+        "the fast symmetry detector (Dmin 25, Dmax 250, Nlines 3) gives its strongest line, with θ limited "
+        "to ±" << g_half_width_deg << "° around the previous estimate (thesis sec. 5.4: the tracker's "
+        "detection with the filter switched off) and to ±" << kDetectHalfRangeDeg << "° of vertical; the "
+        "previous estimate is the last detection made while the bottle clearly moved (at least "
+        << g_steady_fraction << " × the typical number of moving blocks; near turning points a background "
+        "line may win and must not steer the next search). The first detection searches ±" << kDetectHalfRangeDeg
+     << "° of vertical. Frames within " << kTurningMargin
      << " of a turning point of the fitted motion are ignored. **Colour centroid**: hue–saturation histogram "
         "(45 × 8) of the bottle's true mask in frame 0, V < 30 or V > 240 rejected, back-projection, motion mask, "
         "threshold 64/255, largest 8-connected blob, distance of its centroid to the ground-truth line.\n\n"
@@ -571,10 +614,16 @@ int main(int argc, char** argv) {
   std::string only;
   Flags flags("nudge-exp-pendulum", "Thesis sec. 5.4: pendulum ground truth, detection error and colour centroid.");
   flags.add_int("frames", &frames, "frames per background (thesis: 1000)");
+  flags.add_double("half-width", &g_half_width_deg,
+                   "angle limits: previous detection +- this many degrees (0: always +-30 deg of vertical)");
+  flags.add_double("steady", &g_steady_fraction,
+                   "only detections with at least this fraction of the typical motion re-centre the limits");
   flags.add_string("only", &only, "run only this background (white, red, edge, mixed; results are not written)");
   try {
     if (!flags.parse(argc, argv)) return 0;
     if (frames < 60) throw FlagError("--frames: at least 60 (the fit needs a few swings)");
+    if (!(g_half_width_deg >= 0 && g_half_width_deg < 90)) throw FlagError("--half-width: in [0, 90)");
+    if (!(g_steady_fraction >= 0 && g_steady_fraction <= 1)) throw FlagError("--steady: in [0, 1]");
     std::vector<BackgroundResult> results;
     for (const std::string name : {"white", "red", "edge", "mixed"}) {
       if (!only.empty() && name != only) continue;

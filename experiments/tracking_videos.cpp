@@ -3,9 +3,12 @@
 // Per video: convergent or not, mean and max |R| and |theta| error against the true axis, frames
 // without an estimate after the start, and the tracker's speed per stage (Table 5.1).
 //   nudge-exp-tracking-videos [--frames N] [--camera 0] [--only NAME] [--preview DIR]
+//                             [--support-weight W] [--still-fraction F]   (ablations, nothing written)
+// NUDGE_TRACE=1 prints every frame's status, estimate, truth and measurements to stderr.
 // Writes docs/results/tracking_videos.{json,md}, tracking_videos_errors.png (error against frame)
 // and tracking_videos_frames.png (one frame per video, truth green, estimate red).
 #include <cmath>
+#include <cstdlib>
 #include <iomanip>
 #include <iostream>
 #include <sstream>
@@ -29,6 +32,7 @@ namespace {
 constexpr double kDivergeR = 20.0;        // px: a tracked line further off than this has diverged
 constexpr double kDivergeThetaDeg = 10.0; // deg
 constexpr int kMaxStartDelay = 15;        // frames after motion onset to acquire the track
+trk::TrackerParams g_tracker_params;      // defaults; --support-weight / --still-fraction for ablations
 
 struct VideoResult {
   std::string name, thesis_video, description;
@@ -66,7 +70,7 @@ VideoResult run_video(const Scenario& sc, int camera, int max_frames, const std:
       last_moving = k;
     }
   }
-  trk::SymmetryTracker tracker;
+  trk::SymmetryTracker tracker(g_tracker_params);
   std::vector<double> r_abs, t_abs;
   double total_ms = 0, tracking_ms = 0;
   int tracking_frames = 0;
@@ -105,6 +109,14 @@ VideoResult run_video(const Scenario& sc, int camera, int max_frames, const std:
       res.frame.push_back(k);
       res.r_err.push_back(e.r);
       res.t_err_deg.push_back(e.theta * 180 / M_PI);
+    }
+    if (std::getenv("NUDGE_TRACE")) {  // per-frame trace for debugging (stderr)
+      std::cerr << sc.name << " #" << k << " " << trk::to_string(s.status) << (s.measurement_used ? " used" : "")
+                << " truth " << f.truth.r << "/" << f.truth.theta * 180 / M_PI;
+      if (s.has_estimate) std::cerr << " est " << s.line.r << "/" << s.line.theta * 180 / M_PI;
+      std::cerr << " blocks " << s.moving_blocks << " obj " << s.object_motion << " lines";
+      for (const auto& m : s.measurements) std::cerr << " " << m.r << "/" << m.theta_deg << "(" << m.votes << ")";
+      std::cerr << (s.reason.empty() ? "" : " | ") << s.reason << "\n";
     }
     if (k == snap_frame || !preview.empty()) {
       cv::Mat img = f.image.clone();
@@ -274,8 +286,18 @@ int main(int argc, char** argv) {
   flags.add_int("camera", &camera, "camera of the stereo rig (0 left, 1 right)");
   flags.add_string("only", &only, "run only the video of this name (results are not written)");
   flags.add_string("preview", &preview, "write a contact sheet of every 8th annotated frame per video to this directory");
+  flags.add_double("support-weight", &g_tracker_params.support_weight,
+                   "ablation: the tracker's association support weight (0 = the thesis' nearest line; results are "
+                   "not written unless the default)");
+  flags.add_double("still-fraction", &g_tracker_params.still_fraction,
+                   "ablation: the tracker's still-object fraction (0 = always predict, the thesis; results are not "
+                   "written unless the default)");
   try {
     if (!flags.parse(argc, argv)) return 0;
+    const trk::TrackerParams defaults;
+    const bool ablation = g_tracker_params.support_weight != defaults.support_weight ||
+                          g_tracker_params.still_fraction != defaults.still_fraction;
+    trk::validate(g_tracker_params);
     if (camera < 0 || camera > 1) throw FlagError("--camera: must be 0 or 1");
     if (frames < 0) throw FlagError("--frames: must be >= 0");
     std::vector<VideoResult> results;
@@ -284,7 +306,7 @@ int main(int argc, char** argv) {
       results.push_back(run_video(sc, camera, frames, preview));
     }
     if (results.empty()) throw FlagError("--only: no video named '" + only + "'");
-    if (only.empty()) write_results(results, camera);
+    if (only.empty() && !ablation) write_results(results, camera);
   } catch (const std::exception& e) {
     std::cerr << "nudge-exp-tracking-videos: " << e.what() << "\n";
     return 1;

@@ -102,7 +102,11 @@ int main(int argc, char** argv) {
     f.add_int("block-size", &params.motion.block_size, "SB: motion block side, px");
     f.add_int("start-min-blocks", &params.start.min_blocks, "moving blocks needed to start tracking");
     f.add_double("gate-sigmas", &params.gate_sigmas, "angle limits = prediction +- this many sigma");
-    f.add_int("max-missed", &params.max_missed_frames, "predict-only frames before a track is lost");
+    f.add_int("max-missed", &params.max_missed_frames, "predict-only (or held) frames before a track is lost");
+    f.add_double("still-fraction", &params.still_fraction,
+                 "hold the line when less than this fraction of the track's blocks moves (0 = always predict)");
+    f.add_double("support-weight", &params.support_weight,
+                 "association: gate error + this * 2 ln(strongest votes / votes) (0 = nearest line)");
     f.add_bool("no-mask", &no_mask, "do not send the block motion mask in track_t");
     if (!service.parse(argc, argv)) return 0;
     const bool send_mask = !no_mask;

@@ -179,6 +179,60 @@ TEST(Kalman, NoisyMeasurementsAreSmoothed) {
   EXPECT_LT(filtered, 0.85 * raw);
 }
 
+TEST(Kalman, HoldStopsTheLineWhereItIs) {
+  LineKalman kf;
+  kf.initialise({0, 0});
+  for (int t = 1; t <= 20; ++t) {  // moving at 3 px and 1 deg per frame
+    kf.predict();
+    kf.update({3.0 * t, 1.0 * t});
+  }
+  ASSERT_NEAR(kf.state()(2), 3.0, 0.1);
+  const KalmanState before = kf.state();
+  const Eigen::Matrix2d line_cov = kf.line_covariance();
+  kf.hold();
+  EXPECT_EQ(kf.state().head<2>(), before.head<2>()) << "the line stays where it is";
+  EXPECT_EQ(kf.state().tail<4>(), (Eigen::Matrix<double, 4, 1>::Zero())) << "no velocity, no acceleration";
+  EXPECT_EQ(kf.line_covariance(), line_cov);
+  for (int i = 0; i < 5; ++i) kf.hold();
+  EXPECT_NEAR(kf.state()(0), 60.0, 0.5) << "no coasting on the old velocity";
+  // A held filter is an ordinary filter again: the object moving off is followed.
+  for (int t = 1; t <= 20; ++t) {
+    kf.predict();
+    kf.update({60.0 - 2.0 * t, 20.0});
+  }
+  EXPECT_NEAR(kf.state()(0), 20.0, 0.5);
+  EXPECT_NEAR(kf.state()(2), -2.0, 0.2);
+  EXPECT_LT((kf.covariance() - kf.covariance().transpose()).norm(), 1e-9);
+  EXPECT_GT(kf.covariance().diagonal().minCoeff(), 0);
+}
+
+TEST(Kalman, AssociationWeighsGateErrorAgainstSupport) {
+  LineKalman kf;
+  kf.initialise({50, 10});
+  for (int t = 0; t < 20; ++t) {
+    kf.predict();
+    kf.update({50, 10});
+  }
+  kf.predict();
+  // A weak line next to the prediction, the object's strong line a few px off, a very strong line
+  // far outside the gate.
+  const std::vector<LineMeasurement> lines = {{100, 10, 200}, {55, 11, 60}, {50.5, 10, 12}};
+  ASSERT_TRUE(kf.in_gate(kf.gate_error(lines[1])));
+  ASSERT_TRUE(kf.in_gate(kf.gate_error(lines[2])));
+  double e = -1;
+  EXPECT_EQ(associate(kf, lines, 0.0, &e), 2) << "thesis: the nearest line";
+  EXPECT_DOUBLE_EQ(e, kf.gate_error(lines[2]));
+  EXPECT_EQ(associate(kf, lines, 4.0, &e), 1) << "support: the strong line inside the gate";
+  EXPECT_DOUBLE_EQ(e, kf.gate_error(lines[1]));
+  // Similar support: the nearer line still wins.
+  EXPECT_EQ(associate(kf, {{55, 11, 60}, {50.5, 10, 55}}, 4.0), 1);
+  // Unknown votes (0): gate error only.
+  EXPECT_EQ(associate(kf, {{55, 11, 0}, {50.5, 10, 0}}, 4.0), 1);
+  // Nothing inside the gate.
+  EXPECT_EQ(associate(kf, {{100, 10, 200}}, 4.0, &e), -1);
+  EXPECT_EQ(associate(kf, {}, 4.0), -1);
+}
+
 TEST(Kalman, GateRejectsOutliersAndKeepsNearLines) {
   LineKalman kf;
   kf.initialise({50, 10});
@@ -463,6 +517,55 @@ TEST(Tracker, StaysOnItsObjectWhenAnotherSymmetricObjectCrossesIt) {
   EXPECT_LT(max_r, 10.0) << "never latched onto the other object";
 }
 
+// Thesis video 8 (a collision): the tracked object stops dead and, being still, offers no edges;
+// a second symmetric object next to it starts to move and turn. The track holds the stopped
+// object's line instead of coasting on its old velocity into the other object's line.
+TEST(Tracker, HoldsTheLineOfAnObjectThatStopsDeadBesideAnotherMovingObject) {
+  const Video video;
+  const int stop = 24;  // the bottle stops here
+  auto bottle = [&](int i) { return video.truth(std::min(i, stop)); };
+  // A cup 70 px beyond where the bottle stops, tipping over once the bottle has stopped.
+  const Pose rest = bottle(stop);
+  auto cup = [&](int i) { return Pose{rest.r + 70, rest.theta + std::max(0, i - stop - 1) * 5 * kDeg}; };
+  for (const double still_fraction : {0.0, TrackerParams{}.still_fraction}) {
+    TrackerParams params;
+    params.still_fraction = still_fraction;
+    SymmetryTracker tracker(params);
+    double max_err_after_stop = 0;
+    int held = 0, tracked_after_stop = 0;
+    TrackState s;
+    for (int i = 0; i < stop + 14; ++i) {
+      cv::Mat img = static_scene(640, 480);
+      draw_bottle(img, bottle(i), 1.0);
+      syn::draw_shape(img, syn::cup_profile(150, 55, 40), cup(i).r, cup(i).theta, 0, cv::Scalar(215));
+      s = tracker.feed(img, i * kFramePeriodUs);
+      if (i == stop) {
+        ASSERT_EQ(s.status, TrackStatus::Tracking) << s.reason;
+      }
+      if (i > stop && s.has_estimate) {
+        ++tracked_after_stop;
+        held += s.holding;
+        if (s.holding) {
+          EXPECT_TRUE(s.has_box) << "the box of the object's last motion, where it stands";
+        }
+        max_err_after_stop = std::max(max_err_after_stop, std::fabs(s.line.r - rest.r));
+      }
+    }
+    std::printf("still_fraction %.2f: %d frames with an estimate after the stop, %d held, max |R| error %.1f px\n",
+                still_fraction, tracked_after_stop, held, max_err_after_stop);
+    if (still_fraction > 0) {
+      // Frames where the tipping cup's motion reaches into the bottle's blocks are predicted
+      // normally; the cup's line is outside the gate of a held (not coasting) track.
+      EXPECT_GE(held, params.max_missed_frames / 2) << "held while the bottle is still";
+      EXPECT_LT(max_err_after_stop, 3.0) << "the line stays on the stopped bottle";
+      EXPECT_EQ(s.status, TrackStatus::Lost);
+      EXPECT_NE(s.reason.find("validation gate"), std::string::npos) << s.reason;
+    } else {
+      EXPECT_EQ(held, 0);
+    }
+  }
+}
+
 TEST(Tracker, GoesLostWithAReasonWhenTheObjectVanishes) {
   const Video video;
   SymmetryTracker tracker;
@@ -549,6 +652,12 @@ TEST(Tracker, SurvivesGarbageInputAndRestarts) {
   TrackerParams bad;
   bad.kalman.gate = -1;
   EXPECT_THROW(SymmetryTracker{bad}, std::invalid_argument);
+  TrackerParams bad_still;
+  bad_still.still_fraction = 1.5;
+  EXPECT_THROW(SymmetryTracker{bad_still}, std::invalid_argument);
+  TrackerParams bad_support;
+  bad_support.support_weight = -1;
+  EXPECT_THROW(SymmetryTracker{bad_support}, std::invalid_argument);
 }
 
 }  // namespace

@@ -71,6 +71,12 @@ void LineKalman::predict() {
   keep_theta_in_range();
 }
 
+void LineKalman::hold() {
+  x_.tail<4>().setZero();
+  p_.topRightCorner<2, 4>().setZero();
+  p_.bottomLeftCorner<4, 2>().setZero();
+}
+
 Eigen::Vector2d LineKalman::innovation(const LineMeasurement& measured) const {
   const LineMeasurement m = align_to(measured, x_(1));
   return {m.r - x_(0), m.theta_deg - x_(1)};

@@ -79,6 +79,21 @@ symmetry::EdgeSet motion_masked_edges(const cv::Mat& grey, const BlockMotion& mo
   }
   return edges;
 }
+// Fraction of the blocks set in `object` that are set in `moving` (1 when `object` is empty or
+// does not match: no evidence that the object stopped).
+double moving_fraction(const cv::Mat& object, const cv::Mat& moving) {
+  if (object.empty() || object.size() != moving.size()) return 1.0;
+  int total = 0, hit = 0;
+  for (int y = 0; y < object.rows; ++y) {
+    const uint8_t* o = object.ptr<uint8_t>(y);
+    const uint8_t* m = moving.ptr<uint8_t>(y);
+    for (int x = 0; x < object.cols; ++x) {
+      total += o[x] != 0;
+      hit += o[x] != 0 && m[x] != 0;
+    }
+  }
+  return total > 0 ? static_cast<double>(hit) / total : 1.0;
+}
 }  // namespace
 
 const char* to_string(TrackStatus status) {
@@ -108,6 +123,9 @@ void validate(const TrackerParams& p) {
   require(std::isfinite(p.gate_sigmas) && p.gate_sigmas > 0, "tracker gate_sigmas must be > 0");
   require(std::isfinite(p.min_half_width_deg) && p.min_half_width_deg >= 0.5 && p.min_half_width_deg <= 90,
           "tracker min_half_width_deg must be in [0.5, 90]");
+  require(std::isfinite(p.still_fraction) && p.still_fraction >= 0 && p.still_fraction <= 1,
+          "tracker still_fraction must be in [0, 1]");
+  require(std::isfinite(p.support_weight) && p.support_weight >= 0, "tracker support_weight must be >= 0");
   require(p.max_missed_frames >= 1, "tracker max_missed_frames must be >= 1");
   require(p.max_frame_gap_us > 0, "tracker max_frame_gap_us must be > 0");
 }
@@ -152,6 +170,30 @@ bool best_start(const std::vector<std::vector<LineMeasurement>>& frames, const K
   return std::isfinite(best_error);
 }
 
+int associate(const LineKalman& filter, const std::vector<LineMeasurement>& lines, double support_weight,
+              double* gate_error) {
+  std::vector<double> errors(lines.size());
+  double strongest = 0;
+  for (size_t i = 0; i < lines.size(); ++i) {
+    errors[i] = filter.gate_error(lines[i]);
+    if (filter.in_gate(errors[i])) strongest = std::max(strongest, lines[i].votes);
+  }
+  int best = -1;
+  double best_cost = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < lines.size(); ++i) {
+    if (!filter.in_gate(errors[i])) continue;
+    double cost = errors[i];  // the thesis: the lowest normalised innovation
+    if (support_weight > 0 && strongest > 0 && lines[i].votes > 0)
+      cost += support_weight * 2.0 * std::log(strongest / lines[i].votes);
+    if (cost < best_cost) {
+      best_cost = cost;
+      best = static_cast<int>(i);
+    }
+  }
+  if (gate_error && best >= 0) *gate_error = errors[best];
+  return best;
+}
+
 SymmetryTracker::SymmetryTracker(TrackerParams params)
     : params_(std::move(params)), reason_(kWaitingForFirstFrame), kalman_(params_.kalman) {
   validate(params_);
@@ -165,6 +207,7 @@ void SymmetryTracker::reset(TrackStatus status, const std::string& reason) {
   start_window_.clear();
   start_frames_ = 0;
   missed_ = 0;
+  object_blocks_.release();
 }
 
 void SymmetryTracker::restart(const std::string& reason) {
@@ -274,7 +317,8 @@ std::vector<LineMeasurement> SymmetryTracker::detect_lines(const cv::Mat& grey, 
     p.theta_min_deg = limits.min_deg;
     p.theta_max_deg = limits.max_deg;
     symmetry::Detector detector(p, params_.edges);
-    for (const auto& line : detector.detect(edges).lines) lines.push_back({line.r, line.theta * kDegPerRad});
+    for (const auto& line : detector.detect(edges).lines)
+      lines.push_back({line.r, line.theta * kDegPerRad, line.votes});
     state->ms.detect_ms = watch.lap_ms();
   } catch (const std::exception&) {
     lines.clear();  // a frame the detector cannot use offers no measurements
@@ -312,22 +356,34 @@ void SymmetryTracker::initialise(const cv::Mat& grey, const BlockMotion& motion,
 
 void SymmetryTracker::track(const cv::Mat& grey, const BlockMotion& motion, TrackState* state) {
   Stopwatch watch;
+  state->object_motion = moving_fraction(object_blocks_, motion.blocks);
+  if (state->object_motion < params_.still_fraction) {
+    // The object stopped: hold the line where it is and measure nothing (a line detected now
+    // belongs to something else that moves). The blocks of the last motion stay the object's.
+    kalman_.hold();
+    ++missed_;
+    reason_ = "holding: no motion at the tracked object";
+    state->holding = true;
+    state->missed_frames = missed_;
+    state->ms.kalman_ms = watch.lap_ms();
+    // The box and blocks reported are those of the object's last motion, where it now stands.
+    const cv::Mat object = object_blocks_;
+    BlockMotion held = motion;
+    if (!object.empty()) held.blocks = object;
+    describe_estimate(held, state);
+    object_blocks_ = object;
+    if (missed_ >= params_.max_missed_frames)
+      end_track("no symmetry line inside the validation gate for " + std::to_string(missed_) + " frames", state);
+    return;
+  }
   kalman_.predict();
   const AngleLimits limits = angle_limits(kalman_.line().theta_deg, kalman_.theta_sigma_deg(), params_.gate_sigmas,
                                           params_.min_half_width_deg);
   state->ms.kalman_ms = watch.lap_ms();
   const std::vector<LineMeasurement> lines = detect_lines(grey, motion, limits, state);
   watch.restart();
-  // Nearest in the gate: the lowest normalised innovation among lines that pass 9.21.
-  int best = -1;
-  double best_error = std::numeric_limits<double>::infinity();
-  for (size_t i = 0; i < lines.size(); ++i) {
-    const double e = kalman_.gate_error(lines[i]);
-    if (kalman_.in_gate(e) && e < best_error) {
-      best_error = e;
-      best = static_cast<int>(i);
-    }
-  }
+  double best_error = 0;
+  const int best = associate(kalman_, lines, params_.support_weight, &best_error);
   if (best >= 0) {
     kalman_.update(lines[best]);
     missed_ = 0;
@@ -356,6 +412,7 @@ void SymmetryTracker::end_track(const std::string& reason, TrackState* state) {
   idle_baseline_ = state->moving_blocks;  // a new start needs a new jump in motion
   start_window_.clear();
   missed_ = 0;
+  object_blocks_.release();
 }
 
 void SymmetryTracker::describe_estimate(const BlockMotion& motion, TrackState* state) {
@@ -376,6 +433,7 @@ void SymmetryTracker::describe_estimate(const BlockMotion& motion, TrackState* s
       rotated_box(state->blocks, motion.block_size, state->width, state->height, state->line.r, state->line.theta);
   state->has_box = box.valid;
   if (box.valid) state->box = box.corners;
+  object_blocks_ = state->blocks.clone();  // state->blocks goes to the caller
   state->ms.refine_ms = watch.elapsed_ms();
 }
 

@@ -43,6 +43,7 @@ void validate(const KalmanParams& params);
 struct LineMeasurement {
   double r = 0;          // px
   double theta_deg = 0;  // degrees
+  double votes = 0;      // the detector's accumulator value (support); 0 when unknown
 };
 
 // theta into (-90, 90], negating r for every 180 degrees moved.
@@ -57,6 +58,10 @@ class LineKalman {
   const KalmanParams& params() const { return params_; }
   void initialise(const LineMeasurement& first);
   void predict();
+  // The object is seen to stand still (no motion where it is): velocities and accelerations are
+  // set to zero and decoupled from R and theta, whose estimate and covariance stay as they are.
+  // Used instead of predict() so that a track does not coast on after the object stopped.
+  void hold();
   // Normalised innovation squared (the thesis' "validation gate error") of a measurement.
   double gate_error(const LineMeasurement& measured) const;
   bool in_gate(double gate_error) const { return gate_error <= params_.gate; }

@@ -9,7 +9,8 @@
 // Status (numbers equal track_t's STATUS_* constants):
 //   Idle          waiting for the object to start moving (no estimate)
 //   Initialising  motion started; collecting the three frames of the automatic start
-//   Tracking      the filter has an estimate; `measurement_used` says whether this frame updated it
+//   Tracking      the filter has an estimate; `measurement_used` says whether this frame updated it;
+//                 `holding` = the object stood still this frame (line held, nothing detected)
 //   Lost          the track ended; `reason` says why (no gated line for N frames, the line left the
 //                 image, or bad input: a size change, a frame out of order, a time jump, or a
 //                 restart request). The tracker re-arms itself: after a loss of the line, a new
@@ -62,6 +63,18 @@ struct TrackerParams {
   symmetry::Params detector = default_detector();
   double gate_sigmas = 3.0;          // angle limits = predicted theta +- gate_sigmas * sigma (thesis: 3)
   double min_half_width_deg = 3.0;   // never search a narrower angle range than +- this
+  // Not in the thesis: when less than this fraction of the track's blocks (its symmetry-refined
+  // motion mask of the last frame with motion) moves now, the object has stopped: the filter holds
+  // its line (LineKalman::hold: no coasting on the old velocity) and offers no measurement (any
+  // line now comes from something else that moves). Such frames count as predict-only frames.
+  // 0 = always predict (the thesis).
+  double still_fraction = 0.2;
+  // Not in the thesis: association by gate error AND support. Among the lines inside the gate the
+  // one with the least  gate error + support_weight * 2 ln(strongest votes / its votes)  updates
+  // the filter (0 = the thesis' nearest line). A weaker line next to the prediction then no longer
+  // beats the object's own, much stronger line a little further off (a secondary line that the
+  // estimate drifted onto is otherwise kept for ever, as it is always the nearest).
+  double support_weight = 4.0;
   int max_missed_frames = 10;        // consecutive predict-only frames before the track is Lost
   int64_t max_frame_gap_us = 500000; // a longer gap between frames is a time jump: re-initialise
 
@@ -109,6 +122,8 @@ struct TrackState {
   double gate_error = 0;           // normalised innovation squared of the line used
   int missed_frames = 0;           // consecutive predict-only frames
   AngleLimits limits;              // detection angle limits used for this frame, degrees
+  double object_motion = -1;       // fraction of the track's blocks moving this frame (-1: not tracking)
+  bool holding = false;            // the object stood still: line held, no detection this frame
   TrackTiming ms;
 };
 
@@ -150,6 +165,7 @@ class SymmetryTracker {
   int start_frames_ = 0;
   LineKalman kalman_;
   int missed_ = 0;
+  cv::Mat object_blocks_;  // the track's symmetry-refined blocks of its last frame with motion
 };
 
 // The best of all associations of one line per frame across three frames (27 for Nlines = 3):
@@ -157,6 +173,13 @@ class SymmetryTracker {
 // least accumulated gate error wins if every step passed the gate. Associations within tie_margin
 // of each other count as equally consistent and the one using the stronger lines wins (lines are
 // given strongest first). Returns false when no association passed the gate.
+// The line that updates the filter: among the lines inside the validation gate, the one with the
+// least  gate error + support_weight * 2 ln(v_max / v), where v is its votes and v_max those of the
+// strongest line inside the gate (support_weight 0, or unknown votes: the thesis' nearest line).
+// Returns its index, or -1 when no line is inside the gate; *gate_error gets its gate error.
+int associate(const LineKalman& filter, const std::vector<LineMeasurement>& lines, double support_weight,
+              double* gate_error = nullptr);
+
 bool best_start(const std::vector<std::vector<LineMeasurement>>& frames, const KalmanParams& params,
                 LineKalman* filter, double* total_gate_error, double tie_margin = 0.0);
 
