@@ -55,6 +55,9 @@ double g_half_width_deg = 5.0;
 // Only detections made while at least this fraction of the typical (slowly decaying maximum)
 // number of moving blocks moves re-centre the limits. Set by --steady.
 double g_steady_fraction = 0.6;
+// Canny on the colour image (beyond the thesis, which used grey edges): a red bottle in front of
+// red distracters of the same brightness keeps its outline. --grey-edges restores the thesis'.
+bool g_colour_edges = true;
 
 // The rig (metres, world frame). The swing plane is x = kPivot.x(): face-on to the cameras.
 const Eigen::Vector3d kPivot(-0.25, 0.0, 1.20);
@@ -349,7 +352,9 @@ BackgroundResult run_background(const std::string& name, int frames) {
       const trk::BlockMotion motion = trk::detect_block_motion(prev_grey, grey, tp.motion);
       const cv::Mat imask = trk::upscale_blocks(motion.blocks, motion.block_size, w, h);
       cv::Mat edge_image;
-      sym::detect_edges(grey.clone(), tp.edges, &edge_image);
+      sym::EdgeParams edge_params = tp.edges;
+      edge_params.colour = g_colour_edges;
+      sym::detect_edges(g_colour_edges ? img : grey, edge_params, &edge_image);
       const sym::EdgeSet edges = sym::edges_from_mask(trk::mask_edges(edge_image, imask));
       if (!edges.points.empty()) {
         sym::Params dp = tp.detector;
@@ -513,6 +518,7 @@ void write_results(const std::vector<BackgroundResult>& rs, int frames) {
   j.field("machine", machine_description()).field("date", today()).field("frames", frames);
   j.field("turning_margin_frames", kTurningMargin).field("detect_half_range_deg", kDetectHalfRangeDeg);
   j.field("detect_half_width_around_previous_deg", g_half_width_deg).field("steady_fraction", g_steady_fraction);
+  j.field("edges", g_colour_edges ? "colour" : "grey");
   j.key("true_swing").begin_object();
   j.field("A_rad", s.A).field("alpha_per_s", s.alpha).field("omega_rad_per_s", s.omega).field("t0_s", s.t0);
   j.field("B_rad", s.B).end_object();
@@ -552,8 +558,9 @@ void write_results(const std::vector<BackgroundResult>& rs, int frames) {
         "white); mixed (the same lines and blobs together).\n\n"
      << "**Ground truth** = the line through the two markers' colour centroids (HSV filter, largest blob), "
         "fitted with Ceres to θ(t) = A·e^(−αt)·cos(ω(t − t0)) + B, R(t) = L·θ(t) + L0 (A, α, ω, t0, B, L, L0 "
-        "free). **Detection** without the Kalman filter: block motion masks the Canny edges as in the tracker; "
-        "the fast symmetry detector (Dmin 25, Dmax 250, Nlines 3) gives its strongest line, with θ limited "
+        "free). **Detection** without the Kalman filter: block motion masks the Canny edges as in the tracker "
+     << (g_colour_edges ? "(Canny on the colour image: the thesis used grey edges, `--grey-edges`); " : "(grey edges, as the thesis); ")
+     << "the fast symmetry detector (Dmin 25, Dmax 250, Nlines 3) gives its strongest line, with θ limited "
         "to ±" << g_half_width_deg << "° around the previous estimate (thesis sec. 5.4: the tracker's "
         "detection with the filter switched off) and to ±" << kDetectHalfRangeDeg << "° of vertical; the "
         "previous estimate is the last detection made while the bottle clearly moved (at least "
@@ -618,9 +625,12 @@ int main(int argc, char** argv) {
                    "angle limits: previous detection +- this many degrees (0: always +-30 deg of vertical)");
   flags.add_double("steady", &g_steady_fraction,
                    "only detections with at least this fraction of the typical motion re-centre the limits");
+  bool grey_edges = false;
+  flags.add_bool("grey-edges", &grey_edges, "Canny on the grey image, as the thesis (default: colour edges)");
   flags.add_string("only", &only, "run only this background (white, red, edge, mixed; results are not written)");
   try {
     if (!flags.parse(argc, argv)) return 0;
+    g_colour_edges = !grey_edges;
     if (frames < 60) throw FlagError("--frames: at least 60 (the fit needs a few swings)");
     if (!(g_half_width_deg >= 0 && g_half_width_deg < 90)) throw FlagError("--half-width: in [0, 90)");
     if (!(g_steady_fraction >= 0 && g_steady_fraction <= 1)) throw FlagError("--steady: in [0, 1]");

@@ -413,3 +413,16 @@ TEST(PhotoDetection, CompetitionRule) {
   EXPECT_FALSE(competition_match(l, {100, 50}, {180, 250}));   // angle over 10 deg
   EXPECT_FALSE(competition_match(l, {100, 240}, {100, 260}));  // short truth: its centre is too far
 }
+
+TEST(SymmetryEdges, ColourEdgesSeeOutlinesOfEqualBrightness) {
+  // Red on green of (nearly) the same grey level: invisible to grey Canny, plain in colour.
+  cv::Mat img(120, 160, CV_8UC3, cv::Scalar(0, 130, 0));                    // green, grey 76
+  cv::rectangle(img, cv::Rect(40, 30, 80, 60), cv::Scalar(0, 0, 255), cv::FILLED);  // red, grey 76
+  cv::Mat grey;
+  cv::cvtColor(img, grey, cv::COLOR_BGR2GRAY);
+  ASSERT_LT(std::abs(grey.at<uint8_t>(60, 80) - grey.at<uint8_t>(5, 5)), 6) << "the test needs equal brightness";
+  EdgeParams e{0, 30, 90, false, false};
+  EXPECT_EQ(detect_edges(img, e).points.size(), 0u);
+  e.colour = true;
+  EXPECT_GT(detect_edges(img, e).points.size(), 200u);
+}

@@ -80,7 +80,9 @@ namespace {
 // Thresholds from the image itself, for photographs of any exposure: the high threshold is a high
 // quantile (93 %) of the L1 gradient magnitude that Canny uses, the low one 40 % of it: a few per
 // cent of the pixels become edges whatever the exposure or texture.
-void auto_thresholds(const cv::Mat& grey, double* low, double* high) {
+void auto_thresholds(const cv::Mat& image, double* low, double* high) {
+  cv::Mat grey = image;
+  if (image.channels() == 3) cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);  // colour edges: grey statistics
   cv::Mat gx, gy;
   cv::Sobel(grey, gx, CV_16S, 1, 0, 3);
   cv::Sobel(grey, gy, CV_16S, 0, 1, 3);
@@ -117,9 +119,13 @@ EdgeSet detect_edges(const cv::Mat& image, const EdgeParams& params, cv::Mat* ed
   require(!image.empty(), "image is empty");
   require(image.depth() == CV_8U && (image.channels() == 1 || image.channels() == 3 || image.channels() == 4),
           "image must be 8-bit grey, BGR or BGRA");
-  cv::Mat grey;
-  if (image.channels() == 3) {
+  cv::Mat grey;  // the image Canny sees: grey, or BGR for colour edges
+  if (image.channels() == 3 && params.colour) {
+    grey = image;
+  } else if (image.channels() == 3) {
     cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
+  } else if (image.channels() == 4 && params.colour) {
+    cv::cvtColor(image, grey, cv::COLOR_BGRA2BGR);
   } else if (image.channels() == 4) {
     cv::cvtColor(image, grey, cv::COLOR_BGRA2GRAY);
   } else {

@@ -18,6 +18,9 @@ struct EdgeParams {
   double canny_low = 30.0;
   double canny_high = 90.0;
   bool auto_canny = false;  // derive the thresholds from the image's gradient statistics
+  // Canny on the colour image (the gradient of the channel that changes most) instead of grey:
+  // finds outlines between regions of equal brightness but different colour.
+  bool colour = false;
 };
 
 struct Params {
