@@ -119,6 +119,20 @@ void write_png(const std::string& name, const cv::Mat& image) {
   std::cerr << "wrote " << path << "\n";
 }
 
+cv::Mat tile(std::vector<cv::Mat> images, int columns) {
+  if (images.empty() || columns < 1) return {};
+  while (images.size() % columns != 0) images.push_back(cv::Mat(images[0].size(), images[0].type(), cv::Scalar::all(255)));
+  std::vector<cv::Mat> rows;
+  for (size_t i = 0; i < images.size(); i += columns) {
+    cv::Mat row;
+    cv::hconcat(std::vector<cv::Mat>(images.begin() + i, images.begin() + i + columns), row);
+    rows.push_back(row);
+  }
+  cv::Mat grid;
+  cv::vconcat(rows, grid);
+  return grid;
+}
+
 std::string machine_description() {
   std::ifstream cpu("/proc/cpuinfo");
   std::string line, model = "unknown CPU";

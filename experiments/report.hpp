@@ -33,6 +33,9 @@ cv::Mat plot(const std::vector<Series>& series, const std::string& title, const 
              const std::string& y_label, cv::Size size = {720, 480});
 void write_png(const std::string& name, const cv::Mat& image);
 
+// Images of one size and type in a grid, `columns` a row; a short last row is padded with white.
+cv::Mat tile(std::vector<cv::Mat> images, int columns);
+
 // "Machine: <cpu model>, <cores> cores" for result files.
 std::string machine_description();
 std::string today();

@@ -294,16 +294,7 @@ void write_results(const std::vector<VideoScores>& videos, int camera) {
     }
     tiles.push_back(plot(series, v.name + " (clipped at 100 px)", "frame", "distance to true axis (px)", {640, 300}));
   }
-  if (tiles.size() % 2 == 1) tiles.push_back(cv::Mat(tiles.back().size(), tiles.back().type(), cv::Scalar::all(255)));
-  std::vector<cv::Mat> rows;
-  for (size_t i = 0; i + 1 < tiles.size(); i += 2) {
-    cv::Mat row;
-    cv::hconcat(tiles[i], tiles[i + 1], row);
-    rows.push_back(row);
-  }
-  cv::Mat grid;
-  cv::vconcat(rows, grid);
-  write_png("tracker_comparison_errors.png", grid);
+  write_png("tracker_comparison_errors.png", tile(tiles, 2));
 }
 
 }  // namespace

@@ -135,18 +135,7 @@ VideoResult run_video(const Scenario& sc, int camera, int max_frames, const std:
       }
     }
   }
-  if (!previews.empty()) {  // a contact sheet, four frames a row
-    while (previews.size() % 4 != 0) previews.push_back(cv::Mat(240, 320, CV_8UC3, cv::Scalar::all(255)));
-    std::vector<cv::Mat> rows;
-    for (size_t i = 0; i < previews.size(); i += 4) {
-      cv::Mat row;
-      cv::hconcat(std::vector<cv::Mat>(previews.begin() + i, previews.begin() + i + 4), row);
-      rows.push_back(row);
-    }
-    cv::Mat sheet;
-    cv::vconcat(rows, sheet);
-    cv::imwrite(preview + "/" + sc.name + ".png", sheet);
-  }
+  if (!previews.empty()) cv::imwrite(preview + "/" + sc.name + ".png", tile(previews, 4));  // a contact sheet
   res.ms_per_frame = total_ms / std::max(1, res.frames);
   if (tracking_frames > 0) {
     res.sym_ms /= tracking_frames;
@@ -247,16 +236,7 @@ void write_results(const std::vector<VideoResult>& rs, int camera) {
     Series st{"theta error (deg)", r.frame, r.t_err_deg, cv::Scalar(0, 0, 200), false};
     tiles.push_back(plot({sr, st}, r.name, "frame", "error (px / deg)", {640, 300}));
   }
-  if (tiles.size() % 2 == 1) tiles.push_back(cv::Mat(tiles.back().size(), tiles.back().type(), cv::Scalar::all(255)));
-  std::vector<cv::Mat> rows;
-  for (size_t i = 0; i + 1 < tiles.size(); i += 2) {
-    cv::Mat row;
-    cv::hconcat(tiles[i], tiles[i + 1], row);
-    rows.push_back(row);
-  }
-  cv::Mat grid;
-  cv::vconcat(rows, grid);
-  write_png("tracking_videos_errors.png", grid);
+  write_png("tracking_videos_errors.png", tile(tiles, 2));
 
   std::vector<cv::Mat> snaps;
   for (const auto& r : rs) {
@@ -264,16 +244,7 @@ void write_results(const std::vector<VideoResult>& rs, int camera) {
     cv::resize(r.snapshot, s, {320, 240}, 0, 0, cv::INTER_AREA);
     snaps.push_back(s);
   }
-  while (snaps.size() % 5 != 0) snaps.push_back(cv::Mat(240, 320, CV_8UC3, cv::Scalar::all(255)));
-  std::vector<cv::Mat> srows;
-  for (size_t i = 0; i < snaps.size(); i += 5) {
-    cv::Mat row;
-    cv::hconcat(std::vector<cv::Mat>(snaps.begin() + i, snaps.begin() + i + 5), row);
-    srows.push_back(row);
-  }
-  cv::Mat sheet;
-  cv::vconcat(srows, sheet);
-  write_png("tracking_videos_frames.png", sheet);
+  write_png("tracking_videos_frames.png", tile(snaps, 5));
 }
 
 }  // namespace
