@@ -99,9 +99,13 @@ int run_sim_camera(bus::Service& service, const SimOptions& options) {
   });
   if (options.snapshots) {
     service.subscriptions().subscribe<snapshot_request_t>(
-        kSnapshotRequestChannel, [&](const snapshot_request_t&, const std::string&) {
+        kSnapshotRequestChannel, [&](const snapshot_request_t& request, const std::string&) {
           if (!last_state_utime) throw std::runtime_error("no SIM_STATE rendered yet: nothing to snapshot");
+          if (request.cameras < snapshot_request_t::CAMERAS_BOTH || request.cameras > snapshot_request_t::CAMERAS_RIGHT)
+            throw std::invalid_argument("snapshot request: unknown cameras value " + std::to_string(request.cameras));
           for (int c = 0; c < 2; ++c) {
+            const int8_t this_camera = c == 0 ? snapshot_request_t::CAMERAS_LEFT : snapshot_request_t::CAMERAS_RIGHT;
+            if (request.cameras != snapshot_request_t::CAMERAS_BOTH && request.cameras != this_camera) continue;
             service.publish(kSnapshotChannels[c],
                             bus::to_message(world.render_snapshot(c), options.pixel_format, *last_state_utime,
                                             snapshot_id, kCameraNames[c], options.jpeg_quality));

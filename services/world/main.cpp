@@ -104,15 +104,27 @@ class Simulation {
     arm_ = msg;
   }
 
-  void on_truth_request() {
+  void on_truth_request(bool with_masks) {
     // After a step MuJoCo's body positions are those from before its integration: restoring the
     // state recomputes them from the poses the state message reports (and changes nothing else).
     world_.set_state(world_.state());
     sim_truth_t truth;
     truth.state = state_message();
     truth.utime = truth.state.utime;
-    truth.mask_left = bus::to_message(world_.render_mask(0), image_t::FORMAT_GRAY8, truth.utime, step_, "left");
-    truth.mask_right = bus::to_message(world_.render_mask(1), image_t::FORMAT_GRAY8, truth.utime, step_, "right");
+    for (int c = 0; c < 2; ++c) {
+      image_t& mask = c == 0 ? truth.mask_left : truth.mask_right;
+      const char* camera = c == 0 ? "left" : "right";
+      if (with_masks) {
+        mask = bus::to_message(world_.render_mask(c), image_t::FORMAT_GRAY8, truth.utime, step_, camera);
+      } else {  // an empty image (LCM types start uninitialised: every field is set)
+        mask = image_t{};
+        mask.utime = truth.utime;
+        mask.frame_id = step_;
+        mask.camera = camera;
+        mask.width = mask.height = mask.row_stride = mask.size = 0;
+        mask.pixel_format = image_t::FORMAT_GRAY8;
+      }
+    }
     service_.publish(kTruthChannel, truth);
   }
 
@@ -174,7 +186,7 @@ class Inputs {
     service.subscriptions().subscribe<sim_truth_request_t>(
         kTruthRequestChannel, [this](const sim_truth_request_t& msg, const std::string&) {
           catch_up(msg.utime);
-          sim_.on_truth_request();
+          sim_.on_truth_request(!msg.without_masks);
         });
   }
 

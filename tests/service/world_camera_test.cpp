@@ -124,6 +124,7 @@ TEST(WorldCamera, EveryStateBecomesAStereoPairWhoseBottleAxisTheDetectorFinds) {
     if (states.size() == 10) {
       nudge::snapshot_request_t request;
       request.utime = e.timestamp;
+      request.cameras = nudge::snapshot_request_t::CAMERAS_BOTH;
       camera_input.push_back({e.timestamp + 1, "CAMERA_SNAPSHOT_REQUEST", encode(request)});
     }
     if (states.size() == 5) {  // a state of another scene: reported, counted, no frames
@@ -254,6 +255,7 @@ TEST(World, ArmStateDrivesThePusherTruthIsAnsweredAndTheRunIsDeterministic) {
   std::vector<Event> input;
   nudge::sim_truth_request_t request;
   request.utime = t0;
+  request.without_masks = false;
   input.push_back({t0, "SIM_TRUTH_REQUEST", encode(request)});
   // The tool's x axis along +y: the pad sweeps 9 cm along +y, 2 cm above the table, from 10 cm
   // before the cup's axis to 1 cm before it (the cup's base radius is ~3 cm), at 4.5 cm/s.
@@ -428,6 +430,7 @@ TEST(World, InputStampedInSimulatedTimeActsAtThatTimeAndOtherClocksAreRefused) {
   }
   nudge::sim_truth_request_t wall_clock;  // a wall-clock stamp among simulated ones: refused
   wall_clock.utime = 1700000000000000;
+  wall_clock.without_masks = true;
   input.push_back({1700000000000100, "SIM_TRUTH_REQUEST", encode(wall_clock)});
   write_log(in, input);
   ASSERT_EQ(run(kBin + "/nudge-world --scene " + scene + " --duration 1 --lcm-in 'file://" + in +
