@@ -60,6 +60,8 @@ int main(int argc, char** argv) {
   Flags flags("nudge-exp-photos", "Fast symmetry against Loy & Eklundh (2006) on annotated photographs.");
   flags.add_string("annotations", &annotations, "CSV of path, x1, y1, x2, y2");
   flags.add_string("name", &name, "result file name (docs/results/NAME.json)");
+  double mirror_tolerance = sym::PhotoOptions{}.params.mirror_tolerance_deg;
+  flags.add_double("mirror-tolerance", &mirror_tolerance, "fast symmetry's mirror rule, degrees (0: off)");
   try {
     if (!flags.parse(argc, argv)) return 0;
     const auto rows = read_annotations(annotations);
@@ -76,6 +78,7 @@ int main(int argc, char** argv) {
       ++images;
       sym::PhotoOptions options;
       options.params.num_lines = 1;
+      options.params.mirror_tolerance_deg = mirror_tolerance;
       Stopwatch watch;
       const sym::PhotoDetection fast = sym::detect_photo(image, options);
       fast_ms.push_back(watch.lap_ms());

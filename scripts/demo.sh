@@ -6,7 +6,8 @@
 #   scripts/demo.sh                       # the simulated world (NUDGE_DEMO_SCENE, default three_objects.yaml)
 #   scripts/demo.sh 'images:/data/left/*.png' 'images:/data/right/*.png'   # recorded stereo data
 #   scripts/demo.sh synthetic             # the synthetic image sequence (generated into out/scenes)
-# NUDGE_DEMO_SECONDS (4) and NUDGE_DEMO_RATE (10 Hz) set the simulated run; NUDGE_DEMO_FRAMES (20)
+# NUDGE_DEMO_SECONDS (4) and NUDGE_DEMO_RATE (10 Hz) set the simulated run, NUDGE_DEMO_SYMMETRY_FLAGS
+# the symmetry extensions (default "--once-per-row --mirror-tolerance 15"); NUDGE_DEMO_FRAMES (20)
 # the length of the synthetic sequence.
 # By default the processes share a private network namespace (when run as root), so no
 # traffic leaves it; NUDGE_HOST_NETWORK=1 uses this host's network instead (to watch with
@@ -47,7 +48,10 @@ run_sim_pipeline() {
   lcm-logger --lcm-url="$url" -q "$log" & local logger=$!
   # Upright objects: +-25 deg about vertical. The backdrop's foot is a long straight edge: the
   # thesis' rule that a row of Rot votes for a bin at most once keeps it from outvoting objects.
-  "$bin/nudge-symmetry" --lcm-url "$url" --lines 5 --theta-min -25 --theta-max 25 --once-per-row \
+  # Mirror-consistent pairs keep a striped mug's texture from taking the other objects' lines
+  # (NUDGE_DEMO_SYMMETRY_FLAGS replaces these extensions, e.g. with "" for Algorithm 1 as published).
+  "$bin/nudge-symmetry" --lcm-url "$url" --lines 5 --theta-min -25 --theta-max 25 \
+    ${NUDGE_DEMO_SYMMETRY_FLAGS---once-per-row --mirror-tolerance 15} \
     2>"$out/demo/symmetry.log" & local sym=$!
   "$bin/nudge-monitor" --lcm-url "$url" --truth --draw-dir "$out/demo" --expect-frames "$frames" --timeout 120 \
     2>"$out/demo/monitor.log" & local mon=$!

@@ -74,6 +74,8 @@ int main(int argc, char** argv) {
     f.add_double("min-peak-ratio", &params.min_peak_ratio, "drop peaks below this fraction of the top one");
     f.add_bool("once-per-row", &params.once_per_row, "a row of Rot increments a bin at most once");
     f.add_int("max-row-pixels", &params.max_row_pixels, "skip rows of Rot with more pixels (0: off)");
+    f.add_double("mirror-tolerance", &params.mirror_tolerance_deg,
+                 "pairs vote only if their edge orientations mirror about the axis within DEG (0: off)");
     f.add_int("threads", &params.threads, "threads across angles");
     int contours = 0;
     f.add_int("contours", &contours, "also segment the contours of the top N lines (CONTOURS_*); 0: off");
@@ -87,6 +89,7 @@ int main(int argc, char** argv) {
       throw FlagError(e.what());
     }
     if (contours < 0) throw FlagError("--contours must be >= 0");
+    edge.gradients = params.mirror_tolerance_deg > 0;
     symmetry::Detector detector(params, edge);
     segmentation::SegmentParams segment_params;
     if (params.dmax > 0) segment_params.max_width = params.dmax;  // thesis: MAXw is usually Dmax

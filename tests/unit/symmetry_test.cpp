@@ -83,6 +83,100 @@ TEST(SymmetryVote, FastEqualsPlainOnScenesAndOptions) {
   }
 }
 
+TEST(SymmetryVote, MirrorRuleFastEqualsPlainOnGreyColourWideAndNarrowImages) {
+  // Narrow (16-bit) rows on a 320x240 frame, 32-bit rows on one too large for them, short and
+  // long rows, colour gradients: the fast voting casts exactly the plain loop's votes.
+  struct Case {
+    int w, h;
+    double tolerance, dmin, dmax, tmin, tmax;
+    bool colour, once;
+  };
+  const std::vector<Case> cases = {{320, 240, 15, 25, 250, -90, 90, false, false},
+                                   {320, 240, 5, 10, 0, -25, 25, true, false},
+                                   {320, 240, 30, 5, 60, -90, 90, false, true},
+                                   {3000, 60, 20, 10, 0, -90, 90, false, false}};
+  for (size_t i = 0; i < cases.size(); ++i) {
+    const Case& c = cases[i];
+    Params p;
+    p.mirror_tolerance_deg = c.tolerance;
+    p.dmin = c.dmin;
+    p.dmax = c.dmax;
+    p.theta_min_deg = c.tmin;
+    p.theta_max_deg = c.tmax;
+    p.once_per_row = c.once;
+    const cv::Mat scene = syn::indoor_scene(static_cast<uint32_t>(40 + i), c.w, c.h, 2);
+    EdgeParams e{1.0, 30, 90, false};
+    e.colour = c.colour;
+    e.gradients = true;
+    const EdgeSet edges = detect_edges(scene, e);
+    ASSERT_EQ(edges.orientation.size(), edges.points.size());
+    SCOPED_TRACE("case " + std::to_string(i));
+    Detector fast(p);
+    expect_same_accumulator(fast.vote(edges), reference_vote(edges, p));
+  }
+}
+
+TEST(SymmetryVote, MirrorRuleKeepsMirroredOrientationsAndDropsOthers) {
+  // Edge pixels placed mirror-symmetrically about the vertical line x = 100 of a 201 x 201 image.
+  // Votes for that axis (R = 0, theta = 0) need the two orientations of a pair to be mirror
+  // images about it: a + b = 0 (mod 180 deg).
+  EdgeSet edges;
+  edges.width = edges.height = 201;
+  std::mt19937 rng(5);
+  for (int y = 20; y < 180; y += 2) {
+    const int dx = std::uniform_int_distribution<int>(15, 80)(rng);
+    edges.points.emplace_back(100 - dx, y);
+    edges.points.emplace_back(100 + dx, y);
+  }
+  auto axis_votes = [&](double left_deg, double right_deg, double tolerance) {
+    edges.orientation.clear();
+    for (size_t i = 0; i < edges.points.size(); ++i)
+      edges.orientation.push_back(orientation_units((i % 2 == 0 ? left_deg : right_deg) * kDeg));
+    Params p = synthetic_params();
+    p.mirror_tolerance_deg = tolerance;
+    Detector d(p);
+    const Accumulator& acc = d.vote(edges);
+    return acc.votes[0].at<int32_t>(89 /* theta 0 */, acc.r_max /* R 0 */);
+  };
+  const int all = axis_votes(30, 30, 0);
+  ASSERT_GE(all, 80);                                // one pair per row of the shape
+  EXPECT_EQ(axis_votes(30, -30, 10), all);           // mirrored: every pair still votes
+  EXPECT_EQ(axis_votes(30, 150, 10), all);           // mirrored, opposite polarity (mod 180 deg)
+  EXPECT_EQ(axis_votes(30, -22, 10), all);           // 8 deg off: inside the tolerance
+  EXPECT_EQ(axis_votes(30, -18, 10), 0);             // 12 deg off: outside
+  EXPECT_EQ(axis_votes(30, 30, 10), 0);              // parallel, not mirrored
+  EXPECT_EQ(axis_votes(30, 30, 90), all);            // a tolerance of 90 deg accepts everything
+}
+
+TEST(SymmetryDetect, MirrorRuleRaisesTheAxisAboveClutter) {
+  // A bottle among random line-segment clutter: with mirror-consistent pairs the clutter's votes
+  // drop far more than the axis' do, so the axis stands out further from the next line.
+  cv::Mat img = blank(320, 240);
+  std::mt19937 rng(11);
+  for (int i = 0; i < 60; ++i) {
+    auto u = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+    const cv::Point a(u(0, 319), u(0, 239));
+    cv::line(img, a, a + cv::Point(u(-30, 30), u(-30, 30)), cv::Scalar(u(0, 120)), 2);
+  }
+  const double r = 20.0, theta = 3.0 * kDeg;
+  syn::draw_shape(img, syn::bottle_profile(170, 30), r, theta, 0, cv::Scalar(60));
+  auto margin = [&](double tolerance) {
+    Params p = synthetic_params();
+    p.num_lines = 2;
+    p.theta_min_deg = -25;
+    p.theta_max_deg = 25;
+    p.mirror_tolerance_deg = tolerance;
+    const Result res = Detector(p).detect(img);
+    EXPECT_EQ(res.lines.size(), 2u);
+    if (res.lines.size() < 2) return 0.0;
+    EXPECT_LT(angle_diff_deg(res.lines[0].theta, theta), 1.0) << "tolerance " << tolerance;
+    EXPECT_LT(r_diff(res.lines[0], r, theta), 1.5) << "tolerance " << tolerance;
+    return res.lines[0].votes / res.lines[1].votes;
+  };
+  const double plain = margin(0), mirrored = margin(15);
+  EXPECT_GT(mirrored, 1.5 * plain) << "top / second line: " << plain << " plain, " << mirrored << " mirrored";
+}
+
 TEST(SymmetryVote, ThreadsGiveTheSameAccumulator) {
   const cv::Mat scene = syn::indoor_scene(7);
   const EdgeSet edges = detect_edges(scene, EdgeParams{1.0, 30, 90, false});
@@ -291,10 +385,34 @@ TEST(SymmetryBadInput, BadParametersAreRejectedNamingTheParameter) {
   p = Params{};
   p.dmax = std::nan("");
   EXPECT_NE(message_of(p).find("dmax"), std::string::npos);
+  p = Params{};
+  p.mirror_tolerance_deg = 120;
+  EXPECT_NE(message_of(p).find("mirror_tolerance"), std::string::npos);
+  p.mirror_tolerance_deg = std::nan("");
+  EXPECT_NE(message_of(p).find("mirror_tolerance"), std::string::npos);
+  p.mirror_tolerance_deg = 10;
+  p.skew_deg = {20};
+  EXPECT_NE(message_of(p).find("skew"), std::string::npos);
   EdgeParams e;
   e.canny_low = 100;
   e.canny_high = 10;
   EXPECT_THROW(Detector(Params{}, e), std::invalid_argument);
+}
+
+TEST(SymmetryBadInput, MirrorRuleWithoutOrientationsIsAClearError) {
+  Params p;
+  p.mirror_tolerance_deg = 15;
+  Detector d(p);
+  EdgeSet edges = detect_edges(syn::indoor_scene(1, 160, 120, 2), EdgeParams{});
+  ASSERT_TRUE(edges.orientation.empty());
+  try {
+    d.vote(edges);
+    FAIL() << "voting without orientations was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("orientation"), std::string::npos) << e.what();
+  }
+  // From an image the detector measures the orientations itself.
+  EXPECT_GT(d.detect(syn::indoor_scene(1, 160, 120, 2)).num_edges, 0);
 }
 
 TEST(SymmetryGeometry, BorderEndpointsOfVerticalAndDiagonalLines) {

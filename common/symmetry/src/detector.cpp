@@ -37,6 +37,17 @@ void validate(const Params& p) {
   for (double s : p.skew_deg) {
     require(std::isfinite(s) && std::fabs(s) <= 60, "symmetry skew angles must be within [-60, 60] degrees");
   }
+  require(std::isfinite(p.mirror_tolerance_deg) && p.mirror_tolerance_deg >= 0 && p.mirror_tolerance_deg <= 90,
+          "symmetry parameter mirror_tolerance must be in [0, 90] degrees");
+  require(p.mirror_tolerance_deg == 0 || p.skew_deg.empty(),
+          "symmetry parameters: mirror_tolerance does not combine with skew angles");
+}
+
+int16_t orientation_units(double radians) {
+  // 65536 units = 180 deg; the int16 cast wraps, so the result is the angle modulo 180 deg.
+  const double units = radians * (65536.0 / M_PI);
+  const int64_t wrapped = std::llround(units - 65536.0 * std::floor(units / 65536.0)) & 0xFFFF;
+  return static_cast<int16_t>(static_cast<uint16_t>(wrapped));
 }
 
 void validate(const EdgeParams& p) {
@@ -77,6 +88,26 @@ EdgeSet edges_from_mask(const cv::Mat& mask) {
 }
 
 namespace {
+// EdgeSet::orientation from the 3x3 Sobel derivatives of the image Canny saw; on a colour image,
+// those of the channel with the largest L1 gradient at each pixel (as OpenCV's Canny picks it).
+void add_orientations(const cv::Mat& image, EdgeSet* edges) {
+  edges->orientation.assign(edges->points.size(), 0);
+  if (image.rows < 3 || image.cols < 3) return;
+  cv::Mat dx, dy;
+  cv::Sobel(image, dx, CV_16S, 1, 0, 3);
+  cv::Sobel(image, dy, CV_16S, 0, 1, 3);
+  const int channels = image.channels();
+  for (size_t i = 0; i < edges->points.size(); ++i) {
+    const cv::Point p = edges->points[i];
+    const int16_t* gx = dx.ptr<int16_t>(p.y) + p.x * channels;
+    const int16_t* gy = dy.ptr<int16_t>(p.y) + p.x * channels;
+    int best = 0;
+    for (int c = 1; c < channels; ++c)
+      if (std::abs(gx[c]) + std::abs(gy[c]) > std::abs(gx[best]) + std::abs(gy[best])) best = c;
+    edges->orientation[i] = orientation_units(std::atan2(static_cast<double>(gy[best]), static_cast<double>(gx[best])));
+  }
+}
+
 // Thresholds from the image itself, for photographs of any exposure: the high threshold is a high
 // quantile (93 %) of the L1 gradient magnitude that Canny uses, the low one 40 % of it: a few per
 // cent of the pixels become edges whatever the exposure or texture.
@@ -145,7 +176,9 @@ EdgeSet detect_edges(const cv::Mat& image, const EdgeParams& params, cv::Mat* ed
     edges = cv::Mat::zeros(grey.size(), CV_8U);  // too small for a 3x3 aperture: no edges
   }
   if (edge_image) *edge_image = edges;
-  return edges_from_mask(edges);
+  EdgeSet set = edges_from_mask(edges);
+  if (params.gradients) add_orientations(grey, &set);
+  return set;
 }
 
 void border_endpoints(double r, double theta, int width, int height, cv::Point2d* p1, cv::Point2d* p2) {
@@ -200,7 +233,9 @@ Detector::Detector(Params params, EdgeParams edge_params)
 
 Result Detector::detect(const cv::Mat& image) {
   Stopwatch watch;
-  const EdgeSet edges = detect_edges(image, edge_params_);
+  EdgeParams edge_params = edge_params_;
+  edge_params.gradients = edge_params.gradients || params_.mirror_tolerance_deg > 0;
+  const EdgeSet edges = detect_edges(image, edge_params);
   const double edges_ms = watch.elapsed_ms();
   Result result = detect(edges);
   result.ms.edges_ms = edges_ms;

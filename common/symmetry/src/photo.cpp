@@ -33,6 +33,7 @@ PhotoDetection detect_photo(const cv::Mat& image, const PhotoOptions& options) {
   } else {
     out.edge_params.auto_canny = true;
   }
+  out.edge_params.gradients = out.params.mirror_tolerance_deg > 0;
   Detector detector(out.params, out.edge_params);
   Stopwatch watch;
   out.edges = detect_edges(work, out.edge_params, &out.edge_image);

@@ -6,6 +6,7 @@
 //   xq  = round(2 x')  = (u2 C + v2 S + 2^13) >> 14   (rotated x in half pixels)
 //   row = round(y')    = (v2 C - u2 S + 2^14) >> 15   (row of Rot, 1 px high)
 // A pair (a, b) in one row votes for R = (xq_a + xq_b) / 4 px, binned to the nearest pixel.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -35,6 +36,32 @@ inline int32_t rotated_xq(int32_t u2, int32_t v2, const ThetaTable& t) {
 }
 inline int32_t rotated_row(int32_t u2, int32_t v2, const ThetaTable& t) {
   return (v2 * t.c - u2 * t.s + (1 << kFixedShift)) >> (kFixedShift + 1);
+}
+
+// Mirror-consistent pairs (Params::mirror_tolerance_deg): the gradient orientations a, b of a pair
+// voting for the line of normal angle theta are mirror images about it iff a + b = 2 theta
+// (modulo 180 deg). In EdgeSet::orientation units the sum wraps in int16 by itself.
+struct MirrorRule {
+  bool on = false;
+  int16_t target = 0;     // 2 theta, orientation units
+  int16_t tolerance = 0;  // orientation units
+};
+
+inline MirrorRule mirror_rule(int bin, double tolerance_deg) {
+  MirrorRule m;
+  m.on = tolerance_deg > 0;
+  m.target = orientation_units(2.0 * theta_of_bin_deg(bin) * M_PI / 180.0);
+  m.tolerance = static_cast<int16_t>(std::min(32767.0, std::round(tolerance_deg * 65536.0 / 180.0)));
+  return m;
+}
+
+inline int16_t mirror_error(int16_t a, int16_t b, int16_t target) {
+  return static_cast<int16_t>(static_cast<uint16_t>(static_cast<uint16_t>(a) + static_cast<uint16_t>(b) -
+                                                    static_cast<uint16_t>(target)));
+}
+
+inline bool mirror_consistent(int16_t a, int16_t b, const MirrorRule& m) {
+  return !m.on || std::abs(static_cast<int>(mirror_error(a, b, m.target))) <= m.tolerance;
 }
 
 // Geometry of the accumulator and the pair-distance limits, in the quantised units above.

@@ -16,6 +16,7 @@
 // The accumulator is bit-identical to reference_vote() (tests compare them).
 #include <algorithm>
 #include <cstring>
+#include <stdexcept>
 #include <thread>
 #include <type_traits>
 
@@ -42,6 +43,23 @@ struct PairRule {
   uint32_t span;    // dmax2 - dmin2: valid iff (|d| - dmin2) <= span, as unsigned
   int32_t offset;   // added to xq_a + xq_b (+2 to round, + skew shift); >> 2 gives the histogram index
 };
+
+// The branch-free scalar loop with the mirror rule on the orientations a[0..n) (wide rows only:
+// large images with mirror-consistent pairs).
+inline int row_pair_bins_mirror(const int32_t* x, const int16_t* a, int n, const PairRule& rule,
+                                const detail::MirrorRule& mirror, int32_t* out) {
+  int count = 0;
+  for (int i = 0; i + 1 < n; ++i) {
+    const int32_t xi = x[i];
+    for (int j = i + 1; j < n; ++j) {
+      const int32_t d = std::abs(x[j] - xi);
+      out[count] = (xi + x[j] + rule.offset) >> 2;
+      count += (static_cast<uint32_t>(d - rule.dmin2) <= rule.span) &
+               (std::abs(static_cast<int>(detail::mirror_error(a[i], a[j], mirror.target))) <= mirror.tolerance);
+    }
+  }
+  return count;
+}
 
 // Writes the histogram index of every valid pair of the row x[0..n) to out; returns how many.
 // out needs room for n (n - 1) / 2 + 16 entries.
@@ -104,17 +122,28 @@ constexpr bool kHaveNarrowPath = true;
 // The same as row_pair_bins with 16-bit lanes: one 256-bit vector holds a row of up to 16 pixels
 // and one 512-bit vector a row of up to 32, so most rows need a single compare per pixel. Only
 // valid when every coordinate, difference and histogram index fits in int16 (see narrow_fits).
-inline int row_pair_bins16(const int16_t* x, int n, const PairRule& rule, int16_t* out) {
+// With kMirror, a[0..n) are the row's orientations and pairs must also pass the mirror rule.
+template <bool kMirror>
+inline int row_pair_bins16(const int16_t* x, const int16_t* a, int n, const PairRule& rule,
+                           const detail::MirrorRule& mirror, int16_t* out) {
   int count = 0;
   const int16_t dmin2 = static_cast<int16_t>(rule.dmin2);
   const int16_t span = static_cast<int16_t>(std::min<uint32_t>(rule.span, 0xFFFF));
   const int16_t offset = static_cast<int16_t>(rule.offset);
+  const __m512i vtol = _mm512_set1_epi16(mirror.tolerance);
+  // |a_i + a_j - 2 theta| (int16 wraps modulo 180 deg) within the tolerance.
+  auto mirror_ok = [&](__mmask32 ok, __m512i aj, __m512i ai_minus_target) {
+    if constexpr (!kMirror) return ok;
+    return _mm512_mask_cmple_epu16_mask(ok, _mm512_abs_epi16(_mm512_add_epi16(aj, ai_minus_target)), vtol);
+  };
   if (n <= 16) {
     // Two pixels per step: the row sits in both 256-bit halves of one 512-bit vector, the low
     // half compared with x[i] and the high half with x[i + 1].
     const uint32_t row_lanes = (1u << n) - 1;
     const __m512i xs = _mm512_broadcast_i64x4(_mm256_maskz_loadu_epi16(static_cast<__mmask16>(row_lanes), x));
     const __m512i vdmin = _mm512_set1_epi16(dmin2), vspan = _mm512_set1_epi16(span);
+    __m512i as = _mm512_setzero_si512();
+    if constexpr (kMirror) as = _mm512_broadcast_i64x4(_mm256_maskz_loadu_epi16(static_cast<__mmask16>(row_lanes), a));
     for (int i = 0; i + 1 < n; i += 2) {
       const int16_t next = i + 1 < n ? x[i + 1] : x[i];
       const __m512i xi = _mm512_inserti64x4(_mm512_castsi256_si512(_mm256_set1_epi16(x[i])), _mm256_set1_epi16(next), 1);
@@ -124,7 +153,14 @@ inline int row_pair_bins16(const int16_t* x, int n, const PairRule& rule, int16_
       const uint32_t after_next = i + 1 < n ? row_lanes & ~((4u << i) - 1) : 0;
       const __mmask32 lanes = static_cast<__mmask32>(after_i | (after_next << 16));
       const __m512i d = _mm512_abs_epi16(_mm512_sub_epi16(xs, xi));
-      const __mmask32 ok = _mm512_mask_cmple_epu16_mask(lanes, _mm512_sub_epi16(d, vdmin), vspan);
+      __mmask32 ok = _mm512_mask_cmple_epu16_mask(lanes, _mm512_sub_epi16(d, vdmin), vspan);
+      if constexpr (kMirror) {
+        const int16_t a_next = i + 1 < n ? a[i + 1] : a[i];
+        const __m512i ai = _mm512_inserti64x4(
+            _mm512_castsi256_si512(_mm256_set1_epi16(static_cast<int16_t>(a[i] - mirror.target))),
+            _mm256_set1_epi16(static_cast<int16_t>(a_next - mirror.target)), 1);
+        ok = mirror_ok(ok, as, ai);
+      }
       const __m512i bins = _mm512_srai_epi16(_mm512_add_epi16(xs, base), 2);
       _mm512_storeu_si512(out + count, _mm512_maskz_compress_epi16(ok, bins));
       count += __builtin_popcount(static_cast<unsigned>(ok));
@@ -135,12 +171,14 @@ inline int row_pair_bins16(const int16_t* x, int n, const PairRule& rule, int16_
   for (int i = 0; i + 1 < n; ++i) {
     const __m512i xi = _mm512_set1_epi16(x[i]);
     const __m512i base = _mm512_set1_epi16(static_cast<int16_t>(x[i] + offset));
+    const __m512i ai = _mm512_set1_epi16(kMirror ? static_cast<int16_t>(a[i] - mirror.target) : int16_t{0});
     for (int j = i + 1; j < n; j += 32) {
       const int left = n - j;
       const __mmask32 lanes = left >= 32 ? ~__mmask32{0} : static_cast<__mmask32>((1ull << left) - 1);
       const __m512i xj = _mm512_maskz_loadu_epi16(lanes, x + j);
       const __m512i d = _mm512_abs_epi16(_mm512_sub_epi16(xj, xi));
-      const __mmask32 ok = _mm512_mask_cmple_epu16_mask(lanes, _mm512_sub_epi16(d, vdmin), vspan);
+      __mmask32 ok = _mm512_mask_cmple_epu16_mask(lanes, _mm512_sub_epi16(d, vdmin), vspan);
+      if constexpr (kMirror) ok = mirror_ok(ok, _mm512_maskz_loadu_epi16(lanes, a + j), ai);
       const __m512i bins = _mm512_srai_epi16(_mm512_add_epi16(xj, base), 2);
       _mm512_storeu_si512(out + count, _mm512_maskz_compress_epi16(ok, bins));
       count += __builtin_popcount(static_cast<unsigned>(ok));
@@ -150,7 +188,10 @@ inline int row_pair_bins16(const int16_t* x, int n, const PairRule& rule, int16_
 }
 #else
 constexpr bool kHaveNarrowPath = false;
-inline int row_pair_bins16(const int16_t*, int, const PairRule&, int16_t*) { return 0; }
+template <bool kMirror>
+inline int row_pair_bins16(const int16_t*, const int16_t*, int, const PairRule&, const detail::MirrorRule&, int16_t*) {
+  return 0;
+}
 #endif
 
 // Skew offsets are whole quarter-pixels of the pair sum: R_skew = x'_mid - y' tan(phi).
@@ -203,6 +244,9 @@ const Accumulator& Detector::vote(const EdgeSet& edges) {
     m.setTo(0);
   }
   const size_t n = edges.points.size();
+  if (params_.mirror_tolerance_deg > 0 && edges.orientation.size() != n)
+    throw std::invalid_argument("symmetry parameter mirror_tolerance needs the edge pixels' orientations "
+                                "(EdgeParams::gradients)");
   u2_.resize(n);
   v2_.resize(n);
   for (size_t i = 0; i < n; ++i) {
@@ -249,6 +293,8 @@ void Detector::vote_thetas(const EdgeSet& edges, const std::vector<int>& thetas,
   // 16-bit lanes when coordinates, sums plus offsets and histogram indices all fit in int16.
   const bool narrow = kHaveNarrowPath && 4 * layout.r_max + 2 * offset + 16 < 32767;
   if (narrow) s.sorted16.resize(n);
+  const bool mirror = params_.mirror_tolerance_deg > 0;
+  if (mirror) s.angle16.resize(n);
 
   for (size_t ti = first; ti < thetas.size(); ti += step) {
     const int k = thetas[ti];
@@ -281,15 +327,26 @@ void Detector::vote_thetas(const EdgeSet& edges, const std::vector<int>& thetas,
       }
     }
     s.starts[num_rows] = running;
-    auto scatter = [&](auto* out) {
+    // With the mirror rule each pixel's orientation goes to the same place as its xq.
+    const int16_t* orientation = edges.orientation.data();
+    int16_t* angle_out = s.angle16.data();
+    auto scatter = [&](auto* out, auto with_angles) {
       using Value = std::remove_pointer_t<decltype(out)>;
+      auto place = [&](size_t src, int32_t& slot) {
+        const int32_t dst = slot++;
+        out[dst] = static_cast<Value>(xq[src]);
+        if constexpr (decltype(with_angles)::value) angle_out[dst] = orientation[src];
+      };
       size_t j = 0;
       for (; j + kLanes <= n; j += kLanes)
-        for (int l = 0; l < kLanes; ++l) out[counts[l * num_rows + row[j + l]]++] = static_cast<Value>(xq[j + l]);
-      for (; j < n; ++j) out[counts[row[j]]++] = static_cast<Value>(xq[j]);
+        for (int l = 0; l < kLanes; ++l) place(j + l, counts[l * num_rows + row[j + l]]);
+      for (; j < n; ++j) place(j, counts[row[j]]);
     };
-    if (narrow) scatter(s.sorted16.data());
-    else scatter(s.sorted.data());
+    if (narrow && mirror) scatter(s.sorted16.data(), std::true_type{});
+    else if (narrow) scatter(s.sorted16.data(), std::false_type{});
+    else if (mirror) scatter(s.sorted.data(), std::true_type{});
+    else scatter(s.sorted.data(), std::false_type{});
+    const detail::MirrorRule mirror_rule = detail::mirror_rule(k, params_.mirror_tolerance_deg);
 
     for (int layer = 0; layer < num_layers; ++layer) {
       const double tan_phi = layer == 0 ? 0.0 : tan_skew[layer - 1];
@@ -308,14 +365,20 @@ void Detector::vote_thetas(const EdgeSet& edges, const std::vector<int>& thetas,
             pending = 0;
             if (need > s.pairs16.size()) s.pairs16.resize(std::max(need, size_t{16384}));
           }
-          pending += row_pair_bins16(s.sorted16.data() + s.starts[r], count, rule, s.pairs16.data() + pending);
+          const int16_t* x16 = s.sorted16.data() + s.starts[r];
+          int16_t* out16 = s.pairs16.data() + pending;
+          pending += mirror ? row_pair_bins16<true>(x16, s.angle16.data() + s.starts[r], count, rule, mirror_rule, out16)
+                            : row_pair_bins16<false>(x16, nullptr, count, rule, mirror_rule, out16);
         } else {
           if (pending + need > s.pairs.size()) {
             add_votes(s.pairs.data(), static_cast<int>(pending), hist_size, s);
             pending = 0;
             if (need > s.pairs.size()) s.pairs.resize(std::max(need, size_t{16384}));
           }
-          pending += row_pair_bins(s.sorted.data() + s.starts[r], count, rule, s.pairs.data() + pending);
+          const int32_t* x32 = s.sorted.data() + s.starts[r];
+          int32_t* out32 = s.pairs.data() + pending;
+          pending += mirror ? row_pair_bins_mirror(x32, s.angle16.data() + s.starts[r], count, rule, mirror_rule, out32)
+                            : row_pair_bins(x32, count, rule, out32);
         }
         if (params_.once_per_row) {  // the rule needs each row's bins on their own
           if (narrow) add_votes_once(s.pairs16.data(), static_cast<int>(pending), (k * num_layers + layer) * num_rows + r, s);
@@ -340,6 +403,8 @@ void Detector::vote_thetas(const EdgeSet& edges, const std::vector<int>& thetas,
 
 Accumulator reference_vote(const EdgeSet& edges, const Params& params) {
   validate(params);
+  if (params.mirror_tolerance_deg > 0 && edges.orientation.size() != edges.points.size())
+    throw std::invalid_argument("symmetry parameter mirror_tolerance needs the edge pixels' orientations");
   const Layout layout = detail::make_layout(edges.width, edges.height, params);
   Accumulator acc;
   acc.r_max = layout.r_max;
@@ -348,11 +413,18 @@ Accumulator reference_vote(const EdgeSet& edges, const Params& params) {
   for (int k : theta_bins_in_range(params.theta_min_deg, params.theta_max_deg)) {
     const ThetaTable t = detail::theta_table(k);
     // Rotate every edge pixel and group by row of Rot.
-    std::vector<std::vector<int32_t>> rows(2 * layout.row_max + 1);
-    for (const auto& p : edges.points) {
+    struct Pixel {
+      int32_t xq;
+      int16_t orientation;
+    };
+    std::vector<std::vector<Pixel>> rows(2 * layout.row_max + 1);
+    for (size_t i = 0; i < edges.points.size(); ++i) {
+      const cv::Point p = edges.points[i];
       const int32_t u2 = 2 * p.x - (edges.width - 1), v2 = 2 * p.y - (edges.height - 1);
-      rows[detail::rotated_row(u2, v2, t) + layout.row_max].push_back(detail::rotated_xq(u2, v2, t));
+      const int16_t orientation = edges.orientation.empty() ? int16_t{0} : edges.orientation[i];
+      rows[detail::rotated_row(u2, v2, t) + layout.row_max].push_back({detail::rotated_xq(u2, v2, t), orientation});
     }
+    const detail::MirrorRule mirror = detail::mirror_rule(k, params.mirror_tolerance_deg);
     for (size_t sk = 0; sk < acc.votes.size(); ++sk) {
       const double tan_phi = sk == 0 ? 0.0 : std::tan(params.skew_deg[sk - 1] * M_PI / 180.0);
       int32_t* out = acc.votes[sk].ptr<int32_t>(k);
@@ -365,9 +437,10 @@ Accumulator reference_vote(const EdgeSet& edges, const Params& params) {
         // Every pair of the row, checked against [Dmin, Dmax].
         for (size_t i = 0; i < row.size(); ++i) {
           for (size_t j = i + 1; j < row.size(); ++j) {
-            const int32_t dx = std::abs(row[i] - row[j]);
+            const int32_t dx = std::abs(row[i].xq - row[j].xq);
             if (dx < layout.dmin2 || dx > layout.dmax2) continue;
-            const int b = layout.bin_of_sum(row[i] + row[j] + shift);
+            if (!detail::mirror_consistent(row[i].orientation, row[j].orientation, mirror)) continue;
+            const int b = layout.bin_of_sum(row[i].xq + row[j].xq + shift);
             if (b < 0 || b >= layout.num_r()) continue;
             if (params.once_per_row) {
               if (voted[b]) continue;

@@ -21,6 +21,9 @@ struct EdgeParams {
   // Canny on the colour image (the gradient of the channel that changes most) instead of grey:
   // finds outlines between regions of equal brightness but different colour.
   bool colour = false;
+  // Also measure each edge pixel's gradient orientation (EdgeSet::orientation), from the same
+  // 3x3 Sobel derivatives Canny uses (on colour images: of the channel that changes most).
+  bool gradients = false;
 };
 
 struct Params {
@@ -38,6 +41,12 @@ struct Params {
   bool once_per_row = false;   // each row of Rot increments a given bin at most once
   bool anti_alias = false;     // 3x3 Gaussian vote kernel (applied as an accumulator blur)
   std::vector<double> skew_deg;// skew angles to vote for (skew symmetry); empty = bilateral only
+  // Mirror-consistent pairs only: a pair votes for an axis only if the gradient orientations of
+  // its two edge pixels are mirror images about that axis, within this many degrees. Random pairs
+  // of texture and clutter rarely are, the two sides of a symmetric outline always are. Needs
+  // EdgeSet::orientation (EdgeParams::gradients); not with skew. 0 = off (Algorithm 1 as published
+  // uses edge locations only).
+  double mirror_tolerance_deg = 0;
   int threads = 1;             // threads across theta; results are identical for any count
 };
 
@@ -50,7 +59,13 @@ struct EdgeSet {
   int width = 0;
   int height = 0;
   std::vector<cv::Point> points;
+  // Optional, one per point: the gradient's orientation modulo 180 deg (polarity-free) in units of
+  // 180/65536 deg, so that int16 arithmetic wraps exactly as angles modulo 180 deg do.
+  std::vector<int16_t> orientation;
 };
+
+// An angle (radians) as EdgeSet::orientation units, modulo 180 deg.
+int16_t orientation_units(double radians);
 
 struct Line {
   double r = 0;          // px
@@ -124,7 +139,7 @@ class Detector {
  private:
   struct Scratch {  // per-thread working memory, kept between frames to avoid allocation
     std::vector<int32_t> xq, row, sorted, starts, fill, pairs, hist, stamp;
-    std::vector<int16_t> sorted16, pairs16;
+    std::vector<int16_t> sorted16, pairs16, angle16;  // angle16: orientations in row order
   };
   template <typename Bin>
   void add_votes(const Bin* bins, int votes, size_t hist_size, Scratch& s) const;
