@@ -41,6 +41,24 @@ void BM_VoteFast(benchmark::State& state) {
   state.counters["edges"] = static_cast<double>(edges.points.size());
 }
 
+// Mirror-consistent pairs (Params::mirror_tolerance_deg = 15): the same frame with orientations.
+void BM_VoteFastMirror(benchmark::State& state) {
+  static const sym::EdgeSet edges = [] {
+    sym::EdgeParams e{1.0, 30, 90, false};
+    e.gradients = true;
+    return sym::detect_edges(sym::synthetic::indoor_scene(3, 640, 480, 4), e);
+  }();
+  sym::Params p = table_params();
+  p.mirror_tolerance_deg = 15;
+  sym::Detector d(p);
+  if (cv::countNonZero(d.vote(edges).votes[0] != sym::reference_vote(edges, p).votes[0]) != 0) {
+    state.SkipWithError("fast accumulator differs from the plain one");
+    return;
+  }
+  for (auto _ : state) benchmark::DoNotOptimize(d.vote(edges));
+  state.counters["edges"] = static_cast<double>(edges.points.size());
+}
+
 void BM_VotePlain(benchmark::State& state) {
   const auto& edges = frame_edges();
   for (auto _ : state) benchmark::DoNotOptimize(sym::reference_vote(edges, table_params()));
@@ -72,6 +90,7 @@ void BM_VoteOrientationRange(benchmark::State& state) {
 
 BENCHMARK(BM_Canny)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_VoteFast)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_VoteFastMirror)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_VotePlain)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Peaks)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_DetectFromEdges)->Unit(benchmark::kMillisecond);

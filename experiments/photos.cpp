@@ -6,7 +6,9 @@
 // docs/results/NAME.{json,md}. Point it at a published dataset's annotations for real numbers.
 #include <opencv2/imgcodecs.hpp>
 
+#include <algorithm>
 #include <fstream>
+#include <iomanip>
 #include <iostream>
 #include <sstream>
 
@@ -53,77 +55,125 @@ std::vector<Annotated> read_annotations(const std::string& file) {
   return rows;
 }
 
+
+struct Method {
+  std::string key, title;
+  std::vector<bool> hits;
+  std::vector<double> ms;
+  std::vector<std::string> cells;  // the table's cell per image
+  int hit_count() const { return static_cast<int>(std::count(hits.begin(), hits.end(), true)); }
+};
+
+std::string describe(const std::vector<sym::Line>& lines, bool ok) {
+  if (lines.empty()) return "none";
+  std::ostringstream s;
+  s.precision(4);
+  s << (ok ? "hit" : "miss") << " (R " << lines[0].r << ", θ " << lines[0].theta * 180 / M_PI << "°)";
+  return s.str();
+}
+
+void score(Method& m, const std::vector<sym::Line>& lines, const Annotated& row, double ms) {
+  const bool ok = !lines.empty() && sym::competition_match(lines[0], row.a, row.b);
+  m.hits.push_back(ok);
+  m.ms.push_back(ms);
+  std::ostringstream cell;
+  cell << describe(lines, ok) << ", " << std::fixed << std::setprecision(1) << ms << " ms";
+  m.cells.push_back(cell.str());
+}
+
+std::string format_number(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+sym::PhotoOptions options_with_mirror(double tolerance_deg) {
+  sym::PhotoOptions options;
+  options.params.num_lines = 1;
+  options.params.mirror_tolerance_deg = tolerance_deg;
+  return options;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string annotations = std::string(NUDGE_SOURCE_DIR) + "/experiments/data/photo_axes.csv", name = "photos";
+  std::string annotations = std::string(NUDGE_SOURCE_DIR) + "/experiments/data/photo_axes.csv";
+  std::string name = "photos";
   Flags flags("nudge-exp-photos", "Fast symmetry against Loy & Eklundh (2006) on annotated photographs.");
   flags.add_string("annotations", &annotations, "CSV of path, x1, y1, x2, y2");
   flags.add_string("name", &name, "result file name (docs/results/NAME.json)");
-  double mirror_tolerance = sym::PhotoOptions{}.params.mirror_tolerance_deg;
-  flags.add_double("mirror-tolerance", &mirror_tolerance, "fast symmetry's mirror rule, degrees (0: off)");
   try {
     if (!flags.parse(argc, argv)) return 0;
     const auto rows = read_annotations(annotations);
-    int fast_hits = 0, le_hits = 0, images = 0;
-    std::vector<double> fast_ms, le_ms;
-    std::ostringstream table;
-    table << "| image | fast symmetry top line | ms | Loy & Eklundh top line | ms |\n|---|---|---|---|---|\n";
+    const double default_tolerance = sym::PhotoOptions{}.params.mirror_tolerance_deg;
+    const std::vector<double> sweep = {5, 10, 15, 20, 30, 45};
+    Method fast{"fast", "fast symmetry (defaults: mirror rule " + format_number(default_tolerance) + "°)", {}, {}, {}};
+    Method plain{"fast_locations_only", "fast symmetry, locations only (Algorithm 1)", {}, {}, {}};
+    Method le{"loy_eklundh", "Loy & Eklundh", {}, {}, {}};
+    std::vector<int> sweep_hits(sweep.size(), 0);
+    std::vector<std::string> files;
     for (const auto& row : rows) {
       const cv::Mat image = cv::imread(row.path, cv::IMREAD_COLOR);
       if (image.empty()) {
         std::cerr << "skipped " << row.path << ": cannot read it\n";
         continue;
       }
-      ++images;
-      sym::PhotoOptions options;
-      options.params.num_lines = 1;
-      options.params.mirror_tolerance_deg = mirror_tolerance;
+      files.push_back(row.path.substr(row.path.rfind('/') + 1));
+      // Each method's lines first, then its time (a function's arguments have no evaluation order).
       Stopwatch watch;
-      const sym::PhotoDetection fast = sym::detect_photo(image, options);
-      fast_ms.push_back(watch.lap_ms());
-      const auto le = sym::loy_eklundh(image, sym::LoyEklundhParams{1});
-      le_ms.push_back(watch.lap_ms());
-      const bool fast_ok = !fast.in_image.lines.empty() && sym::competition_match(fast.in_image.lines[0], row.a, row.b);
-      const bool le_ok = !le.empty() && sym::competition_match(le[0], row.a, row.b);
-      fast_hits += fast_ok;
-      le_hits += le_ok;
-      auto describe = [](const std::vector<sym::Line>& lines, bool ok) {
-        if (lines.empty()) return std::string("none");
-        std::ostringstream s;
-        s.precision(4);
-        s << (ok ? "hit" : "miss") << " (R " << lines[0].r << ", θ " << lines[0].theta * 180 / M_PI << "°)";
-        return s.str();
-      };
-      const std::string file = row.path.substr(row.path.rfind('/') + 1);
-      table << "| " << file << " | " << describe(fast.in_image.lines, fast_ok) << " | " << fast_ms.back() << " | "
-            << describe(le, le_ok) << " | " << le_ms.back() << " |\n";
-      std::cout << file << ": fast " << (fast_ok ? "hit" : "miss") << ", Loy-Eklundh " << (le_ok ? "hit" : "miss") << "\n";
+      const auto fast_lines = sym::detect_photo(image, options_with_mirror(default_tolerance)).in_image.lines;
+      score(fast, fast_lines, row, watch.lap_ms());
+      const auto plain_lines = sym::detect_photo(image, options_with_mirror(0)).in_image.lines;
+      score(plain, plain_lines, row, watch.lap_ms());
+      const auto le_lines = sym::loy_eklundh(image, sym::LoyEklundhParams{1});
+      score(le, le_lines, row, watch.lap_ms());
+      for (size_t t = 0; t < sweep.size(); ++t) {
+        const auto lines = sym::detect_photo(image, options_with_mirror(sweep[t])).in_image.lines;
+        sweep_hits[t] += !lines.empty() && sym::competition_match(lines[0], row.a, row.b);
+      }
+      std::cout << files.back() << ": fast " << (fast.hits.back() ? "hit" : "miss") << ", locations only "
+                << (plain.hits.back() ? "hit" : "miss") << ", Loy-Eklundh " << (le.hits.back() ? "hit" : "miss") << "\n";
     }
+    const int images = static_cast<int>(files.size());
     if (images == 0) throw std::runtime_error("no readable images in " + annotations);
     JsonWriter j;
     j.begin_object();
     j.field("machine", machine_description()).field("date", today());
     j.field("annotations", annotations.substr(annotations.rfind('/') + 1));
     j.field("images", images);
-    j.key("fast").begin_object().field("top_line_hits", fast_hits).field("hit_rate", double(fast_hits) / images);
-    j.field("median_ms", median(fast_ms)).end_object();
-    j.key("loy_eklundh").begin_object().field("top_line_hits", le_hits).field("hit_rate", double(le_hits) / images);
-    j.field("median_ms", median(le_ms)).end_object();
-    j.field("time_ratio_le_over_fast", median(le_ms) / median(fast_ms));
+    for (const Method* m : {&fast, &plain, &le}) {
+      j.key(m->key).begin_object().field("top_line_hits", m->hit_count());
+      j.field("hit_rate", double(m->hit_count()) / images).field("median_ms", median(m->ms)).end_object();
+    }
+    j.field("mirror_tolerance_deg", default_tolerance);
+    j.key("mirror_tolerance_sweep").begin_array();
+    for (size_t t = 0; t < sweep.size(); ++t)
+      j.begin_object().field("tolerance_deg", sweep[t]).field("top_line_hits", sweep_hits[t]).end_object();
+    j.end_array();
+    j.field("time_ratio_le_over_fast", median(le.ms) / median(fast.ms));
     j.end_object();
     write_result(name + ".json", j.str() + "\n");
+
     std::ostringstream md;
     md << "# Symmetry on photographs: fast symmetry against Loy & Eklundh (2006)\n\n"
        << "Top line of each method scored with the symmetry competitions' rule (angle within 10°, centre "
           "within 0.2 × the shorter segment). Fast symmetry runs with `nudge-detect`'s defaults (working size "
-          "480 px, automatic Canny thresholds, Dmin/Dmax relative to the image); Loy & Eklundh is this "
-          "project's implementation (`symmetry/loy_eklundh.hpp`: SIFT mirror matching, 1° × 1 px Hough). "
-          "Annotations: `" << annotations.substr(annotations.rfind('/') + 1) << "`.\n\nMachine: "
-       << machine_description() << ", " << today() << ".\n\n" << table.str()
-       << "\n| | fast symmetry | Loy & Eklundh |\n|---|---|---|\n"
-       << "| top line correct | " << fast_hits << " / " << images << " | " << le_hits << " / " << images << " |\n"
-       << "| median ms per image | " << median(fast_ms) << " | " << median(le_ms) << " |\n";
+          "480 px, automatic Canny thresholds, Dmin/Dmax relative to the image, and only pairs whose edge "
+          "orientations mirror about the axis within " << format_number(default_tolerance) << "° vote), and once more "
+          "with edge locations only, as Algorithm 1 is published; Loy & Eklundh is this project's implementation "
+          "(`symmetry/loy_eklundh.hpp`: SIFT mirror matching, 1° × 1 px Hough). Annotations: `"
+       << annotations.substr(annotations.rfind('/') + 1) << "` (" << images << " images: a small set, "
+       << "annotated by eye; point `--annotations` at a published dataset's for real numbers).\n\nMachine: "
+       << machine_description() << ", " << today() << ".\n\n| image | " << fast.title << " | " << plain.title
+       << " | " << le.title << " |\n|---|---|---|---|\n";
+    for (int i = 0; i < images; ++i)
+      md << "| " << files[i] << " | " << fast.cells[i] << " | " << plain.cells[i] << " | " << le.cells[i] << " |\n";
+    md << "\n| | fast symmetry (defaults) | locations only | Loy & Eklundh |\n|---|---|---|---|\n"
+       << "| top line correct | " << fast.hit_count() << " / " << images << " | " << plain.hit_count() << " / "
+       << images << " | " << le.hit_count() << " / " << images << " |\n"
+       << "| median ms per image | " << median(fast.ms) << " | " << median(plain.ms) << " | " << median(le.ms) << " |\n"
+       << "\nThe mirror rule's tolerance (top lines correct, of " << images << "):\n\n| tolerance | hits |\n|---|---|\n";
+    for (size_t t = 0; t < sweep.size(); ++t) md << "| " << sweep[t] << "° | " << sweep_hits[t] << " |\n";
     write_result(name + ".md", md.str());
   } catch (const std::exception& e) {
     std::cerr << "nudge-exp-photos: " << e.what() << "\n";

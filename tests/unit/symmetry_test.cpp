@@ -519,6 +519,16 @@ TEST(PhotoDetection, LargeImagesAreDetectedAtWorkingSizeAndMappedBack) {
   EXPECT_LT(angle_diff_deg(found.in_image.lines[0].theta, 4.0 * kDeg), 1.0);
   EXPECT_NEAR(found.in_image.lines[0].r, -150.0, 3.0);
   EXPECT_EQ(found.in_image.width, 1280);
+  // Photographs use mirror-consistent pairs by default, with orientations measured for them.
+  EXPECT_GT(found.params.mirror_tolerance_deg, 0);
+  EXPECT_TRUE(found.edge_params.gradients);
+  EXPECT_EQ(found.edges.orientation.size(), found.edges.points.size());
+  // ...and without the rule the edges carry no orientations (no Sobel pass to pay for).
+  options.params.mirror_tolerance_deg = 0;
+  const PhotoDetection plain = detect_photo(img, options);
+  EXPECT_TRUE(plain.edges.orientation.empty());
+  ASSERT_EQ(plain.in_image.lines.size(), 1u);
+  EXPECT_LT(angle_diff_deg(plain.in_image.lines[0].theta, 4.0 * kDeg), 1.0);
 }
 
 TEST(PhotoDetection, CompetitionRule) {

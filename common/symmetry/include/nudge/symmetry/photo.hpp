@@ -11,8 +11,16 @@
 
 namespace nudge::symmetry {
 
+// Photographs are full of texture whose edge pixels pair up by chance: there, only pairs whose
+// edge orientations mirror about the axis vote (Params::mirror_tolerance_deg, 15 deg).
+inline Params default_photo_params() {
+  Params p;
+  p.mirror_tolerance_deg = 15;
+  return p;
+}
+
 struct PhotoOptions {
-  Params params;              // Nlines, orientation limits, extensions; dmin/dmax as below
+  Params params = default_photo_params();  // Nlines, orientation limits, extensions; dmin/dmax as below
   double dmin = -1;           // px at the working size; < 0: 5 % of the short side (>= 5 px)
   double dmax = -1;           // px at the working size; < 0: 50 % of the long side; 0: no limit
   double blur = -1;           // Gaussian sigma; < 0: max(1, short side / 480)
