@@ -5,6 +5,7 @@
 #include <cmath>
 #include <random>
 
+#include "nudge/symmetry/corner_cutting.hpp"
 #include "nudge/symmetry/detector.hpp"
 #include "nudge/symmetry/gst.hpp"
 #include "nudge/symmetry/loy_eklundh.hpp"
@@ -175,6 +176,29 @@ TEST(SymmetryDetect, MirrorRuleRaisesTheAxisAboveClutter) {
   };
   const double plain = margin(0), mirrored = margin(15);
   EXPECT_GT(mirrored, 1.5 * plain) << "top / second line: " << plain << " plain, " << mirrored << " mirrored";
+}
+
+TEST(SymmetryVote, CornerCuttingBaselineCastsOnlySomeOfTheVotes) {
+  const EdgeSet edges = detect_edges(syn::indoor_scene(3, 640, 480, 4), EdgeParams{1.0, 30, 90, false});
+  Params p;
+  p.dmin = 25;
+  p.dmax = 250;
+  CornerCuttingVoter voter;
+  const double cast = cv::sum(voter.vote(edges, p).votes[0])[0];
+  const double all = cv::sum(reference_vote(edges, p).votes[0])[0];
+  EXPECT_GT(cast, 0.05 * all);
+  EXPECT_LT(cast, 0.6 * all) << "the shortcut should skip many of Algorithm 1's votes";
+  // A row with one valid pair and nothing else: the shortcut finds it too.
+  EdgeSet pair;
+  pair.width = pair.height = 101;
+  pair.points = {{20, 50}, {80, 50}};
+  p.dmin = 10;
+  p.dmax = 0;
+  p.theta_min_deg = p.theta_max_deg = 0;
+  const Accumulator& acc = voter.vote(pair, p);
+  EXPECT_EQ(acc.votes[0].at<int32_t>(89, acc.r_max), 1);
+  p.skew_deg = {10};
+  EXPECT_THROW(voter.vote(edges, p), std::invalid_argument);
 }
 
 TEST(SymmetryVote, ThreadsGiveTheSameAccumulator) {
