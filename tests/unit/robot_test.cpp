@@ -479,6 +479,87 @@ TEST(Safety, RefusesNonsenseConfig) {
   SafetyConfig safety;
   safety.ring_outer = 0.1;  // smaller than ring_inner
   EXPECT_THROW(validate(safety), std::invalid_argument);
+  safety = SafetyConfig{};
+  safety.tool_radius = -0.01;
+  EXPECT_THROW(validate(safety), std::invalid_argument);
+}
+
+TEST(SegmentDistance, KnownGeometry) {
+  using V = Eigen::Vector3d;
+  EXPECT_NEAR(segment_distance(V(0, 0, 0), V(1, 0, 0), V(0.5, -1, 2), V(0.5, 1, 2)), 2.0, 1e-12);  // crossing
+  EXPECT_NEAR(segment_distance(V(0, 0, 0), V(1, 0, 0), V(0, 1, 0), V(1, 1, 0)), 1.0, 1e-12);       // parallel
+  EXPECT_NEAR(segment_distance(V(0, 0, 0), V(1, 0, 0), V(3, 4, 0), V(5, 4, 0)), std::hypot(2, 4), 1e-12);  // ends
+  EXPECT_NEAR(segment_distance(V(0, 0, 0), V(1, 0, 0), V(0.3, 0.2, 0), V(0.3, 0.2, 0)), 0.2, 1e-12);  // a point
+  EXPECT_NEAR(segment_distance(V(1, 1, 1), V(1, 1, 1), V(1, 1, 4), V(1, 1, 4)), 3.0, 1e-12);  // two points
+  EXPECT_NEAR(segment_distance(V(0, 0, 0), V(2, 2, 0), V(0, 2, 0), V(2, 0, 0)), 0.0, 1e-12);  // intersecting
+}
+
+TEST(Safety, SelfCollisionOfTheToolWithThePedestalOrTheUpperArm) {
+  const ArmModel model = puma260();
+  SafetyConfig safety;
+  // Upper arm level, forearm folded back and down past the pedestal, wrist bent: the tool points
+  // into the column the arm stands on...
+  const CheckResult pedestal = check_self_collision(model, safety, joints_from_degrees(0, 0, -215, 90, -90, 0));
+  EXPECT_FALSE(pedestal.ok());
+  EXPECT_TRUE(contains(pedestal.reason, "tool") && contains(pedestal.reason, "pedestal")) << pedestal.reason;
+  // ...or, turned the other way, back up at the upper arm.
+  const CheckResult upper_arm = check_self_collision(model, safety, joints_from_degrees(0, 0, -225, 0, -90, 0));
+  EXPECT_FALSE(upper_arm.ok());
+  EXPECT_TRUE(contains(upper_arm.reason, "upper arm")) << upper_arm.reason;
+  EXPECT_EQ(check_configuration(model, safety, joints_from_degrees(0, 0, -225, 0, -90, 0)).reason, upper_arm.reason);
+  // The capsules are where the kinematics put the links.
+  const ArmCapsules c = arm_capsules(model, safety, joints_from_degrees(0, 0, -225, 0, -90, 0));
+  const ArmPoints points = arm_points(model, joints_from_degrees(0, 0, -225, 0, -90, 0));
+  EXPECT_TRUE(c.tool.a.isApprox(points.wrist) && c.tool.b.isApprox(points.tool));
+  EXPECT_TRUE(c.forearm.b.isApprox(points.wrist));
+  EXPECT_NEAR((c.upper_arm.b - c.upper_arm.a).norm(), 0.2032, 1e-9);  // a2
+  EXPECT_NEAR((c.forearm.b - c.forearm.a).norm(), 0.2032, 1e-9);      // d4
+  // Stretched out, straight up, and the home pose are clear of themselves.
+  EXPECT_TRUE(check_self_collision(model, safety, joints_from_degrees(0, 0, -90, 0, 0, 0)).ok());
+  EXPECT_TRUE(check_self_collision(model, safety, joints_from_degrees(0, 90, -90, 0, 0, 0)).ok());
+  const IkResult home = home_configuration(model, safety);
+  ASSERT_TRUE(home.ok()) << home.reason;
+  EXPECT_TRUE(check_self_collision(model, safety, home.q).ok());
+  // Switched off, nothing is refused for self-collision.
+  safety.check_self_collision = false;
+  EXPECT_TRUE(check_self_collision(model, safety, joints_from_degrees(0, 0, -215, 90, -90, 0)).ok());
+}
+
+TEST(Safety, JointPathBetweenSelfCollisionFreeEndsCanFoldTheToolIntoTheArm) {
+  // Turning joint 4 through 270 deg with the wrist bent back sweeps the tool past the upper arm:
+  // both ends are clear, the middle is not.
+  const ArmModel model = puma260();
+  SafetyConfig safety;
+  safety.enforce_ring = false;  // folded poses lie inside the ring: look at self-collision only
+  const JointVector from = joints_from_degrees(0, 0, -215, -100, -90, 0);
+  const JointVector to = joints_from_degrees(0, 0, -215, 170, -90, 0);
+  ASSERT_TRUE(check_configuration(model, safety, from).ok()) << check_configuration(model, safety, from).reason;
+  ASSERT_TRUE(check_configuration(model, safety, to).ok()) << check_configuration(model, safety, to).reason;
+  const CheckResult path = check_joint_path(model, safety, from, to);
+  EXPECT_FALSE(path.ok());
+  EXPECT_TRUE(contains(path.reason, "self-collision")) << path.reason;
+}
+
+TEST(Safety, EveryThesisMotionIsClearOfItselfAcrossTheRing) {
+  // The nudges and grasps the system plans are checked with self-collision on (check_joint_path):
+  // across the workspace ring and push directions they must all still be planned.
+  const ArmModel model = puma260();
+  const SafetyConfig safety;
+  const IkResult home = home_configuration(model, safety);
+  ASSERT_TRUE(home.ok()) << home.reason;
+  const NudgeParams params = nudge_params_for_objects(0.09, 0.03, 0.25);
+  int planned = 0;
+  for (double radius : {0.20, 0.25, 0.30}) {
+    for (double bearing_deg : {-60.0, -30.0, 0.0, 30.0, 60.0}) {
+      const double b = deg_to_rad(bearing_deg);
+      const Eigen::Vector3d target(radius * std::cos(b), radius * std::sin(b), safety.table_z);
+      const Eigen::Vector3d direction(-std::sin(b), std::cos(b), 0.0);  // across the ring
+      const NudgePlan plan = plan_nudge(model, safety, target, direction, params, home.q);
+      EXPECT_TRUE(plan.ok()) << "r " << radius << " bearing " << bearing_deg << ": " << plan.reason;
+      planned += plan.ok();
+    }
+  }
+  EXPECT_EQ(planned, 15);
 }
 
 // ---------------------------------------------------------------- nudge and other motions

@@ -1,5 +1,6 @@
 #include "nudge/robot/safety.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -33,6 +34,76 @@ void validate(const SafetyConfig& config) {
           "ring_outer must be finite and larger than ring_inner");
   require(std::isfinite(config.path_step) && config.path_step > 0,
           "path_step must be finite and positive");
+  for (double r : {config.pedestal_radius, config.upper_arm_radius, config.forearm_radius, config.tool_radius,
+                   config.self_clearance})
+    require(std::isfinite(r) && r >= 0, "link radii and self_clearance must be finite and non-negative");
+}
+
+double segment_distance(const Eigen::Vector3d& a0, const Eigen::Vector3d& a1, const Eigen::Vector3d& b0,
+                        const Eigen::Vector3d& b1) {
+  // Closest points of two segments (Ericson, Real-Time Collision Detection, sec. 5.1.9).
+  const Eigen::Vector3d d1 = a1 - a0, d2 = b1 - b0, r = a0 - b0;
+  const double a = d1.squaredNorm(), e = d2.squaredNorm(), f = d2.dot(r);
+  constexpr double kTiny = 1e-18;
+  double s = 0, t = 0;
+  if (a <= kTiny && e <= kTiny) return r.norm();
+  if (a <= kTiny) {
+    t = std::clamp(f / e, 0.0, 1.0);
+  } else {
+    const double c = d1.dot(r);
+    if (e <= kTiny) {
+      s = std::clamp(-c / a, 0.0, 1.0);
+    } else {
+      const double b = d1.dot(d2), denom = a * e - b * b;
+      s = denom > kTiny ? std::clamp((b * f - c * e) / denom, 0.0, 1.0) : 0.0;
+      t = (b * s + f) / e;
+      if (t < 0) {
+        t = 0;
+        s = std::clamp(-c / a, 0.0, 1.0);
+      } else if (t > 1) {
+        t = 1;
+        s = std::clamp((b - c) / a, 0.0, 1.0);
+      }
+    }
+  }
+  return ((a0 + s * d1) - (b0 + t * d2)).norm();
+}
+
+ArmCapsules arm_capsules(const ArmModel& model, const SafetyConfig& config, const JointVector& q) {
+  const Eigen::Isometry3d t1 = dh_transform(model.links[0], q[0]);
+  const Eigen::Isometry3d t2 = t1 * dh_transform(model.links[1], q[1]);
+  const Eigen::Isometry3d t3 = t2 * dh_transform(model.links[2], q[2]);
+  const ArmPoints points = arm_points(model, q);
+  // The shoulder offset d3 runs along the (parallel) joint 2 and 3 axes: the upper arm lies beside
+  // the base axis, from the shoulder to the forearm's root (DH frame 3's origin).
+  const Eigen::Vector3d offset = t3.translation() - t2.translation();
+  ArmCapsules c;
+  c.pedestal = {Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, config.table_z), config.pedestal_radius};
+  c.upper_arm = {t1.translation() + offset, t3.translation(), config.upper_arm_radius};
+  c.forearm = {t3.translation(), points.wrist, config.forearm_radius};
+  c.tool = {points.wrist, points.tool, config.tool_radius};
+  return c;
+}
+
+CheckResult check_self_collision(const ArmModel& model, const SafetyConfig& config, const JointVector& q) {
+  if (!config.check_self_collision) return CheckResult::pass();
+  const ArmCapsules c = arm_capsules(model, config, q);
+  struct Pair {
+    const char* first;
+    const Capsule& a;
+    const char* second;
+    const Capsule& b;
+  };
+  for (const Pair& p : {Pair{"forearm", c.forearm, "pedestal", c.pedestal}, Pair{"tool", c.tool, "pedestal", c.pedestal},
+                        Pair{"tool", c.tool, "upper arm", c.upper_arm}}) {
+    const double gap = segment_distance(p.a.a, p.a.b, p.b.a, p.b.b) - p.a.radius - p.b.radius;
+    if (gap < config.self_clearance) {
+      return CheckResult::fail(std::string("self-collision: the ") + p.first + " comes within " +
+                               format_number(std::max(0.0, gap), 3) + " m of the " + p.second + " (" +
+                               format_number(config.self_clearance, 3) + " m required)");
+    }
+  }
+  return CheckResult::pass();
 }
 
 CheckResult check_joint_limits(const ArmModel& model, const JointVector& q) {
@@ -76,6 +147,8 @@ CheckResult check_configuration(const ArmModel& model, const SafetyConfig& confi
   CheckResult result = check_joint_limits(model, q);
   if (!result.ok()) return result;
   result = check_table_clearance(model, config, q);
+  if (!result.ok()) return result;
+  result = check_self_collision(model, config, q);
   if (!result.ok() || !config.enforce_ring) return result;
   return check_workspace_ring(config, forward_kinematics(model, q).translation());
 }

@@ -1,8 +1,8 @@
 #pragma once
 // Safety checks the arm service applies to every motion, whatever the backend (sim or hardware):
 // joint limits, the workspace ring around the arm base (Li 2008, sec. 6.3: roughly 150-350 mm),
-// clearance above the table, and densely sampled joint-space paths. Each check returns a reason
-// when it fails. All positions are in the arm base frame (see puma260.hpp).
+// clearance above the table, self-collision, and densely sampled joint-space paths. Each check
+// returns a reason when it fails. All positions are in the arm base frame (see puma260.hpp).
 #include <Eigen/Geometry>
 
 #include <vector>
@@ -23,6 +23,14 @@ struct SafetyConfig {
   double ring_outer = 0.350;
   bool enforce_ring = true;     // the arm service may lift this for parking poses outside the ring
   double path_step = deg_to_rad(1.0);  // largest joint change between checked path samples
+  // Self-collision: the links as capsules (a segment and a radius), metres. Assumed sizes of a
+  // PUMA 260 carrying a small gripper or the nudging sponge; measure the real arm and tool.
+  bool check_self_collision = true;
+  double pedestal_radius = 0.065;   // the column from the shoulder down to the table
+  double upper_arm_radius = 0.045;  // shoulder to elbow, beside the base axis by the offset d3
+  double forearm_radius = 0.035;    // elbow to wrist centre
+  double tool_radius = 0.035;       // wrist centre to tool point (gripper, bracket, sponge)
+  double self_clearance = 0.01;     // extra gap kept between capsules that must not touch
 };
 
 // Throws std::invalid_argument naming the field when the configuration makes no sense.
@@ -37,7 +45,28 @@ CheckResult check_workspace_ring(const SafetyConfig& config, const Eigen::Vector
 CheckResult check_table_clearance(const ArmModel& model, const SafetyConfig& config,
                                   const JointVector& q);
 
-// Joint limits, then table clearance, then (if enforced) the workspace ring.
+// The links as capsules in the base frame (see SafetyConfig), for the self-collision check and
+// for pictures.
+struct Capsule {
+  Eigen::Vector3d a, b;
+  double radius = 0;
+};
+struct ArmCapsules {
+  Capsule pedestal, upper_arm, forearm, tool;
+};
+ArmCapsules arm_capsules(const ArmModel& model, const SafetyConfig& config, const JointVector& q);
+
+// The pairs of links that are not joined to each other: the forearm and the tool against the
+// pedestal, the tool against the upper arm. Names the pair and their gap when they come closer
+// than config.self_clearance. (The tool cannot fold back onto the forearm: joint 5 stops at
+// +-100 deg.) Passes when config.check_self_collision is off.
+CheckResult check_self_collision(const ArmModel& model, const SafetyConfig& config, const JointVector& q);
+
+// Closest distance between the segments [a0, a1] and [b0, b1] (either may be a point).
+double segment_distance(const Eigen::Vector3d& a0, const Eigen::Vector3d& a1, const Eigen::Vector3d& b0,
+                        const Eigen::Vector3d& b1);
+
+// Joint limits, then table clearance, then self-collision, then (if enforced) the workspace ring.
 CheckResult check_configuration(const ArmModel& model, const SafetyConfig& config,
                                 const JointVector& q);
 
