@@ -163,6 +163,11 @@ TEST(ArmService, MovesNudgesRefusesAndSkipsMalformedCommands) {
     nudge.height = 0.02;
     log.command(kStart + 10 * kSecond + 20, nudge);
     log.traffic(kStart + 10 * kSecond + 50000, kStart + 40 * kSecond);
+    arm_command_t folded{};  // joints within their limits, but the tool folded into the pedestal
+    folded.seq = 5;
+    folded.command = arm_command_t::COMMAND_MOVE_JOINTS;
+    for (double deg : {0.0, 0.0, -215.0, 90.0, -90.0, 0.0}) folded.joints.push_back(deg * M_PI / 180);
+    log.command(kStart + 40 * kSecond - 10, folded);
     log.raw(kStart + 40 * kSecond, "ARM_COMMAND", {1, 2, 3});  // does not decode
     arm_command_t three_joints{};
     three_joints.seq = 6;
@@ -240,6 +245,12 @@ TEST(ArmService, MovesNudgesRefusesAndSkipsMalformedCommands) {
   EXPECT_EQ(next_key, keys.size()) << "passed P0, P1, P2, P1, P0 in order";
   EXPECT_GT(lowest, 0.02 - 1e-3);
   EXPECT_LT(lowest, 0.02 + 1e-3);
+
+  // 5: a self-colliding joint target is refused, whatever the backend.
+  const auto folded = of_command(output.states, 5);
+  ASSERT_FALSE(folded.empty());
+  EXPECT_EQ(folded.front().motion + 0, kRefused);
+  EXPECT_NE(folded.front().last_error.find("self-collision"), std::string::npos) << folded.front().last_error;
 
   // 6, 7, 8: malformed content is refused and counted with the undecodable message.
   for (int64_t seq : {6, 7, 8}) {
