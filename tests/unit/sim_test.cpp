@@ -4,11 +4,13 @@
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <string>
 #include <unistd.h>
 
@@ -17,6 +19,8 @@
 #include "nudge/sim/objects.hpp"
 #include "nudge/sim/scene.hpp"
 #include "nudge/sim/world.hpp"
+#include "nudge/robot/kinematics.hpp"
+#include "nudge/robot/puma260.hpp"
 
 using namespace nudge::sim;
 
@@ -831,4 +835,121 @@ TEST(SimGripper, DeterministicAndRestoredStatesReplay) {
   world.set_state(pad_state);
   EXPECT_FALSE(world.gripper_in_use());
   EXPECT_NEAR(world.gripper_opening(), gripper_geometry().max_opening, 1e-9);
+}
+
+// ---------------------------------------------------------------- the PUMA 260 in the world
+
+namespace {
+
+Scene with_arm(Scene scene) {
+  scene.arm.present = true;
+  return scene;
+}
+
+std::array<double, 6> degrees(double j1, double j2, double j3, double j4, double j5, double j6) {
+  return {j1 * kDeg, j2 * kDeg, j3 * kDeg, j4 * kDeg, j5 * kDeg, j6 * kDeg};
+}
+
+nudge::robot::JointVector as_joint_vector(const std::array<double, 6>& q) {
+  return Eigen::Map<const nudge::robot::JointVector>(q.data());
+}
+
+}  // namespace
+
+TEST(SimArm, LinksFollowTheRobotLibrarysKinematics) {
+  // The MuJoCo bodies built from Table B.1 put the flange exactly where the robot library's
+  // forward kinematics (eq. B.1-B.2) does, lifted to the shoulder.
+  const Scene scene = with_arm(default_scene());
+  World world(scene);
+  ASSERT_TRUE(world.has_arm());
+  const nudge::robot::ArmModel puma = nudge::robot::puma260();
+  std::mt19937 rng(4);
+  for (int trial = 0; trial < 200; ++trial) {
+    std::array<double, 6> q;
+    for (int j = 0; j < 6; ++j) q[j] = std::uniform_real_distribution<double>(puma.limits.lower[j], puma.limits.upper[j])(rng);
+    world.set_arm_joints(q);
+    Eigen::Isometry3d expected = nudge::robot::flange_pose(puma, as_joint_vector(q));
+    expected.translation().z() += scene.arm.shoulder_height;
+    const Eigen::Isometry3d simulated = world.arm_flange_pose();
+    ASSERT_LT((simulated.translation() - expected.translation()).norm(), 1e-9) << "trial " << trial;
+    ASSERT_LT((simulated.linear() - expected.linear()).norm(), 1e-9) << "trial " << trial;
+    for (int j = 0; j < 6; ++j) ASSERT_DOUBLE_EQ(world.arm_joints()[j], q[j]);
+  }
+}
+
+TEST(SimArm, ServosBringTheArmToItsTargetsAgainstGravity) {
+  World world(with_arm(default_scene()));
+  const std::array<double, 6> start = world.arm_joints();
+  // The arm leaning out over the table: gravity pulls hardest on the shoulder and elbow here.
+  const std::array<double, 6> target = degrees(20, -10, -100, 30, 60, -45);
+  world.set_arm_targets(target);
+  world.step_for(0.02);
+  double moved = 0, left = 0;
+  for (int j = 0; j < 6; ++j) {
+    moved = std::max(moved, std::fabs(world.arm_joints()[j] - start[j]));
+    left = std::max(left, std::fabs(world.arm_joints()[j] - target[j]));
+  }
+  EXPECT_GT(moved, 0.1 * kDeg) << "the servos move the joints";
+  EXPECT_GT(left, 5 * kDeg) << "with their dynamics: not there after 20 ms";
+  world.step_for(2.0);
+  for (int j = 0; j < 6; ++j) EXPECT_NEAR(world.arm_joints()[j], target[j], 0.05 * kDeg) << "joint " << j + 1;
+  // Held there: a second later it has not drooped.
+  world.step_for(1.0);
+  for (int j = 0; j < 6; ++j) EXPECT_NEAR(world.arm_joints()[j], target[j], 0.05 * kDeg) << "joint " << j + 1;
+  // Targets beyond a joint's limits are clamped to them.
+  world.set_arm_targets(degrees(0, 0, -90, 0, 150, 0));
+  EXPECT_NEAR(world.arm_targets()[4], nudge::robot::puma260().limits.upper[4], 1e-8);
+  EXPECT_THROW(world.set_arm_targets(degrees(0, std::nan(""), 0, 0, 0, 0)), std::invalid_argument);
+  World armless(default_scene());
+  EXPECT_FALSE(armless.has_arm());
+  EXPECT_THROW(armless.set_arm_targets(target), SimError);
+}
+
+TEST(SimArm, TheForearmSweepsACupAside) {
+  // The upper arm tilted down and the forearm hanging: turning joint 1 swings the wrist through
+  // a cup standing on its circle.
+  Scene scene = with_arm(one_object("cup", 0.3, 0.0));
+  scene.arm.joints = degrees(-50, -20, -180, 0, 0, 0);
+  World probe(scene);
+  probe.set_arm_joints(degrees(0, -20, -180, 0, 0, 0));
+  const Eigen::Vector3d wrist = probe.arm_flange_pose().translation();
+  ASSERT_LT(wrist.z(), 0.08) << "the wrist hangs low enough to meet a cup";
+  scene.objects[0].position = wrist.head<2>();
+  World world(scene);
+  const Eigen::Vector3d before = world.object(0).position;
+  world.step_for(0.5);
+  EXPECT_LT((world.object(0).position - before).norm(), 1e-3) << "untouched while the arm is away";
+  world.set_arm_targets(degrees(50, -20, -180, 0, 0, 0));
+  world.step_for(3.0);
+  const ObjectState after = world.object(0);
+  EXPECT_GT((after.position - before).norm() + 0.1 * after.tilt(), 0.02) << "moved or knocked over";
+}
+
+TEST(SimArm, ReplaysExactlyAndIsDrawn) {
+  World world(with_arm(load_scene(scene_path("three_objects.yaml"))));
+  world.set_arm_targets(degrees(10, 30, -120, 0, 45, 0));
+  world.step(100);
+  const std::vector<double> saved = world.state();
+  auto run = [&world]() {
+    for (int k = 0; k < 200; ++k) {
+      world.set_arm_targets(degrees(10 + 0.05 * k, 30, -120, 0, 45, 0));
+      world.step();
+    }
+    return world.state();
+  };
+  const std::vector<double> first = run();
+  world.set_state(saved);
+  EXPECT_EQ(first, run());
+  // The arm stands in front of the cameras: the pictures with it differ from those without.
+  World armless(load_scene(scene_path("three_objects.yaml")));
+  cv::Mat with = world.render(1), without = armless.render(1), diff;
+  cv::absdiff(with, without, diff);
+  cv::cvtColor(diff, diff, cv::COLOR_BGR2GRAY);
+  EXPECT_GT(cv::countNonZero(diff > 30), 2000) << "the arm is in the right camera's view";
+  // It is not an object: masks gain no pixels from it (a few on object outlines may differ: the
+  // objects settled in two different models).
+  cv::Mat mask_diff;
+  const cv::Mat armless_objects = armless.render_mask(1) > 0;
+  cv::compare(world.render_mask(1) > 0, armless_objects, mask_diff, cv::CMP_GT);
+  EXPECT_LT(cv::countNonZero(mask_diff), 0.002 * cv::countNonZero(armless_objects));
 }

@@ -3,6 +3,8 @@
 #include "nudge/sim/camera.hpp"
 #include "nudge/sim/objects.hpp"
 
+#include "nudge/robot/puma260.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <locale>
@@ -137,6 +139,77 @@ void add_finger(Xml& x, const std::string& name, int side) {
     << "      </body>\n";
 }
 
+// The PUMA 260 as nested bodies, one per DH link (standard DH: T_i = Rz(theta_i) Tz(d_i)
+// Tx(a_i) Rx(alpha_i)): body i turns about its own z axis (joint i) and holds body i + 1 at
+// (a_i, 0, d_i), rotated by alpha_i about x. Link geometry runs along those offsets. Masses are
+// estimates for a PUMA 260 (about 13 kg in all, most of it in the base); the joints carry the
+// reflected inertia of geared motors (armature), which also keeps the stiff position servos
+// stable at the physics time step. Links collide with objects only (contype 4), not with the
+// table, the tools or each other: the arm service's safety checks keep them apart.
+void add_arm(Xml& x, const ArmSpec& spec) {
+  const robot::ArmModel puma = robot::puma260();
+  const char* colour = "0.82 0.82 0.78 1";
+  const char* geom_flags = "contype=\"4\" conaffinity=\"0\" condim=\"3\" friction=\"0.6 0.005 0.0001\" group=\"1\"";
+  const double link_mass[6] = {2.0, 1.6, 0.9, 1.0, 0.3, 0.2};
+  const double radius[6] = {0.06, 0.045, 0.045, 0.035, 0.03, 0.025};
+  const double armature[6] = {0.15, 0.15, 0.1, 0.03, 0.03, 0.02};
+  const double damping[6] = {30, 30, 20, 5, 5, 4};
+  const double h = spec.shoulder_height;
+  auto alpha_quat = [](double alpha) {
+    std::ostringstream q;
+    q.imbue(std::locale::classic());
+    q.precision(12);
+    q << std::cos(0.5 * alpha) << ' ' << std::sin(0.5 * alpha) << " 0 0";
+    return q.str();
+  };
+  x << "    <body name=\"puma_base\" pos=\"0 0 " << h << "\">\n"
+    << "      <geom name=\"puma_pedestal\" type=\"cylinder\" size=\"0.065 " << 0.5 * (h - 0.06) << "\" pos=\"0 0 "
+    << -0.5 * (h + 0.06) << "\" rgba=\"" << colour << "\" mass=\"6\" " << geom_flags << "/>\n";
+  std::string indent = "      ";
+  for (int i = 0; i < 6; ++i) {
+    const robot::DhLink& l = puma.links[i];
+    x << indent << "<body name=\"puma_link" << i + 1 << "\"";
+    if (i > 0) {  // where the previous link's DH offsets put this joint's frame
+      const robot::DhLink& prev = puma.links[i - 1];
+      x << " pos=\"" << prev.a << " 0 " << prev.d << "\" quat=\"" << alpha_quat(prev.alpha) << "\"";
+    }
+    x << ">\n"
+      << indent << "  <joint name=\"puma_j" << i + 1 << "\" type=\"hinge\" axis=\"0 0 1\" limited=\"true\" range=\""
+      << puma.limits.lower[i] << ' ' << puma.limits.upper[i] << "\" armature=\"" << armature[i]
+      << "\" damping=\"" << damping[i] << "\"/>\n";
+    // A joint housing at the body origin, and the link along its DH offsets when it has length.
+    x << indent << "  <geom name=\"puma_joint" << i + 1 << "\" type=\"sphere\" size=\"" << radius[i] + 0.005
+      << "\" rgba=\"0.35 0.35 0.38 1\" mass=\"" << 0.3 * link_mass[i] << "\" " << geom_flags << "/>\n";
+    if (std::hypot(l.a, l.d) > 1e-9) {
+      x << indent << "  <geom name=\"puma_link" << i + 1 << "_geom\" type=\"capsule\" fromto=\"0 0 0 " << l.a << " 0 "
+        << l.d << "\" size=\"" << radius[i] << "\" rgba=\"" << colour << "\" mass=\"" << 0.7 * link_mass[i] << "\" "
+        << geom_flags << "/>\n";
+    }
+    if (i == 5) {  // DH frame 6: the flange (wrist centre), where the tool is mounted
+      x << indent << "  <site name=\"puma_flange\" pos=\"" << l.a << " 0 " << l.d << "\" quat=\""
+        << alpha_quat(l.alpha) << "\" size=\"0.01\"/>\n";
+    }
+    indent += "  ";
+  }
+  for (int i = 0; i < 6; ++i) {
+    indent.resize(indent.size() - 2);
+    x << indent << "</body>\n";
+  }
+  x << "    </body>\n";
+}
+
+// Position servos on the six joints, within their limits.
+void add_arm_actuators(Xml& x) {
+  const robot::ArmModel puma = robot::puma260();
+  const double kp[6] = {600, 600, 400, 80, 80, 60};
+  const double max_torque[6] = {60, 60, 40, 10, 10, 8};
+  for (int i = 0; i < 6; ++i) {
+    x << "    <position name=\"puma_act" << i + 1 << "\" joint=\"puma_j" << i + 1 << "\" kp=\"" << kp[i]
+      << "\" ctrllimited=\"true\" ctrlrange=\"" << puma.limits.lower[i] << ' ' << puma.limits.upper[i]
+      << "\" forcelimited=\"true\" forcerange=\"" << -max_torque[i] << ' ' << max_torque[i] << "\"/>\n";
+  }
+}
+
 }  // namespace
 
 std::string build_mjcf(const Scene& scene) {
@@ -186,7 +259,7 @@ std::string build_mjcf(const Scene& scene) {
            << ' ' << I(0, 2) << ' ' << I(1, 2) << "\"/>\n";
     for (size_t k = 0; k < model.parts.size(); ++k) {
       bodies << "      <geom name=\"" << id << "_part" << k << "\" type=\"mesh\" mesh=\"" << id
-             << "_part" << k << "\" material=\"" << id << "_mat\" contype=\"3\" conaffinity=\"3\""
+             << "_part" << k << "\" material=\"" << id << "_mat\" contype=\"3\" conaffinity=\"7\""
              << " condim=\"3\" friction=\"" << friction << " 0.005 0.0001\"/>\n";
     }
     bodies << "    </body>\n";
@@ -253,7 +326,9 @@ std::string build_mjcf(const Scene& scene) {
   add_finger(x, "finger_left", 1);
   add_finger(x, "finger_right", -1);
   x << "    </body>\n"
-    << bodies.str() << "  </worldbody>\n"
+    << bodies.str();
+  if (scene.arm.present) add_arm(x, scene.arm);
+  x << "  </worldbody>\n"
     << "  <equality>\n"
     << "    <weld name=\"hand_weld\" body1=\"pusher\" body2=\"hand\" relpose=\"0 0 0 1 0 0 0\""
     << " solref=\"" << g.weld_timeconst << " 1\"/>\n"
@@ -263,6 +338,7 @@ std::string build_mjcf(const Scene& scene) {
     x << "    <position name=\"" << finger << "_act\" joint=\"" << finger << "_slide\" kp=\"" << g.kp
       << "\" ctrllimited=\"true\" ctrlrange=\"0 " << range << "\" forcelimited=\"true\" forcerange=\""
       << -g.max_force << ' ' << g.max_force << "\"/>\n";
+  if (scene.arm.present) add_arm_actuators(x);
   x << "  </actuator>\n"
     << "</mujoco>\n";
   return x.str();

@@ -1,5 +1,7 @@
 #include "nudge/sim/scene.hpp"
 
+#include "nudge/robot/puma260.hpp"
+
 #include "nudge/sim/objects.hpp"
 
 #include <opencv2/core.hpp>
@@ -262,6 +264,17 @@ Scene load_scene(const std::string& path) {
     render.light = r.number("light", render.light);
     r.finish();
   }
+  if (top.has("arm")) {
+    MapReader r(top.node("arm"), path, "arm");
+    ArmSpec& arm = scene.arm;
+    arm.present = r.boolean("present", true);
+    arm.shoulder_height = r.number("shoulder_height", arm.shoulder_height);
+    if (r.has("joints_deg")) {
+      const auto j = r.numbers("joints_deg", 6, 6);
+      for (int i = 0; i < 6; ++i) arm.joints[i] = j[i] * kDeg;
+    }
+    r.finish();
+  }
   if (top.has("physics")) {
     MapReader r(top.node("physics"), path, "physics");
     PhysicsSpec& physics = scene.physics;
@@ -364,6 +377,13 @@ void validate(const Scene& scene) {
   if (r.snapshot_scale < 1 || r.snapshot_scale > 4) fail(src, "render.snapshot_scale", "must be 1, 2, 3 or 4");
   if (!(r.ambient >= 0 && r.ambient <= 1)) fail(src, "render.ambient", "must be in [0, 1]");
   if (!(r.light >= 0 && r.light <= 1)) fail(src, "render.light", "must be in [0, 1]");
+  const ArmSpec& arm = scene.arm;
+  if (!(arm.shoulder_height >= 0.1 && arm.shoulder_height <= 1.0)) fail(src, "arm.shoulder_height", "must be in [0.1, 1] m");
+  const robot::ArmModel puma = robot::puma260();
+  for (int j = 0; j < 6; ++j) {
+    if (!(arm.joints[j] >= puma.limits.lower[j] && arm.joints[j] <= puma.limits.upper[j]))
+      fail(src, "arm.joints_deg", "joint " + std::to_string(j + 1) + " is outside its limits (docs/robot.md)");
+  }
   const PhysicsSpec& p = scene.physics;
   if (!(p.timestep > 0 && p.timestep <= 0.01)) fail(src, "physics.timestep", "must be in (0, 0.01] s");
   if (!(p.settle_time >= 0 && p.settle_time <= 10)) fail(src, "physics.settle_time", "must be in [0, 10] s");

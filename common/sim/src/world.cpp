@@ -64,6 +64,9 @@ struct World::Impl {
   int finger_act[2] = {-1, -1};
   bool gripper = false;              // the tool in use: the gripper (else the pad)
   int camera_id[2] = {-1, -1};
+  bool arm = false;                  // the scene has the PUMA 260
+  int arm_qpos[6], arm_dof[6], arm_act[6];
+  int flange_site = -1;
   std::mt19937_64 noise_rng;
   // Distortion warps, [0] for the rig's size, [1] for snapshots (built on first use).
   struct Warp {
@@ -184,6 +187,21 @@ World::World(const Scene& input) : impl_(std::make_unique<Impl>()), scene_(input
     s.data->qpos[s.finger_qpos[f]] = open;
   }
 
+  if (scene_.arm.present) {
+    for (int j = 0; j < 6; ++j) {
+      const std::string n = std::to_string(j + 1);
+      const int joint = mj_name2id(s.model, mjOBJ_JOINT, ("puma_j" + n).c_str());
+      s.arm_act[j] = mj_name2id(s.model, mjOBJ_ACTUATOR, ("puma_act" + n).c_str());
+      if (joint < 0 || s.arm_act[j] < 0) throw SimError(scene_.source + ": generated model lacks the arm's joint " + n);
+      s.arm_qpos[j] = s.model->jnt_qposadr[joint];
+      s.arm_dof[j] = s.model->jnt_dofadr[joint];
+    }
+    s.flange_site = mj_name2id(s.model, mjOBJ_SITE, "puma_flange");
+    if (s.flange_site < 0) throw SimError(scene_.source + ": generated model lacks the arm's flange");
+    s.arm = true;
+    for (int j = 0; j < 6; ++j) s.data->qpos[s.arm_qpos[j]] = s.data->ctrl[s.arm_act[j]] = scene_.arm.joints[j];
+  }
+
   mj_forward(s.model, s.data);
   step_for(scene_.physics.settle_time);
   s.data->time = 0;
@@ -195,7 +213,66 @@ double World::time() const { return impl_->data->time; }
 double World::timestep() const { return impl_->model->opt.timestep; }
 
 void World::step(int n) {
-  for (int i = 0; i < n; ++i) mj_step(impl_->model, impl_->data);
+  Impl& s = *impl_;
+  if (!s.arm) {
+    for (int i = 0; i < n; ++i) mj_step(s.model, s.data);
+    return;
+  }
+  // The arm's gravity and Coriolis forces at this very state (mj_step1 computes them), applied
+  // back as the servo's feed-forward before the accelerations: exact, and a function of the
+  // state only, so a restored state replays bit for bit.
+  for (int i = 0; i < n; ++i) {
+    mj_step1(s.model, s.data);
+    for (int j = 0; j < 6; ++j) s.data->qfrc_applied[s.arm_dof[j]] = s.data->qfrc_bias[s.arm_dof[j]];
+    mj_step2(s.model, s.data);
+  }
+}
+
+bool World::has_arm() const { return impl_->arm; }
+
+void World::set_arm_targets(const std::array<double, 6>& joints) {
+  Impl& s = *impl_;
+  if (!s.arm) throw SimError(scene_.source + ": the scene has no arm (arm: present)");
+  for (int j = 0; j < 6; ++j) {
+    if (!std::isfinite(joints[j])) throw std::invalid_argument("arm joint " + std::to_string(j + 1) + " target is not finite");
+    const double* range = s.model->actuator_ctrlrange + 2 * s.arm_act[j];
+    s.data->ctrl[s.arm_act[j]] = std::clamp(joints[j], range[0], range[1]);
+  }
+}
+
+std::array<double, 6> World::arm_targets() const {
+  std::array<double, 6> q{};
+  if (impl_->arm)
+    for (int j = 0; j < 6; ++j) q[j] = impl_->data->ctrl[impl_->arm_act[j]];
+  return q;
+}
+
+std::array<double, 6> World::arm_joints() const {
+  std::array<double, 6> q{};
+  if (impl_->arm)
+    for (int j = 0; j < 6; ++j) q[j] = impl_->data->qpos[impl_->arm_qpos[j]];
+  return q;
+}
+
+void World::set_arm_joints(const std::array<double, 6>& joints) {
+  set_arm_targets(joints);
+  Impl& s = *impl_;
+  for (int j = 0; j < 6; ++j) {
+    s.data->qpos[s.arm_qpos[j]] = s.data->ctrl[s.arm_act[j]];
+    s.data->qvel[s.arm_dof[j]] = 0;
+  }
+  mj_kinematics(s.model, s.data);
+}
+
+Eigen::Isometry3d World::arm_flange_pose() const {
+  const Impl& s = *impl_;
+  if (!s.arm) throw SimError(scene_.source + ": the scene has no arm (arm: present)");
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  for (int r = 0; r < 3; ++r) {
+    pose.translation()[r] = s.data->site_xpos[3 * s.flange_site + r];
+    for (int c = 0; c < 3; ++c) pose.linear()(r, c) = s.data->site_xmat[9 * s.flange_site + 3 * r + c];
+  }
+  return pose;
 }
 
 void World::step_for(double seconds) {

@@ -95,6 +95,15 @@ struct PhysicsSpec {
   int noslip_iterations = 0;
 };
 
+// The PUMA 260 arm (thesis App. B, Table B.1) standing on the table with its base axis on the
+// world z axis: six hinge joints with the robot library's limits, position actuators, links that
+// push objects aside. Its DH frame 0 is the world frame lifted to the shoulder.
+struct ArmSpec {
+  bool present = false;
+  double shoulder_height = 0.33;  // the shoulder above the table top, m (SafetyConfig::table_z = -this)
+  std::array<double, 6> joints{{0, M_PI / 2, -M_PI / 2, 0, 0, 0}};  // start pose, rad: straight up
+};
+
 struct Scene {
   std::string source = "scene";  // file the scene came from (for messages)
   uint64_t seed = 1;
@@ -104,6 +113,7 @@ struct Scene {
   RigSpec rig;
   RenderSpec render;
   PhysicsSpec physics;
+  ArmSpec arm;
 };
 
 // Defaults for the table and backdrop: light wood-coloured table, plain off-white wall.

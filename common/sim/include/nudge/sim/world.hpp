@@ -122,6 +122,20 @@ class World {
   // True when both fingers touch object `index` (contacts as of the last step).
   bool gripper_holds(int index) const;
 
+  // ---- the PUMA 260 (scenes with arm.present; see ArmSpec)
+  // Its joints are driven by position servos towards the targets, with the links' gravity and
+  // Coriolis forces compensated (as the thesis' controller card holds a pose), so the arm settles
+  // on its targets; its links push objects they meet.
+  bool has_arm() const;
+  // Servo targets, rad, clamped to the joint limits. Throws SimError without an arm.
+  void set_arm_targets(const std::array<double, 6>& joints);
+  std::array<double, 6> arm_targets() const;
+  std::array<double, 6> arm_joints() const;  // where the simulated joints are now, rad
+  // Puts the arm at `joints` at rest, targets too (for rendering a published state, or resets).
+  void set_arm_joints(const std::array<double, 6>& joints);
+  // The flange (DH frame 6, the wrist centre) of the simulated arm, world frame.
+  Eigen::Isometry3d arm_flange_pose() const;
+
   // ---- rendering (OSMesa context created on first use)
   cv::Mat render(int camera);       // BGR, rig width x height
   cv::Mat render_mask(int camera);  // CV_8U, object index + 1, 0 elsewhere
