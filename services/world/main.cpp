@@ -96,6 +96,11 @@ class Simulation {
     if (!std::isfinite(msg.gripper)) throw std::invalid_argument("gripper: not finite");
     for (double j : msg.joints)
       if (!std::isfinite(j)) throw std::invalid_argument("joints: not finite");
+    if (world_.has_arm()) {  // the simulated PUMA's servos follow the arm's joints
+      std::array<double, 6> joints;
+      std::copy(std::begin(msg.joints), std::end(msg.joints), joints.begin());
+      world_.set_arm_targets(joints);
+    }
     if (const auto yaw = sim::pad_yaw_from_tool(q)) pusher_yaw_ = *yaw;
     if (gripper_)
       world_.set_end_effector(p, pusher_yaw_, msg.gripper);
@@ -132,7 +137,9 @@ class Simulation {
     sim_state_t msg;
     msg.utime = utime();
     msg.step = step_;
-    for (int i = 0; i < 6; ++i) msg.joints[i] = arm_ ? arm_->joints[i] : 0.0;
+    // With an arm in the scene, its joints as simulated; else the latest ARM_STATE's.
+    const std::array<double, 6> simulated = world_.arm_joints();
+    for (int i = 0; i < 6; ++i) msg.joints[i] = world_.has_arm() ? simulated[i] : arm_ ? arm_->joints[i] : 0.0;
     msg.gripper = arm_ ? arm_->gripper : 0.0;
     msg.num_objects = world_.num_objects();
     for (int i = 0; i < world_.num_objects(); ++i) {

@@ -13,7 +13,9 @@
 #include <sys/wait.h>
 
 #include <Eigen/Geometry>
+#include <opencv2/imgproc.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -449,4 +451,59 @@ TEST(World, InputStampedInSimulatedTimeActsAtThatTimeAndOtherClocksAreRefused) {
   EXPECT_LT(states.at(480000).pusher.position[0], -0.6) << "parked before t = 0.5 s";
   EXPECT_NEAR(states.at(520000).pusher.position[1], -0.2, 1e-12) << "at the tool point from t = 0.5 s";
   EXPECT_EQ(last_heartbeat_errors(events), 1);
+}
+
+TEST(World, ArmJointsDriveTheSimulatedPumaWhichTheCameraDraws) {
+  const std::string dir = testing::TempDir();
+  const std::string objects = "  - { kind: cup, name: cup, position: [0.25, 0.15] }\n";
+  const std::string scene = write_scene("world_arm", objects + "arm: { present: 1, joints_deg: [0, 90, -90, 0, 0, 0] }\n");
+  const std::string armless = write_scene("world_no_arm", objects);
+  const std::string in = dir + "/world_arm_in.lcmlog";
+  const int64_t t0 = 1700000000000000;
+  // From straight up to leaning out over the table, commanded at 0.5 s.
+  const double target[6] = {-30 * kDeg, 20 * kDeg, -120 * kDeg, 10 * kDeg, 40 * kDeg, 0};
+  nudge::arm_state_t arm{};
+  arm.utime = t0 + 500000;
+  arm.end_effector.position[0] = -1.0;  // the tool pad parked far away: only the joints matter here
+  arm.end_effector.orientation[0] = 1;
+  for (int j = 0; j < 6; ++j) arm.joints[j] = target[j];
+  write_log(in, {{arm.utime, "ARM_STATE", encode(arm)}});
+  const std::string out = dir + "/world_arm_out.lcmlog";
+  std::remove(out.c_str());
+  ASSERT_EQ(run(kBin + "/nudge-world --scene " + scene + " --duration 2.5 --rate 10 --lcm-in 'file://" + in +
+                "?speed=0' --lcm-out 'file://" + out + "?mode=w'"),
+            0);
+  std::vector<nudge::sim_state_t> states;
+  for (const Event& e : read_log(out))
+    if (e.channel == "SIM_STATE") states.push_back(decode<nudge::sim_state_t>(e));
+  ASSERT_GE(states.size(), 20u);
+  EXPECT_NEAR(states.front().joints[1], 90 * kDeg, 1e-6) << "straight up before the command";
+  for (int j = 0; j < 6; ++j) EXPECT_NEAR(states.back().joints[j], target[j], 0.1 * kDeg) << "joint " << j + 1;
+  const auto at = [&](double t) {  // the state nearest simulated time t
+    return *std::min_element(states.begin(), states.end(), [&](const auto& a, const auto& b) {
+      return std::abs(a.utime - t * 1e6) < std::abs(b.utime - t * 1e6);
+    });
+  };
+  EXPECT_GT(std::abs(at(0.6).joints[1] - target[1]), 1 * kDeg) << "the servos take time: not there 0.1 s later";
+
+  // The camera draws the arm where SIM_STATE puts it: its frames differ from those of the same
+  // scene without an arm.
+  auto render_last = [&](const std::string& scene_file, const std::string& name) {
+    const std::string frames = dir + "/" + name + "_frames.lcmlog";
+    std::remove(frames.c_str());
+    EXPECT_EQ(run(kBin + "/nudge-camera --source sim --scene " + scene_file + " --lcm-in 'file://" + out +
+                  "?speed=0' --lcm-out 'file://" + frames + "?mode=w'"),
+              0);
+    cv::Mat last;
+    for (const Event& e : read_log(frames))
+      if (e.channel == "CAMERA_RIGHT") last = nudge::bus::to_mat(decode<nudge::image_t>(e));
+    return last;
+  };
+  const cv::Mat with = render_last(scene, "arm"), without = render_last(armless, "no_arm");
+  ASSERT_FALSE(with.empty());
+  ASSERT_EQ(with.size(), without.size());
+  cv::Mat diff;
+  cv::absdiff(with, without, diff);
+  if (diff.channels() == 3) cv::cvtColor(diff, diff, cv::COLOR_BGR2GRAY);
+  EXPECT_GT(cv::countNonZero(diff > 30), 2000) << "the arm shows in the right camera";
 }

@@ -80,6 +80,11 @@ TEST(SimScene, LoadsTheShippedScenes) {
   EXPECT_EQ(scene.objects[1].appearance.kind, Appearance::Kind::Checker);
   EXPECT_NEAR(scene.objects[0].position.y(), 0.10, 1e-12);
   EXPECT_NO_THROW(load_scene(scene_path("single_cup.yaml")));
+  EXPECT_FALSE(scene.arm.present);
+  const Scene with_arm = load_scene(scene_path("arm_three_objects.yaml"));
+  EXPECT_TRUE(with_arm.arm.present);
+  EXPECT_NEAR(with_arm.arm.shoulder_height, 0.33, 1e-12);
+  EXPECT_NEAR(with_arm.arm.joints[1], 90 * kDeg, 1e-12);
 }
 
 TEST(SimScene, EveryShippedSceneBuildsAndRenders) {
@@ -128,6 +133,14 @@ TEST(SimScene, ErrorsNameTheFileAndTheField) {
 
   msg = load_error("%YAML:1.0\nphysics: { impratio: 0.5 }\n");
   EXPECT_NE(msg.find("physics.impratio"), std::string::npos) << msg;
+
+  msg = load_error("%YAML:1.0\narm: { present: 1, joints_deg: [0, 0, 90, 0, 0, 0] }\n");
+  EXPECT_NE(msg.find("arm.joints_deg"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("joint 3"), std::string::npos) << msg;
+  msg = load_error("%YAML:1.0\narm: { shoulder_height: 3 }\n");
+  EXPECT_NE(msg.find("arm.shoulder_height"), std::string::npos) << msg;
+  msg = load_error("%YAML:1.0\narm: { present: 1 }\nobjects:\n  - { kind: cup, position: [0.05, 0] }\n");
+  EXPECT_NE(msg.find("pedestal"), std::string::npos) << msg;
 
   msg = load_error("%YAML:1.0\nrender: { shadows: maybe }\n");
   EXPECT_NE(msg.find("render.shadows"), std::string::npos) << msg;

@@ -163,7 +163,7 @@ void add_arm(Xml& x, const ArmSpec& spec) {
     return q.str();
   };
   x << "    <body name=\"puma_base\" pos=\"0 0 " << h << "\">\n"
-    << "      <geom name=\"puma_pedestal\" type=\"cylinder\" size=\"0.065 " << 0.5 * (h - 0.06) << "\" pos=\"0 0 "
+    << "      <geom name=\"puma_pedestal\" type=\"cylinder\" size=\"" << kArmPedestalRadius << ' ' << 0.5 * (h - 0.06) << "\" pos=\"0 0 "
     << -0.5 * (h + 0.06) << "\" rgba=\"" << colour << "\" mass=\"6\" " << geom_flags << "/>\n";
   std::string indent = "      ";
   for (int i = 0; i < 6; ++i) {

@@ -379,6 +379,13 @@ void validate(const Scene& scene) {
   if (!(r.light >= 0 && r.light <= 1)) fail(src, "render.light", "must be in [0, 1]");
   const ArmSpec& arm = scene.arm;
   if (!(arm.shoulder_height >= 0.1 && arm.shoulder_height <= 1.0)) fail(src, "arm.shoulder_height", "must be in [0.1, 1] m");
+  if (arm.present) {
+    for (size_t i = 0; i < scene.objects.size(); ++i) {
+      const ObjectSpec& o = scene.objects[i];
+      if (o.position.norm() < kArmPedestalRadius + make_object(o.kind, 8).max_radius)
+        fail(src, "objects[" + std::to_string(i) + "].position", "overlaps the arm's pedestal at the origin");
+    }
+  }
   const robot::ArmModel puma = robot::puma260();
   for (int j = 0; j < 6; ++j) {
     if (!(arm.joints[j] >= puma.limits.lower[j] && arm.joints[j] <= puma.limits.upper[j]))

@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -27,6 +28,7 @@ struct PoseSnapshot {
   std::vector<ObjectPose> objects;
   Eigen::Vector3d pusher_position = Eigen::Vector3d::Zero();
   double pusher_yaw = 0;
+  std::optional<std::array<double, 6>> arm_joints;  // the PUMA 260's joints, rad (worlds with an arm)
 };
 
 // The pad's yaw for a tool orientation: the horizontal direction of the tool's x axis (the arm's
@@ -48,7 +50,8 @@ PoseSnapshot snapshot_poses(const World& world, double pusher_yaw);
 // carry the same names; otherwise `to` is returned unchanged.
 PoseSnapshot interpolate_poses(const PoseSnapshot& from, const PoseSnapshot& to, double t);
 
-// Teleports every object of `world` (matched by name) and the pusher to `poses` and updates the
+// Teleports every object of `world` (matched by name), the pusher and, when both have one, the
+// arm (joints clamped to their limits) to `poses` and updates the
 // derived positions, so that the next render shows them. Throws std::invalid_argument naming the
 // object when a name is unknown, a pose is not finite, or the object counts differ.
 void apply_poses(World& world, const PoseSnapshot& poses);
