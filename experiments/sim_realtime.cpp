@@ -122,7 +122,9 @@ int main(int argc, char** argv) {
   Flags flags("nudge-exp-sim-realtime", "Realtime factor of the simulated lab: physics + stereo rendering at 25 Hz.");
   double seconds = 4.0;
   std::string scenes = std::string(NUDGE_SOURCE_DIR) + "/common/sim/scenes/single_cup.yaml," + NUDGE_SOURCE_DIR +
-                       "/common/sim/scenes/three_objects.yaml," + NUDGE_SOURCE_DIR + "/common/sim/scenes/cluttered.yaml";
+                       "/common/sim/scenes/three_objects.yaml," + NUDGE_SOURCE_DIR +
+                       "/common/sim/scenes/arm_three_objects.yaml," + NUDGE_SOURCE_DIR +
+                       "/common/sim/scenes/cluttered.yaml";
   flags.add_double("seconds", &seconds, "simulated seconds per scene");
   flags.add_string("scenes", &scenes, "comma-separated scene files");
   try {
