@@ -14,6 +14,7 @@
 #include "nudge/bus/image.hpp"
 #include "nudge/bus/service.hpp"
 #include "nudge/log.hpp"
+#include "nudge/sim/mjcf.hpp"
 #include "nudge/sim/state_sync.hpp"
 #include "nudge/sim/world.hpp"
 #include "nudge/sim_state_t.hpp"
@@ -47,7 +48,7 @@ pose_t to_pose(const Eigen::Vector3d& p, const Eigen::Quaterniond& q) {
 // The world's physics, its pusher (driven by the arm) and what it publishes, on simulated time.
 class Simulation {
  public:
-  Simulation(bus::Service& service, const sim::Scene& scene, double rate, bool gripper)
+  Simulation(bus::Service& service, const sim::Scene& scene, double rate, bool gripper, double tool_length)
       : service_(service), world_(scene), gripper_(gripper) {
     const double period = 1.0 / rate;
     steps_per_state_ = std::max<int64_t>(1, std::llround(period / world_.timestep()));
@@ -56,6 +57,12 @@ class Simulation {
                   << " ms physics steps: publishing every " << steps_per_state_ << " steps ("
                   << 1.0 / (steps_per_state_ * world_.timestep()) << " Hz)";
     world_.park_pusher();
+    // With the PUMA 260 in the scene the tools ride on its simulated flange; ARM_STATE's joints
+    // drive it, its tool pose then only checks out.
+    if (world_.has_arm()) {
+      world_.mount_tools_on_arm(tool_length);
+      if (gripper_) world_.set_gripper_opening(sim::gripper_geometry().max_opening);
+    }
   }
 
   double time() const { return static_cast<double>(step_) * world_.timestep(); }
@@ -100,6 +107,11 @@ class Simulation {
       std::array<double, 6> joints;
       std::copy(std::begin(msg.joints), std::end(msg.joints), joints.begin());
       world_.set_arm_targets(joints);
+    }
+    if (world_.tools_on_arm()) {  // the tool is where the simulated arm puts it
+      if (gripper_) world_.set_gripper_opening(msg.gripper);
+      arm_ = msg;
+      return;
     }
     if (const auto yaw = sim::pad_yaw_from_tool(q)) pusher_yaw_ = *yaw;
     if (gripper_)
@@ -273,6 +285,9 @@ int main(int argc, char** argv) {
     f.add_double("duration", &duration, "stop after this many simulated seconds (0: run until stopped)");
     std::string tool = "pad";
     f.add_string("tool", &tool, "the arm's tool: pad (pushes) or gripper (grasps; fingers follow ARM_STATE.gripper)");
+    double tool_length = 0.15;
+    f.add_double("tool-length", &tool_length,
+                 "scenes with the arm: the tool point along the simulated flange's z axis, m (as nudge-arm's)");
     double log_origin_s = -1;
     f.add_double("log-origin", &log_origin_s,
                  "input from a log: the utime (s) that is simulated time 0 (-1: automatic, docs/sim.md)");
@@ -283,6 +298,7 @@ int main(int argc, char** argv) {
     if (!(duration >= 0 && std::isfinite(duration))) throw FlagError("--duration must be >= 0");
     if (seed < -1) throw FlagError("--seed must be >= 0 (or -1 for the scene's)");
     if (tool != "pad" && tool != "gripper") throw FlagError("--tool must be pad or gripper, not '" + tool + "'");
+    if (!(tool_length >= 0 && tool_length < 0.5)) throw FlagError("--tool-length must lie in [0, 0.5) m");
     if (!(log_origin_s >= 0 || log_origin_s == -1)) throw FlagError("--log-origin must be >= 0 (or -1)");
     const int64_t log_origin = log_origin_s >= 0 ? std::llround(log_origin_s * 1e6) : -1;
     sim::Scene scene;
@@ -294,7 +310,7 @@ int main(int argc, char** argv) {
     if (seed >= 0) scene.seed = static_cast<uint64_t>(seed);
 
     service.start();
-    Simulation sim(service, scene, rate, tool == "gripper");
+    Simulation sim(service, scene, rate, tool == "gripper", tool_length);
     if (duration > 0) sim.set_end_time(duration);
     const bool from_log = service.input_is_log();
     Inputs inputs(service, sim, from_log, log_origin >= 0 ? std::optional<int64_t>(log_origin) : std::nullopt);

@@ -31,6 +31,7 @@
 #include "nudge/sim_truth_request_t.hpp"
 #include "nudge/sim_truth_t.hpp"
 #include "nudge/snapshot_request_t.hpp"
+#include "nudge/robot/kinematics.hpp"
 #include "nudge/symmetry/detector.hpp"
 #include "lcm_log.hpp"
 
@@ -485,6 +486,15 @@ TEST(World, ArmJointsDriveTheSimulatedPumaWhichTheCameraDraws) {
     });
   };
   EXPECT_GT(std::abs(at(0.6).joints[1] - target[1]), 1 * kDeg) << "the servos take time: not there 0.1 s later";
+  // The pad rides on the simulated flange: SIM_STATE.pusher is the tool point of the joints it
+  // reports (robot library's kinematics, shoulder 0.33 m above the table), not ARM_STATE's pose.
+  nudge::robot::JointVector q;
+  for (int j = 0; j < 6; ++j) q[j] = states.back().joints[j];
+  const Eigen::Vector3d tool =
+      nudge::robot::forward_kinematics(nudge::robot::puma260(), q).translation() + Eigen::Vector3d(0, 0, 0.33);
+  const Eigen::Vector3d pad(states.back().pusher.position[0], states.back().pusher.position[1],
+                            states.back().pusher.position[2]);
+  EXPECT_LT((pad - tool).norm(), 2e-3) << "pad " << pad.transpose() << ", tool point " << tool.transpose();
 
   // The camera draws the arm where SIM_STATE puts it: its frames differ from those of the same
   // scene without an arm.

@@ -20,6 +20,8 @@
 #include "nudge/sim/scene.hpp"
 #include "nudge/sim/world.hpp"
 #include "nudge/robot/kinematics.hpp"
+#include "nudge/robot/motions.hpp"
+#include "nudge/robot/safety.hpp"
 #include "nudge/robot/puma260.hpp"
 
 using namespace nudge::sim;
@@ -965,4 +967,67 @@ TEST(SimArm, ReplaysExactlyAndIsDrawn) {
   const cv::Mat armless_objects = armless.render_mask(1) > 0;
   cv::compare(world.render_mask(1) > 0, armless_objects, mask_diff, cv::CMP_GT);
   EXPECT_LT(cv::countNonZero(mask_diff), 0.002 * cv::countNonZero(armless_objects));
+}
+
+TEST(SimArm, ToolsRideOnTheFlange) {
+  World world(with_arm(default_scene()));
+  EXPECT_FALSE(world.tools_on_arm());
+  world.mount_tools_on_arm(0.15);
+  EXPECT_TRUE(world.tools_on_arm());
+  world.set_arm_targets(degrees(15, 40, -150, 0, 20, 30));
+  world.step_for(2.0);
+  const Eigen::Isometry3d flange = world.arm_flange_pose();
+  const Eigen::Vector3d tool = flange.translation() + 0.15 * flange.linear().col(2);
+  EXPECT_LT((world.pusher_position() - tool).norm(), 1e-4) << "the pad is at the arm's tool point";
+  // The gripper, picked by its opening, is there too and closes.
+  world.set_gripper_opening(0.02);
+  EXPECT_TRUE(world.gripper_in_use());
+  world.step_for(0.5);
+  EXPECT_NEAR(world.gripper_opening(), 0.02, 2e-3);
+  EXPECT_LT((world.pusher_position() - tool).norm(), 1e-4);
+  World armless(default_scene());
+  EXPECT_THROW(armless.mount_tools_on_arm(), SimError);
+}
+
+TEST(SimArm, TheSimulatedArmNudgesACupAcrossTheTable) {
+  // The thesis' nudge (fig. 6.3-6.4) planned by the robot library and played on the simulated
+  // arm's servos, the pad mounted on its flange: the cup slides a few centimetres, upright.
+  namespace robot = nudge::robot;
+  Scene scene = with_arm(one_object("cup", 0.25, 0.0));
+  World world(scene);
+  world.mount_tools_on_arm(0.15);
+  const robot::ArmModel puma = robot::puma260();
+  robot::SafetyConfig safety;
+  safety.table_z = -scene.arm.shoulder_height;
+  const robot::IkResult home = robot::home_configuration(puma, safety);
+  ASSERT_TRUE(home.ok()) << home.reason;
+  const robot::NudgePlan plan =
+      robot::plan_nudge(puma, safety, Eigen::Vector3d(0.25, 0.0, safety.table_z), Eigen::Vector3d(0, 1, 0),
+                        robot::NudgeParams{}, home.q);
+  ASSERT_TRUE(plan.ok()) << plan.reason;
+  auto as_array = [](const robot::JointVector& q) {
+    std::array<double, 6> a;
+    for (int j = 0; j < 6; ++j) a[j] = q[j];
+    return a;
+  };
+  // Home first, then the planned path at no more than 0.5 deg per 10 ms.
+  world.set_arm_joints(as_array(home.q));
+  world.step_for(0.5);
+  const Eigen::Vector3d before = world.object(0).position;
+  robot::JointVector at = home.q;
+  for (const robot::JointVector& next : plan.waypoints) {
+    const int steps = std::max(1, static_cast<int>(std::ceil((next - at).cwiseAbs().maxCoeff() / (0.5 * kDeg))));
+    for (int k = 1; k <= steps; ++k) {
+      world.set_arm_targets(as_array(at + (next - at) * (static_cast<double>(k) / steps)));
+      world.step(5);
+    }
+    at = next;
+  }
+  world.step_for(1.5);
+  const ObjectState after = world.object(0);
+  const double moved = (after.position - before).head<2>().norm();
+  EXPECT_GT(moved, 0.01) << "the cup moved 1-3 cm";
+  EXPECT_LT(moved, 0.03) << "the cup moved 1-3 cm";
+  EXPECT_GT(after.position.y() - before.y(), 0.004) << "along the push direction";
+  EXPECT_LT(after.tilt(), 5 * kDeg) << "and stayed upright";
 }

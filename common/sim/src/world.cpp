@@ -67,6 +67,20 @@ struct World::Impl {
   bool arm = false;                  // the scene has the PUMA 260
   int arm_qpos[6], arm_dof[6], arm_act[6];
   int flange_site = -1;
+  bool tools_on_arm = false;         // the tools ride on the simulated flange
+  double tool_length = 0.15;
+  double tool_yaw = 0;
+  // Puts the tool point on the simulated flange (kinematics as of the last mj_step1/mj_forward).
+  void follow_flange() {
+    const double* p = data->site_xpos + 3 * flange_site;
+    const double* R = data->site_xmat + 9 * flange_site;  // row-major: column c = flange axis c
+    const Eigen::Vector3d z(R[2], R[5], R[8]);
+    const Eigen::Vector3d tool = Eigen::Vector3d(p[0], p[1], p[2]) + tool_length * z;
+    const double horizontal = std::hypot(R[0], R[3]);  // the flange x axis' horizontal part
+    if (horizontal > 1e-3) tool_yaw = std::atan2(R[3], R[0]);
+    place_tool(tool, tool_yaw);
+    if (!gripper) snap_hand();  // the gripper, not in use, rides along
+  }
   std::mt19937_64 noise_rng;
   // Distortion warps, [0] for the rig's size, [1] for snapshots (built on first use).
   struct Warp {
@@ -224,8 +238,37 @@ void World::step(int n) {
   for (int i = 0; i < n; ++i) {
     mj_step1(s.model, s.data);
     for (int j = 0; j < 6; ++j) s.data->qfrc_applied[s.arm_dof[j]] = s.data->qfrc_bias[s.arm_dof[j]];
+    // The tools follow the flange as it is at this state (the mocap body moves in the next step's
+    // kinematics: 2 ms behind the arm).
+    if (s.tools_on_arm) s.follow_flange();
     mj_step2(s.model, s.data);
   }
+}
+
+void World::mount_tools_on_arm(double tool_length) {
+  Impl& s = *impl_;
+  if (!s.arm) throw SimError(scene_.source + ": the scene has no arm (arm: present)");
+  if (!(tool_length >= 0 && tool_length <= 0.5)) throw std::invalid_argument("tool length must be in [0, 0.5] m");
+  s.tools_on_arm = true;
+  s.tool_length = tool_length;
+  mj_kinematics(s.model, s.data);
+  s.follow_flange();
+  s.snap_hand();
+  mj_kinematics(s.model, s.data);
+}
+
+bool World::tools_on_arm() const { return impl_->tools_on_arm; }
+
+void World::set_gripper_opening(double opening) {
+  if (!std::isfinite(opening)) throw std::invalid_argument("World::set_gripper_opening: opening must be finite");
+  Impl& s = *impl_;
+  if (!s.gripper) {
+    use_gripper(true);
+    s.snap_hand();
+  }
+  const GripperGeometry& g = gripper_geometry();
+  const double apex = g.apex_for_opening(std::clamp(opening, 0.0, g.max_opening));
+  for (int f = 0; f < 2; ++f) s.data->ctrl[s.finger_act[f]] = apex;
 }
 
 bool World::has_arm() const { return impl_->arm; }

@@ -135,6 +135,16 @@ class World {
   void set_arm_joints(const std::array<double, 6>& joints);
   // The flange (DH frame 6, the wrist centre) of the simulated arm, world frame.
   Eigen::Isometry3d arm_flange_pose() const;
+  // Mounts the tools on the simulated flange: from then on, every step puts the tool point
+  // `tool_length` along the flange's z axis (robot::default_tool()) and turns the pad to the
+  // horizontal direction of the flange's x axis, so pushes and grasps happen where the simulated
+  // arm really is (servo lag included). set_pusher()/set_end_effector() positions are then
+  // overridden at the next step; set_gripper_opening() picks the gripper and its opening.
+  // Throws SimError without an arm.
+  void mount_tools_on_arm(double tool_length = 0.15);
+  bool tools_on_arm() const;
+  // The gripper in use, opening towards `opening` (m, clamped), the tool point where it is.
+  void set_gripper_opening(double opening);
 
   // ---- rendering (OSMesa context created on first use)
   cv::Mat render(int camera);       // BGR, rig width x height
