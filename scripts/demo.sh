@@ -3,7 +3,7 @@
 # processes over LCM: world (MuJoCo physics) -> camera (--source sim: renders every state) ->
 # symmetry -> monitor (draws the lines and the true axes into out/demo/, prints how well the
 # detected lines match the ground truth). The whole run is recorded to an LCM log under out/.
-#   scripts/demo.sh                       # the simulated world (NUDGE_DEMO_SCENE, default three_objects.yaml)
+#   scripts/demo.sh                       # the simulated world (NUDGE_DEMO_SCENE, default arm_three_objects.yaml)
 #   scripts/demo.sh 'images:/data/left/*.png' 'images:/data/right/*.png'   # recorded stereo data
 #   scripts/demo.sh synthetic             # the synthetic image sequence (generated into out/scenes)
 # NUDGE_DEMO_SECONDS (4) and NUDGE_DEMO_RATE (10 Hz) set the simulated run, NUDGE_DEMO_SYMMETRY_FLAGS
@@ -98,7 +98,7 @@ if [ $# -ge 2 ] || [ "${1:-}" = synthetic ]; then
   pipeline=(run_images_pipeline "$NUDGE_BUILD_DIR/bin" "$left" "$right" "$log" "$out" "$frames")
   drawn="detections drawn in out/demo/"
 else
-  scene=${NUDGE_DEMO_SCENE:-$NUDGE_ROOT/common/sim/scenes/three_objects.yaml}
+  scene=${NUDGE_DEMO_SCENE:-$NUDGE_ROOT/common/sim/scenes/arm_three_objects.yaml}
   seconds=${NUDGE_DEMO_SECONDS:-4}
   rate=${NUDGE_DEMO_RATE:-10}
   nudge_log "world ($(basename "$scene"), ${seconds} s in real time) -> camera (sim, $rate Hz) -> symmetry -> monitor over LCM; recording $log"
