@@ -131,9 +131,9 @@ inline int row_pair_bins16(const int16_t* x, const int16_t* a, int n, const Pair
   const int16_t span = static_cast<int16_t>(std::min<uint32_t>(rule.span, 0xFFFF));
   const int16_t offset = static_cast<int16_t>(rule.offset);
   const __m512i vtol = _mm512_set1_epi16(mirror.tolerance);
-  // |a_i + a_j - 2 theta| (int16 wraps modulo 180 deg) within the tolerance.
+  // With kMirror: keeps the pairs whose |a_i + a_j - 2 theta| (int16 wraps modulo 180 deg) is
+  // within the tolerance.
   auto mirror_ok = [&](__mmask32 ok, __m512i aj, __m512i ai_minus_target) {
-    if constexpr (!kMirror) return ok;
     return _mm512_mask_cmple_epu16_mask(ok, _mm512_abs_epi16(_mm512_add_epi16(aj, ai_minus_target)), vtol);
   };
   if (n <= 16) {
