@@ -1031,3 +1031,18 @@ TEST(SimArm, TheSimulatedArmNudgesACupAcrossTheTable) {
   EXPECT_GT(after.position.y() - before.y(), 0.004) << "along the push direction";
   EXPECT_LT(after.tilt(), 5 * kDeg) << "and stayed upright";
 }
+
+TEST(SimArm, TheTableStopsALinkCommandedThroughIt) {
+  // Upper arm 45 deg down, forearm straight down: by the robot library's kinematics the wrist
+  // would be under the table top; the simulated forearm comes to rest on the table instead.
+  const Scene scene = with_arm(default_scene());
+  const std::array<double, 6> below = degrees(0, -45, -135, 0, 0, 0);
+  const nudge::robot::ArmPoints p = nudge::robot::arm_points(nudge::robot::puma260(), as_joint_vector(below));
+  ASSERT_LT(p.wrist.z() + scene.arm.shoulder_height, 0.0);
+  World world(scene);
+  world.set_arm_targets(below);
+  world.step_for(2.0);
+  EXPECT_GT(world.arm_flange_pose().translation().z(), 0.01) << "the wrist stays above the table top";
+  EXPECT_GT(std::fabs(world.arm_joints()[1] - below[1]) + std::fabs(world.arm_joints()[2] - below[2]), 1 * kDeg)
+      << "so the joints cannot reach their targets";
+}

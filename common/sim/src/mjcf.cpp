@@ -144,12 +144,13 @@ void add_finger(Xml& x, const std::string& name, int side) {
 // (a_i, 0, d_i), rotated by alpha_i about x. Link geometry runs along those offsets. Masses are
 // estimates for a PUMA 260 (about 13 kg in all, most of it in the base); the joints carry the
 // reflected inertia of geared motors (armature), which also keeps the stiff position servos
-// stable at the physics time step. Links collide with objects only (contype 4), not with the
-// table, the tools or each other: the arm service's safety checks keep them apart.
+// stable at the physics time step. Links collide with objects and the table (contype 4,
+// conaffinity 1), not with the tools or each other (the arm service's safety checks keep those
+// apart); the pedestal, welded to the world, touches nothing.
 void add_arm(Xml& x, const ArmSpec& spec) {
   const robot::ArmModel puma = robot::puma260();
   const char* colour = "0.82 0.82 0.78 1";
-  const char* geom_flags = "contype=\"4\" conaffinity=\"0\" condim=\"3\" friction=\"0.6 0.005 0.0001\" group=\"1\"";
+  const char* geom_flags = "contype=\"4\" conaffinity=\"1\" condim=\"3\" friction=\"0.6 0.005 0.0001\" group=\"1\"";
   const double link_mass[6] = {2.0, 1.6, 0.9, 1.0, 0.3, 0.2};
   const double radius[6] = {0.06, 0.045, 0.045, 0.035, 0.03, 0.025};
   const double armature[6] = {0.15, 0.15, 0.1, 0.03, 0.03, 0.02};
