@@ -4,6 +4,7 @@
 #include "nudge/sim/objects.hpp"
 
 #include "nudge/robot/puma260.hpp"
+#include "nudge/robot/safety.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -164,7 +165,7 @@ void add_arm(Xml& x, const ArmSpec& spec) {
     return q.str();
   };
   x << "    <body name=\"puma_base\" pos=\"0 0 " << h << "\">\n"
-    << "      <geom name=\"puma_pedestal\" type=\"cylinder\" size=\"" << kArmPedestalRadius << ' ' << 0.5 * (h - 0.06) << "\" pos=\"0 0 "
+    << "      <geom name=\"puma_pedestal\" type=\"cylinder\" size=\"" << robot::SafetyConfig{}.pedestal_radius << ' ' << 0.5 * (h - 0.06) << "\" pos=\"0 0 "
     << -0.5 * (h + 0.06) << "\" rgba=\"" << colour << "\" mass=\"6\" " << geom_flags << "/>\n";
   std::string indent = "      ";
   for (int i = 0; i < 6; ++i) {

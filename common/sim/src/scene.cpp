@@ -1,6 +1,7 @@
 #include "nudge/sim/scene.hpp"
 
 #include "nudge/robot/puma260.hpp"
+#include "nudge/robot/safety.hpp"
 
 #include "nudge/sim/objects.hpp"
 
@@ -382,7 +383,7 @@ void validate(const Scene& scene) {
   if (arm.present) {
     for (size_t i = 0; i < scene.objects.size(); ++i) {
       const ObjectSpec& o = scene.objects[i];
-      if (o.position.norm() < kArmPedestalRadius + make_object(o.kind, 8).max_radius)
+      if (o.position.norm() < robot::SafetyConfig{}.pedestal_radius + make_object(o.kind, 8).max_radius)
         fail(src, "objects[" + std::to_string(i) + "].position", "overlaps the arm's pedestal at the origin");
     }
   }

@@ -17,7 +17,9 @@ const Accumulator& CornerCuttingVoter::vote(const EdgeSet& edges, const Params& 
   rows_.resize(static_cast<size_t>(num_rows) * capacity);
   fill_.resize(num_rows);
   acc_.r_max = layout.r_max;
-  acc_.votes.assign(1, cv::Mat::zeros(kThetaBins, layout.num_r(), CV_32S));
+  acc_.votes.resize(1);
+  acc_.votes[0].create(kThetaBins, layout.num_r(), CV_32S);  // kept between calls, as Detector's
+  acc_.votes[0].setTo(0);
   const float cx = 0.5f * (edges.width - 1), cy = 0.5f * (edges.height - 1);
   const float dmin = static_cast<float>(params.dmin);
   const float dmax = params.dmax > 0 && std::isfinite(params.dmax) ? static_cast<float>(params.dmax) : 1e30f;

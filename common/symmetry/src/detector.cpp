@@ -88,15 +88,11 @@ EdgeSet edges_from_mask(const cv::Mat& mask) {
 }
 
 namespace {
-// EdgeSet::orientation from the 3x3 Sobel derivatives of the image Canny saw; on a colour image,
-// those of the channel with the largest L1 gradient at each pixel (as OpenCV's Canny picks it).
-void add_orientations(const cv::Mat& image, EdgeSet* edges) {
-  edges->orientation.assign(edges->points.size(), 0);
-  if (image.rows < 3 || image.cols < 3) return;
-  cv::Mat dx, dy;
-  cv::Sobel(image, dx, CV_16S, 1, 0, 3);
-  cv::Sobel(image, dy, CV_16S, 0, 1, 3);
-  const int channels = image.channels();
+// EdgeSet::orientation from the 3x3 Sobel derivatives Canny used; on a colour image, those of
+// the channel with the largest L1 gradient at each pixel (as OpenCV's Canny picks it).
+void add_orientations(const cv::Mat& dx, const cv::Mat& dy, EdgeSet* edges) {
+  const int channels = dx.channels();
+  edges->orientation.resize(edges->points.size());
   for (size_t i = 0; i < edges->points.size(); ++i) {
     const cv::Point p = edges->points[i];
     const int16_t* gx = dx.ptr<int16_t>(p.y) + p.x * channels;
@@ -169,15 +165,25 @@ EdgeSet detect_edges(const cv::Mat& image, const EdgeParams& params, cv::Mat* ed
   }
   double low = params.canny_low, high = params.canny_high;
   if (params.auto_canny) auto_thresholds(grey, &low, &high);
-  cv::Mat edges;
-  if (grey.rows >= 3 && grey.cols >= 3) {
+  cv::Mat edges, dx, dy;
+  const bool big_enough = grey.rows >= 3 && grey.cols >= 3;  // for a 3x3 aperture
+  if (big_enough && params.gradients) {
+    // The derivatives Canny would compute itself (3x3 Sobel, replicated border: the same edges,
+    // pixel for pixel), kept for the orientations.
+    cv::Sobel(grey, dx, CV_16S, 1, 0, 3, 1, 0, cv::BORDER_REPLICATE);
+    cv::Sobel(grey, dy, CV_16S, 0, 1, 3, 1, 0, cv::BORDER_REPLICATE);
+    cv::Canny(dx, dy, edges, low, high);
+  } else if (big_enough) {
     cv::Canny(grey, edges, low, high, 3);
   } else {
-    edges = cv::Mat::zeros(grey.size(), CV_8U);  // too small for a 3x3 aperture: no edges
+    edges = cv::Mat::zeros(grey.size(), CV_8U);  // no edges
   }
   if (edge_image) *edge_image = edges;
   EdgeSet set = edges_from_mask(edges);
-  if (params.gradients) add_orientations(grey, &set);
+  if (params.gradients) {
+    if (big_enough) add_orientations(dx, dy, &set);
+    else set.orientation.assign(set.points.size(), 0);
+  }
   return set;
 }
 

@@ -98,8 +98,6 @@ struct PhysicsSpec {
 // The PUMA 260 arm (thesis App. B, Table B.1) standing on the table with its base axis on the
 // world z axis: six hinge joints with the robot library's limits, position actuators, links that
 // push objects aside. Its DH frame 0 is the world frame lifted to the shoulder.
-constexpr double kArmPedestalRadius = 0.065;  // m, the column the arm stands on
-
 struct ArmSpec {
   bool present = false;
   double shoulder_height = 0.33;  // the shoulder above the table top, m (SafetyConfig::table_z = -this)
