@@ -61,6 +61,22 @@ std::string numbers(std::initializer_list<double> values) {
   return out.str();
 }
 
+// The camera-arm calibration: both fields or neither; the rotation must be one.
+std::optional<RigidTransform> read_arm_to_right(const cv::FileStorage& fs, const std::string& path) {
+  const auto rotation = read_numbers(fs, path, "arm_to_right_rotation", 9);
+  const auto translation = read_numbers(fs, path, "arm_to_right_translation", 3);
+  if (!rotation && !translation) return std::nullopt;
+  if (!rotation || !translation)
+    throw std::runtime_error(path + ": fields 'arm_to_right_rotation' and 'arm_to_right_translation' come together");
+  RigidTransform transform;
+  for (int i = 0; i < 9; ++i) transform.R(i / 3, i % 3) = (*rotation)[i];
+  transform.t = Eigen::Vector3d((*translation)[0], (*translation)[1], (*translation)[2]);
+  const double orthogonality = (transform.R * transform.R.transpose() - Eigen::Matrix3d::Identity()).norm();
+  if (orthogonality > 1e-6 || transform.R.determinant() < 0)
+    throw std::runtime_error(path + ": field 'arm_to_right_rotation' is not a rotation");
+  return transform;
+}
+
 }  // namespace
 
 Workspace load_workspace(const std::string& path) {
@@ -81,6 +97,7 @@ Workspace load_workspace(const std::string& path) {
   }
   if (const auto base = read_numbers(fs, path, "arm_base", 3))
     workspace.arm_base = Eigen::Vector3d((*base)[0], (*base)[1], (*base)[2]);
+  workspace.arm_to_right = read_arm_to_right(fs, path);
   return workspace;
 }
 
@@ -134,6 +151,13 @@ void save_rig(const StereoRig& rig, const Workspace& workspace, const std::strin
   if (workspace.arm_base) {
     const Eigen::Vector3d& b = *workspace.arm_base;
     contents += "arm_base: " + numbers({b.x(), b.y(), b.z()}) + "\n";
+  }
+  if (workspace.arm_to_right) {
+    const Eigen::Matrix3d& R = workspace.arm_to_right->R;
+    const Eigen::Vector3d& t = workspace.arm_to_right->t;
+    contents += "arm_to_right_rotation: " + numbers({R(0, 0), R(0, 1), R(0, 2), R(1, 0), R(1, 1), R(1, 2),
+                                                     R(2, 0), R(2, 1), R(2, 2)}) + "\n";
+    contents += "arm_to_right_translation: " + numbers({t.x(), t.y(), t.z()}) + "\n";
   }
   write_file_atomically(path, contents);
 }

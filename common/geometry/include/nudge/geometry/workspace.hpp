@@ -4,6 +4,8 @@
 // the ch. 6 workspace ring). Both optional, both in the right camera's frame, metres:
 //   table_plane: [ nx, ny, nz, d ]     # n . p + d = 0
 //   arm_base: [ x, y, z ]
+//   arm_to_right_rotation: [ 9 numbers, row-major ]   arm_to_right_translation: [ x, y, z ]
+//     (the camera-arm calibration, App. B: p_right = R p_arm + t; the arm/world frame of docs/sim.md)
 // They live in the same OpenCV YAML file as the rig, so one file describes the whole set-up.
 #include <Eigen/Core>
 
@@ -11,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "nudge/geometry/absolute_orientation.hpp"
 #include "nudge/geometry/plane.hpp"
 #include "nudge/geometry/stereo_rig.hpp"
 
@@ -19,6 +22,7 @@ namespace nudge::geometry {
 struct Workspace {
   std::optional<Plane> table;
   std::optional<Eigen::Vector3d> arm_base;
+  std::optional<RigidTransform> arm_to_right;  // arm (world) frame -> right camera frame
 };
 
 // A plane from n . p + d = 0: normal normalised and oriented so the camera (origin) lies on the

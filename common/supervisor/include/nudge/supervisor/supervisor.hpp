@@ -1,0 +1,185 @@
+#pragma once
+// The autonomous segmentation loop of thesis fig. 6.2 as a plain state machine: it consumes what
+// the other services report (candidates, arm states, frames, stills, 3D axes, which services are
+// alive) with the task clock's time, and emits what to ask of them (outputs). No LCM, no threads,
+// no wall clock: fed the same inputs it emits the same outputs, so it is tested on hand-made
+// message sequences and replayed from a run's log. docs/supervisor.md has the protocol.
+//
+//   WAIT_SERVICES -> FIND_CANDIDATES -> CHOOSE -> SNAPSHOT_BEFORE -> NUDGE -> TRACK (settle, verify)
+//        -> SNAPSHOT_AFTER -> SEGMENT -> FIND_CANDIDATES ...   until no nudgeable candidate is left: DONE
+//   Every failure (not nudgeable, arm refused, no motion, tipped, snapshot lost, timeout) ends the
+//   attempt with its reason and goes on to the next candidate; a silent service stops the arm and
+//   PAUSES until it is back, then the run resumes from a fresh survey.
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <set>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "nudge/supervisor/line_search.hpp"
+#include "nudge/supervisor/motion_watch.hpp"
+#include "nudge/supervisor/scene.hpp"
+#include "nudge/supervisor/targets.hpp"
+
+namespace nudge::supervisor {
+
+// Values mirror supervisor_state_t's STATE_* constants.
+enum class State : int8_t {
+  Idle = 0, FindCandidates = 1, Nudge = 2, Track = 3, Segment = 4, Done = 9, Failed = 10,
+  WaitServices = 11, Paused = 12, SnapshotBefore = 13, SnapshotAfter = 14, Choose = 15,
+};
+const char* to_string(State state);
+
+struct Config {
+  int survey_frames = 25;            // stereo pairs per candidate request (thesis 6.2)
+  int survey_lines = 3;              // lines per image (3 x 3 pairings)
+  int max_attempts = 12;             // nudges per run
+  double services_timeout_s = 60;    // for every required service's first heartbeat
+  double candidates_timeout_s = 60;  // task-clock seconds for a CANDIDATES answer
+  double snapshot_timeout_s = 10;
+  double nudge_timeout_s = 60;       // arm: from the command to MOTION_DONE
+  double settle_s = 1.5;             // after the arm is done: the object comes to rest
+  double axes_from_s = 0.5;          // AXES after this much of the settling time count
+  int min_axes = 3;                  // upright axes near the expected place that confirm the object
+  double max_travel_m = 0.12;        // how far beyond its place a nudged object is looked for
+  double max_lateral_m = 0.03;       // and how far off the push line
+  double upright_max_tilt_deg = 10;  // thesis ch. 6: within 10 deg of the table normal
+  double min_displacement_m = 0.004; // a smaller slide gives no difference to segment
+  double object_height_m = 0.25;     // rows watched for motion: table to this height
+  cv::Size frame_size{640, 480};     // CAMERA_RIGHT
+  cv::Size still_size{1280, 960};    // SNAPSHOT_RIGHT
+  TargetParams targets;
+  MotionWatchParams motion;
+  LineSearchParams line_search;
+};
+
+// ---- inputs ----
+struct ArmStatus {
+  enum class Motion { Idle, Moving, Done, Refused, Stopped };
+  Motion motion = Motion::Idle;
+  int64_t command_seq = 0;
+  std::string last_error;
+  robot::JointVector joints = robot::JointVector::Zero();
+};
+struct Axis {
+  Eigen::Vector3d foot;     // where it meets the table, world frame
+  double tilt_rad = 0;      // from the table normal
+};
+
+// ---- what motion segmentation returns (common/segmentation, thesis sec. 6.4) ----
+struct Segmentation {
+  cv::Mat mask;                                            // CV_8U 0/255, the still's size
+  cv::Mat cutout;                                          // the after still where the mask is set
+  std::vector<std::pair<std::string, cv::Mat>> stages;     // fig. 6.7's intermediate images
+  std::string error;                                       // why there is no mask
+};
+using SegmentFunction = std::function<Segmentation(const cv::Mat& before, const cv::Mat& after,
+                                                   const symmetry::Line& before_line, const symmetry::Line& after_line)>;
+
+// ---- outputs ----
+struct CandidatesRequest { int frames = 25, lines = 3; };
+struct SnapshotRequest {};
+struct NudgeCommand { int64_t seq = 0; Eigen::Vector3d target, direction; };
+struct StopCommand { int64_t seq = 0; std::string reason; };
+struct StateReport {
+  State state = State::Idle;
+  int attempt = 0;                 // 1-based; 0 before the first
+  int candidate_index = -1;        // in the last CANDIDATES
+  int num_candidates = 0;
+  Eigen::Vector3d target = Eigen::Vector3d::Zero();
+  std::string reason;              // of this transition
+  int segmented = 0, failed_attempts = 0, rejected = 0;
+};
+
+enum class Outcome { Segmented, NoMotion, Tipped, Refused, SnapshotLost, ArmFailed, Aborted, SegmentationFailed };
+const char* to_string(Outcome outcome);
+
+struct Attempt {
+  int number = 0;
+  Candidate target;
+  Eigen::Vector3d direction = Eigen::Vector3d::UnitX();
+  robot::NudgePlan plan;
+  std::vector<Candidate> candidates;       // the survey it was chosen from
+  std::vector<Rejection> rejected;         // candidates passed over for it
+  Outcome outcome = Outcome::Aborted;
+  std::string reason;
+  int64_t started = 0, ended = 0;          // task clock, us
+  int motion_frames = 0, motion_blocks = 0;
+  std::optional<Eigen::Vector3d> rest;     // where the object came to rest
+  cv::Mat before, after;                   // right stills
+  std::optional<symmetry::Line> before_line, after_line;  // in the stills
+  Segmentation segmentation;
+};
+struct AttemptEnded { std::shared_ptr<const Attempt> attempt; };
+
+struct Summary {
+  int surveys = 0, attempts = 0, segmented = 0;
+  std::map<std::string, int> outcomes;      // outcome name -> count
+  std::map<std::string, int> rejections;    // reason -> candidates passed over for it (last survey)
+  std::string end_reason;
+};
+struct Finished { Summary summary; };
+
+using Output = std::variant<CandidatesRequest, SnapshotRequest, NudgeCommand, StopCommand, StateReport,
+                            AttemptEnded, Finished>;
+
+class Supervisor {
+ public:
+  Supervisor(Config config, SceneGeometry scene, ArmSetup arm, SegmentFunction segment);
+
+  // Every handler takes the task clock's time (us) at which the input arrived.
+  void start(int64_t now, int64_t first_command_seq);
+  void on_time(int64_t now);
+  // The required services not heard from within the watchdog's limit (empty: all alive).
+  void on_services(const std::set<std::string>& silent, int64_t now);
+  void on_candidates(const std::vector<Candidate>& candidates, int64_t utime, int64_t now);
+  void on_arm_state(const ArmStatus& arm, int64_t now);
+  void on_right_frame(const cv::Mat& frame, int64_t now);
+  void on_right_still(const cv::Mat& still, int64_t utime, int64_t now);
+  void on_axes(const std::vector<Axis>& axes, int64_t now);
+
+  std::vector<Output> take_outputs();
+  State state() const { return state_; }
+  const StateReport& report() const { return report_; }
+  const Summary& summary() const { return summary_; }
+  bool finished() const { return state_ == State::Done || state_ == State::Failed; }
+
+ private:
+  void enter(State state, int64_t now, const std::string& reason);
+  void survey(int64_t now);
+  void choose(int64_t now);
+  void request_still(State state, int64_t now);
+  void start_nudge(int64_t now);
+  void verify(int64_t now);
+  void segment(int64_t now);
+  void end_attempt(Outcome outcome, const std::string& reason, int64_t now);
+  void finish(State state, const std::string& reason, int64_t now);
+  bool timed_out(double seconds, int64_t now) const;
+  bool in_attempt() const;
+
+  Config config_;
+  SceneGeometry scene_;
+  ArmSetup arm_;
+  SegmentFunction segment_;
+  std::vector<Output> outputs_;
+  State state_ = State::Idle;
+  State paused_from_ = State::Idle;
+  int64_t entered_ = 0, request_time_ = 0, arm_done_time_ = 0, next_seq_ = 1, nudge_seq_ = 0;
+  std::vector<Candidate> candidates_;
+  std::vector<Eigen::Vector3d> explored_;
+  std::vector<Axis> settled_axes_;
+  robot::JointVector joints_ = robot::JointVector::Zero();
+  std::set<std::string> silent_;
+  std::unique_ptr<Attempt> attempt_;
+  std::unique_ptr<MotionWatch> watch_;
+  StateReport report_;
+  Summary summary_;
+};
+
+}  // namespace nudge::supervisor

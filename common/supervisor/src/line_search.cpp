@@ -1,0 +1,42 @@
+#include "nudge/supervisor/line_search.hpp"
+
+#include <cmath>
+
+namespace nudge::supervisor {
+
+std::optional<symmetry::Line> find_line_near(const cv::Mat& image, const symmetry::Line& predicted,
+                                             const LineSearchParams& params) {
+  if (image.empty()) return std::nullopt;
+  const double scale = image.cols / 640.0;  // the detector's thesis distances are for 640x480
+  symmetry::Params p;
+  p.dmin = 25 * scale;
+  p.dmax = 250 * scale;
+  const double theta_deg = predicted.theta * 180 / M_PI;
+  p.theta_min_deg = theta_deg - params.window_deg;
+  p.theta_max_deg = theta_deg + params.window_deg;
+  // The window may cross +-90 deg: the detector takes a wrapped range as theta_min > theta_max.
+  if (p.theta_max_deg > 90) p.theta_max_deg -= 180;
+  if (p.theta_min_deg <= -90) p.theta_min_deg += 180;
+  p.num_lines = params.lines;
+  p.once_per_row = true;
+  p.mirror_tolerance_deg = params.mirror_tolerance_deg;
+  symmetry::EdgeParams edges;
+  edges.gradients = params.mirror_tolerance_deg > 0;
+  symmetry::Detector detector(p, edges);
+  const symmetry::Result result = detector.detect(image);
+  std::optional<symmetry::Line> best;
+  double best_offset = params.window_px;
+  for (const symmetry::Line& line : result.lines) {
+    // Compare in the form nearer the prediction: (R, theta) equals (-R, theta +- 180 deg).
+    const double same = std::abs(line.r - predicted.r), flipped = std::abs(line.r + predicted.r);
+    const bool wrapped = std::abs(line.theta - predicted.theta) > M_PI / 2;
+    const double offset = wrapped ? flipped : same;
+    if (offset <= best_offset) {
+      best_offset = offset;
+      best = line;
+    }
+  }
+  return best;
+}
+
+}  // namespace nudge::supervisor

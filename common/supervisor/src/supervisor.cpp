@@ -1,0 +1,365 @@
+#include "nudge/supervisor/supervisor.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+namespace nudge::supervisor {
+
+namespace {
+
+constexpr double kMicro = 1e6;
+
+std::string millimetres(const Eigen::Vector3d& p) {
+  char text[64];
+  std::snprintf(text, sizeof text, "(%.0f, %.0f) mm", 1e3 * p.x(), 1e3 * p.y());
+  return text;
+}
+
+double median(std::vector<double> values) {
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  return values[values.size() / 2];
+}
+
+}  // namespace
+
+const char* to_string(State state) {
+  switch (state) {
+    case State::Idle: return "IDLE";
+    case State::FindCandidates: return "FIND_CANDIDATES";
+    case State::Nudge: return "NUDGE";
+    case State::Track: return "TRACK";
+    case State::Segment: return "SEGMENT";
+    case State::Done: return "DONE";
+    case State::Failed: return "FAILED";
+    case State::WaitServices: return "WAIT_SERVICES";
+    case State::Paused: return "PAUSED";
+    case State::SnapshotBefore: return "SNAPSHOT_BEFORE";
+    case State::SnapshotAfter: return "SNAPSHOT_AFTER";
+    case State::Choose: return "CHOOSE";
+  }
+  return "?";
+}
+
+const char* to_string(Outcome outcome) {
+  switch (outcome) {
+    case Outcome::Segmented: return "segmented";
+    case Outcome::NoMotion: return "no motion";
+    case Outcome::Tipped: return "tipped or lost";
+    case Outcome::Refused: return "arm refused";
+    case Outcome::SnapshotLost: return "snapshot lost";
+    case Outcome::ArmFailed: return "arm failed";
+    case Outcome::Aborted: return "aborted";
+    case Outcome::SegmentationFailed: return "segmentation failed";
+  }
+  return "?";
+}
+
+Supervisor::Supervisor(Config config, SceneGeometry scene, ArmSetup arm, SegmentFunction segment)
+    : config_(std::move(config)), scene_(std::move(scene)), arm_(std::move(arm)), segment_(std::move(segment)) {
+  if (!segment_) throw std::invalid_argument("supervisor: a segmentation function is required");
+  if (config_.survey_frames <= 0 || config_.survey_lines <= 0 || config_.max_attempts <= 0)
+    throw std::invalid_argument("supervisor: survey_frames, survey_lines and max_attempts must be positive");
+  joints_ = arm_.home();
+}
+
+std::vector<Output> Supervisor::take_outputs() {
+  std::vector<Output> out;
+  out.swap(outputs_);
+  return out;
+}
+
+void Supervisor::start(int64_t now, int64_t first_command_seq) {
+  next_seq_ = first_command_seq;
+  enter(State::WaitServices, now, "waiting for every required service's heartbeat");
+  if (silent_.empty()) survey(now);
+}
+
+bool Supervisor::timed_out(double seconds, int64_t now) const {
+  return static_cast<double>(now - entered_) > seconds * kMicro;
+}
+
+bool Supervisor::in_attempt() const { return attempt_ != nullptr; }
+
+void Supervisor::enter(State state, int64_t now, const std::string& reason) {
+  state_ = state;
+  entered_ = now;
+  report_.state = state;
+  report_.reason = reason;
+  report_.segmented = summary_.segmented;
+  report_.failed_attempts = summary_.attempts - summary_.segmented;
+  outputs_.push_back(report_);
+}
+
+void Supervisor::finish(State state, const std::string& reason, int64_t now) {
+  summary_.end_reason = reason;
+  enter(state, now, reason);
+  outputs_.push_back(Finished{summary_});
+}
+
+// ---- the loop ----
+
+void Supervisor::survey(int64_t now) {
+  if (summary_.attempts >= config_.max_attempts) {
+    finish(State::Done, "attempt limit reached (" + std::to_string(config_.max_attempts) + " nudges)", now);
+    return;
+  }
+  ++summary_.surveys;
+  request_time_ = now;
+  enter(State::FindCandidates, now, "surveying: candidates from " + std::to_string(config_.survey_frames) + " stereo pairs");
+  outputs_.push_back(CandidatesRequest{config_.survey_frames, config_.survey_lines});
+}
+
+void Supervisor::choose(int64_t now) {
+  const Eigen::Vector3d camera = scene_.right_camera_in_world();
+  TargetChoice choice = choose_target(candidates_, explored_, camera, arm_, joints_, config_.targets);
+  summary_.rejections.clear();
+  for (const Rejection& r : choice.rejected) ++summary_.rejections[r.reason];
+  report_.num_candidates = static_cast<int>(candidates_.size());
+  report_.rejected = static_cast<int>(choice.rejected.size());
+  if (!choice.found) {
+    std::string why = candidates_.empty() ? "no candidate found on the table" : "no nudgeable candidate left";
+    const bool any_new = std::any_of(choice.rejected.begin(), choice.rejected.end(),
+                                     [](const Rejection& r) { return r.reason != "already explored"; });
+    if (any_new) why += " (" + choice.rejected.back().reason + ")";
+    finish(State::Done, why, now);
+    return;
+  }
+  attempt_ = std::make_unique<Attempt>();
+  attempt_->number = ++summary_.attempts;
+  attempt_->target = choice.target;
+  attempt_->direction = choice.direction;
+  attempt_->plan = choice.plan;
+  attempt_->candidates = candidates_;
+  attempt_->rejected = choice.rejected;
+  attempt_->started = now;
+  report_.attempt = attempt_->number;
+  report_.candidate_index = choice.target.index;
+  report_.target = choice.target.position;
+  request_still(State::SnapshotBefore, now);
+}
+
+void Supervisor::request_still(State state, int64_t now) {
+  request_time_ = now;
+  enter(state, now, state == State::SnapshotBefore ? "still before the nudge of candidate " + std::to_string(attempt_->target.index) + " at " + millimetres(attempt_->target.position)
+                                                   : "still after the nudge");
+  outputs_.push_back(SnapshotRequest{});
+}
+
+void Supervisor::start_nudge(int64_t now) {
+  const Attempt& a = *attempt_;
+  const auto line = scene_.right_axis_line(a.target.position, config_.object_height_m, config_.frame_size);
+  const auto foot = scene_.project_right(a.target.position, config_.frame_size);
+  const auto top = scene_.project_right(a.target.position + Eigen::Vector3d(0, 0, config_.object_height_m), config_.frame_size);
+  const auto ahead = scene_.project_right(a.target.position + 0.03 * a.direction, config_.frame_size);
+  if (!line || !foot || !top || !ahead) {
+    end_attempt(Outcome::Refused, "the target is not in the right camera's view", now);
+    return;
+  }
+  watch_ = std::make_unique<MotionWatch>(*line, *ahead - *foot, static_cast<int>(std::min(top->y, foot->y)) - 8,
+                                         static_cast<int>(std::max(top->y, foot->y)) + 8, config_.frame_size, config_.motion);
+  nudge_seq_ = next_seq_++;
+  enter(State::Nudge, now, "nudging candidate " + std::to_string(a.target.index) + " at " + millimetres(a.target.position));
+  outputs_.push_back(NudgeCommand{nudge_seq_, a.target.position, a.direction});
+}
+
+void Supervisor::verify(int64_t now) {
+  Attempt& a = *attempt_;
+  a.motion_frames = watch_ ? watch_->frames_with_motion() : 0;
+  a.motion_blocks = watch_ ? watch_->max_blocks() : 0;
+  if (!watch_ || !watch_->moved()) {
+    end_attempt(Outcome::NoMotion, "no motion after nudge: nothing stood there (phantom candidate)", now);
+    return;
+  }
+  std::vector<double> xs, ys, tilts;
+  for (const Axis& axis : settled_axes_) {
+    const Eigen::Vector3d offset = axis.foot - a.target.position;
+    const double along = offset.head<2>().dot(a.direction.head<2>());
+    const double across = (offset.head<2>() - along * a.direction.head<2>()).norm();
+    if (along < -config_.max_lateral_m || along > config_.max_travel_m || across > config_.max_lateral_m) continue;
+    xs.push_back(axis.foot.x());
+    ys.push_back(axis.foot.y());
+    tilts.push_back(axis.tilt_rad);
+  }
+  if (static_cast<int>(xs.size()) < config_.min_axes) {
+    end_attempt(Outcome::Tipped, "object tipped or lost: " + std::to_string(xs.size()) +
+                                     " upright axes near the push line after the nudge", now);
+    return;
+  }
+  const double tilt_deg = median(tilts) * 180 / M_PI;
+  if (tilt_deg > config_.upright_max_tilt_deg) {
+    char text[96];
+    std::snprintf(text, sizeof text, "object tipped: its axis leans %.1f deg after the nudge", tilt_deg);
+    end_attempt(Outcome::Tipped, text, now);
+    return;
+  }
+  a.rest = Eigen::Vector3d(median(xs), median(ys), 0.0);
+  const double moved = (*a.rest - a.target.position).head<2>().norm();
+  if (moved < config_.min_displacement_m) {
+    end_attempt(Outcome::NoMotion, "the object moved only " + std::to_string(static_cast<int>(std::lround(moved * 1e3))) + " mm", now);
+    return;
+  }
+  request_still(State::SnapshotAfter, now);
+}
+
+void Supervisor::segment(int64_t now) {
+  Attempt& a = *attempt_;
+  enter(State::Segment, now, "motion segmentation of the stills");
+  const auto predicted_before = scene_.right_axis_line(a.target.position, config_.object_height_m, config_.still_size);
+  const auto predicted_after = scene_.right_axis_line(*a.rest, config_.object_height_m, config_.still_size);
+  if (!predicted_before || !predicted_after) {
+    end_attempt(Outcome::SegmentationFailed, "the object left the right camera's view", now);
+    return;
+  }
+  // The object's own lines in the stills; the calibration's prediction where none is detected.
+  a.before_line = find_line_near(a.before, *predicted_before, config_.line_search);
+  a.after_line = find_line_near(a.after, *predicted_after, config_.line_search);
+  if (!a.before_line) a.before_line = predicted_before;
+  if (!a.after_line) a.after_line = predicted_after;
+  a.segmentation = segment_(a.before, a.after, *a.before_line, *a.after_line);
+  if (a.segmentation.mask.empty() || cv::countNonZero(a.segmentation.mask) == 0) {
+    end_attempt(Outcome::SegmentationFailed,
+                "segmentation empty" + (a.segmentation.error.empty() ? std::string() : ": " + a.segmentation.error), now);
+    return;
+  }
+  end_attempt(Outcome::Segmented, "segmented", now);
+}
+
+void Supervisor::end_attempt(Outcome outcome, const std::string& reason, int64_t now) {
+  Attempt& a = *attempt_;
+  a.outcome = outcome;
+  a.reason = reason;
+  a.ended = now;
+  ++summary_.outcomes[to_string(outcome)];
+  if (outcome == Outcome::Segmented) ++summary_.segmented;
+  // A place once nudged is not nudged again (unless the attempt never touched it).
+  if (outcome != Outcome::Aborted && outcome != Outcome::SnapshotLost) explored_.push_back(a.target.position);
+  if (a.rest) explored_.push_back(*a.rest);
+  if (outcome == Outcome::SnapshotLost && a.before.empty()) explored_.push_back(a.target.position);
+  outputs_.push_back(AttemptEnded{std::shared_ptr<const Attempt>(attempt_.release())});
+  watch_.reset();
+  settled_axes_.clear();
+  report_.reason = reason;
+  survey(now);
+  // survey() reports FIND_CANDIDATES with its own reason: keep the attempt's outcome visible in it.
+  report_.reason = reason;
+}
+
+// ---- inputs ----
+
+void Supervisor::on_time(int64_t now) {
+  switch (state_) {
+    case State::WaitServices:
+      if (timed_out(config_.services_timeout_s, now)) {
+        std::string names;
+        for (const std::string& s : silent_) names += (names.empty() ? "" : ", ") + s;
+        finish(State::Failed, "services never came up: " + names, now);
+      }
+      break;
+    case State::FindCandidates:
+      if (timed_out(config_.candidates_timeout_s, now))
+        finish(State::Failed, "no CANDIDATES answer within " + std::to_string(static_cast<int>(config_.candidates_timeout_s)) + " s", now);
+      break;
+    case State::SnapshotBefore:
+    case State::SnapshotAfter:
+      if (timed_out(config_.snapshot_timeout_s, now)) end_attempt(Outcome::SnapshotLost, std::string("the ") + (state_ == State::SnapshotBefore ? "before" : "after") + " still never came", now);
+      break;
+    case State::Nudge:
+      if (timed_out(config_.nudge_timeout_s, now)) {
+        outputs_.push_back(StopCommand{next_seq_++, "nudge timed out"});
+        end_attempt(Outcome::ArmFailed, "the arm did not finish the nudge within " + std::to_string(static_cast<int>(config_.nudge_timeout_s)) + " s", now);
+      }
+      break;
+    case State::Track:
+      if (static_cast<double>(now - arm_done_time_) >= config_.settle_s * kMicro) verify(now);
+      break;
+    default:
+      break;
+  }
+}
+
+void Supervisor::on_services(const std::set<std::string>& silent, int64_t now) {
+  const bool was_silent = !silent_.empty();
+  silent_ = silent;
+  if (finished() || state_ == State::Idle) return;
+  if (state_ == State::WaitServices) {
+    if (silent_.empty()) survey(now);
+    return;
+  }
+  std::string names;
+  for (const std::string& s : silent_) names += (names.empty() ? "" : ", ") + s;
+  if (!silent_.empty() && state_ != State::Paused) {
+    // Stop first, then say why: the arm must not move while the loop cannot see.
+    outputs_.push_back(StopCommand{next_seq_++, "service silent: " + names});
+    paused_from_ = state_;
+    enter(State::Paused, now, "paused: no heartbeat from " + names);
+  } else if (silent_.empty() && was_silent && state_ == State::Paused) {
+    if (in_attempt()) {
+      watch_.reset();
+      settled_axes_.clear();
+      Attempt& a = *attempt_;
+      const bool touched = paused_from_ != State::SnapshotBefore;
+      end_attempt(touched ? Outcome::Aborted : Outcome::SnapshotLost,
+                  std::string("aborted: a service went silent during ") + to_string(paused_from_), now);
+      (void)a;
+    } else {
+      survey(now);
+    }
+  }
+}
+
+void Supervisor::on_candidates(const std::vector<Candidate>& candidates, int64_t utime, int64_t now) {
+  if (state_ != State::FindCandidates) return;
+  if (utime < request_time_) return;  // an answer to an older request (or another run's)
+  candidates_ = candidates;
+  enter(State::Choose, now, std::to_string(candidates.size()) + " candidates");
+  choose(now);
+}
+
+void Supervisor::on_arm_state(const ArmStatus& arm, int64_t now) {
+  joints_ = arm.joints;
+  if (state_ != State::Nudge || arm.command_seq != nudge_seq_) return;  // not about our nudge
+  switch (arm.motion) {
+    case ArmStatus::Motion::Refused:
+      end_attempt(Outcome::Refused, "arm refused the nudge: " + arm.last_error, now);
+      break;
+    case ArmStatus::Motion::Stopped:
+      end_attempt(Outcome::ArmFailed, "arm stopped during the nudge: " + arm.last_error, now);
+      break;
+    case ArmStatus::Motion::Done:
+      arm_done_time_ = now;
+      settled_axes_.clear();
+      enter(State::Track, now, "nudge done: waiting for the object to settle");
+      break;
+    default:
+      break;
+  }
+}
+
+void Supervisor::on_right_frame(const cv::Mat& frame, int64_t now) {
+  (void)now;
+  if (state_ == State::Nudge && watch_) watch_->feed(frame);
+}
+
+void Supervisor::on_right_still(const cv::Mat& still, int64_t utime, int64_t now) {
+  if (utime < request_time_) return;  // taken before we asked
+  if (still.size() != config_.still_size)
+    throw std::invalid_argument("right still of " + std::to_string(still.cols) + "x" + std::to_string(still.rows) +
+                                ", expected " + std::to_string(config_.still_size.width) + "x" + std::to_string(config_.still_size.height));
+  if (state_ == State::SnapshotBefore) {
+    attempt_->before = still.clone();
+    start_nudge(now);
+  } else if (state_ == State::SnapshotAfter) {
+    attempt_->after = still.clone();
+    segment(now);
+  }
+}
+
+void Supervisor::on_axes(const std::vector<Axis>& axes, int64_t now) {
+  if (state_ != State::Track) return;
+  if (static_cast<double>(now - arm_done_time_) < config_.axes_from_s * kMicro) return;  // still sliding
+  settled_axes_.insert(settled_axes_.end(), axes.begin(), axes.end());
+}
+
+}  // namespace nudge::supervisor

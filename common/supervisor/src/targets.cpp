@@ -1,0 +1,107 @@
+#include "nudge/supervisor/targets.hpp"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cstdio>
+#include <numeric>
+
+namespace nudge::supervisor {
+
+namespace {
+
+Eigen::Matrix3d yaw_rotation(double yaw) { return Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix(); }
+
+std::string millimetres(const Eigen::Vector3d& p) {
+  char text[64];
+  std::snprintf(text, sizeof text, "(%.0f, %.0f) mm", 1e3 * p.x(), 1e3 * p.y());
+  return text;
+}
+
+Eigen::Vector3d horizontal(const Eigen::Vector3d& v) { return Eigen::Vector3d(v.x(), v.y(), 0.0); }
+
+}  // namespace
+
+robot::SafetyConfig ArmSetup::safety_config() const {
+  robot::SafetyConfig config = safety;
+  config.table_z = -base_height;
+  return config;
+}
+
+robot::JointVector ArmSetup::home() const {
+  const robot::IkResult home = robot::home_configuration(model, safety_config());
+  return home.ok() ? home.q : robot::JointVector::Zero();
+}
+
+Eigen::Vector3d ArmSetup::point_to_base(const Eigen::Vector3d& world) const {
+  return yaw_rotation(-base_yaw) * (world - Eigen::Vector3d(0, 0, base_height));
+}
+Eigen::Vector3d ArmSetup::direction_to_base(const Eigen::Vector3d& world) const { return yaw_rotation(-base_yaw) * world; }
+Eigen::Vector3d ArmSetup::direction_to_world(const Eigen::Vector3d& base) const { return yaw_rotation(base_yaw) * base; }
+
+std::string push_conflict(const Eigen::Vector3d& target, const Eigen::Vector3d& direction,
+                          const Eigen::Vector3d& other, const ArmSetup& arm, const TargetParams& params) {
+  const Eigen::Vector3d d = horizontal(direction).normalized();
+  const Eigen::Vector3d offset = horizontal(other - target);
+  const double along = offset.dot(d);
+  const double across = (offset - along * d).norm();
+  // The pad descends at P1 (start_distance before the axis) and the object slides up to `travel`
+  // beyond P2; both sweep a band two object radii wide (the pad is narrower than an object).
+  const double behind = arm.nudge.start_distance + params.object_radius;
+  const double ahead = params.travel + 2 * params.object_radius;
+  if (along < -behind || along > ahead || across >= 2 * params.object_radius) return "";
+  return "the push would touch the candidate at " + millimetres(other);
+}
+
+TargetChoice choose_target(const std::vector<Candidate>& candidates, const std::vector<Eigen::Vector3d>& explored,
+                           const Eigen::Vector3d& right_camera, const ArmSetup& arm,
+                           const robot::JointVector& seed, const TargetParams& params) {
+  std::vector<size_t> order(candidates.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    return (candidates[a].position - right_camera).norm() < (candidates[b].position - right_camera).norm();
+  });
+  TargetChoice choice;
+  const Eigen::Vector3d camera_base = arm.point_to_base(right_camera);
+  for (size_t i : order) {
+    const Candidate& c = candidates[i];
+    auto reject = [&](const std::string& reason) { choice.rejected.push_back({c.index, c.position, reason}); };
+    const bool was_explored = std::any_of(explored.begin(), explored.end(), [&](const Eigen::Vector3d& e) {
+      return horizontal(e - c.position).norm() < params.explored_radius;
+    });
+    if (was_explored) {
+      reject("already explored");
+      continue;
+    }
+    std::string why_not;
+    for (const Eigen::Vector3d& direction_base :
+         robot::directions_across_view(camera_base, arm.point_to_base(c.position))) {
+      const Eigen::Vector3d direction = arm.direction_to_world(direction_base);
+      std::string conflict;
+      for (const Candidate& other : candidates) {
+        if (other.index == c.index) continue;
+        conflict = push_conflict(c.position, direction, other.position, arm, params);
+        if (!conflict.empty()) break;
+      }
+      if (!conflict.empty()) {
+        why_not += std::string(why_not.empty() ? "" : "; the other way: ") + conflict;
+        continue;
+      }
+      Eigen::Vector3d target_base = arm.point_to_base(c.position);
+      robot::NudgePlan plan = robot::plan_nudge(arm.model, arm.safety_config(), target_base, direction_base, arm.nudge, seed);
+      if (!plan.ok()) {
+        why_not += std::string(why_not.empty() ? "" : "; the other way: ") + "out of reach: " + plan.reason;
+        continue;
+      }
+      choice.found = true;
+      choice.target = c;
+      choice.direction = horizontal(direction).normalized();
+      choice.plan = std::move(plan);
+      return choice;
+    }
+    reject(why_not);
+  }
+  return choice;
+}
+
+}  // namespace nudge::supervisor

@@ -1,0 +1,394 @@
+// The supervisor's state machine (common/supervisor) on hand-made message sequences: a synthetic
+// calibrated scene (a right camera facing the arm across the table, as in the simulated lab), an
+// object drawn where it stands, and the arm's answers played by the test.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <opencv2/imgproc.hpp>
+
+#include "nudge/supervisor/supervisor.hpp"
+
+namespace sv = nudge::supervisor;
+namespace geo = nudge::geometry;
+
+namespace {
+
+constexpr int64_t kSecond = 1000000;
+
+// A right camera 0.95 m from the arm base looking down at the middle of the workspace ring.
+sv::SceneGeometry make_scene() {
+  const Eigen::Vector3d camera(0.95, 0.0, 0.45), look_at(0.25, 0.0, 0.05);
+  const Eigen::Vector3d z = (look_at - camera).normalized();
+  const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ()).normalized();  // image right
+  const Eigen::Vector3d y = z.cross(x);                                     // image down
+  geo::RigidTransform arm_to_right;
+  arm_to_right.R.row(0) = x.transpose();
+  arm_to_right.R.row(1) = y.transpose();
+  arm_to_right.R.row(2) = z.transpose();
+  arm_to_right.t = -arm_to_right.R * camera;
+  geo::StereoRig rig;
+  for (geo::Camera* c : {&rig.left, &rig.right}) c->K << 580, 0, 319.5, 0, 580, 239.5, 0, 0, 1;
+  rig.T = Eigen::Vector3d(-0.25, 0, 0.03);
+  geo::Plane table;
+  table.normal = arm_to_right.R * Eigen::Vector3d::UnitZ();
+  table.offset = -table.normal.dot(arm_to_right.t);
+  if (table.offset < 0) {
+    table.normal = -table.normal;
+    table.offset = -table.offset;
+  }
+  return sv::SceneGeometry(rig, table, arm_to_right.t, arm_to_right);
+}
+
+// A grey box 7 cm wide and 12 cm tall standing at `foot` (world), drawn into a textured background.
+cv::Mat draw_scene(const sv::SceneGeometry& scene, cv::Size size, const std::vector<Eigen::Vector3d>& objects) {
+  cv::Mat image(size, CV_8UC3);
+  cv::RNG rng(7);
+  rng.fill(image, cv::RNG::UNIFORM, 90, 110);
+  cv::GaussianBlur(image, image, cv::Size(5, 5), 0);
+  const Eigen::Vector3d across = Eigen::Vector3d(0, 1, 0);
+  for (const Eigen::Vector3d& foot : objects) {
+    std::vector<cv::Point> corners;
+    const Eigen::Vector3d up(0, 0, 0.12);
+    const std::vector<Eigen::Vector3d> outline = {foot - 0.035 * across, foot + 0.035 * across,
+                                                  foot + 0.035 * across + up, foot - 0.035 * across + up};
+    for (const Eigen::Vector3d& corner : outline) {
+      const auto p = scene.project_right(corner, size);
+      corners.emplace_back(cvRound(p->x), cvRound(p->y));
+    }
+    cv::fillConvexPoly(image, corners, cv::Scalar(230, 60, 40));
+  }
+  return image;
+}
+
+sv::Segmentation mask_of_difference(const cv::Mat& before, const cv::Mat& after, const nudge::symmetry::Line&,
+                                    const nudge::symmetry::Line&) {
+  sv::Segmentation s;
+  cv::Mat diff, grey;
+  cv::absdiff(before, after, diff);
+  cv::cvtColor(diff, grey, cv::COLOR_BGR2GRAY);
+  cv::threshold(grey, s.mask, 40, 255, cv::THRESH_BINARY);
+  return s;
+}
+
+template <typename T>
+std::vector<T> outputs_of(const std::vector<sv::Output>& outputs) {
+  std::vector<T> found;
+  for (const sv::Output& o : outputs)
+    if (const T* t = std::get_if<T>(&o)) found.push_back(*t);
+  return found;
+}
+
+nudge::robot::JointVector arm_state_joints() {
+  return sv::ArmSetup{}.home();  // where the arm service parks
+}
+
+sv::ArmStatus arm(sv::ArmStatus::Motion motion, int64_t seq, const std::string& error = "") {
+  sv::ArmStatus a;
+  a.motion = motion;
+  a.command_seq = seq;
+  a.last_error = error;
+  a.joints = arm_state_joints();
+  return a;
+}
+
+class SupervisorTest : public ::testing::Test {
+ protected:
+  SupervisorTest() : scene_(make_scene()) {}
+
+  sv::Supervisor make(sv::Config config = {}) {
+    return sv::Supervisor(config, scene_, sv::ArmSetup{}, mask_of_difference);
+  }
+
+  // Starts a run and answers its first survey with `candidates` (world positions).
+  std::vector<sv::Output> start_with(sv::Supervisor& s, const std::vector<Eigen::Vector3d>& candidates) {
+    s.start(now_, 100);
+    s.on_services({}, now_);
+    return answer_survey(s, candidates);
+  }
+  std::vector<sv::Output> answer_survey(sv::Supervisor& s, const std::vector<Eigen::Vector3d>& candidates) {
+    s.take_outputs();
+    EXPECT_EQ(s.state(), sv::State::FindCandidates);
+    now_ += 3 * kSecond;
+    std::vector<sv::Candidate> list;
+    for (size_t i = 0; i < candidates.size(); ++i) list.push_back({static_cast<int>(i), candidates[i], 20});
+    s.on_candidates(list, now_, now_);
+    return s.take_outputs();
+  }
+  // Frames of the object sliding from `from` to `to` while the arm reports MOVING, then DONE.
+  void play_nudge(sv::Supervisor& s, int64_t seq, const Eigen::Vector3d& from, const Eigen::Vector3d& to,
+                  const std::vector<Eigen::Vector3d>& others = {}) {
+    s.on_arm_state(arm(sv::ArmStatus::Motion::Moving, seq), now_);
+    for (int i = 0; i <= 10; ++i) {
+      std::vector<Eigen::Vector3d> objects = others;
+      objects.push_back(from + (to - from) * (i / 10.0));
+      now_ += kSecond / 10;
+      s.on_right_frame(draw_scene(scene_, {640, 480}, objects), now_);
+    }
+    now_ += kSecond / 10;
+    s.on_arm_state(arm(sv::ArmStatus::Motion::Done, seq), now_);
+  }
+  void settle_with_axes(sv::Supervisor& s, const std::vector<Eigen::Vector3d>& feet, double tilt = 0.02) {
+    for (int i = 1; i <= 20; ++i) {
+      now_ += kSecond / 10;
+      std::vector<sv::Axis> axes;
+      for (const auto& f : feet) axes.push_back({f, tilt});
+      s.on_axes(axes, now_);
+      s.on_time(now_);
+    }
+  }
+
+  sv::SceneGeometry scene_;
+  int64_t now_ = 50 * kSecond;
+};
+
+}  // namespace
+
+TEST(SceneGeometry, ProjectsAVerticalAxisToAnUprightLineAndBack) {
+  const sv::SceneGeometry scene = make_scene();
+  const Eigen::Vector3d foot(0.25, 0.05, 0);
+  const auto line = scene.right_axis_line(foot, 0.2, {640, 480});
+  ASSERT_TRUE(line);
+  EXPECT_LT(std::abs(line->theta), 0.2);  // nearly vertical in the image
+  const auto p = scene.project_right(foot + Eigen::Vector3d(0, 0, 0.1), {640, 480});
+  EXPECT_NEAR(sv::signed_distance(*line, *p, {640, 480}), 0.0, 1e-6);
+  // World +y lies to the image's right; the stills are the same camera at twice the resolution.
+  EXPECT_GT(scene.project_right(foot + Eigen::Vector3d(0, 0.05, 0), {640, 480})->x, scene.project_right(foot, {640, 480})->x);
+  const auto small = scene.project_right(foot, {640, 480}), large = scene.project_right(foot, {1280, 960});
+  EXPECT_NEAR(large->x, 2 * small->x + 0.5, 1e-9);
+  // Table frame of the triangulation service -> world: the arm base's foot is the origin of both.
+  EXPECT_NEAR(scene.table_to_world(Eigen::Vector3d::Zero()).norm(), 0.0, 1e-9);
+  EXPECT_NEAR(scene.table_to_world(Eigen::Vector3d(0.1, 0, 0)).norm(), 0.1, 1e-9);
+  EXPECT_NEAR(scene.table_to_world(Eigen::Vector3d(0.1, 0.2, 0)).z(), 0.0, 1e-9);
+}
+
+TEST(Targets, PushPathConflictsOnlyWithCandidatesInTheSweep) {
+  sv::ArmSetup arm;
+  sv::TargetParams params;
+  const Eigen::Vector3d target(0.25, 0, 0), direction(0, 1, 0);
+  EXPECT_FALSE(sv::push_conflict(target, direction, Eigen::Vector3d(0.25, 0.06, 0), arm, params).empty());   // ahead
+  EXPECT_FALSE(sv::push_conflict(target, direction, Eigen::Vector3d(0.25, -0.10, 0), arm, params).empty());  // where the pad descends
+  EXPECT_TRUE(sv::push_conflict(target, direction, Eigen::Vector3d(0.35, 0.0, 0), arm, params).empty());    // beside
+  EXPECT_TRUE(sv::push_conflict(target, direction, Eigen::Vector3d(0.25, 0.30, 0), arm, params).empty());   // far ahead
+}
+
+TEST(Targets, NearestTheCameraFirstAndEveryPassOverHasAReason) {
+  const sv::SceneGeometry scene = make_scene();
+  const sv::ArmSetup arm;
+  const std::vector<sv::Candidate> candidates = {{0, Eigen::Vector3d(0.20, 0.12, 0), 9},
+                                                 {1, Eigen::Vector3d(0.30, -0.10, 0), 9},
+                                                 {2, Eigen::Vector3d(0.62, 0.0, 0), 9},   // beyond the ring
+                                                 {3, Eigen::Vector3d(0.05, 0.0, 0), 9}};  // inside it
+  const auto choice = sv::choose_target(candidates, {}, scene.right_camera_in_world(), arm,
+                                        arm_state_joints(), sv::TargetParams{});
+  ASSERT_TRUE(choice.found);
+  EXPECT_EQ(choice.target.index, 1);  // the nearest reachable one
+  ASSERT_EQ(choice.rejected.size(), 1u);  // only the one nearer the camera is passed over
+  EXPECT_EQ(choice.rejected[0].index, 2);
+  EXPECT_NE(choice.rejected[0].reason.find("out of reach"), std::string::npos) << choice.rejected[0].reason;
+  // Perpendicular to the camera's ray, horizontal.
+  const Eigen::Vector3d ray = (choice.target.position - scene.right_camera_in_world()).normalized();
+  EXPECT_NEAR(choice.direction.dot(Eigen::Vector3d(ray.x(), ray.y(), 0).normalized()), 0.0, 1e-6);
+  EXPECT_NEAR(choice.direction.z(), 0.0, 1e-12);
+  // Explored places are skipped; with everything explored or unreachable nothing is chosen.
+  const auto rest = sv::choose_target(candidates, {candidates[0].position, candidates[1].position},
+                                      scene.right_camera_in_world(), arm, arm_state_joints(), sv::TargetParams{});
+  EXPECT_FALSE(rest.found);
+  EXPECT_EQ(rest.rejected.size(), 4u);
+}
+
+TEST_F(SupervisorTest, SegmentsTheObjectThenFindsNothingLeftToNudge) {
+  sv::Supervisor s = make();
+  const Eigen::Vector3d object(0.28, -0.05, 0);
+  auto out = start_with(s, {object});
+  ASSERT_EQ(outputs_of<sv::SnapshotRequest>(out).size(), 1u);
+  EXPECT_EQ(s.state(), sv::State::SnapshotBefore);
+  now_ += kSecond / 5;
+  s.on_right_still(draw_scene(scene_, {1280, 960}, {object}), now_, now_);
+  out = s.take_outputs();
+  const auto nudges = outputs_of<sv::NudgeCommand>(out);
+  ASSERT_EQ(nudges.size(), 1u);
+  EXPECT_EQ(nudges[0].seq, 100);
+  EXPECT_NEAR((nudges[0].target - object).norm(), 0.0, 1e-12);
+  const Eigen::Vector3d rest = object + 0.03 * nudges[0].direction;
+  play_nudge(s, nudges[0].seq, object, rest);
+  EXPECT_EQ(s.state(), sv::State::Track);
+  settle_with_axes(s, {rest + Eigen::Vector3d(0.002, -0.001, 0)});
+  ASSERT_EQ(s.state(), sv::State::SnapshotAfter);
+  now_ += kSecond / 5;
+  s.on_right_still(draw_scene(scene_, {1280, 960}, {rest}), now_, now_);
+  out = s.take_outputs();
+  const auto ended = outputs_of<sv::AttemptEnded>(out);
+  ASSERT_EQ(ended.size(), 1u);
+  const sv::Attempt& a = *ended[0].attempt;
+  EXPECT_EQ(a.outcome, sv::Outcome::Segmented) << a.reason;
+  EXPECT_GE(a.motion_frames, 2);
+  ASSERT_TRUE(a.rest);
+  EXPECT_LT((*a.rest - rest).norm(), 0.005);
+  EXPECT_GT(cv::countNonZero(a.segmentation.mask), 1000);
+  ASSERT_TRUE(a.before_line && a.after_line);
+  // The lines found in the stills are the object's: where the calibration predicts them, apart
+  // by the slide (3 cm at ~0.75 m is ~45 px at 1280x960).
+  const auto predicted = scene_.right_axis_line(rest, 0.2, {1280, 960});
+  EXPECT_NEAR(a.after_line->r, predicted->r, 4.0);
+  EXPECT_GT(std::abs(a.after_line->r - a.before_line->r), 25.0);
+  EXPECT_EQ(s.state(), sv::State::FindCandidates);
+  // The same place again (and the object's new place): nothing new to nudge.
+  out = answer_survey(s, {object, rest});
+  EXPECT_EQ(s.state(), sv::State::Done);
+  EXPECT_EQ(s.summary().segmented, 1);
+  EXPECT_EQ(s.summary().attempts, 1);
+  ASSERT_EQ(outputs_of<sv::Finished>(out).size(), 1u);
+  EXPECT_NE(s.summary().end_reason.find("no nudgeable candidate left"), std::string::npos) << s.summary().end_reason;
+}
+
+TEST_F(SupervisorTest, NoCandidateAtAllEndsTheRunWithItsReason) {
+  sv::Supervisor s = make();
+  start_with(s, {});
+  EXPECT_EQ(s.state(), sv::State::Done);
+  EXPECT_EQ(s.summary().end_reason, "no candidate found on the table");
+}
+
+TEST_F(SupervisorTest, EveryCandidateOutOfReachIsReportedNotNudged) {
+  sv::Supervisor s = make();
+  const auto out = start_with(s, {Eigen::Vector3d(0.7, 0.0, 0), Eigen::Vector3d(0.0, 0.5, 0)});
+  EXPECT_TRUE(outputs_of<sv::NudgeCommand>(out).empty());
+  EXPECT_TRUE(outputs_of<sv::SnapshotRequest>(out).empty());
+  EXPECT_EQ(s.state(), sv::State::Done);
+  EXPECT_NE(s.summary().end_reason.find("out of reach"), std::string::npos) << s.summary().end_reason;
+  EXPECT_EQ(s.report().rejected, 2);
+}
+
+TEST_F(SupervisorTest, ARefusedNudgeGoesOnToTheNextCandidate) {
+  sv::Supervisor s = make();
+  const Eigen::Vector3d first(0.28, -0.05, 0), second(0.22, 0.20, 0);
+  start_with(s, {first, second});
+  s.on_right_still(draw_scene(scene_, {1280, 960}, {first, second}), now_, now_);
+  const auto nudge = outputs_of<sv::NudgeCommand>(s.take_outputs()).at(0);
+  EXPECT_NEAR((nudge.target - first).norm(), 0.0, 1e-12);  // nearer the camera
+  s.on_arm_state(arm(sv::ArmStatus::Motion::Refused, nudge.seq - 1, "an older command"), now_);  // not ours
+  EXPECT_EQ(s.state(), sv::State::Nudge);
+  s.on_arm_state(arm(sv::ArmStatus::Motion::Refused, nudge.seq, "nudge: elbow below the table"), now_);
+  auto out = s.take_outputs();
+  const auto ended = outputs_of<sv::AttemptEnded>(out);
+  ASSERT_EQ(ended.size(), 1u);
+  EXPECT_EQ(ended[0].attempt->outcome, sv::Outcome::Refused);
+  EXPECT_NE(ended[0].attempt->reason.find("elbow below the table"), std::string::npos);
+  out = answer_survey(s, {first, second});
+  const auto next = outputs_of<sv::SnapshotRequest>(out);
+  ASSERT_EQ(next.size(), 1u);
+  EXPECT_NEAR((s.report().target - second).norm(), 0.0, 1e-12);
+}
+
+TEST_F(SupervisorTest, APhantomCandidateShowsNoMotionAndIsRecordedAsSuch) {
+  sv::Supervisor s = make();
+  const Eigen::Vector3d phantom(0.28, -0.05, 0);
+  start_with(s, {phantom});
+  s.on_right_still(draw_scene(scene_, {1280, 960}, {}), now_, now_);
+  const auto nudge = outputs_of<sv::NudgeCommand>(s.take_outputs()).at(0);
+  // Nothing stands there: the frames do not change (the arm stays on its own side of the line).
+  s.on_arm_state(arm(sv::ArmStatus::Motion::Moving, nudge.seq), now_);
+  for (int i = 0; i < 10; ++i) s.on_right_frame(draw_scene(scene_, {640, 480}, {}), now_ += kSecond / 10);
+  s.on_arm_state(arm(sv::ArmStatus::Motion::Done, nudge.seq), now_);
+  settle_with_axes(s, {});
+  const auto ended = outputs_of<sv::AttemptEnded>(s.take_outputs());
+  ASSERT_EQ(ended.size(), 1u);
+  EXPECT_EQ(ended[0].attempt->outcome, sv::Outcome::NoMotion);
+  EXPECT_NE(ended[0].attempt->reason.find("phantom"), std::string::npos);
+  EXPECT_EQ(s.state(), sv::State::FindCandidates);
+}
+
+TEST_F(SupervisorTest, ATippedObjectIsReportedNotSegmented) {
+  sv::Supervisor s = make();
+  const Eigen::Vector3d object(0.28, -0.05, 0);
+  start_with(s, {object});
+  s.on_right_still(draw_scene(scene_, {1280, 960}, {object}), now_, now_);
+  const auto nudge = outputs_of<sv::NudgeCommand>(s.take_outputs()).at(0);
+  play_nudge(s, nudge.seq, object, object + 0.03 * nudge.direction);
+  settle_with_axes(s, {object + 0.03 * nudge.direction}, /*tilt=*/0.4);  // 23 deg from upright
+  auto ended = outputs_of<sv::AttemptEnded>(s.take_outputs());
+  ASSERT_EQ(ended.size(), 1u);
+  EXPECT_EQ(ended[0].attempt->outcome, sv::Outcome::Tipped);
+  EXPECT_TRUE(ended[0].attempt->after.empty());  // no still taken, nothing segmented
+  // Lying down it has no upright axis at all: also reported.
+  answer_survey(s, {Eigen::Vector3d(0.30, 0.10, 0)});
+  s.on_right_still(draw_scene(scene_, {1280, 960}, {Eigen::Vector3d(0.30, 0.10, 0)}), now_, now_);
+  const auto second = outputs_of<sv::NudgeCommand>(s.take_outputs()).at(0);
+  play_nudge(s, second.seq, second.target, second.target + 0.03 * second.direction);
+  settle_with_axes(s, {});
+  ended = outputs_of<sv::AttemptEnded>(s.take_outputs());
+  ASSERT_EQ(ended.size(), 1u);
+  EXPECT_EQ(ended[0].attempt->outcome, sv::Outcome::Tipped);
+}
+
+TEST_F(SupervisorTest, ASnapshotThatNeverComesEndsTheAttemptAfterItsTimeout) {
+  sv::Supervisor s = make();
+  start_with(s, {Eigen::Vector3d(0.28, -0.05, 0)});
+  s.on_time(now_ += 5 * kSecond);
+  EXPECT_EQ(s.state(), sv::State::SnapshotBefore);
+  s.on_right_still(draw_scene(scene_, {1280, 960}, {}), now_ - 8 * kSecond, now_);  // taken before the request
+  EXPECT_EQ(s.state(), sv::State::SnapshotBefore);
+  s.on_time(now_ += 6 * kSecond);
+  const auto ended = outputs_of<sv::AttemptEnded>(s.take_outputs());
+  ASSERT_EQ(ended.size(), 1u);
+  EXPECT_EQ(ended[0].attempt->outcome, sv::Outcome::SnapshotLost);
+  EXPECT_EQ(s.state(), sv::State::FindCandidates);
+  EXPECT_THROW(s.on_right_still(cv::Mat(480, 640, CV_8UC3), now_, now_), std::invalid_argument);  // wrong size: named
+}
+
+TEST_F(SupervisorTest, AServiceDyingMidNudgeStopsTheArmPausesAndResumesWithASurvey) {
+  sv::Supervisor s = make();
+  const Eigen::Vector3d object(0.28, -0.05, 0);
+  start_with(s, {object});
+  s.on_right_still(draw_scene(scene_, {1280, 960}, {object}), now_, now_);
+  const auto nudge = outputs_of<sv::NudgeCommand>(s.take_outputs()).at(0);
+  s.on_arm_state(arm(sv::ArmStatus::Motion::Moving, nudge.seq), now_);
+  s.on_services({"camera"}, now_ += kSecond);
+  auto out = s.take_outputs();
+  ASSERT_EQ(outputs_of<sv::StopCommand>(out).size(), 1u);
+  EXPECT_EQ(s.state(), sv::State::Paused);
+  EXPECT_NE(s.report().reason.find("camera"), std::string::npos);
+  // Paused: time passes without timeouts firing, arm reports are not taken for the nudge's.
+  s.on_time(now_ += 100 * kSecond);
+  s.on_arm_state(arm(sv::ArmStatus::Motion::Done, nudge.seq), now_);
+  EXPECT_EQ(s.state(), sv::State::Paused);
+  s.on_services({}, now_ += kSecond);
+  out = s.take_outputs();
+  const auto ended = outputs_of<sv::AttemptEnded>(out);
+  ASSERT_EQ(ended.size(), 1u);
+  EXPECT_EQ(ended[0].attempt->outcome, sv::Outcome::Aborted);
+  EXPECT_EQ(outputs_of<sv::CandidatesRequest>(out).size(), 1u);
+  EXPECT_EQ(s.state(), sv::State::FindCandidates);
+}
+
+TEST_F(SupervisorTest, StaleAnswersAreIgnoredAndASilentTriangulationFailsTheRun) {
+  sv::Supervisor s = make();
+  s.start(now_, 1);
+  EXPECT_EQ(s.state(), sv::State::FindCandidates);
+  s.take_outputs();
+  s.on_candidates({{0, Eigen::Vector3d(0.28, -0.05, 0), 9}}, now_ - kSecond, now_);  // from before the request
+  EXPECT_EQ(s.state(), sv::State::FindCandidates);
+  s.on_time(now_ += 61 * kSecond);
+  EXPECT_EQ(s.state(), sv::State::Failed);
+  EXPECT_NE(s.summary().end_reason.find("CANDIDATES"), std::string::npos);
+}
+
+TEST_F(SupervisorTest, SameInputsSameOutputs) {
+  auto run = [&](std::vector<std::string>* trace) {
+    now_ = 50 * kSecond;
+    sv::Supervisor s = make();
+    const Eigen::Vector3d object(0.28, -0.05, 0);
+    start_with(s, {object});
+    s.on_right_still(draw_scene(scene_, {1280, 960}, {object}), now_, now_);
+    const auto nudge = outputs_of<sv::NudgeCommand>(s.take_outputs()).at(0);
+    play_nudge(s, nudge.seq, object, object + 0.03 * nudge.direction);
+    settle_with_axes(s, {object + 0.03 * nudge.direction});
+    s.on_right_still(draw_scene(scene_, {1280, 960}, {object + 0.03 * nudge.direction}), now_, now_);
+    for (const auto& report : outputs_of<sv::StateReport>(s.take_outputs()))
+      trace->push_back(std::string(sv::to_string(report.state)) + ": " + report.reason);
+  };
+  std::vector<std::string> a, b;
+  run(&a);
+  run(&b);
+  EXPECT_EQ(a, b);
+  EXPECT_FALSE(a.empty());
+}
