@@ -35,6 +35,8 @@ class JsonWriter {
   JsonWriter& value(bool v) { separate(); out_ << (v ? "true" : "false"); return *this; }
   JsonWriter& value(const std::string& v) { separate(); write_string(v); return *this; }
   JsonWriter& value(const char* v) { return value(std::string(v)); }
+  // A value that is already JSON (e.g. another writer's str()).
+  JsonWriter& raw(const std::string& json) { separate(); out_ << json; return *this; }
   template <typename T>
   JsonWriter& field(const std::string& k, const T& v) { key(k); return value(v); }
 

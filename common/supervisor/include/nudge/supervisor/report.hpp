@@ -1,0 +1,29 @@
+#pragma once
+// What a run leaves on disk: per attempt the stills, the segmentation (mask, cut-out, fig. 6.7's
+// stages) and the fig. 6.6 picture of the planned push; per run a JSON summary. Every file is
+// written atomically (temporary file + rename): a crash leaves no half-written file.
+#include <opencv2/core.hpp>
+
+#include <string>
+
+#include "nudge/supervisor/supervisor.hpp"
+
+namespace nudge::supervisor {
+
+// Fig. 6.6: the table from above (1 px per mm, the arm base at the centre of the ring): the
+// workspace ring white, the right camera red, every candidate of the survey as a blue circle with
+// its centroid, those passed over crossed, the target ringed and the planned push a green arrow
+// from P1 to P2.
+cv::Mat draw_workspace(const Attempt& attempt, const ArmSetup& arm, const Eigen::Vector3d& right_camera);
+
+// Writes `directory`/attempt_NN/{before,after,mask,cutout,workspace}.png, stages/ and attempt.json.
+// Returns the attempt's folder. Throws std::runtime_error naming a file that cannot be written.
+std::string save_attempt(const std::string& directory, const Attempt& attempt, const ArmSetup& arm,
+                         const Eigen::Vector3d& right_camera);
+
+// One attempt as a JSON object (outcome, reason, target, rest, motion, lines, mask pixels, times).
+std::string attempt_json(const Attempt& attempt);
+// The run's summary: run id, counts, outcomes, the attempts, the end reason.
+std::string summary_json(const std::string& run_id, const Summary& summary, const std::vector<std::string>& attempts_json);
+
+}  // namespace nudge::supervisor

@@ -1,0 +1,141 @@
+#include "nudge/supervisor/report.hpp"
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <cstdio>
+#include <filesystem>
+#include <stdexcept>
+
+#include "nudge/atomic_file.hpp"
+#include "nudge/json.hpp"
+
+namespace nudge::supervisor {
+
+namespace {
+
+constexpr int kHalfSize = 420;  // mm shown either side of the arm base
+
+cv::Point top_view(const Eigen::Vector3d& world) {
+  // World +x towards the camera is drawn downwards, +y to the right: as the right camera sees it.
+  return {kHalfSize + static_cast<int>(std::lround(1e3 * world.y())), kHalfSize + static_cast<int>(std::lround(1e3 * world.x()))};
+}
+
+void write_png(const std::string& path, const cv::Mat& image) {
+  if (image.empty()) return;
+  std::vector<uchar> bytes;
+  if (!cv::imencode(".png", image, bytes)) throw std::runtime_error(path + ": cannot encode the image");
+  write_file_atomically(path, std::string(bytes.begin(), bytes.end()));
+}
+
+void write_line(JsonWriter& j, const std::string& key, const std::optional<symmetry::Line>& line) {
+  j.key(key);
+  if (!line) {
+    j.raw("null");
+    return;
+  }
+  j.begin_object().field("r", line->r).field("theta", line->theta).field("votes", line->votes).end_object();
+}
+
+void write_point(JsonWriter& j, const std::string& key, const Eigen::Vector3d& p) {
+  j.key(key).begin_array().value(p.x()).value(p.y()).value(p.z()).end_array();
+}
+
+}  // namespace
+
+cv::Mat draw_workspace(const Attempt& attempt, const ArmSetup& arm, const Eigen::Vector3d& right_camera) {
+  cv::Mat picture(2 * kHalfSize, 2 * kHalfSize, CV_8UC3, cv::Scalar(90, 90, 90));
+  const cv::Point base = top_view(Eigen::Vector3d::Zero());
+  cv::circle(picture, base, static_cast<int>(1e3 * arm.safety.ring_outer), cv::Scalar(255, 255, 255), cv::FILLED, cv::LINE_AA);
+  cv::circle(picture, base, static_cast<int>(1e3 * arm.safety.ring_inner), cv::Scalar(90, 90, 90), cv::FILLED, cv::LINE_AA);
+  cv::circle(picture, base, 6, cv::Scalar(0, 0, 0), cv::FILLED);
+  // The camera: beyond the picture's edge it is drawn on the edge, in its direction.
+  Eigen::Vector3d camera = right_camera;
+  const double reach = 1e-3 * (kHalfSize - 12);
+  if (std::abs(camera.x()) > reach || std::abs(camera.y()) > reach)
+    camera *= reach / std::max(std::abs(camera.x()), std::abs(camera.y()));
+  const cv::Point c = top_view(camera);
+  cv::rectangle(picture, c - cv::Point(10, 6), c + cv::Point(10, 6), cv::Scalar(0, 0, 255), cv::FILLED);
+  for (const Candidate& candidate : attempt.candidates) {
+    const cv::Point p = top_view(candidate.position);
+    cv::circle(picture, p, 20, cv::Scalar(255, 0, 0), 2, cv::LINE_AA);
+    cv::circle(picture, p, 3, cv::Scalar(255, 0, 0), cv::FILLED);
+  }
+  for (const Rejection& r : attempt.rejected) {
+    const cv::Point p = top_view(r.position);
+    cv::line(picture, p - cv::Point(14, 14), p + cv::Point(14, 14), cv::Scalar(0, 0, 200), 2, cv::LINE_AA);
+    cv::line(picture, p - cv::Point(14, -14), p + cv::Point(14, -14), cv::Scalar(0, 0, 200), 2, cv::LINE_AA);
+  }
+  cv::circle(picture, top_view(attempt.target.position), 26, cv::Scalar(255, 0, 0), 3, cv::LINE_AA);
+  const Eigen::Vector3d p1 = attempt.target.position - arm.nudge.start_distance * attempt.direction;
+  const Eigen::Vector3d p2 = attempt.target.position - arm.nudge.stop_distance * attempt.direction;
+  cv::arrowedLine(picture, top_view(p1), top_view(p2), cv::Scalar(0, 170, 0), 4, cv::LINE_AA, 0, 0.3);
+  if (attempt.rest) cv::drawMarker(picture, top_view(*attempt.rest), cv::Scalar(0, 140, 255), cv::MARKER_CROSS, 16, 2);
+  char text[96];
+  std::snprintf(text, sizeof text, "attempt %d: %s", attempt.number, to_string(attempt.outcome));
+  cv::putText(picture, text, {10, 24}, cv::FONT_HERSHEY_SIMPLEX, 0.6, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+  return picture;
+}
+
+std::string attempt_json(const Attempt& a) {
+  JsonWriter j(9);
+  j.begin_object();
+  j.field("attempt", a.number).field("outcome", to_string(a.outcome)).field("reason", a.reason);
+  j.field("candidate_index", a.target.index).field("candidate_support", a.target.support);
+  write_point(j, "target", a.target.position);
+  write_point(j, "direction", a.direction);
+  j.key("rest");
+  if (a.rest) {
+    j.begin_array().value(a.rest->x()).value(a.rest->y()).value(a.rest->z()).end_array();
+  } else {
+    j.raw("null");
+  }
+  j.field("motion_frames", a.motion_frames).field("motion_blocks", a.motion_blocks);
+  write_line(j, "line_before", a.before_line);
+  write_line(j, "line_after", a.after_line);
+  j.field("mask_pixels", a.segmentation.mask.empty() ? 0 : cv::countNonZero(a.segmentation.mask));
+  j.field("started_s", a.started / 1e6).field("ended_s", a.ended / 1e6);
+  j.key("rejected").begin_array();
+  for (const Rejection& r : a.rejected) j.begin_object().field("candidate_index", r.index).field("reason", r.reason).end_object();
+  j.end_array();
+  j.end_object();
+  return j.str();
+}
+
+std::string save_attempt(const std::string& directory, const Attempt& attempt, const ArmSetup& arm,
+                         const Eigen::Vector3d& right_camera) {
+  char name[32];
+  std::snprintf(name, sizeof name, "attempt_%02d", attempt.number);
+  const std::filesystem::path folder = std::filesystem::path(directory) / name;
+  std::error_code error;
+  std::filesystem::create_directories(folder / "stages", error);
+  if (error) throw std::runtime_error(folder.string() + ": cannot create the folder (" + error.message() + ")");
+  write_png((folder / "before.png").string(), attempt.before);
+  write_png((folder / "after.png").string(), attempt.after);
+  write_png((folder / "mask.png").string(), attempt.segmentation.mask);
+  write_png((folder / "cutout.png").string(), attempt.segmentation.cutout);
+  write_png((folder / "workspace.png").string(), draw_workspace(attempt, arm, right_camera));
+  for (const auto& [stage, image] : attempt.segmentation.stages) write_png((folder / "stages" / (stage + ".png")).string(), image);
+  write_file_atomically((folder / "attempt.json").string(), attempt_json(attempt) + "\n");
+  return folder.string();
+}
+
+std::string summary_json(const std::string& run_id, const Summary& s, const std::vector<std::string>& attempts) {
+  JsonWriter j(9);
+  j.begin_object();
+  j.field("run_id", run_id).field("surveys", s.surveys).field("attempts", s.attempts).field("segmented", s.segmented);
+  j.field("end_reason", s.end_reason);
+  j.key("outcomes").begin_object();
+  for (const auto& [outcome, count] : s.outcomes) j.field(outcome, count);
+  j.end_object();
+  j.key("last_survey_rejections").begin_object();
+  for (const auto& [reason, count] : s.rejections) j.field(reason, count);
+  j.end_object();
+  j.key("attempt_list").begin_array();
+  for (const std::string& a : attempts) j.raw(a);
+  j.end_array();
+  j.end_object();
+  return j.str();
+}
+
+}  // namespace nudge::supervisor

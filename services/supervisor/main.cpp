@@ -1,0 +1,413 @@
+// supervisor: the autonomous segmentation loop (thesis ch. 6, fig. 6.2). A thin shell around
+// nudge::supervisor::Supervisor: it turns messages into the state machine's inputs, its outputs
+// into messages and files, keeps the task clock, watches every required service's heartbeat, and
+// writes the whole run to an LCM log named by the run id with a JSON summary beside it.
+// docs/supervisor.md has the protocol (channels in and out, and why).
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "nudge/arm_command_t.hpp"
+#include "nudge/arm_state_t.hpp"
+#include "nudge/atomic_file.hpp"
+#include "nudge/axes_t.hpp"
+#include "nudge/bus/image.hpp"
+#include "nudge/bus/service.hpp"
+#include "nudge/bus/symmetry_convert.hpp"
+#include "nudge/candidates_request_t.hpp"
+#include "nudge/candidates_t.hpp"
+#include "nudge/heartbeat_t.hpp"
+#include "nudge/image_t.hpp"
+#include "nudge/log.hpp"
+#include "nudge/segmentation_t.hpp"
+#include "nudge/sim_state_t.hpp"
+#include "nudge/snapshot_request_t.hpp"
+#include "nudge/supervisor/report.hpp"
+#include "nudge/supervisor/segment.hpp"
+#include "nudge/supervisor/supervisor.hpp"
+#include "nudge/supervisor_state_t.hpp"
+#include "nudge/timing.hpp"
+
+using namespace nudge;
+namespace sv = nudge::supervisor;
+
+namespace {
+
+struct Options {
+  std::string calibration, run_id, out_dir = "out/runs", clock = "sim", require;
+  double service_timeout_s = 3.0;
+  double base_yaw_deg = 0;
+  int first_seq = 0;
+  bool keep_running = false;
+  sv::Config config;
+  sv::ArmSetup arm;
+};
+
+std::string default_run_id() {
+  const std::time_t t = std::time(nullptr);
+  char text[32];
+  std::strftime(text, sizeof text, "run-%Y%m%d-%H%M%S", std::gmtime(&t));
+  return text;
+}
+
+std::set<std::string> split(const std::string& list) {
+  std::set<std::string> items;
+  std::stringstream in(list);
+  for (std::string item; std::getline(in, item, ',');)
+    if (!item.empty()) items.insert(item);
+  return items;
+}
+
+sv::ArmStatus::Motion motion_of(int8_t motion) {
+  switch (motion) {
+    case arm_state_t::MOTION_MOVING: return sv::ArmStatus::Motion::Moving;
+    case arm_state_t::MOTION_DONE: return sv::ArmStatus::Motion::Done;
+    case arm_state_t::MOTION_REFUSED: return sv::ArmStatus::Motion::Refused;
+    case arm_state_t::MOTION_STOPPED: return sv::ArmStatus::Motion::Stopped;
+    default: return sv::ArmStatus::Motion::Idle;
+  }
+}
+
+void copy3(const Eigen::Vector3d& v, double* out) {
+  for (int i = 0; i < 3; ++i) out[i] = v[i];
+}
+
+// The run's LCM log: every event the supervisor receives, in the order it handles them (so that a
+// replay re-derives the same states), under a temporary name until the run ends.
+class RunLog {
+ public:
+  explicit RunLog(const std::string& path)
+      : path_(path), partial_(path + ".partial"), file_(std::make_unique<lcm::LogFile>(partial_, "w")) {
+    if (!file_->good()) throw std::runtime_error(partial_ + ": cannot open the run's log for writing");
+  }
+  void write(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+    lcm::LogEvent event;
+    event.eventnum = 0;
+    event.timestamp = rbuf->recv_utime;
+    event.channel = channel;
+    event.datalen = static_cast<int32_t>(rbuf->data_size);
+    event.data = rbuf->data;
+    if (file_) file_->writeEvent(&event);
+  }
+  void close() {
+    if (!file_) return;
+    file_.reset();  // flushes and closes
+    std::filesystem::rename(partial_, path_);
+  }
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_, partial_;
+  std::unique_ptr<lcm::LogFile> file_;
+};
+
+class Shell {
+ public:
+  Shell(bus::Service& service, Options& opt)
+      : service_(service), opt_(opt), scene_(sv::SceneGeometry::load(opt.calibration)),
+        supervisor_(opt.config, scene_, opt.arm, sv::motion_segmentation()),
+        required_(split(opt.require)), run_dir_(opt.out_dir + "/" + opt.run_id) {
+    std::error_code error;
+    std::filesystem::create_directories(run_dir_, error);
+    if (error) throw std::runtime_error(run_dir_ + ": cannot create the run's folder (" + error.message() + ")");
+    log_ = std::make_unique<RunLog>(run_dir_ + "/" + opt.run_id + ".lcmlog");
+    log::info() << "run " << opt.run_id << ": files in " << run_dir_ << "; waiting for " << opt.require;
+  }
+
+  void subscribe() {
+    auto& in = service_.input();
+    in.subscribe(".*", &Shell::record, this);
+    auto& subs = service_.subscriptions();
+    subs.subscribe<heartbeat_t>("HEARTBEAT", [this](const heartbeat_t& m, const std::string&) { on_heartbeat(m); });
+    subs.subscribe<sim_state_t>("SIM_STATE", [this](const sim_state_t& m, const std::string&) { on_sim_state(m); });
+    subs.subscribe<candidates_t>("CANDIDATES", [this](const candidates_t& m, const std::string&) { on_candidates(m); });
+    subs.subscribe<arm_state_t>("ARM_STATE", [this](const arm_state_t& m, const std::string&) { on_arm_state(m); });
+    subs.subscribe<axes_t>("AXES", [this](const axes_t& m, const std::string&) { on_axes(m); });
+    subs.subscribe<image_t>("CAMERA_RIGHT", [this](const image_t& m, const std::string&) { on_frame(m); });
+    subs.subscribe<image_t>("SNAPSHOT_RIGHT", [this](const image_t& m, const std::string&) { on_still(m); });
+  }
+
+  // Wall-clock duties: the task clock (--clock wall), the 1 Hz state, the heartbeat watchdog live.
+  int tick() {
+    const int64_t wall = wall_utime();
+    if (opt_.clock == "wall") advance(wall);
+    if (!service_.input_is_log()) check_services(wall);
+    if (wall >= next_state_publish_ && started_) {
+      publish_state(supervisor_.report());
+      next_state_publish_ = wall + 1000000;
+    }
+    return 20;
+  }
+
+  bool refused() const { return refused_; }
+
+  void finish_interrupted() {
+    if (!finished_) {
+      log::info() << "interrupted in " << sv::to_string(supervisor_.state());
+      write_summary("interrupted in " + std::string(sv::to_string(supervisor_.state())));
+    }
+    log_->close();
+  }
+
+ private:
+  // ---- inputs ----
+  void record(const lcm::ReceiveBuffer* rbuf, const std::string& channel) { log_->write(rbuf, channel); }
+
+  void on_heartbeat(const heartbeat_t& m) {
+    if (m.service == "supervisor" && m.pid != getpid() && !service_.input_is_log() && !started_ && !refused_) {
+      // Two loops commanding one arm would fight: the second one to start gives way.
+      refused_ = true;
+      log::error() << "another supervisor (pid " << m.pid << ") runs on this bus: refusing to start";
+      service_.request_stop();
+      return;
+    }
+    last_beat_[m.service] = m.utime;
+    newest_beat_ = std::max(newest_beat_, m.utime);
+    if (service_.input_is_log()) check_services(newest_beat_);  // replay: the senders' clocks are the time
+  }
+
+  void on_sim_state(const sim_state_t& m) {
+    if (opt_.clock == "sim") advance(m.utime);
+  }
+
+  void on_candidates(const candidates_t& m) {
+    std::vector<sv::Candidate> candidates;
+    for (int i = 0; i < m.num_candidates; ++i) {
+      const Eigen::Vector3d p(m.position[i][0], m.position[i][1], m.position[i][2]);
+      if (!p.allFinite()) throw std::runtime_error("candidate " + std::to_string(i) + " has a non-finite position");
+      candidates.push_back({i, scene_.table_to_world(p), m.cluster_size[i]});
+    }
+    supervisor_.on_candidates(candidates, m.utime, now_);
+    drain();
+  }
+
+  void on_arm_state(const arm_state_t& m) {
+    sv::ArmStatus status;
+    status.motion = motion_of(m.motion);
+    status.command_seq = m.command_seq;
+    status.last_error = m.last_error;
+    for (int i = 0; i < 6; ++i) status.joints[i] = m.joints[i];
+    supervisor_.on_arm_state(status, now_);
+    drain();
+  }
+
+  void on_axes(const axes_t& m) {
+    if (supervisor_.state() != sv::State::Track) return;
+    std::vector<sv::Axis> axes;
+    for (const axis3d_t& a : m.axes) {
+      const Eigen::Vector3d foot(a.table_point[0], a.table_point[1], a.table_point[2]);
+      if (foot.allFinite() && std::isfinite(a.angle_to_normal)) axes.push_back({scene_.table_to_world(foot), a.angle_to_normal});
+    }
+    supervisor_.on_axes(axes, now_);
+    drain();
+  }
+
+  void on_frame(const image_t& m) {
+    if (supervisor_.state() != sv::State::Nudge) return;  // decoding costs: only while watching
+    supervisor_.on_right_frame(bus::to_mat(m), now_);
+    drain();
+  }
+
+  void on_still(const image_t& m) {
+    supervisor_.on_right_still(bus::to_mat(m), m.utime, now_);
+    drain();
+  }
+
+  // ---- time and health ----
+  void advance(int64_t now) {
+    now_ = std::max(now_, now);
+    if (!started_) {
+      started_ = true;
+      const int64_t first_seq = opt_.first_seq > 0 ? opt_.first_seq : 1000 * (wall_utime() / 1000000 % 1000000) + 1;
+      log::info() << "first ARM_COMMAND seq " << first_seq;
+      silent_ = required_;
+      supervisor_.on_services(silent_, now_);
+      supervisor_.start(now_, first_seq);
+    }
+    supervisor_.on_time(now_);
+    drain();
+  }
+
+  void check_services(int64_t reference) {
+    if (!started_) return;
+    std::set<std::string> silent;
+    for (const std::string& name : required_) {
+      const auto it = last_beat_.find(name);
+      if (it == last_beat_.end() || static_cast<double>(reference - it->second) > opt_.service_timeout_s * 1e6) silent.insert(name);
+    }
+    if (silent == silent_) return;
+    silent_ = silent;
+    supervisor_.on_services(silent_, now_);
+    drain();
+  }
+
+  // ---- outputs ----
+  void drain() {
+    for (sv::Output& output : supervisor_.take_outputs()) std::visit([this](auto& o) { handle(o); }, output);
+  }
+
+  void handle(const sv::CandidatesRequest& r) {
+    candidates_request_t m{};
+    m.utime = now_;
+    m.frames = r.frames;
+    m.lines_per_image = r.lines;
+    service_.publish("CANDIDATES_REQUEST", m);
+  }
+  void handle(const sv::SnapshotRequest&) {
+    snapshot_request_t m{};
+    m.utime = now_;
+    m.cameras = snapshot_request_t::CAMERAS_RIGHT;
+    service_.publish("CAMERA_SNAPSHOT_REQUEST", m);
+  }
+  void handle(const sv::NudgeCommand& c) {
+    arm_command_t m{};
+    m.utime = now_;
+    m.seq = c.seq;
+    m.command = arm_command_t::COMMAND_NUDGE;
+    copy3(c.target, m.target.position);
+    m.target.orientation[0] = 1;
+    copy3(c.direction, m.direction);
+    m.approach_height = opt_.arm.nudge.approach_height;
+    m.height = opt_.arm.nudge.push_height;
+    m.start_distance = opt_.arm.nudge.start_distance;
+    m.stop_distance = opt_.arm.nudge.stop_distance;
+    service_.publish("ARM_COMMAND", m);
+  }
+  void handle(const sv::StopCommand& c) {
+    arm_command_t m{};
+    m.utime = now_;
+    m.seq = c.seq;
+    m.command = arm_command_t::COMMAND_STOP;
+    m.target.orientation[0] = 1;
+    service_.publish("ARM_COMMAND", m);
+    log::warn() << "arm stopped: " << c.reason;
+  }
+  void handle(const sv::StateReport& r) {
+    publish_state(r);
+    log::info() << "[attempt " << r.attempt << "] " << sv::to_string(r.state) << ": " << r.reason;
+    service_.set_status(std::string(sv::to_string(r.state)) + ": " + r.reason);
+  }
+  void handle(const sv::AttemptEnded& e) {
+    const sv::Attempt& a = *e.attempt;
+    const std::string folder = sv::save_attempt(run_dir_, a, opt_.arm, scene_.right_camera_in_world());
+    attempts_json_.push_back(sv::attempt_json(a));
+    log::info() << "attempt " << a.number << ": " << sv::to_string(a.outcome) << " (" << a.reason << "), files in " << folder;
+    if (a.outcome == sv::Outcome::Segmented) publish_segmentation(a);
+  }
+  void handle(const sv::Finished& f) {
+    finished_ = true;
+    write_summary(f.summary.end_reason);
+    log::info() << "run " << opt_.run_id << " ended: " << f.summary.segmented << " objects segmented in "
+                << f.summary.attempts << " attempts; " << f.summary.end_reason;
+    if (!opt_.keep_running) service_.request_stop();
+  }
+
+  void publish_state(const sv::StateReport& r) {
+    supervisor_state_t m{};
+    m.utime = now_;
+    m.run_id = opt_.run_id;
+    m.state = static_cast<int8_t>(r.state);
+    m.state_name = sv::to_string(r.state);
+    m.attempt = r.attempt;
+    m.candidate_index = r.candidate_index;
+    m.num_candidates = r.num_candidates;
+    copy3(r.target, m.target);
+    m.reason = r.reason;
+    m.segmented = r.segmented;
+    m.failed_attempts = r.failed_attempts;
+    m.rejected = r.rejected;
+    service_.publish("SUPERVISOR_STATE", m);
+  }
+
+  void publish_segmentation(const sv::Attempt& a) {
+    segmentation_t m{};
+    m.utime = now_;
+    m.run_id = opt_.run_id;
+    m.attempt = a.number;
+    copy3(a.target.position, m.position_before);
+    copy3(*a.rest, m.position_after);
+    m.line_before = bus::to_message(*a.before_line);
+    m.line_after = bus::to_message(*a.after_line);
+    m.mask_pixels = cv::countNonZero(a.segmentation.mask);
+    m.mask = bus::to_message(a.segmentation.mask, image_t::FORMAT_PNG, now_, a.number, "right");
+    service_.publish("SEGMENTATION", m);
+  }
+
+  void write_summary(const std::string& end_reason) {
+    sv::Summary summary = supervisor_.summary();
+    summary.end_reason = end_reason;
+    write_file_atomically(run_dir_ + "/summary.json", sv::summary_json(opt_.run_id, summary, attempts_json_) + "\n");
+  }
+
+  bus::Service& service_;
+  Options& opt_;
+  sv::SceneGeometry scene_;
+  sv::Supervisor supervisor_;
+  std::set<std::string> required_, silent_;
+  std::string run_dir_;
+  std::unique_ptr<RunLog> log_;
+  std::map<std::string, int64_t> last_beat_;
+  int64_t newest_beat_ = 0, now_ = 0, next_state_publish_ = 0;
+  bool started_ = false, finished_ = false, refused_ = false;
+  std::vector<std::string> attempts_json_;
+};
+
+void add_flags(Flags& f, Options& o) {
+  f.add_string("calibration", &o.calibration, "calibration file: stereo rig, table_plane, arm_base, arm_to_right_* (required)");
+  f.add_string("run-id", &o.run_id, "names the run's folder, log and summary (default: run-<UTC time>)");
+  f.add_string("out", &o.out_dir, "folder for the runs' folders");
+  f.add_string("clock", &o.clock, "task clock: sim (SIM_STATE utime) or wall");
+  f.add_string("require", &o.require, "services whose heartbeats the loop needs, comma-separated (default: camera,symmetry,triangulation,arm, plus world with --clock sim)");
+  f.add_double("service-timeout", &o.service_timeout_s, "a required service silent this long pauses the run and stops the arm, s");
+  f.add_bool("keep-running", &o.keep_running, "stay up after the run ends (default: exit)");
+  f.add_int("survey-frames", &o.config.survey_frames, "stereo pairs per candidate survey (thesis 25)");
+  f.add_int("survey-lines", &o.config.survey_lines, "lines per image in a survey (thesis 3)");
+  f.add_int("max-attempts", &o.config.max_attempts, "nudges per run");
+  f.add_double("settle", &o.config.settle_s, "after the nudge, wait this long for the object to rest, s");
+  f.add_double("snapshot-timeout", &o.config.snapshot_timeout_s, "for a still, s of the task clock");
+  f.add_double("candidates-timeout", &o.config.candidates_timeout_s, "for a CANDIDATES answer, s of the task clock");
+  f.add_double("nudge-timeout", &o.config.nudge_timeout_s, "for the arm to finish a nudge, s of the task clock");
+  f.add_double("base-height", &o.arm.base_height, "arm shoulder above the table top, m (as nudge-arm's)");
+  f.add_double("base-yaw-deg", &o.base_yaw_deg, "arm base x axis about the world z axis, degrees (as nudge-arm's)");
+  f.add_double("ring-inner", &o.arm.safety.ring_inner, "workspace ring inner radius, m (as nudge-arm's)");
+  f.add_double("ring-outer", &o.arm.safety.ring_outer, "workspace ring outer radius, m (as nudge-arm's)");
+  f.add_double("object-radius", &o.config.targets.object_radius, "largest expected object radius (push clearance), m");
+  f.add_int("first-seq", &o.first_seq, "first ARM_COMMAND seq (default: from the wall clock; set it to replay a run)");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return bus::guarded_main("supervisor", [&] {
+    bus::Service service("supervisor",
+                         "Autonomous segmentation by a robotic nudge (thesis ch. 6): survey, nudge, watch, segment,\n"
+                         "with nobody in the loop. Writes the run's LCM log and summary under --out.");
+    Options opt;
+    add_flags(service.flags(), opt);
+    if (!service.parse(argc, argv)) return 0;
+    if (opt.calibration.empty()) throw FlagError("--calibration FILE is required");
+    if (opt.clock != "sim" && opt.clock != "wall") throw FlagError("--clock must be sim or wall, not '" + opt.clock + "'");
+    if (opt.run_id.empty()) opt.run_id = default_run_id();
+    if (opt.run_id.find('/') != std::string::npos) throw FlagError("--run-id must not contain '/'");
+    if (opt.require.empty()) opt.require = std::string("camera,symmetry,triangulation,arm") + (opt.clock == "sim" ? ",world" : "");
+    if (!(opt.service_timeout_s > 0)) throw FlagError("--service-timeout must be > 0");
+    opt.arm.base_yaw = opt.base_yaw_deg * M_PI / 180;
+    Shell shell(service, opt);  // loads the calibration: a bad file ends here, naming the field
+    service.start();
+    shell.subscribe();
+    const int code = service.run([&] { return shell.tick(); });
+    shell.finish_interrupted();
+    return shell.refused() ? 1 : code;
+  });
+}
