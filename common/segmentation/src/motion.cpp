@@ -141,18 +141,30 @@ int fill_row(const uint8_t* strength, const uint8_t* spread, int centre, int thr
   return half_width;
 }
 
-// Opening along the line: a row keeps the widest half-width shared by some run of `run` rows
-// through it (-1 = empty row).
-std::vector<int> open_rows(const std::vector<int>& half_width, int run) {
-  const int rows = static_cast<int>(half_width.size());
+// Morphology along the line on the rows' half-widths (-1 = empty row, also beyond the ends),
+// windows of `run` rows. min_then_max = true is an opening (a row keeps the widest half-width
+// shared by some run of `run` rows through it), false a closing (gaps shorter than `run` - 1 rows
+// take their neighbours' width).
+std::vector<int> morph_rows(const std::vector<int>& half_width, int run, bool min_then_max) {
   if (run <= 1) return half_width;
-  std::vector<int> eroded(rows, -1), opened(rows, -1);
-  for (int y = 0; y + run <= rows; ++y)
-    eroded[y] = *std::min_element(half_width.begin() + y, half_width.begin() + y + run);
-  for (int y = 0; y < rows; ++y)
-    for (int start = std::max(0, y - run + 1); start <= std::min(y, rows - run); ++start)
-      opened[y] = std::max(opened[y], eroded[start]);
-  return opened;
+  std::vector<int> padded(half_width.size() + 2 * run, -1);
+  std::copy(half_width.begin(), half_width.end(), padded.begin() + run);
+  const int rows = static_cast<int>(padded.size());
+  const auto first = [&](int a, int b) { return min_then_max ? std::min(a, b) : std::max(a, b); };
+  const auto second = [&](int a, int b) { return min_then_max ? std::max(a, b) : std::min(a, b); };
+  std::vector<int> windowed(rows - run + 1);
+  for (int y = 0; y + run <= rows; ++y) {
+    int value = padded[y];
+    for (int j = y + 1; j < y + run; ++j) value = first(value, padded[j]);
+    windowed[y] = value;
+  }
+  std::vector<int> out(half_width.size());
+  for (int y = run; y < rows - run; ++y) {  // every window through an image row lies in `padded`
+    int value = windowed[y - run + 1];
+    for (int start = y - run + 2; start <= y; ++start) value = second(value, windowed[start]);
+    out[y - run] = value;
+  }
+  return out;
 }
 
 // Keeps the run of consecutive non-empty rows with the largest area (the object; chance motion
@@ -221,6 +233,7 @@ void validate(const MotionParams& params) {
   if (params.max_half_width < 1 || params.max_half_width > 10000) fail("max_half_width must be in [1, 10000] px");
   if (params.mirror_tolerance < 0 || params.mirror_tolerance > 50) fail("mirror_tolerance must be in [0, 50] px");
   if (params.min_vertical_run < 1 || params.min_vertical_run > 1000) fail("min_vertical_run must be in [1, 1000] rows");
+  if (params.max_row_gap < 0 || params.max_row_gap > 1000) fail("max_row_gap must be in [0, 1000] rows");
   if (params.min_area < 0) fail("min_area must be >= 0");
   if (!(params.max_rotation_deg >= 0 && params.max_rotation_deg < 90)) fail("max_rotation_deg must be in [0, 90)");
 }
@@ -287,7 +300,8 @@ MotionSegmentation MotionSegmenter::segment(const cv::Mat& before, const cv::Mat
   std::vector<int> half_width(blurred_.rows);
   for (int y = 0; y < blurred_.rows; ++y)
     half_width[y] = fill_row(blurred_.ptr<uint8_t>(y), dilated_.ptr<uint8_t>(y), centre, threshold, refined_.ptr<uint8_t>(y));
-  half_width = open_rows(half_width, params_.min_vertical_run);
+  half_width = morph_rows(half_width, params_.min_vertical_run, true);
+  half_width = morph_rows(half_width, params_.max_row_gap + 2, false);
   keep_largest_run(half_width);
 
   // (f) the mask at the after position, and the cut-out.

@@ -13,8 +13,9 @@
 //                    moving pixels mirrored about the merged line gets that pair's (weaker)
 //                    strength. Motion whose mirror did not move (an arm, a hand, another object)
 //                    does not count;
-//   threshold        (e) >= threshold, rows shorter than min_vertical_run dropped, the largest run
-//                    of rows kept: the object's mask in the line frame;
+//   threshold        (e) >= threshold, rows shorter than min_vertical_run dropped, gaps up to
+//                    max_row_gap rows bridged, the largest run of rows kept: the object's mask in
+//                    the line frame;
 //   (f) result       the mask placed at the object's AFTER position, and the after image cut out.
 // The mask is symmetric about the after line by construction: asymmetric parts (a mug's handle)
 // are left out (docs/segmentation_geometry.md).
@@ -41,6 +42,10 @@ struct MotionParams {
   // Rows of the mask must be part of a vertical run at least this long (opening along the line):
   // rows lengthened by a chance pair of noisy pixels far out are cut back. 1 = off.
   int min_vertical_run = 5;
+  // Gaps along the line up to this many rows are bridged (closing along the line): rows where the
+  // object's outline does not contrast with the background (a stripe the background's colour)
+  // take their neighbours' width. 0 = off.
+  int max_row_gap = 15;
   // Fewer mask pixels than this: no object found (no motion, or too little of it).
   int min_area = 100;
   // The lines' orientations may differ by at most this much (the object turned in the image).
