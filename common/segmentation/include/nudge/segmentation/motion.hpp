@@ -1,0 +1,115 @@
+#pragma once
+// Object segmentation by motion (Li 2008, sec. 6.4, fig. 6.7).
+//
+// Inputs: one camera's images before and after a nudge and the object's symmetry line in each
+// ((R, theta) about the image centre, symmetry/detector.hpp). Steps:
+//   (c) difference   |after - before| (largest change over the colour channels), minus its median
+//                    (the noise floor: sensor noise, lighting flicker);
+//   (d) compressed   the difference in the frame of the lines, where they are vertical: the half
+//                    on the leading side of the motion is taken beyond the AFTER line, the half on
+//                    the trailing side beyond the BEFORE line, and the pixels between the lines are
+//                    dropped, so the two lines merge into one (column max_half_width);
+//   (e) refined      symmetric filling: in each row, every pixel out to the outermost pair of
+//                    moving pixels mirrored about the merged line gets that pair's (weaker)
+//                    strength. Motion whose mirror did not move (an arm, a hand, another object)
+//                    does not count;
+//   threshold        (e) >= threshold, rows shorter than min_vertical_run dropped, gaps up to
+//                    max_row_gap rows bridged, the largest run of rows kept: the object's mask in
+//                    the line frame;
+//   (f) result       the mask placed at the object's AFTER position, and the after image cut out.
+// The mask is symmetric about the after line by construction: asymmetric parts (a mug's handle)
+// are left out (docs/segmentation_geometry.md).
+#include <opencv2/core.hpp>
+
+#include <string>
+
+#include "nudge/symmetry/detector.hpp"
+
+namespace nudge::segmentation {
+
+struct MotionParams {
+  // Grey levels (0-255) above the noise floor a mirrored pair of pixels must both exceed to count
+  // as the object's motion. The object's contrast against its background has to exceed it.
+  double threshold = 15;
+  // Subtract the difference image's median (the change most pixels show: noise, flicker) first.
+  bool subtract_noise_floor = true;
+  // Gaussian blur of the compressed difference, px; 0 = none. Removes single-pixel noise.
+  double blur_sigma = 1.0;
+  // Widest object half-width considered, px: the compressed image is 2 * max_half_width + 1 wide.
+  int max_half_width = 300;
+  // A moving pixel pairs with motion within this many px of its mirror image (the lines' error).
+  int mirror_tolerance = 1;
+  // Rows of the mask must be part of a vertical run at least this long (opening along the line):
+  // rows lengthened by a chance pair of noisy pixels far out are cut back. 1 = off.
+  int min_vertical_run = 5;
+  // Gaps along the line up to this many rows are bridged (closing along the line): rows where the
+  // object's outline does not contrast with the background (a stripe the background's colour)
+  // take their neighbours' width. 0 = off.
+  int max_row_gap = 15;
+  // Fewer mask pixels than this: no object found (no motion, or too little of it).
+  int min_area = 100;
+  // The lines' orientations may differ by at most this much (the object turned in the image).
+  double max_rotation_deg = 20;
+};
+
+// Throws std::invalid_argument naming the offending parameter.
+void validate(const MotionParams& params);
+
+// Fig. 6.7's images, filled on request. The line-frame images are rotated so that the merged line
+// is vertical (column max_half_width); row 0 is `first_row` px along the line from its point
+// nearest the image centre.
+struct MotionStages {
+  cv::Mat before, after;     // (a), (b) the inputs
+  cv::Mat difference;        // (c) CV_8U, image frame, noise floor not yet subtracted
+  cv::Mat compressed;        // (d) CV_8U, line frame, noise floor subtracted, blurred
+  cv::Mat refined;           // (e) CV_8U, line frame, symmetric filling
+  cv::Mat line_frame_mask;   // (e) thresholded, cleaned: CV_8U, 255 = object
+  cv::Mat mask;              // CV_8U, after image frame, 255 = object
+  cv::Mat cutout;            // (f) the after image where mask, 0 elsewhere
+  symmetry::Line line_before, line_after;
+  int first_row = 0;
+  int noise_floor = 0;       // grey levels subtracted
+
+  // Writes the stages as PNGs into `directory` (created if missing): a_before.png, b_after.png,
+  // c_difference.png (with the lines: before green, after red), d_compressed.png, e_refined.png,
+  // e_mask_line_frame.png, f_segmentation.png, mask.png. Throws std::runtime_error naming the file
+  // that could not be written; std::logic_error if the stages are empty.
+  void save(const std::string& directory) const;
+};
+
+struct MotionSegmentation {
+  bool found = false;   // a mask of at least min_area pixels
+  std::string reason;   // why not, when !found
+  cv::Mat mask;         // CV_8U, the after image's size, 255 = object (all 0 when !found)
+  cv::Mat cutout;       // the after image where mask, 0 elsewhere
+  int area = 0;         // mask pixels
+  cv::Rect bounding_box;
+  // The after line's offset from the before line along its normal at its point nearest the image
+  // centre, px (the motion), and the change of orientation, radians.
+  double shift = 0;
+  double rotation = 0;
+};
+
+// Keeps its scratch images between calls (a 1280x960 pair allocates nothing after the first):
+// one instance per thread.
+class MotionSegmenter {
+ public:
+  explicit MotionSegmenter(MotionParams params = {});  // validates
+  const MotionParams& params() const { return params_; }
+
+  // `before`, `after`: the same size and type, 8-bit, 1 or 3 channels. The lines must cross the
+  // image. Throws std::invalid_argument naming the bad input. `stages`, if given, gets fig. 6.7.
+  MotionSegmentation segment(const cv::Mat& before, const cv::Mat& after, const symmetry::Line& line_before,
+                             const symmetry::Line& line_after, MotionStages* stages = nullptr);
+
+ private:
+  MotionParams params_;
+  cv::Mat difference_, colour_difference_, compressed_, blurred_, dilated_, refined_;
+};
+
+// One-shot convenience around MotionSegmenter.
+MotionSegmentation segment_by_motion(const cv::Mat& before, const cv::Mat& after, const symmetry::Line& line_before,
+                                     const symmetry::Line& line_after, const MotionParams& params = {},
+                                     MotionStages* stages = nullptr);
+
+}  // namespace nudge::segmentation

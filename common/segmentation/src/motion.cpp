@@ -1,0 +1,401 @@
+// Object segmentation by motion (Li 2008, sec. 6.4): see motion.hpp for the steps.
+#include "nudge/segmentation/motion.hpp"
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <sstream>
+#include <stdexcept>
+#include <vector>
+
+#include "line_frame.hpp"
+
+namespace nudge::segmentation {
+namespace {
+
+using detail::LineFrame;
+
+std::string describe(const symmetry::Line& line) {
+  std::ostringstream out;
+  out << "(R = " << line.r << " px, theta = " << line.theta * 180.0 / M_PI << " deg)";
+  return out.str();
+}
+
+void check_image(const cv::Mat& image, const char* name) {
+  if (image.empty()) throw std::invalid_argument(std::string("motion segmentation: the ") + name + " image is empty");
+  if (image.depth() != CV_8U || (image.channels() != 1 && image.channels() != 3))
+    throw std::invalid_argument(std::string("motion segmentation: the ") + name +
+                                " image must be 8-bit with 1 or 3 channels (got type " + cv::typeToString(image.type()) +
+                                ")");
+}
+
+// The line must meet the image: its distance from the centre at most the farthest corner's
+// projection onto its normal.
+void check_line(const symmetry::Line& line, const char* name, cv::Size size) {
+  if (!std::isfinite(line.r) || !std::isfinite(line.theta))
+    throw std::invalid_argument(std::string("motion segmentation: ") + name + " is not finite " + describe(line));
+  const double reach = 0.5 * (std::abs(std::cos(line.theta)) * (size.width - 1) +
+                              std::abs(std::sin(line.theta)) * (size.height - 1));
+  if (std::abs(line.r) > reach) {
+    std::ostringstream out;
+    out << "motion segmentation: " << name << ' ' << describe(line) << " does not cross the " << size.width << 'x'
+        << size.height << " image";
+    throw std::invalid_argument(out.str());
+  }
+}
+
+void check_inputs(const cv::Mat& before, const cv::Mat& after, const symmetry::Line& line_before,
+                  const symmetry::Line& line_after) {
+  check_image(before, "before");
+  check_image(after, "after");
+  if (before.size() != after.size()) {
+    std::ostringstream out;
+    out << "motion segmentation: the before image is " << before.cols << 'x' << before.rows << ", the after image "
+        << after.cols << 'x' << after.rows;
+    throw std::invalid_argument(out.str());
+  }
+  if (before.type() != after.type())
+    throw std::invalid_argument("motion segmentation: the before image is " + cv::typeToString(before.type()) +
+                                ", the after image " + cv::typeToString(after.type()));
+  check_line(line_before, "line_before", before.size());
+  check_line(line_after, "line_after", after.size());
+}
+
+// The same line with its normal on the side of `reference`'s normal (theta and theta + 180 deg
+// describe one line with opposite normals), so that offsets along both normals compare.
+symmetry::Line facing(const symmetry::Line& line, const symmetry::Line& reference) {
+  symmetry::Line out = line;
+  if (std::cos(line.theta - reference.theta) < 0) {
+    out.r = -line.r;
+    out.theta = line.theta + (line.theta < reference.theta ? M_PI : -M_PI);
+  }
+  return out;
+}
+
+// |after - before|, the largest change over the channels (a change of hue counts too).
+void channel_max_difference(const cv::Mat& before, const cv::Mat& after, cv::Mat& colour_scratch, cv::Mat& out) {
+  if (before.channels() == 1) {
+    cv::absdiff(before, after, out);
+    return;
+  }
+  cv::absdiff(before, after, colour_scratch);
+  out.create(before.size(), CV_8U);
+  for (int y = 0; y < out.rows; ++y) {
+    const uint8_t* in = colour_scratch.ptr<uint8_t>(y);
+    uint8_t* row = out.ptr<uint8_t>(y);
+    for (int x = 0; x < out.cols; ++x) row[x] = std::max(in[3 * x], std::max(in[3 * x + 1], in[3 * x + 2]));
+  }
+}
+
+// +-2.5 sigma is plenty for a blur meant against single-pixel noise (OpenCV would take +-3 sigma).
+cv::Size kernel_size(double sigma) {
+  const int half = std::max(1, static_cast<int>(std::ceil(2.5 * sigma)));
+  return {2 * half + 1, 2 * half + 1};
+}
+
+// The part of the image the line-frame image samples: the strips of +-reach px about both lines.
+cv::Rect band_around(const LineFrame& a, const LineFrame& b, double reach, int first_row, int last_row, cv::Size size) {
+  std::vector<cv::Point2f> corners;
+  for (const LineFrame* frame : {&a, &b})
+    for (const double u : {-reach, reach})
+      for (const double v : {first_row - 1.0, last_row + 1.0}) corners.emplace_back(frame->to_image(u, v));
+  return cv::boundingRect(corners) & cv::Rect(cv::Point(0, 0), size);
+}
+
+// The median grey level of an 8-bit image (every other row: plenty for a median).
+int median_level(const cv::Mat& image) {
+  std::array<uint32_t, 256> counts{};
+  uint64_t total = 0;
+  for (int y = 0; y < image.rows; y += 2) {
+    const uint8_t* row = image.ptr<uint8_t>(y);
+    for (int x = 0; x < image.cols; ++x) ++counts[row[x]];
+    total += image.cols;
+  }
+  uint64_t seen = 0;
+  for (int level = 0; level < 256; ++level) {
+    seen += counts[level];
+    if (2 * seen >= total) return level;
+  }
+  return 255;
+}
+
+// Samples `image` in `frame` into columns [x0, x0 + dst.cols) of the line-frame image whose
+// column `centre_column` is the line and whose row 0 lies `first_row` px along it.
+void sample_in_frame(const cv::Mat& image, const LineFrame& frame, int centre_column, int x0, int first_row,
+                     cv::Mat dst) {
+  const double u0 = frame.r + x0 - centre_column;
+  const cv::Matx23d line_to_image(frame.normal.x, frame.direction.x,
+                                  frame.centre.x + u0 * frame.normal.x + first_row * frame.direction.x,
+                                  frame.normal.y, frame.direction.y,
+                                  frame.centre.y + u0 * frame.normal.y + first_row * frame.direction.y);
+  // Nearest neighbour: the blur that follows smooths more than bilinear interpolation would, at
+  // half the cost.
+  cv::warpAffine(image, dst, line_to_image, dst.size(), cv::INTER_NEAREST | cv::WARP_INVERSE_MAP, cv::BORDER_CONSTANT,
+                 cv::Scalar(0));
+}
+
+// Symmetric filling of one row of the compressed difference (`strength`; `spread` the same row
+// dilated by the mirror tolerance). A pair at +-k is as strong as its weaker side; every pixel
+// inside the outermost pair gets the strongest pair at or beyond it. Returns the half-width out to
+// the outermost pair of at least `threshold`, -1 if none.
+int fill_row(const uint8_t* strength, const uint8_t* spread, int centre, int threshold, uint8_t* refined) {
+  int half_width = -1;
+  uint8_t outer = 0;
+  for (int k = centre; k >= 0; --k) {
+    const uint8_t left = strength[centre - k], right = strength[centre + k];
+    const uint8_t left_near = spread[centre - k], right_near = spread[centre + k];
+    const uint8_t pair = std::max(std::min(left, right_near), std::min(left_near, right));
+    if (half_width < 0 && pair >= threshold) half_width = k;
+    outer = std::max(outer, pair);
+    refined[centre - k] = outer;
+    refined[centre + k] = outer;
+  }
+  return half_width;
+}
+
+// Morphology along the line on the rows' half-widths (-1 = empty row, also beyond the ends),
+// windows of `run` rows. min_then_max = true is an opening (a row keeps the widest half-width
+// shared by some run of `run` rows through it), false a closing (gaps shorter than `run` - 1 rows
+// take their neighbours' width).
+std::vector<int> morph_rows(const std::vector<int>& half_width, int run, bool min_then_max) {
+  if (run <= 1) return half_width;
+  std::vector<int> padded(half_width.size() + 2 * run, -1);
+  std::copy(half_width.begin(), half_width.end(), padded.begin() + run);
+  const int rows = static_cast<int>(padded.size());
+  const auto first = [&](int a, int b) { return min_then_max ? std::min(a, b) : std::max(a, b); };
+  const auto second = [&](int a, int b) { return min_then_max ? std::max(a, b) : std::min(a, b); };
+  std::vector<int> windowed(rows - run + 1);
+  for (int y = 0; y + run <= rows; ++y) {
+    int value = padded[y];
+    for (int j = y + 1; j < y + run; ++j) value = first(value, padded[j]);
+    windowed[y] = value;
+  }
+  std::vector<int> out(half_width.size());
+  for (int y = run; y < rows - run; ++y) {  // every window through an image row lies in `padded`
+    int value = windowed[y - run + 1];
+    for (int start = y - run + 2; start <= y; ++start) value = second(value, windowed[start]);
+    out[y - run] = value;
+  }
+  return out;
+}
+
+// Keeps the run of consecutive non-empty rows with the largest area (the object; chance motion
+// elsewhere along the line forms smaller runs).
+void keep_largest_run(std::vector<int>& half_width) {
+  const int rows = static_cast<int>(half_width.size());
+  long best_area = 0;
+  int best_first = 0, best_end = 0;
+  for (int y = 0; y < rows;) {
+    if (half_width[y] < 0) {
+      ++y;
+      continue;
+    }
+    const int first = y;
+    long area = 0;
+    for (; y < rows && half_width[y] >= 0; ++y) area += 2L * half_width[y] + 1;
+    if (area > best_area) best_area = area, best_first = first, best_end = y;
+  }
+  for (int y = 0; y < rows; ++y)
+    if (y < best_first || y >= best_end) half_width[y] = -1;
+}
+
+// The mask rows (half-widths about the line, row y at first_row + y along it) as a staircase
+// polygon filled into the image.
+// Returns the polygon's bounding box within the mask.
+cv::Rect fill_mask(const std::vector<int>& half_width, const LineFrame& frame, int first_row, cv::Mat& mask) {
+  constexpr int kShift = 4;  // sub-pixel vertices: 1/16 px
+  const auto vertex = [&](double u, double v) {
+    const cv::Point2d p = frame.to_image(u, v);
+    return cv::Point(cvRound(p.x * (1 << kShift)), cvRound(p.y * (1 << kShift)));
+  };
+  std::vector<cv::Point> left, right;
+  for (int y = 0; y < static_cast<int>(half_width.size()); ++y) {
+    if (half_width[y] < 0) continue;
+    const double reach = half_width[y] + 0.5, v = first_row + y;
+    left.push_back(vertex(-reach, v - 0.5));
+    left.push_back(vertex(-reach, v + 0.5));
+    right.push_back(vertex(reach, v - 0.5));
+    right.push_back(vertex(reach, v + 0.5));
+  }
+  if (left.empty()) return {};
+  left.insert(left.end(), right.rbegin(), right.rend());
+  cv::fillPoly(mask, std::vector<std::vector<cv::Point>>{left}, cv::Scalar(255), cv::LINE_8, kShift);
+  const cv::Rect fixed_point_box = cv::boundingRect(left);
+  const cv::Rect box(fixed_point_box.x >> kShift, fixed_point_box.y >> kShift, (fixed_point_box.width >> kShift) + 2,
+                     (fixed_point_box.height >> kShift) + 2);
+  return box & cv::Rect(0, 0, mask.cols, mask.rows);
+}
+
+cv::Mat line_frame_mask(const std::vector<int>& half_width, int columns) {
+  cv::Mat mask(static_cast<int>(half_width.size()), columns, CV_8U, cv::Scalar(0));
+  const int centre = columns / 2;
+  for (int y = 0; y < mask.rows; ++y)
+    if (half_width[y] >= 0) mask.row(y).colRange(centre - half_width[y], centre + half_width[y] + 1).setTo(255);
+  return mask;
+}
+
+void draw_line(cv::Mat& image, const symmetry::Line& line, const cv::Scalar& colour) {
+  const LineFrame frame(line, image.cols, image.rows);
+  const double reach = image.cols + image.rows;
+  const cv::Point2d a = frame.to_image(0, -reach), b = frame.to_image(0, reach);
+  cv::line(image, cv::Point(cvRound(a.x), cvRound(a.y)), cv::Point(cvRound(b.x), cvRound(b.y)), colour, 2, cv::LINE_AA);
+}
+
+}  // namespace
+
+void validate(const MotionParams& params) {
+  const auto fail = [](const std::string& what) { throw std::invalid_argument("MotionParams: " + what); };
+  if (!(params.threshold > 0 && params.threshold <= 255)) fail("threshold must be in (0, 255]");
+  if (!(params.blur_sigma >= 0 && params.blur_sigma <= 20)) fail("blur_sigma must be in [0, 20] px");
+  if (params.max_half_width < 1 || params.max_half_width > 10000) fail("max_half_width must be in [1, 10000] px");
+  if (params.mirror_tolerance < 0 || params.mirror_tolerance > 50) fail("mirror_tolerance must be in [0, 50] px");
+  if (params.min_vertical_run < 1 || params.min_vertical_run > 1000) fail("min_vertical_run must be in [1, 1000] rows");
+  if (params.max_row_gap < 0 || params.max_row_gap > 1000) fail("max_row_gap must be in [0, 1000] rows");
+  if (params.min_area < 0) fail("min_area must be >= 0");
+  if (!(params.max_rotation_deg >= 0 && params.max_rotation_deg < 90)) fail("max_rotation_deg must be in [0, 90)");
+}
+
+MotionSegmenter::MotionSegmenter(MotionParams params) : params_(params) { validate(params_); }
+
+MotionSegmentation MotionSegmenter::segment(const cv::Mat& before, const cv::Mat& after,
+                                            const symmetry::Line& line_before_in, const symmetry::Line& line_after,
+                                            MotionStages* stages) {
+  check_inputs(before, after, line_before_in, line_after);
+  const symmetry::Line line_before = facing(line_before_in, line_after);
+  const LineFrame frame_before(line_before, before.cols, before.rows);
+  const LineFrame frame_after(line_after, after.cols, after.rows);
+
+  MotionSegmentation result;
+  result.mask = cv::Mat::zeros(after.size(), CV_8U);
+  result.cutout = cv::Mat::zeros(after.size(), after.type());
+  // The motion: where the after line's foot lies relative to the before line.
+  result.shift = (frame_after.centre + line_after.r * frame_after.normal - frame_before.centre).dot(frame_before.normal) -
+                 line_before.r;
+  result.rotation = line_after.theta - line_before.theta;
+  if (std::abs(result.rotation) > params_.max_rotation_deg * M_PI / 180.0) {
+    std::ostringstream out;
+    out << "the lines' orientations differ by " << std::abs(result.rotation) * 180.0 / M_PI << " deg > max_rotation_deg "
+        << params_.max_rotation_deg << " (not the same object?): line_before " << describe(line_before_in)
+        << ", line_after " << describe(line_after);
+    result.reason = out.str();
+    return result;
+  }
+
+  int first_row = 0, last_row = 0, first_b = 0, last_b = 0;
+  detail::row_range(frame_after, after.cols, after.rows, &first_row, &last_row);
+  detail::row_range(frame_before, before.cols, before.rows, &first_b, &last_b);
+  first_row = std::min(first_row, first_b);
+  last_row = std::max(last_row, last_b);
+  const int centre = params_.max_half_width, columns = 2 * centre + 1;
+
+  // (c) the difference and its noise floor, only where the line-frame image will sample it.
+  const cv::Rect band = band_around(frame_after, frame_before, centre + 2, first_row, last_row, after.size());
+  channel_max_difference(before(band), after(band), colour_difference_, difference_);
+  const int noise_floor = params_.subtract_noise_floor ? median_level(difference_) : 0;
+  LineFrame band_after = frame_after, band_before = frame_before;  // the same lines, the band's origin
+  band_after.centre -= cv::Point2d(band.tl());
+  band_before.centre -= cv::Point2d(band.tl());
+
+  // (d) compression: the leading half (in the direction of motion) beyond the after line, the
+  // trailing half beyond the before line; the strip between the lines is dropped.
+  compressed_.create(last_row - first_row + 1, columns, CV_8U);
+  const bool leading_is_positive = result.shift >= 0;
+  const int after_x0 = leading_is_positive ? centre : 0;
+  const int before_x0 = leading_is_positive ? 0 : centre + 1;
+  sample_in_frame(difference_, band_after, centre, after_x0, first_row,
+                  compressed_.colRange(after_x0, after_x0 + centre + 1));
+  sample_in_frame(difference_, band_before, centre, before_x0, first_row,
+                  compressed_.colRange(before_x0, before_x0 + centre));
+  if (noise_floor > 0) cv::subtract(compressed_, cv::Scalar(noise_floor), compressed_);
+  if (params_.blur_sigma > 0)
+    cv::GaussianBlur(compressed_, blurred_, kernel_size(params_.blur_sigma), params_.blur_sigma);
+  else
+    compressed_.copyTo(blurred_);
+
+  // (e) symmetric filling, then the threshold row by row.
+  if (params_.mirror_tolerance > 0)
+    cv::dilate(blurred_, dilated_, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * params_.mirror_tolerance + 1, 1)));
+  else
+    blurred_.copyTo(dilated_);
+  refined_.create(blurred_.size(), CV_8U);
+  const int threshold = static_cast<int>(std::ceil(params_.threshold));
+  std::vector<int> half_width(blurred_.rows);
+  for (int y = 0; y < blurred_.rows; ++y)
+    half_width[y] = fill_row(blurred_.ptr<uint8_t>(y), dilated_.ptr<uint8_t>(y), centre, threshold, refined_.ptr<uint8_t>(y));
+  half_width = morph_rows(half_width, params_.min_vertical_run, true);
+  half_width = morph_rows(half_width, params_.max_row_gap + 2, false);
+  keep_largest_run(half_width);
+
+  // (f) the mask at the after position, and the cut-out.
+  const cv::Rect box = fill_mask(half_width, frame_after, first_row, result.mask);
+  result.area = box.empty() ? 0 : cv::countNonZero(result.mask(box));
+  if (result.area < params_.min_area || result.area == 0) {
+    std::ostringstream out;
+    out << "no symmetric motion about the lines: " << result.area << " px < min_area " << params_.min_area
+        << " (shift " << result.shift << " px)";
+    result.reason = out.str();
+    result.mask.setTo(0);
+    result.area = 0;
+  } else {
+    result.found = true;
+    result.bounding_box = cv::boundingRect(result.mask(box)) + box.tl();
+    after(box).copyTo(result.cutout(box), result.mask(box));
+  }
+
+  if (stages) {
+    stages->before = before.clone();
+    stages->after = after.clone();
+    channel_max_difference(before, after, colour_difference_, stages->difference);  // the whole image
+    stages->compressed = blurred_.clone();
+    stages->refined = refined_.clone();
+    stages->line_frame_mask = line_frame_mask(half_width, columns);
+    stages->mask = result.mask.clone();
+    stages->cutout = result.cutout.clone();
+    stages->line_before = line_before_in;
+    stages->line_after = line_after;
+    stages->first_row = first_row;
+    stages->noise_floor = noise_floor;
+  }
+  return result;
+}
+
+MotionSegmentation segment_by_motion(const cv::Mat& before, const cv::Mat& after, const symmetry::Line& line_before,
+                                     const symmetry::Line& line_after, const MotionParams& params, MotionStages* stages) {
+  return MotionSegmenter(params).segment(before, after, line_before, line_after, stages);
+}
+
+void MotionStages::save(const std::string& directory) const {
+  if (before.empty() || after.empty() || difference.empty() || compressed.empty())
+    throw std::logic_error("MotionStages::save: no stages to save (pass stages to segment first)");
+  std::error_code error;
+  std::filesystem::create_directories(directory, error);
+  if (error) throw std::runtime_error("MotionStages::save: cannot create directory " + directory + ": " + error.message());
+
+  cv::Mat difference_lines;
+  cv::cvtColor(difference, difference_lines, cv::COLOR_GRAY2BGR);
+  draw_line(difference_lines, line_before, cv::Scalar(0, 255, 0));
+  draw_line(difference_lines, line_after, cv::Scalar(0, 0, 255));
+
+  const std::vector<std::pair<std::string, const cv::Mat*>> files = {
+      {"a_before.png", &before},         {"b_after.png", &after},
+      {"c_difference.png", &difference_lines}, {"d_compressed.png", &compressed},
+      {"e_refined.png", &refined},       {"e_mask_line_frame.png", &line_frame_mask},
+      {"f_segmentation.png", &cutout},   {"mask.png", &mask}};
+  for (const auto& [name, image] : files) {
+    const std::string path = (std::filesystem::path(directory) / name).string();
+    bool written = false;
+    try {
+      written = !image->empty() && cv::imwrite(path, *image);
+    } catch (const cv::Exception& e) {
+      throw std::runtime_error("MotionStages::save: cannot write " + path + ": " + e.what());
+    }
+    if (!written) throw std::runtime_error("MotionStages::save: cannot write " + path);
+  }
+}
+
+}  // namespace nudge::segmentation

@@ -1,0 +1,340 @@
+// Motion segmentation (thesis sec. 6.4) on synthetic nudges: a textured cup on a textured
+// background moved by a known amount, so the object's true mask in the after image is known.
+#include <gtest/gtest.h>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+
+#include "nudge/segmentation/motion.hpp"
+#include "nudge/symmetry/synthetic.hpp"
+
+using namespace nudge::segmentation;
+namespace sym = nudge::symmetry;
+namespace syn = nudge::symmetry::synthetic;
+
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+sym::Line make_line(double r, double theta) {
+  sym::Line line;
+  line.r = r;
+  line.theta = theta;
+  return line;
+}
+
+// Smooth random texture: coarse uniform noise blown up, plus fine noise.
+cv::Mat texture(cv::Size size, uint64_t seed, double low, double high, int coarseness) {
+  cv::RNG rng(seed);
+  cv::Mat coarse(size.height / coarseness + 2, size.width / coarseness + 2, CV_8UC3);
+  rng.fill(coarse, cv::RNG::UNIFORM, low, high);
+  cv::Mat out;
+  cv::resize(coarse, out, size, 0, 0, cv::INTER_CUBIC);
+  cv::Mat fine(size, CV_8UC3);
+  rng.fill(fine, cv::RNG::UNIFORM, 0, 25);
+  return out + fine;
+}
+
+struct Object {
+  syn::Profile profile = syn::cup_profile(220, 70, 50);
+  cv::Mat surface;  // texture in the object's frame: column = offset from the axis + kHalf, row = along + kHalf
+  static constexpr int kHalf = 200;
+  explicit Object(uint64_t seed) : surface(texture({2 * kHalf + 1, 2 * kHalf + 1}, seed, 150, 230, 6)) {
+    // Stripes across the body: the interior changes when the object moves.
+    for (int y = 0; y < surface.rows; y += 24)
+      cv::rectangle(surface, {0, y}, {surface.cols, y + 6}, cv::Scalar(60, 90, 200), cv::FILLED);
+  }
+};
+
+// The object's coverage (0-255, anti-aliased) with its axis on `line`, centred `along` px down it.
+cv::Mat coverage(const Object& object, const sym::Line& line, double along, cv::Size size) {
+  cv::Mat alpha(size, CV_8U, cv::Scalar(0));
+  syn::draw_shape(alpha, object.profile, line.r, line.theta, along, cv::Scalar(255));
+  return alpha;
+}
+
+// Draws the textured object over `image`, its surface carried along with its axis.
+void draw_object(cv::Mat& image, const Object& object, const sym::Line& line, double along) {
+  const cv::Point2d centre(0.5 * (image.cols - 1), 0.5 * (image.rows - 1));
+  const cv::Point2d n(std::cos(line.theta), std::sin(line.theta)), d(-std::sin(line.theta), std::cos(line.theta));
+  // image point -> surface: column = (p - c).n - R + kHalf, row = (p - c).d - along + kHalf
+  const cv::Matx23d image_to_surface(n.x, n.y, -centre.dot(n) - line.r + Object::kHalf, d.x, d.y,
+                                     -centre.dot(d) - along + Object::kHalf);
+  cv::Mat surface;
+  cv::warpAffine(object.surface, surface, image_to_surface, image.size(), cv::INTER_LINEAR | cv::WARP_INVERSE_MAP,
+                 cv::BORDER_REPLICATE);
+  const cv::Mat alpha = coverage(object, line, along, image.size());
+  for (int y = 0; y < image.rows; ++y)
+    for (int x = 0; x < image.cols; ++x) {
+      const double a = alpha.at<uint8_t>(y, x) / 255.0;
+      if (a <= 0) continue;
+      cv::Vec3b& p = image.at<cv::Vec3b>(y, x);
+      const cv::Vec3b s = surface.at<cv::Vec3b>(y, x);
+      for (int c = 0; c < 3; ++c) p[c] = cv::saturate_cast<uint8_t>((1 - a) * p[c] + a * s[c]);
+    }
+}
+
+cv::Mat truth_mask(const Object& object, const sym::Line& line, double along, cv::Size size) {
+  cv::Mat mask;
+  cv::threshold(coverage(object, line, along, size), mask, 127, 255, cv::THRESH_BINARY);
+  return mask;
+}
+
+double iou(const cv::Mat& a, const cv::Mat& b) {
+  const double inter = cv::countNonZero(a & b), uni = cv::countNonZero(a | b);
+  return uni > 0 ? inter / uni : 0;
+}
+
+void add_noise(cv::Mat& image, uint64_t seed, double sigma) {
+  cv::Mat noise(image.size(), CV_16SC3);
+  cv::RNG(seed).fill(noise, cv::RNG::NORMAL, 0, sigma);
+  cv::Mat wide;
+  image.convertTo(wide, CV_16SC3);
+  wide += noise;
+  wide.convertTo(image, CV_8UC3);
+}
+
+struct Nudge {
+  cv::Mat before, after, truth_after, truth_before;
+  sym::Line line_before, line_after;
+};
+
+// A cup on a textured background, its axis moved from `line_before` to `line_after`.
+Nudge make_nudge(cv::Size size, const sym::Line& line_before, const sym::Line& line_after, double along = 40,
+                 double noise_sigma = 2) {
+  const Object object(7);
+  const cv::Mat background = texture(size, 11, 40, 120, 12);
+  Nudge out;
+  out.line_before = line_before;
+  out.line_after = line_after;
+  out.before = background.clone();
+  out.after = background.clone();
+  draw_object(out.before, object, line_before, along);
+  draw_object(out.after, object, line_after, along);
+  add_noise(out.before, 21, noise_sigma);
+  add_noise(out.after, 22, noise_sigma);
+  out.truth_after = truth_mask(object, line_after, along, size);
+  out.truth_before = truth_mask(object, line_before, along, size);
+  return out;
+}
+
+const cv::Size kSize(640, 480);
+
+}  // namespace
+
+TEST(MotionSegmentation, SidewaysNudgeGivesTheObjectAtItsAfterPosition) {
+  const Nudge nudge = make_nudge(kSize, make_line(-30, 0), make_line(-10, 0));
+  const MotionSegmentation result = segment_by_motion(nudge.before, nudge.after, nudge.line_before, nudge.line_after);
+  ASSERT_TRUE(result.found) << result.reason;
+  EXPECT_NEAR(result.shift, 20, 1e-9);
+  EXPECT_GE(iou(result.mask, nudge.truth_after), 0.9);
+  // At the after position, not the before one.
+  EXPECT_GT(iou(result.mask, nudge.truth_after), iou(result.mask, nudge.truth_before) + 0.1);
+  EXPECT_EQ(result.area, cv::countNonZero(result.mask));
+  // The cut-out is the after image inside the mask and black outside.
+  cv::Mat expected = cv::Mat::zeros(kSize, CV_8UC3);
+  nudge.after.copyTo(expected, result.mask);
+  EXPECT_EQ(cv::norm(result.cutout, expected, cv::NORM_INF), 0);
+}
+
+TEST(MotionSegmentation, NudgeTowardsNegativeRAndGreyImages) {
+  const Nudge nudge = make_nudge(kSize, make_line(40, 0), make_line(15, 0));
+  cv::Mat before_grey, after_grey;
+  cv::cvtColor(nudge.before, before_grey, cv::COLOR_BGR2GRAY);
+  cv::cvtColor(nudge.after, after_grey, cv::COLOR_BGR2GRAY);
+  const MotionSegmentation result = segment_by_motion(before_grey, after_grey, nudge.line_before, nudge.line_after);
+  ASSERT_TRUE(result.found) << result.reason;
+  EXPECT_NEAR(result.shift, -25, 1e-9);
+  EXPECT_GE(iou(result.mask, nudge.truth_after), 0.9);
+  EXPECT_EQ(result.cutout.type(), CV_8U);
+}
+
+TEST(MotionSegmentation, TiltedLine) {
+  const Nudge nudge = make_nudge(kSize, make_line(-20, 15 * kDeg), make_line(5, 15 * kDeg));
+  const MotionSegmentation result = segment_by_motion(nudge.before, nudge.after, nudge.line_before, nudge.line_after);
+  ASSERT_TRUE(result.found) << result.reason;
+  EXPECT_GE(iou(result.mask, nudge.truth_after), 0.9);
+}
+
+TEST(MotionSegmentation, ObjectTurnsALittleAsWellAsMoving) {
+  const Nudge nudge = make_nudge(kSize, make_line(-30, -2 * kDeg), make_line(-8, 1 * kDeg));
+  const MotionSegmentation result = segment_by_motion(nudge.before, nudge.after, nudge.line_before, nudge.line_after);
+  ASSERT_TRUE(result.found) << result.reason;
+  EXPECT_NEAR(result.rotation, 3 * kDeg, 1e-9);
+  EXPECT_GE(iou(result.mask, nudge.truth_after), 0.9);
+}
+
+TEST(MotionSegmentation, LineGivenWithTheOppositeNormal) {
+  // (R, theta) and (-R, theta - 180 deg) are one line: near-horizontal axes wrap across +-90 deg.
+  const Nudge nudge = make_nudge(kSize, make_line(-30, 0), make_line(-10, 0));
+  const sym::Line flipped_before = make_line(30, M_PI);
+  const MotionSegmentation result = segment_by_motion(nudge.before, nudge.after, flipped_before, nudge.line_after);
+  ASSERT_TRUE(result.found) << result.reason;
+  EXPECT_NEAR(result.shift, 20, 1e-9);
+  EXPECT_NEAR(result.rotation, 0, 1e-9);
+  EXPECT_GE(iou(result.mask, nudge.truth_after), 0.9);
+}
+
+TEST(MotionSegmentation, SmallShiftStillSegments) {
+  // The thesis' white cup moved only a little (fig. 6.8(b)).
+  const Nudge nudge = make_nudge(kSize, make_line(-30, 0), make_line(-24, 0));
+  const MotionSegmentation result = segment_by_motion(nudge.before, nudge.after, nudge.line_before, nudge.line_after);
+  ASSERT_TRUE(result.found) << result.reason;
+  EXPECT_GE(iou(result.mask, nudge.truth_after), 0.85);
+}
+
+TEST(MotionSegmentation, NoiseAndLightingFlicker) {
+  Nudge nudge = make_nudge(kSize, make_line(-30, 0), make_line(-10, 0), 40, 4);
+  nudge.after += cv::Scalar(9, 9, 9);  // the lights brighten between the two images
+  const MotionSegmentation result = segment_by_motion(nudge.before, nudge.after, nudge.line_before, nudge.line_after);
+  ASSERT_TRUE(result.found) << result.reason;
+  EXPECT_GE(iou(result.mask, nudge.truth_after), 0.9);
+}
+
+TEST(MotionSegmentation, NoMotionGivesAnEmptyMaskAndSaysSo) {
+  const Nudge nudge = make_nudge(kSize, make_line(-30, 0), make_line(-30, 0), 40, 3);
+  MotionStages stages;
+  const MotionSegmentation result =
+      segment_by_motion(nudge.before, nudge.after, nudge.line_before, nudge.line_after, {}, &stages);
+  EXPECT_FALSE(result.found);
+  EXPECT_NE(result.reason.find("no symmetric motion"), std::string::npos) << result.reason;
+  EXPECT_EQ(result.area, 0);
+  EXPECT_EQ(cv::countNonZero(result.mask), 0);
+  EXPECT_EQ(cv::countNonZero(result.cutout.reshape(1)), 0);
+  EXPECT_EQ(result.mask.size(), kSize);
+}
+
+TEST(MotionSegmentation, ArmAndOtherMotionStayOutOfTheMask) {
+  const sym::Line line_before = make_line(-30, 0), line_after = make_line(-10, 0);
+  const double along = 40;
+  Nudge nudge = make_nudge(kSize, line_before, line_after, along);
+  // The effector behind the object (it pushed towards +x) and the arm up to the image's top,
+  // in the after image only; the object is in front of it.
+  cv::Mat arm(kSize, CV_8U, cv::Scalar(0));
+  const cv::Rect object_box = cv::boundingRect(nudge.truth_after);
+  const int effector_right = object_box.x + 30, effector_left = object_box.x - 45;
+  const int effector_top = object_box.y + object_box.height / 2;
+  cv::rectangle(arm, cv::Rect(effector_left, effector_top, effector_right - effector_left, 50), 255, cv::FILLED);
+  cv::rectangle(arm, cv::Rect(effector_left, 0, 28, effector_top + 10), 255, cv::FILLED);
+  arm &= ~nudge.truth_after;
+  nudge.after.setTo(cv::Scalar(35, 35, 35), arm);
+  // Another object moves far from the line: a box in the top right corner slides sideways.
+  cv::rectangle(nudge.before, cv::Rect(520, 30, 60, 60), cv::Scalar(240, 240, 240), cv::FILLED);
+  cv::rectangle(nudge.after, cv::Rect(535, 30, 60, 60), cv::Scalar(240, 240, 240), cv::FILLED);
+
+  const MotionSegmentation result = segment_by_motion(nudge.before, nudge.after, line_before, line_after);
+  ASSERT_TRUE(result.found) << result.reason;
+  EXPECT_GE(iou(result.mask, nudge.truth_after), 0.9);
+  EXPECT_LE(cv::countNonZero(result.mask & arm), 0.02 * cv::countNonZero(arm));
+  EXPECT_EQ(cv::countNonZero(result.mask(cv::Rect(500, 0, 140, 120))), 0);
+}
+
+TEST(MotionSegmentation, MugHandleIsLeftOutOfTheSymmetricMask) {
+  // Documented limitation (docs/segmentation_geometry.md): the mask is symmetric about the line,
+  // so a handle on one side is not included; the body still is.
+  const cv::Mat background = texture(kSize, 11, 40, 120, 12);
+  const sym::Line line_before = make_line(-30, 0), line_after = make_line(-10, 0);
+  cv::Mat before = background.clone(), after = background.clone();
+  syn::draw_mug(before, line_before.r, line_before.theta, 40, 200, 60, cv::Scalar(210, 200, 190));
+  syn::draw_mug(after, line_after.r, line_after.theta, 40, 200, 60, cv::Scalar(210, 200, 190));
+  cv::Mat body(kSize, CV_8U, cv::Scalar(0)), mug(kSize, CV_8U, cv::Scalar(0));
+  syn::draw_shape(body, syn::cup_profile(200, 60, 54), line_after.r, line_after.theta, 40, cv::Scalar(255));
+  syn::draw_mug(mug, line_after.r, line_after.theta, 40, 200, 60, cv::Scalar(255));
+  cv::threshold(body, body, 127, 255, cv::THRESH_BINARY);
+  cv::threshold(mug, mug, 127, 255, cv::THRESH_BINARY);
+  const cv::Mat handle = mug & ~body;
+  ASSERT_GT(cv::countNonZero(handle), 500);
+
+  const MotionSegmentation result = segment_by_motion(before, after, line_before, line_after);
+  ASSERT_TRUE(result.found) << result.reason;
+  EXPECT_GE(iou(result.mask, body), 0.9);
+  EXPECT_LE(cv::countNonZero(result.mask & handle), 0.1 * cv::countNonZero(handle));
+}
+
+TEST(MotionSegmentation, FullResolutionPair) {
+  const cv::Size size(1280, 960);
+  const Nudge nudge = make_nudge(size, make_line(-100, 3 * kDeg), make_line(-60, 3 * kDeg), 100);
+  MotionSegmenter segmenter;
+  const MotionSegmentation result = segmenter.segment(nudge.before, nudge.after, nudge.line_before, nudge.line_after);
+  ASSERT_TRUE(result.found) << result.reason;
+  EXPECT_GE(iou(result.mask, nudge.truth_after), 0.9);
+  // The segmenter reuses its scratch images: a second call gives the same mask.
+  const MotionSegmentation again = segmenter.segment(nudge.before, nudge.after, nudge.line_before, nudge.line_after);
+  EXPECT_EQ(cv::norm(result.mask, again.mask, cv::NORM_INF), 0);
+}
+
+TEST(MotionSegmentation, StagesOfFigure67AreSaved) {
+  const Nudge nudge = make_nudge(kSize, make_line(-30, 0), make_line(-10, 0));
+  MotionStages stages;
+  const MotionSegmentation result =
+      segment_by_motion(nudge.before, nudge.after, nudge.line_before, nudge.line_after, {}, &stages);
+  ASSERT_TRUE(result.found) << result.reason;
+  EXPECT_EQ(stages.difference.size(), kSize);
+  EXPECT_EQ(stages.compressed.cols, 2 * MotionParams{}.max_half_width + 1);
+  EXPECT_EQ(stages.refined.size(), stages.compressed.size());
+  EXPECT_EQ(cv::norm(stages.mask, result.mask, cv::NORM_INF), 0);
+  // The line-frame mask is symmetric about the merged line (the middle column).
+  cv::Mat mirrored;
+  cv::flip(stages.line_frame_mask, mirrored, 1);
+  EXPECT_EQ(cv::norm(mirrored, stages.line_frame_mask, cv::NORM_INF), 0);
+  EXPECT_GT(cv::countNonZero(stages.line_frame_mask), 0);
+
+  const std::filesystem::path dir =
+      std::filesystem::path(testing::TempDir()) / ("motion_stages_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  stages.save(dir.string());
+  for (const char* name : {"a_before.png", "b_after.png", "c_difference.png", "d_compressed.png", "e_refined.png",
+                           "e_mask_line_frame.png", "f_segmentation.png", "mask.png"}) {
+    const cv::Mat read = cv::imread((dir / name).string(), cv::IMREAD_UNCHANGED);
+    EXPECT_FALSE(read.empty()) << name;
+  }
+  EXPECT_EQ(cv::imread((dir / "mask.png").string(), cv::IMREAD_GRAYSCALE).size(), kSize);
+  std::filesystem::remove_all(dir);
+  EXPECT_THROW(MotionStages{}.save(dir.string()), std::logic_error);
+}
+
+TEST(MotionSegmentation, BadInputsAreNamed) {
+  const cv::Mat image(480, 640, CV_8UC3, cv::Scalar(100, 100, 100));
+  const sym::Line line = make_line(0, 0);
+  const auto message = [&](const cv::Mat& before, const cv::Mat& after, const sym::Line& lb, const sym::Line& la) {
+    try {
+      segment_by_motion(before, after, lb, la);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("no exception");
+  };
+  EXPECT_NE(message(cv::Mat(), image, line, line).find("before image is empty"), std::string::npos);
+  EXPECT_NE(message(image, cv::Mat(), line, line).find("after image is empty"), std::string::npos);
+  EXPECT_NE(message(image, cv::Mat(240, 320, CV_8UC3), line, line).find("320x240"), std::string::npos);
+  EXPECT_NE(message(image, cv::Mat(480, 640, CV_8U), line, line).find("after image"), std::string::npos);
+  EXPECT_NE(message(cv::Mat(480, 640, CV_32F), cv::Mat(480, 640, CV_32F), line, line).find("8-bit"), std::string::npos);
+  EXPECT_NE(message(image, image, make_line(400, 0), line).find("line_before"), std::string::npos);
+  EXPECT_NE(message(image, image, line, make_line(-330, 0)).find("line_after"), std::string::npos);
+  EXPECT_NE(message(image, image, line, make_line(NAN, 0)).find("line_after"), std::string::npos);
+  // A vertical line 300 px right of the centre still crosses a 640 px wide image.
+  EXPECT_EQ(message(image, image, make_line(300, 0), make_line(300, 0)), "no exception");
+
+  MotionParams params;
+  params.threshold = 0;
+  EXPECT_THROW(MotionSegmenter{params}, std::invalid_argument);
+  params = {};
+  params.max_half_width = 0;
+  EXPECT_THROW(MotionSegmenter{params}, std::invalid_argument);
+  params = {};
+  params.min_vertical_run = 0;
+  EXPECT_THROW(validate(params), std::invalid_argument);
+}
+
+TEST(MotionSegmentation, LinesTooDifferentAreReportedNotSegmented) {
+  const Nudge nudge = make_nudge(kSize, make_line(-30, 0), make_line(-10, 0));
+  const MotionSegmentation result =
+      segment_by_motion(nudge.before, nudge.after, nudge.line_before, make_line(-10, 35 * kDeg));
+  EXPECT_FALSE(result.found);
+  EXPECT_NE(result.reason.find("max_rotation_deg"), std::string::npos) << result.reason;
+  EXPECT_EQ(cv::countNonZero(result.mask), 0);
+}
