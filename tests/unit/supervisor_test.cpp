@@ -178,7 +178,7 @@ TEST(Targets, NearestTheCameraFirstAndEveryPassOverHasAReason) {
                                                  {1, Eigen::Vector3d(0.30, -0.10, 0), 9},
                                                  {2, Eigen::Vector3d(0.62, 0.0, 0), 9},   // beyond the ring
                                                  {3, Eigen::Vector3d(0.05, 0.0, 0), 9}};  // inside it
-  const auto choice = sv::choose_target(candidates, {}, scene.right_camera_in_world(), arm,
+  const auto choice = sv::choose_target(candidates, {}, {}, scene.right_camera_in_world(), arm,
                                         arm_state_joints(), sv::TargetParams{});
   ASSERT_TRUE(choice.found);
   EXPECT_EQ(choice.target.index, 1);  // the nearest reachable one
@@ -190,7 +190,7 @@ TEST(Targets, NearestTheCameraFirstAndEveryPassOverHasAReason) {
   EXPECT_NEAR(choice.direction.dot(Eigen::Vector3d(ray.x(), ray.y(), 0).normalized()), 0.0, 1e-6);
   EXPECT_NEAR(choice.direction.z(), 0.0, 1e-12);
   // Explored places are skipped; with everything explored or unreachable nothing is chosen.
-  const auto rest = sv::choose_target(candidates, {candidates[0].position, candidates[1].position},
+  const auto rest = sv::choose_target(candidates, {candidates[0].position, candidates[1].position}, {},
                                       scene.right_camera_in_world(), arm, arm_state_joints(), sv::TargetParams{});
   EXPECT_FALSE(rest.found);
   EXPECT_EQ(rest.rejected.size(), 4u);

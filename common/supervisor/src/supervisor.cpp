@@ -113,7 +113,7 @@ void Supervisor::survey(int64_t now) {
 
 void Supervisor::choose(int64_t now) {
   const Eigen::Vector3d camera = scene_.right_camera_in_world();
-  TargetChoice choice = choose_target(candidates_, explored_, camera, arm_, joints_, config_.targets);
+  TargetChoice choice = choose_target(candidates_, explored_, empty_, camera, arm_, joints_, config_.targets);
   summary_.rejections.clear();
   for (const Rejection& r : choice.rejected) ++summary_.rejections[r.reason];
   report_.num_candidates = static_cast<int>(candidates_.size());
@@ -137,13 +137,16 @@ void Supervisor::choose(int64_t now) {
   report_.attempt = attempt_->number;
   report_.candidate_index = choice.target.index;
   report_.target = choice.target.position;
-  request_still(State::SnapshotBefore, now);
+  request_still(State::SnapshotBefore, now, choice.note);
 }
 
-void Supervisor::request_still(State state, int64_t now) {
+void Supervisor::request_still(State state, int64_t now, const std::string& note) {
   request_time_ = now;
-  enter(state, now, state == State::SnapshotBefore ? "still before the nudge of candidate " + std::to_string(attempt_->target.index) + " at " + millimetres(attempt_->target.position)
-                                                   : "still after the nudge");
+  std::string reason = state == State::SnapshotBefore ? "still before the nudge of candidate " + std::to_string(attempt_->target.index) +
+                                                            " at " + millimetres(attempt_->target.position)
+                                                      : "still after the nudge";
+  if (!note.empty()) reason += " (" + note + ")";
+  enter(state, now, reason);
   outputs_.push_back(SnapshotRequest{});
 }
 
@@ -235,6 +238,7 @@ void Supervisor::end_attempt(Outcome outcome, const std::string& reason, int64_t
   if (outcome == Outcome::Segmented) ++summary_.segmented;
   // A place once nudged is not nudged again (unless the attempt never touched it).
   if (outcome != Outcome::Aborted && outcome != Outcome::SnapshotLost) explored_.push_back(a.target.position);
+  if (outcome == Outcome::NoMotion && !a.rest) empty_.push_back(a.target.position);
   if (a.rest) explored_.push_back(*a.rest);
   if (outcome == Outcome::SnapshotLost && a.before.empty()) explored_.push_back(a.target.position);
   outputs_.push_back(AttemptEnded{std::shared_ptr<const Attempt>(attempt_.release())});
@@ -313,7 +317,9 @@ void Supervisor::on_candidates(const std::vector<Candidate>& candidates, int64_t
   if (state_ != State::FindCandidates) return;
   if (utime < request_time_) return;  // an answer to an older request (or another run's)
   candidates_ = candidates;
-  enter(State::Choose, now, std::to_string(candidates.size()) + " candidates");
+  std::string where;
+  for (const Candidate& c : candidates) where += (where.empty() ? " at " : ", ") + millimetres(c.position);
+  enter(State::Choose, now, std::to_string(candidates.size()) + " candidates" + where);
   choose(now);
 }
 

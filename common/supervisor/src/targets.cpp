@@ -53,23 +53,23 @@ std::string push_conflict(const Eigen::Vector3d& target, const Eigen::Vector3d& 
   return "the push would touch the candidate at " + millimetres(other);
 }
 
-TargetChoice choose_target(const std::vector<Candidate>& candidates, const std::vector<Eigen::Vector3d>& explored,
-                           const Eigen::Vector3d& right_camera, const ArmSetup& arm,
-                           const robot::JointVector& seed, const TargetParams& params) {
-  std::vector<size_t> order(candidates.size());
-  std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
-    return (candidates[a].position - right_camera).norm() < (candidates[b].position - right_camera).norm();
-  });
+namespace {
+
+bool near_any(const Eigen::Vector3d& p, const std::vector<Eigen::Vector3d>& places, double radius) {
+  return std::any_of(places.begin(), places.end(), [&](const Eigen::Vector3d& e) { return horizontal(e - p).norm() < radius; });
+}
+
+// One pass over the candidates in camera order. With `strict`, a push that may touch another
+// candidate is refused; otherwise it is taken and noted.
+TargetChoice choose_pass(const std::vector<Candidate>& candidates, const std::vector<size_t>& order,
+                         const std::vector<Eigen::Vector3d>& explored, const std::vector<Eigen::Vector3d>& empty,
+                         const Eigen::Vector3d& camera_base, const ArmSetup& arm, const robot::JointVector& seed,
+                         const TargetParams& params, bool strict) {
   TargetChoice choice;
-  const Eigen::Vector3d camera_base = arm.point_to_base(right_camera);
   for (size_t i : order) {
     const Candidate& c = candidates[i];
     auto reject = [&](const std::string& reason) { choice.rejected.push_back({c.index, c.position, reason}); };
-    const bool was_explored = std::any_of(explored.begin(), explored.end(), [&](const Eigen::Vector3d& e) {
-      return horizontal(e - c.position).norm() < params.explored_radius;
-    });
-    if (was_explored) {
+    if (near_any(c.position, explored, params.explored_radius)) {
       reject("already explored");
       continue;
     }
@@ -79,16 +79,16 @@ TargetChoice choose_target(const std::vector<Candidate>& candidates, const std::
       const Eigen::Vector3d direction = arm.direction_to_world(direction_base);
       std::string conflict;
       for (const Candidate& other : candidates) {
-        if (other.index == c.index) continue;
+        if (other.index == c.index || near_any(other.position, empty, params.explored_radius)) continue;
         conflict = push_conflict(c.position, direction, other.position, arm, params);
         if (!conflict.empty()) break;
       }
-      if (!conflict.empty()) {
+      if (!conflict.empty() && strict) {
         why_not += std::string(why_not.empty() ? "" : "; the other way: ") + conflict;
         continue;
       }
-      Eigen::Vector3d target_base = arm.point_to_base(c.position);
-      robot::NudgePlan plan = robot::plan_nudge(arm.model, arm.safety_config(), target_base, direction_base, arm.nudge, seed);
+      robot::NudgePlan plan =
+          robot::plan_nudge(arm.model, arm.safety_config(), arm.point_to_base(c.position), direction_base, arm.nudge, seed);
       if (!plan.ok()) {
         why_not += std::string(why_not.empty() ? "" : "; the other way: ") + "out of reach: " + plan.reason;
         continue;
@@ -97,11 +97,34 @@ TargetChoice choose_target(const std::vector<Candidate>& candidates, const std::
       choice.target = c;
       choice.direction = horizontal(direction).normalized();
       choice.plan = std::move(plan);
+      if (!conflict.empty()) choice.note = "no clear push left: nudged although " + conflict;
       return choice;
     }
     reject(why_not);
   }
   return choice;
+}
+
+}  // namespace
+
+TargetChoice choose_target(const std::vector<Candidate>& candidates, const std::vector<Eigen::Vector3d>& explored,
+                           const std::vector<Eigen::Vector3d>& empty, const Eigen::Vector3d& right_camera,
+                           const ArmSetup& arm, const robot::JointVector& seed, const TargetParams& params) {
+  std::vector<size_t> order(candidates.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    return (candidates[a].position - right_camera).norm() < (candidates[b].position - right_camera).norm();
+  });
+  const Eigen::Vector3d camera_base = arm.point_to_base(right_camera);
+  TargetChoice strict = choose_pass(candidates, order, explored, empty, camera_base, arm, seed, params, true);
+  if (strict.found) return strict;
+  TargetChoice relaxed = choose_pass(candidates, order, explored, empty, camera_base, arm, seed, params, false);
+  if (!relaxed.found) return strict;  // the strict pass's reasons say why each was passed over
+  // Keep the strict pass's reasons for the candidates passed over before the chosen one.
+  relaxed.rejected.clear();
+  for (const Rejection& r : strict.rejected)
+    if (r.index != relaxed.target.index) relaxed.rejected.push_back(r);
+  return relaxed;
 }
 
 }  // namespace nudge::supervisor

@@ -154,7 +154,7 @@ class Supervisor {
   void enter(State state, int64_t now, const std::string& reason);
   void survey(int64_t now);
   void choose(int64_t now);
-  void request_still(State state, int64_t now);
+  void request_still(State state, int64_t now, const std::string& note = "");
   void start_nudge(int64_t now);
   void verify(int64_t now);
   void segment(int64_t now);
@@ -172,7 +172,7 @@ class Supervisor {
   State paused_from_ = State::Idle;
   int64_t entered_ = 0, request_time_ = 0, arm_done_time_ = 0, next_seq_ = 1, nudge_seq_ = 0;
   std::vector<Candidate> candidates_;
-  std::vector<Eigen::Vector3d> explored_;
+  std::vector<Eigen::Vector3d> explored_, empty_;
   std::vector<Axis> settled_axes_;
   robot::JointVector joints_ = robot::JointVector::Zero();
   std::set<std::string> silent_;

@@ -54,13 +54,19 @@ struct TargetChoice {
   Eigen::Vector3d direction = Eigen::Vector3d::UnitX();  // push direction, world frame, horizontal
   robot::NudgePlan plan;                                  // base frame (for pictures and checks)
   std::vector<Rejection> rejected;                        // every candidate passed over, and why
+  std::string note;  // set when the push was accepted although it may touch another candidate
 };
 
 // Candidates nearest the right camera first; the first nudgeable one is chosen. `explored` are
-// places already nudged (where a candidate stood, where a nudged object came to rest).
+// places already nudged (where a candidate stood, where a nudged object came to rest); `empty` are
+// places a nudge found nothing at (phantoms): they are no obstacle to other pushes.
+// Beyond the thesis (one object per scene): on a crowded table every push may pass near another
+// candidate, many of them phantoms between two objects. When no push is clear, the nearest
+// candidate the arm can reach is nudged anyway (the nudge is gentle and short) and `note` says
+// which candidate it may touch; the strict rule still decides whenever it can.
 TargetChoice choose_target(const std::vector<Candidate>& candidates, const std::vector<Eigen::Vector3d>& explored,
-                           const Eigen::Vector3d& right_camera, const ArmSetup& arm,
-                           const robot::JointVector& seed, const TargetParams& params = {});
+                           const std::vector<Eigen::Vector3d>& empty, const Eigen::Vector3d& right_camera,
+                           const ArmSetup& arm, const robot::JointVector& seed, const TargetParams& params = {});
 
 // Why pushing `target` along `direction` would touch `other` (empty if it would not): the pad's
 // sweep from P1 to P2 and the object's slide beyond, widened by two object radii.
