@@ -37,6 +37,7 @@
 #include "nudge/supervisor/segment.hpp"
 #include "nudge/supervisor/supervisor.hpp"
 #include "nudge/supervisor_state_t.hpp"
+#include "nudge/symmetry_lines_t.hpp"
 #include "nudge/timing.hpp"
 
 using namespace nudge;
@@ -134,6 +135,8 @@ class Shell {
     subs.subscribe<candidates_t>("CANDIDATES", [this](const candidates_t& m, const std::string&) { on_candidates(m); });
     subs.subscribe<arm_state_t>("ARM_STATE", [this](const arm_state_t& m, const std::string&) { on_arm_state(m); });
     subs.subscribe<axes_t>("AXES", [this](const axes_t& m, const std::string&) { on_axes(m); });
+    subs.subscribe<symmetry_lines_t>("SYMMETRY_LEFT", [this](const symmetry_lines_t& m, const std::string&) { on_lines(true, m); });
+    subs.subscribe<symmetry_lines_t>("SYMMETRY_RIGHT", [this](const symmetry_lines_t& m, const std::string&) { on_lines(false, m); });
     subs.subscribe<image_t>("CAMERA_RIGHT", [this](const image_t& m, const std::string&) { on_frame(m); });
     subs.subscribe<image_t>("SNAPSHOT_RIGHT", [this](const image_t& m, const std::string&) { on_still(m); });
   }
@@ -174,7 +177,7 @@ class Shell {
     }
     last_beat_[m.service] = m.utime;
     newest_beat_ = std::max(newest_beat_, m.utime);
-    if (service_.input_is_log()) check_services(newest_beat_);  // replay: the senders' clocks are the time
+    check_services(service_.input_is_log() ? newest_beat_ : wall_utime());
   }
 
   void on_sim_state(const sim_state_t& m) {
@@ -213,6 +216,13 @@ class Shell {
     drain();
   }
 
+  void on_lines(bool left, const symmetry_lines_t& m) {
+    if (supervisor_.state() != sv::State::FindCandidates) return;
+    std::vector<symmetry::Line> lines;
+    for (const symmetry_line_t& line : m.lines) lines.push_back(bus::from_message(line));
+    supervisor_.on_lines(left, lines, now_);
+  }
+
   void on_frame(const image_t& m) {
     if (supervisor_.state() != sv::State::Nudge) return;  // decoding costs: only while watching
     supervisor_.on_right_frame(bus::to_mat(m), now_);
@@ -230,8 +240,9 @@ class Shell {
     if (!started_) {
       started_ = true;
       const int64_t first_seq = opt_.first_seq > 0 ? opt_.first_seq : 1000 * (wall_utime() / 1000000 % 1000000) + 1;
-      log::info() << "first ARM_COMMAND seq " << first_seq;
-      silent_ = required_;
+      first_seq_ = first_seq;
+      log::info() << "first ARM_COMMAND seq " << first_seq << " (--first-seq to replay this run)";
+      silent_ = silent_services(service_.input_is_log() ? newest_beat_ : wall_utime());
       supervisor_.on_services(silent_, now_);
       supervisor_.start(now_, first_seq);
     }
@@ -239,13 +250,20 @@ class Shell {
     drain();
   }
 
-  void check_services(int64_t reference) {
-    if (!started_) return;
+  // Required services not heard from within the limit of `reference` (live: the wall clock; in a
+  // replay: the newest heartbeat's own time, so that the replay sees what the run saw).
+  std::set<std::string> silent_services(int64_t reference) const {
     std::set<std::string> silent;
     for (const std::string& name : required_) {
       const auto it = last_beat_.find(name);
       if (it == last_beat_.end() || static_cast<double>(reference - it->second) > opt_.service_timeout_s * 1e6) silent.insert(name);
     }
+    return silent;
+  }
+
+  void check_services(int64_t reference) {
+    if (!started_) return;
+    const std::set<std::string> silent = silent_services(reference);
     if (silent == silent_) return;
     silent_ = silent;
     supervisor_.on_services(silent_, now_);
@@ -347,7 +365,8 @@ class Shell {
   void write_summary(const std::string& end_reason) {
     sv::Summary summary = supervisor_.summary();
     summary.end_reason = end_reason;
-    write_file_atomically(run_dir_ + "/summary.json", sv::summary_json(opt_.run_id, summary, attempts_json_) + "\n");
+    write_file_atomically(run_dir_ + "/summary.json",
+                          sv::summary_json(opt_.run_id, first_seq_, summary, attempts_json_) + "\n");
   }
 
   bus::Service& service_;
@@ -358,7 +377,7 @@ class Shell {
   std::string run_dir_;
   std::unique_ptr<RunLog> log_;
   std::map<std::string, int64_t> last_beat_;
-  int64_t newest_beat_ = 0, now_ = 0, next_state_publish_ = 0;
+  int64_t newest_beat_ = 0, now_ = 0, next_state_publish_ = 0, first_seq_ = 0;
   bool started_ = false, finished_ = false, refused_ = false;
   std::vector<std::string> attempts_json_;
 };

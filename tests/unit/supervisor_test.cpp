@@ -165,10 +165,12 @@ TEST(Targets, PushPathConflictsOnlyWithCandidatesInTheSweep) {
   sv::ArmSetup arm;
   sv::TargetParams params;
   const Eigen::Vector3d target(0.25, 0, 0), direction(0, 1, 0);
-  EXPECT_FALSE(sv::push_conflict(target, direction, Eigen::Vector3d(0.25, 0.06, 0), arm, params).empty());   // ahead
-  EXPECT_FALSE(sv::push_conflict(target, direction, Eigen::Vector3d(0.25, -0.10, 0), arm, params).empty());  // where the pad descends
-  EXPECT_TRUE(sv::push_conflict(target, direction, Eigen::Vector3d(0.35, 0.0, 0), arm, params).empty());    // beside
-  EXPECT_TRUE(sv::push_conflict(target, direction, Eigen::Vector3d(0.25, 0.30, 0), arm, params).empty());   // far ahead
+  using Kind = sv::PushConflict::Kind;
+  EXPECT_EQ(sv::push_conflict(target, direction, Eigen::Vector3d(0.25, 0.06, 0), arm, params).kind, Kind::Slide);  // ahead
+  EXPECT_EQ(sv::push_conflict(target, direction, Eigen::Vector3d(0.25, -0.10, 0), arm, params).kind, Kind::Pad);   // where the pad descends
+  EXPECT_EQ(sv::push_conflict(target, direction, Eigen::Vector3d(0.21, -0.03, 0), arm, params).kind, Kind::Pad);   // beside the pad's path
+  EXPECT_EQ(sv::push_conflict(target, direction, Eigen::Vector3d(0.35, 0.0, 0), arm, params).kind, Kind::None);    // beside
+  EXPECT_EQ(sv::push_conflict(target, direction, Eigen::Vector3d(0.25, 0.30, 0), arm, params).kind, Kind::None);   // far ahead
 }
 
 TEST(Targets, NearestTheCameraFirstAndEveryPassOverHasAReason) {

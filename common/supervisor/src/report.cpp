@@ -120,10 +120,10 @@ std::string save_attempt(const std::string& directory, const Attempt& attempt, c
   return folder.string();
 }
 
-std::string summary_json(const std::string& run_id, const Summary& s, const std::vector<std::string>& attempts) {
+std::string summary_json(const std::string& run_id, int64_t first_command_seq, const Summary& s, const std::vector<std::string>& attempts) {
   JsonWriter j(9);
   j.begin_object();
-  j.field("run_id", run_id).field("surveys", s.surveys).field("attempts", s.attempts).field("segmented", s.segmented);
+  j.field("run_id", run_id).field("first_command_seq", static_cast<long long>(first_command_seq)).field("surveys", s.surveys).field("attempts", s.attempts).field("segmented", s.segmented);
   j.field("end_reason", s.end_reason);
   j.key("outcomes").begin_object();
   for (const auto& [outcome, count] : s.outcomes) j.field(outcome, count);

@@ -31,25 +31,57 @@ Eigen::Vector3d SceneGeometry::world_to_right(const Eigen::Vector3d& world_point
 
 Eigen::Vector3d SceneGeometry::right_camera_in_world() const { return arm_to_right_.inverse().t; }
 
-std::optional<cv::Point2d> SceneGeometry::project_right(const Eigen::Vector3d& world_point, cv::Size size) const {
-  const Eigen::Vector3d p = world_to_right(world_point);
+namespace {
+
+// A camera-frame point's pixel at image size `size` (the camera's intrinsics scaled to it: the
+// 1280x960 stills are the same camera at twice the resolution; pixel centres scale about the
+// image's corner, x' + 0.5 = s (x + 0.5)). Nothing for a point behind the camera.
+std::optional<cv::Point2d> project(const geometry::Camera& camera, const Eigen::Vector3d& p, cv::Size size) {
   if (!(p.z() > 1e-6)) return std::nullopt;
-  const Eigen::Vector2d pixel = rig_.right.project(p);
-  // Same camera, other resolution: pixel centres scale about the image's corner (x' + 0.5 = s (x + 0.5)).
-  const double sx = static_cast<double>(size.width) / rig_.right.width;
-  const double sy = static_cast<double>(size.height) / rig_.right.height;
+  const Eigen::Vector2d pixel = camera.project(p);
+  const double sx = static_cast<double>(size.width) / camera.width;
+  const double sy = static_cast<double>(size.height) / camera.height;
   return cv::Point2d(sx * (pixel.x() + 0.5) - 0.5, sy * (pixel.y() + 0.5) - 0.5);
 }
 
-std::optional<symmetry::Line> SceneGeometry::right_axis_line(const Eigen::Vector3d& foot, double height,
-                                                             cv::Size size) const {
-  const Eigen::Vector3d base(foot.x(), foot.y(), 0.0), top(foot.x(), foot.y(), height);
-  const auto a = project_right(base, size), b = project_right(top, size);
+std::optional<symmetry::Line> axis_line(const std::optional<cv::Point2d>& a, const std::optional<cv::Point2d>& b,
+                                        cv::Size size) {
   if (!a || !b || cv::norm(*a - *b) < 1e-6) return std::nullopt;
   symmetry::Line line = line_through(*a, *b, size);
   line.seg1 = *a;
   line.seg2 = *b;
   return line;
+}
+
+Eigen::Vector3d on_table(const Eigen::Vector3d& foot, double height) { return {foot.x(), foot.y(), height}; }
+
+}  // namespace
+
+std::optional<cv::Point2d> SceneGeometry::project_right(const Eigen::Vector3d& world_point, cv::Size size) const {
+  return project(rig_.right, world_to_right(world_point), size);
+}
+
+std::optional<cv::Point2d> SceneGeometry::project_left(const Eigen::Vector3d& world_point, cv::Size size) const {
+  return project(rig_.left, rig_.R.transpose() * (world_to_right(world_point) - rig_.T), size);
+}
+
+std::optional<symmetry::Line> SceneGeometry::left_axis_line(const Eigen::Vector3d& foot, double height, cv::Size size) const {
+  return axis_line(project_left(on_table(foot, 0), size), project_left(on_table(foot, height), size), size);
+}
+
+bool lines_agree(const symmetry::Line& detected, const symmetry::Line& predicted, double max_angle, double max_offset) {
+  double angle = std::abs(detected.theta - predicted.theta);
+  double offset = std::abs(detected.r - predicted.r);
+  if (angle > M_PI / 2) {  // (R, theta) is (-R, theta -+ pi)
+    angle = M_PI - angle;
+    offset = std::abs(detected.r + predicted.r);
+  }
+  return angle <= max_angle && offset <= max_offset;
+}
+
+std::optional<symmetry::Line> SceneGeometry::right_axis_line(const Eigen::Vector3d& foot, double height,
+                                                             cv::Size size) const {
+  return axis_line(project_right(on_table(foot, 0), size), project_right(on_table(foot, height), size), size);
 }
 
 symmetry::Line line_through(const cv::Point2d& a, const cv::Point2d& b, cv::Size size) {

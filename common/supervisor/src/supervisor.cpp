@@ -107,6 +107,7 @@ void Supervisor::survey(int64_t now) {
   }
   ++summary_.surveys;
   request_time_ = now;
+  for (auto& lines : survey_lines_) lines.clear();
   enter(State::FindCandidates, now, "surveying: candidates from " + std::to_string(config_.survey_frames) + " stereo pairs");
   outputs_.push_back(CandidatesRequest{config_.survey_frames, config_.survey_lines});
 }
@@ -237,7 +238,11 @@ void Supervisor::end_attempt(Outcome outcome, const std::string& reason, int64_t
   ++summary_.outcomes[to_string(outcome)];
   if (outcome == Outcome::Segmented) ++summary_.segmented;
   // A place once nudged is not nudged again (unless the attempt never touched it).
-  if (outcome != Outcome::Aborted && outcome != Outcome::SnapshotLost) explored_.push_back(a.target.position);
+  if (outcome != Outcome::Aborted && outcome != Outcome::SnapshotLost) {
+    explored_.push_back(a.target.position);
+    for (const Candidate& c : a.candidates)  // the same object seen at another depth
+      if ((c.position - a.target.position).head<2>().norm() < config_.targets.same_object_radius) explored_.push_back(c.position);
+  }
   if (outcome == Outcome::NoMotion && !a.rest) empty_.push_back(a.target.position);
   if (a.rest) explored_.push_back(*a.rest);
   if (outcome == Outcome::SnapshotLost && a.before.empty()) explored_.push_back(a.target.position);
@@ -318,7 +323,12 @@ void Supervisor::on_candidates(const std::vector<Candidate>& candidates, int64_t
   if (utime < request_time_) return;  // an answer to an older request (or another run's)
   candidates_ = candidates;
   std::string where;
-  for (const Candidate& c : candidates) where += (where.empty() ? " at " : ", ") + millimetres(c.position);
+  for (Candidate& c : candidates_) {
+    c.stereo_agreement = stereo_agreement(c);
+    char agreement[32];
+    std::snprintf(agreement, sizeof agreement, " (seen %.0f%%)", 100 * c.stereo_agreement);
+    where += (where.empty() ? " at " : ", ") + millimetres(c.position) + agreement;
+  }
   enter(State::Choose, now, std::to_string(candidates.size()) + " candidates" + where);
   choose(now);
 }
@@ -360,6 +370,33 @@ void Supervisor::on_right_still(const cv::Mat& still, int64_t utime, int64_t now
     attempt_->after = still.clone();
     segment(now);
   }
+}
+
+void Supervisor::on_lines(bool left, const std::vector<symmetry::Line>& lines, int64_t now) {
+  (void)now;
+  if (state_ != State::FindCandidates) return;
+  auto& kept = survey_lines_[left ? 0 : 1];
+  kept.push_back(lines);
+  if (kept.size() > 50) kept.erase(kept.begin());
+}
+
+double Supervisor::stereo_agreement(const Candidate& candidate) const {
+  const double max_angle = config_.agreement_angle_deg * M_PI / 180;
+  double agreement = 1.0;
+  for (int camera = 0; camera < 2; ++camera) {
+    const auto& messages = survey_lines_[camera];
+    if (messages.empty()) continue;  // no lines heard: no evidence either way
+    const auto predicted = camera == 0 ? scene_.left_axis_line(candidate.position, config_.object_height_m, config_.frame_size)
+                                       : scene_.right_axis_line(candidate.position, config_.object_height_m, config_.frame_size);
+    if (!predicted) return 0.0;
+    int seen = 0;
+    for (const auto& lines : messages)
+      seen += std::any_of(lines.begin(), lines.end(), [&](const symmetry::Line& line) {
+        return lines_agree(line, *predicted, max_angle, config_.agreement_offset_px);
+      });
+    agreement = std::min(agreement, static_cast<double>(seen) / messages.size());
+  }
+  return agreement;
 }
 
 void Supervisor::on_axes(const std::vector<Axis>& axes, int64_t now) {

@@ -39,18 +39,21 @@ Eigen::Vector3d ArmSetup::point_to_base(const Eigen::Vector3d& world) const {
 Eigen::Vector3d ArmSetup::direction_to_base(const Eigen::Vector3d& world) const { return yaw_rotation(-base_yaw) * world; }
 Eigen::Vector3d ArmSetup::direction_to_world(const Eigen::Vector3d& base) const { return yaw_rotation(base_yaw) * base; }
 
-std::string push_conflict(const Eigen::Vector3d& target, const Eigen::Vector3d& direction,
-                          const Eigen::Vector3d& other, const ArmSetup& arm, const TargetParams& params) {
+PushConflict push_conflict(const Eigen::Vector3d& target, const Eigen::Vector3d& direction,
+                           const Eigen::Vector3d& other, const ArmSetup& arm, const TargetParams& params) {
   const Eigen::Vector3d d = horizontal(direction).normalized();
   const Eigen::Vector3d offset = horizontal(other - target);
   const double along = offset.dot(d);
   const double across = (offset - along * d).norm();
-  // The pad descends at P1 (start_distance before the axis) and the object slides up to `travel`
-  // beyond P2; both sweep a band two object radii wide (the pad is narrower than an object).
-  const double behind = arm.nudge.start_distance + params.object_radius;
-  const double ahead = params.travel + 2 * params.object_radius;
-  if (along < -behind || along > ahead || across >= 2 * params.object_radius) return "";
-  return "the push would touch the candidate at " + millimetres(other);
+  // The pad: a segment from P1 (start_distance before the axis) to P2 (stop_distance before it).
+  const double nearest_along = std::clamp(along, -arm.nudge.start_distance, -arm.nudge.stop_distance);
+  const double to_pad = std::hypot(along - nearest_along, across);
+  if (to_pad < params.object_radius + params.pad_half_width)
+    return {PushConflict::Kind::Pad, "the pad would touch the candidate at " + millimetres(other)};
+  // The pushed object slides up to `travel` ahead: a band two object radii wide.
+  if (along >= 0 && along <= params.travel + 2 * params.object_radius && across < 2 * params.object_radius)
+    return {PushConflict::Kind::Slide, "the pushed object may slide into the candidate at " + millimetres(other)};
+  return {};
 }
 
 namespace {
@@ -77,14 +80,17 @@ TargetChoice choose_pass(const std::vector<Candidate>& candidates, const std::ve
     for (const Eigen::Vector3d& direction_base :
          robot::directions_across_view(camera_base, arm.point_to_base(c.position))) {
       const Eigen::Vector3d direction = arm.direction_to_world(direction_base);
-      std::string conflict;
+      PushConflict conflict;
       for (const Candidate& other : candidates) {
         if (other.index == c.index || near_any(other.position, empty, params.explored_radius)) continue;
-        conflict = push_conflict(c.position, direction, other.position, arm, params);
-        if (!conflict.empty()) break;
+        if (other.stereo_agreement < params.min_stereo_agreement) continue;
+        if (horizontal(other.position - c.position).norm() < params.same_object_radius) continue;
+        PushConflict found = push_conflict(c.position, direction, other.position, arm, params);
+        if (found.kind == PushConflict::Kind::Pad || (found && !conflict)) conflict = found;
+        if (conflict.kind == PushConflict::Kind::Pad) break;
       }
-      if (!conflict.empty() && strict) {
-        why_not += std::string(why_not.empty() ? "" : "; the other way: ") + conflict;
+      if (conflict && (strict || conflict.kind == PushConflict::Kind::Pad)) {
+        why_not += std::string(why_not.empty() ? "" : "; the other way: ") + conflict.reason;
         continue;
       }
       robot::NudgePlan plan =
@@ -97,7 +103,7 @@ TargetChoice choose_pass(const std::vector<Candidate>& candidates, const std::ve
       choice.target = c;
       choice.direction = horizontal(direction).normalized();
       choice.plan = std::move(plan);
-      if (!conflict.empty()) choice.note = "no clear push left: nudged although " + conflict;
+      if (conflict) choice.note = "no clear push left: " + conflict.reason;
       return choice;
     }
     reject(why_not);
@@ -113,6 +119,9 @@ TargetChoice choose_target(const std::vector<Candidate>& candidates, const std::
   std::vector<size_t> order(candidates.size());
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    const bool seen_a = candidates[a].stereo_agreement >= params.min_stereo_agreement;
+    const bool seen_b = candidates[b].stereo_agreement >= params.min_stereo_agreement;
+    if (seen_a != seen_b) return seen_a;
     return (candidates[a].position - right_camera).norm() < (candidates[b].position - right_camera).norm();
   });
   const Eigen::Vector3d camera_base = arm.point_to_base(right_camera);

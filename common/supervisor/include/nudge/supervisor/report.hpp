@@ -24,6 +24,6 @@ std::string save_attempt(const std::string& directory, const Attempt& attempt, c
 // One attempt as a JSON object (outcome, reason, target, rest, motion, lines, mask pixels, times).
 std::string attempt_json(const Attempt& attempt);
 // The run's summary: run id, counts, outcomes, the attempts, the end reason.
-std::string summary_json(const std::string& run_id, const Summary& summary, const std::vector<std::string>& attempts_json);
+std::string summary_json(const std::string& run_id, int64_t first_command_seq, const Summary& summary, const std::vector<std::string>& attempts_json);
 
 }  // namespace nudge::supervisor

@@ -38,6 +38,10 @@ class SceneGeometry {
   // tall, in the right camera at `size`; (R, theta) in the project's convention with border ends.
   std::optional<symmetry::Line> right_axis_line(const Eigen::Vector3d& foot, double height, cv::Size size) const;
 
+  // The same for the left camera (the rig's extrinsics: x_right = R x_left + T).
+  std::optional<cv::Point2d> project_left(const Eigen::Vector3d& world_point, cv::Size size) const;
+  std::optional<symmetry::Line> left_axis_line(const Eigen::Vector3d& foot, double height, cv::Size size) const;
+
   const geometry::StereoRig& rig() const { return rig_; }
   const geometry::Plane& table() const { return table_; }
 
@@ -47,6 +51,10 @@ class SceneGeometry {
   geometry::TableFrame table_frame_;
   geometry::RigidTransform arm_to_right_;
 };
+
+// Whether a detected line is the predicted one: angles within `max_angle` (radians) and R within
+// `max_offset` px, comparing (R, theta) in the form nearer the prediction.
+bool lines_agree(const symmetry::Line& detected, const symmetry::Line& predicted, double max_angle, double max_offset);
 
 // The line through two image points in the project's (R, theta) convention for an image of `size`:
 // normal (cos theta, sin theta), theta in (-pi/2, pi/2], R from the image centre ((w-1)/2, (h-1)/2).

@@ -49,11 +49,13 @@ struct Config {
   int min_axes = 3;                  // upright axes near the expected place that confirm the object
   double max_travel_m = 0.12;        // how far beyond its place a nudged object is looked for
   double max_lateral_m = 0.03;       // and how far off the push line
-  double upright_max_tilt_deg = 10;  // thesis ch. 6: within 10 deg of the table normal
+  double upright_max_tilt_deg = 12;  // median tilt; thesis ch. 6 keeps candidates within 10 deg, a settled axis gets 2 deg for noise
   double min_displacement_m = 0.004; // a smaller slide gives no difference to segment
   double object_height_m = 0.25;     // rows watched for motion: table to this height
   cv::Size frame_size{640, 480};     // CAMERA_RIGHT
   cv::Size still_size{1280, 960};    // SNAPSHOT_RIGHT
+  double agreement_angle_deg = 3;    // a detected line is a candidate's: within this angle
+  double agreement_offset_px = 6;    // and this R (at frame_size)
   TargetParams targets;
   MotionWatchParams motion;
   LineSearchParams line_search;
@@ -143,6 +145,9 @@ class Supervisor {
   void on_right_frame(const cv::Mat& frame, int64_t now);
   void on_right_still(const cv::Mat& still, int64_t utime, int64_t now);
   void on_axes(const std::vector<Axis>& axes, int64_t now);
+  // One camera's symmetry lines (SYMMETRY_LEFT / SYMMETRY_RIGHT, 640x480) during a survey: they
+  // tell which candidates both cameras really see (Candidate::stereo_agreement).
+  void on_lines(bool left, const std::vector<symmetry::Line>& lines, int64_t now);
 
   std::vector<Output> take_outputs();
   State state() const { return state_; }
@@ -174,6 +179,8 @@ class Supervisor {
   std::vector<Candidate> candidates_;
   std::vector<Eigen::Vector3d> explored_, empty_;
   std::vector<Axis> settled_axes_;
+  std::vector<std::vector<symmetry::Line>> survey_lines_[2];  // [left, right]: per message, during a survey
+  double stereo_agreement(const Candidate& candidate) const;
   robot::JointVector joints_ = robot::JointVector::Zero();
   std::set<std::string> silent_;
   std::unique_ptr<Attempt> attempt_;

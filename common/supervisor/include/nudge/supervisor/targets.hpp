@@ -34,12 +34,23 @@ struct TargetParams {
   double object_radius = 0.045;   // the largest expected object (thesis: mugs, bottles)
   double travel = 0.04;           // how far a nudged object may slide beyond P2
   double explored_radius = 0.03;  // a candidate this close to a place already explored is skipped
+  double pad_half_width = 0.02;   // the sponge pad across the push direction
+  // Two candidates closer than this cannot both be objects: one is the other seen through a stereo
+  // mismatch (it lies along the same viewing ray). Neither is an obstacle to the other's push, and
+  // nudging one explores both.
+  double same_object_radius = 0.06;
+  // Candidates whose stereo agreement is below this are tried last and are no obstacle to others.
+  double min_stereo_agreement = 0.5;
 };
 
 struct Candidate {
   int index = 0;                   // in the CANDIDATES message
   Eigen::Vector3d position;        // world frame, on the table
   int support = 0;                 // intersects in its cluster
+  // Fraction of the survey's stereo pairs in which BOTH cameras detected a line where this axis
+  // projects. A stereo mismatch (a left line paired with the wrong right line) gives a candidate
+  // along one camera's viewing ray at the wrong depth: the other camera has no line there.
+  double stereo_agreement = 1.0;
 };
 
 struct Rejection {
@@ -62,15 +73,23 @@ struct TargetChoice {
 // places a nudge found nothing at (phantoms): they are no obstacle to other pushes.
 // Beyond the thesis (one object per scene): on a crowded table every push may pass near another
 // candidate, many of them phantoms between two objects. When no push is clear, the nearest
-// candidate the arm can reach is nudged anyway (the nudge is gentle and short) and `note` says
-// which candidate it may touch; the strict rule still decides whenever it can.
+// candidate whose push only risks sliding it into another candidate is nudged anyway (the nudge
+// is gentle and short) and `note` says which; the pad itself never descends onto or sweeps
+// through another candidate, and the strict rule decides whenever it can.
 TargetChoice choose_target(const std::vector<Candidate>& candidates, const std::vector<Eigen::Vector3d>& explored,
                            const std::vector<Eigen::Vector3d>& empty, const Eigen::Vector3d& right_camera,
                            const ArmSetup& arm, const robot::JointVector& seed, const TargetParams& params = {});
 
-// Why pushing `target` along `direction` would touch `other` (empty if it would not): the pad's
-// sweep from P1 to P2 and the object's slide beyond, widened by two object radii.
-std::string push_conflict(const Eigen::Vector3d& target, const Eigen::Vector3d& direction,
-                          const Eigen::Vector3d& other, const ArmSetup& arm, const TargetParams& params);
+// Whether pushing `target` along `direction` would touch `other`, and how: the pad itself on its
+// way down at P1 and along P1 -> P2 (never acceptable), or the pushed object sliding into it
+// (acceptable on a crowded table where `other` may be a phantom).
+struct PushConflict {
+  enum class Kind { None, Pad, Slide };
+  Kind kind = Kind::None;
+  std::string reason;
+  explicit operator bool() const { return kind != Kind::None; }
+};
+PushConflict push_conflict(const Eigen::Vector3d& target, const Eigen::Vector3d& direction,
+                           const Eigen::Vector3d& other, const ArmSetup& arm, const TargetParams& params);
 
 }  // namespace nudge::supervisor
