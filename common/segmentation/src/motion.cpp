@@ -246,6 +246,97 @@ void draw_line(cv::Mat& image, const symmetry::Line& line, const cv::Scalar& col
   cv::line(image, cv::Point(cvRound(a.x), cvRound(a.y)), cv::Point(cvRound(b.x), cvRound(b.y)), colour, 2, cv::LINE_AA);
 }
 
+// The rigid motion between two lines: a point at `from`'s position -> the point with the same
+// offset from `to`'s line and distance along it. Input coordinates counted from `origin`, output
+// in image coordinates.
+cv::Matx23d line_to_line(const LineFrame& to, const LineFrame& from, cv::Point origin) {
+  const LineFrame& before = to;
+  const LineFrame& after = from;
+  const cv::Matx22d rotation(before.normal.x * after.normal.x + before.direction.x * after.direction.x,
+                             before.normal.x * after.normal.y + before.direction.x * after.direction.y,
+                             before.normal.y * after.normal.x + before.direction.y * after.direction.x,
+                             before.normal.y * after.normal.y + before.direction.y * after.direction.y);
+  const cv::Vec2d foot_before(before.centre.x + before.r * before.normal.x, before.centre.y + before.r * before.normal.y);
+  const cv::Vec2d foot_after(after.centre.x + after.r * after.normal.x, after.centre.y + after.r * after.normal.y);
+  const cv::Vec2d offset = foot_before - rotation * foot_after + rotation * cv::Vec2d(origin.x, origin.y);
+  return cv::Matx23d(rotation(0, 0), rotation(0, 1), offset[0], rotation(1, 0), rotation(1, 1), offset[1]);
+}
+
+template <int kChannels>
+int channel_max_change(const uint8_t* a, const uint8_t* b) {
+  int change = 0;
+  for (int c = 0; c < kChannels; ++c) change = std::max(change, std::abs(int(a[c]) - int(b[c])));
+  return change;
+}
+
+// The candidate pixels of attach_rigid_parts within `roi` (255 = candidate). One pass: most
+// pixels did not change and cost one comparison; the maps are only evaluated for the others.
+template <int kChannels>
+cv::Mat rigid_candidates(const cv::Mat& before, const cv::Mat& after, const cv::Mat& mask, const cv::Matx23d& to_before,
+                         const cv::Matx23d& to_after, int changed_level, int rigid_tolerance, const cv::Rect& roi) {
+  cv::Mat candidate(roi.size(), CV_8U, cv::Scalar(0));
+  const cv::Rect image(0, 0, after.cols, after.rows);
+  for (int y = 0; y < roi.height; ++y) {
+    const uint8_t* after_row = after.ptr<uint8_t>(roi.y + y) + kChannels * roi.x;
+    const uint8_t* before_row = before.ptr<uint8_t>(roi.y + y) + kChannels * roi.x;
+    uint8_t* out = candidate.ptr<uint8_t>(y);
+    for (int x = 0; x < roi.width; ++x) {
+      const uint8_t* here = after_row + kChannels * x;
+      if (channel_max_change<kChannels>(here, before_row + kChannels * x) < changed_level) continue;
+      // Where the symmetric mask was before the move: the object uncovered this pixel.
+      const cv::Point back(cvRound(to_after(0, 0) * x + to_after(0, 1) * y + to_after(0, 2)),
+                           cvRound(to_after(1, 0) * x + to_after(1, 1) * y + to_after(1, 2)));
+      if (image.contains(back) && mask.at<uint8_t>(back)) continue;
+      const cv::Point there(cvRound(to_before(0, 0) * x + to_before(0, 1) * y + to_before(0, 2)),
+                            cvRound(to_before(1, 0) * x + to_before(1, 1) * y + to_before(1, 2)));
+      if (!image.contains(there)) continue;
+      if (channel_max_change<kChannels>(here, before.ptr<uint8_t>(there.y) + kChannels * there.x) <= rigid_tolerance)
+        out[x] = 255;
+    }
+  }
+  return candidate;
+}
+
+// Adds to `mask` the asymmetric parts (a mug's handle) that moved rigidly with the object and
+// touch the symmetric mask, within `reach` px of its box. A pixel p at the after position
+// belongs to the object if it changed (|after - before| at p), lies outside the object's
+// symmetric mask at its before position (there the object uncovered the background: the ghost
+// strip behind it), and the after image at p matches the before image at p's before position q
+// (p moved back with the lines): the same surface. An arm or a hand that appeared does not match.
+// Returns the new box.
+cv::Rect attach_rigid_parts(const cv::Mat& before, const cv::Mat& after, const LineFrame& frame_before,
+                            const LineFrame& frame_after, int changed_level, int rigid_tolerance, int reach,
+                            const cv::Rect& box, cv::Mat& mask) {
+  const cv::Rect roi = cv::Rect(box.x - reach, box.y - reach, box.width + 2 * reach, box.height + 2 * reach) &
+                       cv::Rect(0, 0, after.cols, after.rows);
+  // After position -> before position, and the symmetric mask's position before the move.
+  const cv::Matx23d to_before = line_to_line(frame_before, frame_after, roi.tl());
+  const cv::Matx23d to_after = line_to_line(frame_after, frame_before, roi.tl());
+  cv::Mat candidate =
+      after.channels() == 3
+          ? rigid_candidates<3>(before, after, mask, to_before, to_after, changed_level, rigid_tolerance, roi)
+          : rigid_candidates<1>(before, after, mask, to_before, to_after, changed_level, rigid_tolerance, roi);
+  // Single pixels matching by chance on textured backgrounds go; parts a few px thick stay.
+  cv::morphologyEx(candidate, candidate, cv::MORPH_OPEN, cv::getStructuringElement(cv::MORPH_RECT, {3, 3}));
+  cv::Mat core = mask(roi);  // a view: writes go to mask
+  cv::Mat labels;
+  const int count = cv::connectedComponents(candidate | core, labels, 8, CV_32S);
+  std::vector<uint8_t> touches(count, 0);
+  for (int y = 0; y < roi.height; ++y) {
+    const uint8_t* in_core = core.ptr<uint8_t>(y);
+    const int* label = labels.ptr<int>(y);
+    for (int x = 0; x < roi.width; ++x)
+      if (in_core[x]) touches[label[x]] = 1;
+  }
+  for (int y = 0; y < roi.height; ++y) {
+    uint8_t* out = core.ptr<uint8_t>(y);
+    const int* label = labels.ptr<int>(y);
+    for (int x = 0; x < roi.width; ++x)
+      if (label[x] > 0 && touches[label[x]]) out[x] = 255;
+  }
+  return roi;
+}
+
 }  // namespace
 
 void validate(const MotionParams& params) {
@@ -258,6 +349,8 @@ void validate(const MotionParams& params) {
   if (params.max_row_gap < 0 || params.max_row_gap > 1000) fail("max_row_gap must be in [0, 1000] rows");
   if (params.min_area < 0) fail("min_area must be >= 0");
   if (!(params.max_rotation_deg >= 0 && params.max_rotation_deg < 90)) fail("max_rotation_deg must be in [0, 90)");
+  if (params.attach_reach < 0 || params.attach_reach > 10000) fail("attach_reach must be in [0, 10000] px");
+  if (!(params.rigid_tolerance >= 0 && params.rigid_tolerance <= 255)) fail("rigid_tolerance must be in [0, 255]");
 }
 
 MotionSegmenter::MotionSegmenter(MotionParams params) : params_(params) { validate(params_); }
@@ -332,7 +425,10 @@ MotionSegmentation MotionSegmenter::segment(const cv::Mat& before, const cv::Mat
   keep_largest_run(half_width);
 
   // (f) the mask at the after position, and the cut-out.
-  const cv::Rect box = fill_mask(half_width, frame_after, first_row, result.mask);
+  cv::Rect box = fill_mask(half_width, frame_after, first_row, result.mask);
+  if (params_.attach_rigid_parts && !box.empty() && params_.attach_reach > 0)
+    box = attach_rigid_parts(before, after, frame_before, frame_after, noise_floor + threshold,
+                             static_cast<int>(params_.rigid_tolerance), params_.attach_reach, box, result.mask);
   result.area = box.empty() ? 0 : cv::countNonZero(result.mask(box));
   if (result.area < params_.min_area || result.area == 0) {
     std::ostringstream out;

@@ -16,9 +16,9 @@
 //   threshold        (e) >= threshold, rows shorter than min_vertical_run dropped, gaps up to
 //                    max_row_gap rows bridged, the largest run of rows kept: the object's mask in
 //                    the line frame;
-//   (f) result       the mask placed at the object's AFTER position, and the after image cut out.
-// The mask is symmetric about the after line by construction: asymmetric parts (a mug's handle)
-// are left out (docs/segmentation_geometry.md).
+//   (f) result       the mask placed at the object's AFTER position, plus the asymmetric parts
+//                    attached to it that moved rigidly with the lines (a mug's handle; an arm that
+//                    appeared in the after image does not), and the after image cut out.
 #include <opencv2/core.hpp>
 
 #include <string>
@@ -50,6 +50,14 @@ struct MotionParams {
   int min_area = 100;
   // The lines' orientations may differ by at most this much (the object turned in the image).
   double max_rotation_deg = 20;
+  // Asymmetric parts (a mug's handle): add the pixels within attach_reach px of the symmetric
+  // mask's box, connected to it, that moved rigidly with the lines: changed here, outside the
+  // symmetric mask moved back to the before position (the strip the object uncovered), and the
+  // after image here matches the before image where the lines' motion says the point came from,
+  // within rigid_tolerance grey levels (an arm that appeared does not).
+  bool attach_rigid_parts = true;
+  int attach_reach = 100;
+  double rigid_tolerance = 30;
 };
 
 // Throws std::invalid_argument naming the offending parameter.
