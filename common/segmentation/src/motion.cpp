@@ -318,6 +318,7 @@ cv::Rect attach_rigid_parts(const cv::Mat& before, const cv::Mat& after, const L
           : rigid_candidates<1>(before, after, mask, to_before, to_after, changed_level, rigid_tolerance, roi);
   // Single pixels matching by chance on textured backgrounds go; parts a few px thick stay.
   cv::morphologyEx(candidate, candidate, cv::MORPH_OPEN, cv::getStructuringElement(cv::MORPH_RECT, {3, 3}));
+  if (cv::countNonZero(candidate) == 0) return box;  // nothing to attach: skip the labelling
   cv::Mat core = mask(roi);  // a view: writes go to mask
   cv::Mat labels;
   const int count = cv::connectedComponents(candidate | core, labels, 8, CV_32S);
