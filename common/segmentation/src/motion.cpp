@@ -338,6 +338,70 @@ cv::Rect attach_rigid_parts(const cv::Mat& before, const cv::Mat& after, const L
   return roi;
 }
 
+struct Compressed {
+  int first_row = 0;    // row 0 of the line-frame images lies this far along the lines
+  int noise_floor = 0;  // grey levels subtracted from the difference
+};
+
+// (c) the difference and its noise floor, only where the line-frame image will sample it; (d)
+// compression: the leading half (in the direction of motion) sampled beyond the after line, the
+// trailing half beyond the before line, the strip between the lines dropped; then the blur.
+// Leaves the result in scratch.blurred.
+Compressed compress(const cv::Mat& before, const cv::Mat& after, const LineFrame& frame_before,
+                    const LineFrame& frame_after, bool leading_is_positive, const MotionParams& params,
+                    detail::MotionScratch& scratch) {
+  Compressed out;
+  int last_row = 0, first_b = 0, last_b = 0;
+  detail::row_range(frame_after, after.cols, after.rows, &out.first_row, &last_row);
+  detail::row_range(frame_before, before.cols, before.rows, &first_b, &last_b);
+  out.first_row = std::min(out.first_row, first_b);
+  last_row = std::max(last_row, last_b);
+  const int centre = params.max_half_width;
+
+  const cv::Rect band = band_around(frame_after, frame_before, centre + 2, out.first_row, last_row, after.size());
+  channel_max_difference(before(band), after(band), scratch.colour_difference, scratch.difference);
+  out.noise_floor = params.subtract_noise_floor ? median_level(scratch.difference) : 0;
+  LineFrame band_after = frame_after, band_before = frame_before;  // the same lines, the band's origin
+  band_after.centre -= cv::Point2d(band.tl());
+  band_before.centre -= cv::Point2d(band.tl());
+
+  cv::Mat& compressed = scratch.compressed;
+  compressed.create(last_row - out.first_row + 1, 2 * centre + 1, CV_8U);
+  const int after_x0 = leading_is_positive ? centre : 0;
+  const int before_x0 = leading_is_positive ? 0 : centre + 1;
+  sample_in_frame(scratch.difference, band_after, centre, after_x0, out.first_row,
+                  compressed.colRange(after_x0, after_x0 + centre + 1));
+  sample_in_frame(scratch.difference, band_before, centre, before_x0, out.first_row,
+                  compressed.colRange(before_x0, before_x0 + centre));
+  if (out.noise_floor > 0) cv::subtract(compressed, cv::Scalar(out.noise_floor), compressed);
+  if (params.blur_sigma > 0)
+    cv::GaussianBlur(compressed, scratch.blurred, kernel_size(params.blur_sigma), params.blur_sigma);
+  else
+    compressed.copyTo(scratch.blurred);
+  return out;
+}
+
+// (e) symmetric filling of scratch.blurred into scratch.refined, the threshold row by row, and
+// the cleaning along the line: each row's half-width about the merged line, -1 = not object.
+std::vector<int> symmetric_rows(const MotionParams& params, detail::MotionScratch& scratch) {
+  const cv::Mat& blurred = scratch.blurred;
+  if (params.mirror_tolerance > 0)
+    cv::dilate(blurred, scratch.dilated,
+               cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * params.mirror_tolerance + 1, 1)));
+  else
+    blurred.copyTo(scratch.dilated);
+  scratch.refined.create(blurred.size(), CV_8U);
+  const int threshold = static_cast<int>(std::ceil(params.threshold));
+  std::vector<int> half_width(blurred.rows);
+  for (int y = 0; y < blurred.rows; ++y)
+    half_width[y] = fill_row(blurred.ptr<uint8_t>(y), scratch.dilated.ptr<uint8_t>(y), params.max_half_width, threshold,
+                             scratch.refined.ptr<uint8_t>(y));
+  half_width = morph_rows(half_width, params.min_vertical_run, true);
+  half_width = morph_rows(half_width, params.max_row_gap + 2, false);
+  keep_largest_run(half_width);
+  return half_width;
+}
+
 }  // namespace
 
 void validate(const MotionParams& params) {
@@ -380,56 +444,12 @@ MotionSegmentation MotionSegmenter::segment(const cv::Mat& before, const cv::Mat
     return result;
   }
 
-  int first_row = 0, last_row = 0, first_b = 0, last_b = 0;
-  detail::row_range(frame_after, after.cols, after.rows, &first_row, &last_row);
-  detail::row_range(frame_before, before.cols, before.rows, &first_b, &last_b);
-  first_row = std::min(first_row, first_b);
-  last_row = std::max(last_row, last_b);
-  const int centre = params_.max_half_width, columns = 2 * centre + 1;
-
-  // (c) the difference and its noise floor, only where the line-frame image will sample it.
-  const cv::Rect band = band_around(frame_after, frame_before, centre + 2, first_row, last_row, after.size());
-  channel_max_difference(before(band), after(band), colour_difference_, difference_);
-  const int noise_floor = params_.subtract_noise_floor ? median_level(difference_) : 0;
-  LineFrame band_after = frame_after, band_before = frame_before;  // the same lines, the band's origin
-  band_after.centre -= cv::Point2d(band.tl());
-  band_before.centre -= cv::Point2d(band.tl());
-
-  // (d) compression: the leading half (in the direction of motion) beyond the after line, the
-  // trailing half beyond the before line; the strip between the lines is dropped.
-  compressed_.create(last_row - first_row + 1, columns, CV_8U);
-  const bool leading_is_positive = result.shift >= 0;
-  const int after_x0 = leading_is_positive ? centre : 0;
-  const int before_x0 = leading_is_positive ? 0 : centre + 1;
-  sample_in_frame(difference_, band_after, centre, after_x0, first_row,
-                  compressed_.colRange(after_x0, after_x0 + centre + 1));
-  sample_in_frame(difference_, band_before, centre, before_x0, first_row,
-                  compressed_.colRange(before_x0, before_x0 + centre));
-  if (noise_floor > 0) cv::subtract(compressed_, cv::Scalar(noise_floor), compressed_);
-  if (params_.blur_sigma > 0)
-    cv::GaussianBlur(compressed_, blurred_, kernel_size(params_.blur_sigma), params_.blur_sigma);
-  else
-    compressed_.copyTo(blurred_);
-
-  // (e) symmetric filling, then the threshold row by row.
-  if (params_.mirror_tolerance > 0)
-    cv::dilate(blurred_, dilated_, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * params_.mirror_tolerance + 1, 1)));
-  else
-    blurred_.copyTo(dilated_);
-  refined_.create(blurred_.size(), CV_8U);
+  const Compressed compressed = compress(before, after, frame_before, frame_after, result.shift >= 0, params_, scratch_);
+  const std::vector<int> half_width = symmetric_rows(params_, scratch_);
   const int threshold = static_cast<int>(std::ceil(params_.threshold));
-  std::vector<int> half_width(blurred_.rows);
-  for (int y = 0; y < blurred_.rows; ++y)
-    half_width[y] = fill_row(blurred_.ptr<uint8_t>(y), dilated_.ptr<uint8_t>(y), centre, threshold, refined_.ptr<uint8_t>(y));
-  half_width = morph_rows(half_width, params_.min_vertical_run, true);
-  half_width = morph_rows(half_width, params_.max_row_gap + 2, false);
-  keep_largest_run(half_width);
 
-  // (f) the mask at the after position, and the cut-out.
-  cv::Rect box = fill_mask(half_width, frame_after, first_row, result.mask);
-  if (params_.attach_rigid_parts && !box.empty() && params_.attach_reach > 0)
-    box = attach_rigid_parts(before, after, frame_before, frame_after, noise_floor + threshold,
-                             static_cast<int>(params_.rigid_tolerance), params_.attach_reach, box, result.mask);
+  // (f) the mask at the after position (plus what moved with it), and the cut-out.
+  cv::Rect box = fill_mask(half_width, frame_after, compressed.first_row, result.mask);
   result.area = box.empty() ? 0 : cv::countNonZero(result.mask(box));
   if (result.area < params_.min_area || result.area == 0) {
     std::ostringstream out;
@@ -439,6 +459,11 @@ MotionSegmentation MotionSegmenter::segment(const cv::Mat& before, const cv::Mat
     result.mask.setTo(0);
     result.area = 0;
   } else {
+    if (params_.attach_rigid_parts && params_.attach_reach > 0) {
+      box = attach_rigid_parts(before, after, frame_before, frame_after, compressed.noise_floor + threshold,
+                               static_cast<int>(params_.rigid_tolerance), params_.attach_reach, box, result.mask);
+      result.area = cv::countNonZero(result.mask(box));
+    }
     result.found = true;
     result.bounding_box = cv::boundingRect(result.mask(box)) + box.tl();
     after(box).copyTo(result.cutout(box), result.mask(box));
@@ -447,16 +472,16 @@ MotionSegmentation MotionSegmenter::segment(const cv::Mat& before, const cv::Mat
   if (stages) {
     stages->before = before.clone();
     stages->after = after.clone();
-    channel_max_difference(before, after, colour_difference_, stages->difference);  // the whole image
-    stages->compressed = blurred_.clone();
-    stages->refined = refined_.clone();
-    stages->line_frame_mask = line_frame_mask(half_width, columns);
+    channel_max_difference(before, after, scratch_.colour_difference, stages->difference);  // the whole image
+    stages->compressed = scratch_.blurred.clone();
+    stages->refined = scratch_.refined.clone();
+    stages->line_frame_mask = line_frame_mask(half_width, scratch_.blurred.cols);
     stages->mask = result.mask.clone();
     stages->cutout = result.cutout.clone();
     stages->line_before = line_before_in;
     stages->line_after = line_after;
-    stages->first_row = first_row;
-    stages->noise_floor = noise_floor;
+    stages->first_row = compressed.first_row;
+    stages->noise_floor = compressed.noise_floor;
   }
   return result;
 }

@@ -98,8 +98,15 @@ struct MotionSegmentation {
   double rotation = 0;
 };
 
-// Keeps its scratch images between calls (a 1280x960 pair allocates nothing after the first):
-// one instance per thread.
+namespace detail {
+// The images MotionSegmenter reuses between calls.
+struct MotionScratch {
+  cv::Mat colour_difference, difference, compressed, blurred, dilated, refined;
+};
+}  // namespace detail
+
+// Keeps its scratch images between calls (a 1280x960 pair allocates only its results after the
+// first): one instance per thread.
 class MotionSegmenter {
  public:
   explicit MotionSegmenter(MotionParams params = {});  // validates
@@ -112,7 +119,7 @@ class MotionSegmenter {
 
  private:
   MotionParams params_;
-  cv::Mat difference_, colour_difference_, compressed_, blurred_, dilated_, refined_;
+  detail::MotionScratch scratch_;
 };
 
 // One-shot convenience around MotionSegmenter.
