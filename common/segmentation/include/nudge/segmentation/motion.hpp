@@ -9,10 +9,10 @@
 //                    on the leading side of the motion is taken beyond the AFTER line, the half on
 //                    the trailing side beyond the BEFORE line, and the pixels between the lines are
 //                    dropped, so the two lines merge into one (column max_half_width);
-//   (e) refined      symmetric filling: in each row, every pixel out to the outermost pair of
-//                    moving pixels mirrored about the merged line gets that pair's (weaker)
-//                    strength. Motion whose mirror did not move (an arm, a hand, another object)
-//                    does not count;
+//   (e) refined      symmetric filling: in each row, a pair of pixels mirrored about the merged
+//                    line is as strong as its weaker side, and every pixel gets the strongest
+//                    pair at or beyond it. Motion whose mirror did not move (an arm, a hand,
+//                    another object) does not count;
 //   threshold        (e) >= threshold, rows shorter than min_vertical_run dropped, gaps up to
 //                    max_row_gap rows bridged, the largest run of rows kept: the object's mask in
 //                    the line frame;
@@ -71,8 +71,8 @@ struct MotionStages {
   cv::Mat difference;        // (c) CV_8U, image frame, noise floor not yet subtracted
   cv::Mat compressed;        // (d) CV_8U, line frame, noise floor subtracted, blurred
   cv::Mat refined;           // (e) CV_8U, line frame, symmetric filling
-  cv::Mat line_frame_mask;   // (e) thresholded, cleaned: CV_8U, 255 = object
-  cv::Mat mask;              // CV_8U, after image frame, 255 = object
+  cv::Mat line_frame_mask;   // (e) thresholded, cleaned: CV_8U, 255 = object (the symmetric part)
+  cv::Mat mask;              // CV_8U, after image frame, 255 = object (attached parts included)
   cv::Mat cutout;            // (f) the after image where mask, 0 elsewhere
   symmetry::Line line_before, line_after;
   int first_row = 0;
