@@ -77,7 +77,8 @@ double iou(const cv::Mat& a, const cv::Mat& b) {
   return static_cast<double>(cv::countNonZero(a & b)) / std::max(1, cv::countNonZero(a | b));
 }
 
-// range(0): 0 = colour pair, 1 = grey pair; range(1): 1 = also fill fig. 6.7's stages.
+// range(0): 0 = colour pair, 1 = grey pair; range(1): 1 = also fill fig. 6.7's stages;
+// range(2): 1 = attach asymmetric parts that moved with the object (the default), 0 = symmetric mask only.
 void BM_MotionSegment(benchmark::State& state) {
   cv::setNumThreads(0);  // one thread: OpenCV's parallel_for off
   const Pair& p = pair();
@@ -86,7 +87,9 @@ void BM_MotionSegment(benchmark::State& state) {
     cv::cvtColor(p.before, before, cv::COLOR_BGR2GRAY);
     cv::cvtColor(p.after, after, cv::COLOR_BGR2GRAY);
   }
-  seg::MotionSegmenter segmenter;
+  seg::MotionParams params;
+  params.attach_rigid_parts = state.range(2) != 0;
+  seg::MotionSegmenter segmenter(params);
   seg::MotionStages stages;
   seg::MotionStages* want_stages = state.range(1) ? &stages : nullptr;
   seg::MotionSegmentation result = segmenter.segment(before, after, p.line_before, p.line_after, want_stages);
@@ -104,5 +107,10 @@ void BM_MotionSegment(benchmark::State& state) {
 
 }  // namespace
 
-BENCHMARK(BM_MotionSegment)->Args({0, 0})->Args({1, 0})->Args({0, 1})->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_MotionSegment)
+    ->Args({0, 0, 1})
+    ->Args({0, 0, 0})
+    ->Args({1, 0, 1})
+    ->Args({0, 1, 1})
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK_MAIN();

@@ -102,3 +102,15 @@ TEST(MotionSegmentationSim, PusherPadBehindTheCupStaysOut) {
   EXPECT_GE(iou(result.mask, nudge.truth_after), 0.9);
   EXPECT_LE(cv::countNonZero(result.mask & nudge.pad & ~nudge.truth_after), 0.05 * cv::countNonZero(nudge.pad));
 }
+
+TEST(MotionSegmentationSim, CheckeredMugAmongOtherObjects) {
+  // three_objects.yaml: a checkered mug between a cup and a bottle on a plain table. Its handle is
+  // only partly recovered (moving 3 cm turns it a little in perspective and changes its shading,
+  // so the after image does not match the before image point for point there).
+  const SimNudge nudge = nudge_in_sim("three_objects.yaml", "red_mug", 2.0);
+  ASSERT_GT(cv::countNonZero(nudge.truth_after), 1000);
+  const seg::MotionSegmentation result =
+      seg::segment_by_motion(nudge.before, nudge.after, nudge.line_before, nudge.line_after);
+  ASSERT_TRUE(result.found) << result.reason;
+  EXPECT_GE(iou(result.mask, nudge.truth_after), 0.85);
+}

@@ -246,6 +246,162 @@ void draw_line(cv::Mat& image, const symmetry::Line& line, const cv::Scalar& col
   cv::line(image, cv::Point(cvRound(a.x), cvRound(a.y)), cv::Point(cvRound(b.x), cvRound(b.y)), colour, 2, cv::LINE_AA);
 }
 
+// The rigid motion between two lines: a point at `from`'s position -> the point with the same
+// offset from `to`'s line and distance along it. Input coordinates counted from `origin`, output
+// in image coordinates.
+cv::Matx23d line_to_line(const LineFrame& to, const LineFrame& from, cv::Point origin) {
+  const LineFrame& before = to;
+  const LineFrame& after = from;
+  const cv::Matx22d rotation(before.normal.x * after.normal.x + before.direction.x * after.direction.x,
+                             before.normal.x * after.normal.y + before.direction.x * after.direction.y,
+                             before.normal.y * after.normal.x + before.direction.y * after.direction.x,
+                             before.normal.y * after.normal.y + before.direction.y * after.direction.y);
+  const cv::Vec2d foot_before(before.centre.x + before.r * before.normal.x, before.centre.y + before.r * before.normal.y);
+  const cv::Vec2d foot_after(after.centre.x + after.r * after.normal.x, after.centre.y + after.r * after.normal.y);
+  const cv::Vec2d offset = foot_before - rotation * foot_after + rotation * cv::Vec2d(origin.x, origin.y);
+  return cv::Matx23d(rotation(0, 0), rotation(0, 1), offset[0], rotation(1, 0), rotation(1, 1), offset[1]);
+}
+
+template <int kChannels>
+int channel_max_change(const uint8_t* a, const uint8_t* b) {
+  int change = 0;
+  for (int c = 0; c < kChannels; ++c) change = std::max(change, std::abs(int(a[c]) - int(b[c])));
+  return change;
+}
+
+// The candidate pixels of attach_rigid_parts within `roi` (255 = candidate). One pass: most
+// pixels did not change and cost one comparison; the maps are only evaluated for the others.
+template <int kChannels>
+cv::Mat rigid_candidates(const cv::Mat& before, const cv::Mat& after, const cv::Mat& mask, const cv::Matx23d& to_before,
+                         const cv::Matx23d& to_after, int changed_level, int rigid_tolerance, const cv::Rect& roi) {
+  cv::Mat candidate(roi.size(), CV_8U, cv::Scalar(0));
+  const cv::Rect image(0, 0, after.cols, after.rows);
+  for (int y = 0; y < roi.height; ++y) {
+    const uint8_t* after_row = after.ptr<uint8_t>(roi.y + y) + kChannels * roi.x;
+    const uint8_t* before_row = before.ptr<uint8_t>(roi.y + y) + kChannels * roi.x;
+    uint8_t* out = candidate.ptr<uint8_t>(y);
+    for (int x = 0; x < roi.width; ++x) {
+      const uint8_t* here = after_row + kChannels * x;
+      if (channel_max_change<kChannels>(here, before_row + kChannels * x) < changed_level) continue;
+      // Where the symmetric mask was before the move: the object uncovered this pixel.
+      const cv::Point back(cvRound(to_after(0, 0) * x + to_after(0, 1) * y + to_after(0, 2)),
+                           cvRound(to_after(1, 0) * x + to_after(1, 1) * y + to_after(1, 2)));
+      if (image.contains(back) && mask.at<uint8_t>(back)) continue;
+      const cv::Point there(cvRound(to_before(0, 0) * x + to_before(0, 1) * y + to_before(0, 2)),
+                            cvRound(to_before(1, 0) * x + to_before(1, 1) * y + to_before(1, 2)));
+      if (!image.contains(there)) continue;
+      if (channel_max_change<kChannels>(here, before.ptr<uint8_t>(there.y) + kChannels * there.x) <= rigid_tolerance)
+        out[x] = 255;
+    }
+  }
+  return candidate;
+}
+
+// Adds to `mask` the asymmetric parts (a mug's handle) that moved rigidly with the object and
+// touch the symmetric mask, within `reach` px of its box. A pixel p at the after position
+// belongs to the object if it changed (|after - before| at p), lies outside the object's
+// symmetric mask at its before position (there the object uncovered the background: the ghost
+// strip behind it), and the after image at p matches the before image at p's before position q
+// (p moved back with the lines): the same surface. An arm or a hand that appeared does not match.
+// Returns the new box.
+cv::Rect attach_rigid_parts(const cv::Mat& before, const cv::Mat& after, const LineFrame& frame_before,
+                            const LineFrame& frame_after, int changed_level, int rigid_tolerance, int reach,
+                            const cv::Rect& box, cv::Mat& mask) {
+  const cv::Rect roi = cv::Rect(box.x - reach, box.y - reach, box.width + 2 * reach, box.height + 2 * reach) &
+                       cv::Rect(0, 0, after.cols, after.rows);
+  // After position -> before position, and the symmetric mask's position before the move.
+  const cv::Matx23d to_before = line_to_line(frame_before, frame_after, roi.tl());
+  const cv::Matx23d to_after = line_to_line(frame_after, frame_before, roi.tl());
+  cv::Mat candidate =
+      after.channels() == 3
+          ? rigid_candidates<3>(before, after, mask, to_before, to_after, changed_level, rigid_tolerance, roi)
+          : rigid_candidates<1>(before, after, mask, to_before, to_after, changed_level, rigid_tolerance, roi);
+  // Single pixels matching by chance on textured backgrounds go; parts a few px thick stay.
+  cv::morphologyEx(candidate, candidate, cv::MORPH_OPEN, cv::getStructuringElement(cv::MORPH_RECT, {3, 3}));
+  if (cv::countNonZero(candidate) == 0) return box;  // nothing to attach: skip the labelling
+  cv::Mat core = mask(roi);  // a view: writes go to mask
+  cv::Mat labels;
+  const int count = cv::connectedComponents(candidate | core, labels, 8, CV_32S);
+  std::vector<uint8_t> touches(count, 0);
+  for (int y = 0; y < roi.height; ++y) {
+    const uint8_t* in_core = core.ptr<uint8_t>(y);
+    const int* label = labels.ptr<int>(y);
+    for (int x = 0; x < roi.width; ++x)
+      if (in_core[x]) touches[label[x]] = 1;
+  }
+  for (int y = 0; y < roi.height; ++y) {
+    uint8_t* out = core.ptr<uint8_t>(y);
+    const int* label = labels.ptr<int>(y);
+    for (int x = 0; x < roi.width; ++x)
+      if (label[x] > 0 && touches[label[x]]) out[x] = 255;
+  }
+  return roi;
+}
+
+struct Compressed {
+  int first_row = 0;    // row 0 of the line-frame images lies this far along the lines
+  int noise_floor = 0;  // grey levels subtracted from the difference
+};
+
+// (c) the difference and its noise floor, only where the line-frame image will sample it; (d)
+// compression: the leading half (in the direction of motion) sampled beyond the after line, the
+// trailing half beyond the before line, the strip between the lines dropped; then the blur.
+// Leaves the result in scratch.blurred.
+Compressed compress(const cv::Mat& before, const cv::Mat& after, const LineFrame& frame_before,
+                    const LineFrame& frame_after, bool leading_is_positive, const MotionParams& params,
+                    detail::MotionScratch& scratch) {
+  Compressed out;
+  int last_row = 0, first_b = 0, last_b = 0;
+  detail::row_range(frame_after, after.cols, after.rows, &out.first_row, &last_row);
+  detail::row_range(frame_before, before.cols, before.rows, &first_b, &last_b);
+  out.first_row = std::min(out.first_row, first_b);
+  last_row = std::max(last_row, last_b);
+  const int centre = params.max_half_width;
+
+  const cv::Rect band = band_around(frame_after, frame_before, centre + 2, out.first_row, last_row, after.size());
+  channel_max_difference(before(band), after(band), scratch.colour_difference, scratch.difference);
+  out.noise_floor = params.subtract_noise_floor ? median_level(scratch.difference) : 0;
+  LineFrame band_after = frame_after, band_before = frame_before;  // the same lines, the band's origin
+  band_after.centre -= cv::Point2d(band.tl());
+  band_before.centre -= cv::Point2d(band.tl());
+
+  cv::Mat& compressed = scratch.compressed;
+  compressed.create(last_row - out.first_row + 1, 2 * centre + 1, CV_8U);
+  const int after_x0 = leading_is_positive ? centre : 0;
+  const int before_x0 = leading_is_positive ? 0 : centre + 1;
+  sample_in_frame(scratch.difference, band_after, centre, after_x0, out.first_row,
+                  compressed.colRange(after_x0, after_x0 + centre + 1));
+  sample_in_frame(scratch.difference, band_before, centre, before_x0, out.first_row,
+                  compressed.colRange(before_x0, before_x0 + centre));
+  if (out.noise_floor > 0) cv::subtract(compressed, cv::Scalar(out.noise_floor), compressed);
+  if (params.blur_sigma > 0)
+    cv::GaussianBlur(compressed, scratch.blurred, kernel_size(params.blur_sigma), params.blur_sigma);
+  else
+    compressed.copyTo(scratch.blurred);
+  return out;
+}
+
+// (e) symmetric filling of scratch.blurred into scratch.refined, the threshold row by row, and
+// the cleaning along the line: each row's half-width about the merged line, -1 = not object.
+std::vector<int> symmetric_rows(const MotionParams& params, detail::MotionScratch& scratch) {
+  const cv::Mat& blurred = scratch.blurred;
+  if (params.mirror_tolerance > 0)
+    cv::dilate(blurred, scratch.dilated,
+               cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * params.mirror_tolerance + 1, 1)));
+  else
+    blurred.copyTo(scratch.dilated);
+  scratch.refined.create(blurred.size(), CV_8U);
+  const int threshold = static_cast<int>(std::ceil(params.threshold));
+  std::vector<int> half_width(blurred.rows);
+  for (int y = 0; y < blurred.rows; ++y)
+    half_width[y] = fill_row(blurred.ptr<uint8_t>(y), scratch.dilated.ptr<uint8_t>(y), params.max_half_width, threshold,
+                             scratch.refined.ptr<uint8_t>(y));
+  half_width = morph_rows(half_width, params.min_vertical_run, true);
+  half_width = morph_rows(half_width, params.max_row_gap + 2, false);
+  keep_largest_run(half_width);
+  return half_width;
+}
+
 }  // namespace
 
 void validate(const MotionParams& params) {
@@ -258,6 +414,8 @@ void validate(const MotionParams& params) {
   if (params.max_row_gap < 0 || params.max_row_gap > 1000) fail("max_row_gap must be in [0, 1000] rows");
   if (params.min_area < 0) fail("min_area must be >= 0");
   if (!(params.max_rotation_deg >= 0 && params.max_rotation_deg < 90)) fail("max_rotation_deg must be in [0, 90)");
+  if (params.attach_reach < 0 || params.attach_reach > 10000) fail("attach_reach must be in [0, 10000] px");
+  if (!(params.rigid_tolerance >= 0 && params.rigid_tolerance <= 255)) fail("rigid_tolerance must be in [0, 255]");
 }
 
 MotionSegmenter::MotionSegmenter(MotionParams params) : params_(params) { validate(params_); }
@@ -286,53 +444,12 @@ MotionSegmentation MotionSegmenter::segment(const cv::Mat& before, const cv::Mat
     return result;
   }
 
-  int first_row = 0, last_row = 0, first_b = 0, last_b = 0;
-  detail::row_range(frame_after, after.cols, after.rows, &first_row, &last_row);
-  detail::row_range(frame_before, before.cols, before.rows, &first_b, &last_b);
-  first_row = std::min(first_row, first_b);
-  last_row = std::max(last_row, last_b);
-  const int centre = params_.max_half_width, columns = 2 * centre + 1;
-
-  // (c) the difference and its noise floor, only where the line-frame image will sample it.
-  const cv::Rect band = band_around(frame_after, frame_before, centre + 2, first_row, last_row, after.size());
-  channel_max_difference(before(band), after(band), colour_difference_, difference_);
-  const int noise_floor = params_.subtract_noise_floor ? median_level(difference_) : 0;
-  LineFrame band_after = frame_after, band_before = frame_before;  // the same lines, the band's origin
-  band_after.centre -= cv::Point2d(band.tl());
-  band_before.centre -= cv::Point2d(band.tl());
-
-  // (d) compression: the leading half (in the direction of motion) beyond the after line, the
-  // trailing half beyond the before line; the strip between the lines is dropped.
-  compressed_.create(last_row - first_row + 1, columns, CV_8U);
-  const bool leading_is_positive = result.shift >= 0;
-  const int after_x0 = leading_is_positive ? centre : 0;
-  const int before_x0 = leading_is_positive ? 0 : centre + 1;
-  sample_in_frame(difference_, band_after, centre, after_x0, first_row,
-                  compressed_.colRange(after_x0, after_x0 + centre + 1));
-  sample_in_frame(difference_, band_before, centre, before_x0, first_row,
-                  compressed_.colRange(before_x0, before_x0 + centre));
-  if (noise_floor > 0) cv::subtract(compressed_, cv::Scalar(noise_floor), compressed_);
-  if (params_.blur_sigma > 0)
-    cv::GaussianBlur(compressed_, blurred_, kernel_size(params_.blur_sigma), params_.blur_sigma);
-  else
-    compressed_.copyTo(blurred_);
-
-  // (e) symmetric filling, then the threshold row by row.
-  if (params_.mirror_tolerance > 0)
-    cv::dilate(blurred_, dilated_, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * params_.mirror_tolerance + 1, 1)));
-  else
-    blurred_.copyTo(dilated_);
-  refined_.create(blurred_.size(), CV_8U);
+  const Compressed compressed = compress(before, after, frame_before, frame_after, result.shift >= 0, params_, scratch_);
+  const std::vector<int> half_width = symmetric_rows(params_, scratch_);
   const int threshold = static_cast<int>(std::ceil(params_.threshold));
-  std::vector<int> half_width(blurred_.rows);
-  for (int y = 0; y < blurred_.rows; ++y)
-    half_width[y] = fill_row(blurred_.ptr<uint8_t>(y), dilated_.ptr<uint8_t>(y), centre, threshold, refined_.ptr<uint8_t>(y));
-  half_width = morph_rows(half_width, params_.min_vertical_run, true);
-  half_width = morph_rows(half_width, params_.max_row_gap + 2, false);
-  keep_largest_run(half_width);
 
-  // (f) the mask at the after position, and the cut-out.
-  const cv::Rect box = fill_mask(half_width, frame_after, first_row, result.mask);
+  // (f) the mask at the after position (plus what moved with it), and the cut-out.
+  cv::Rect box = fill_mask(half_width, frame_after, compressed.first_row, result.mask);
   result.area = box.empty() ? 0 : cv::countNonZero(result.mask(box));
   if (result.area < params_.min_area || result.area == 0) {
     std::ostringstream out;
@@ -342,6 +459,11 @@ MotionSegmentation MotionSegmenter::segment(const cv::Mat& before, const cv::Mat
     result.mask.setTo(0);
     result.area = 0;
   } else {
+    if (params_.attach_rigid_parts && params_.attach_reach > 0) {
+      box = attach_rigid_parts(before, after, frame_before, frame_after, compressed.noise_floor + threshold,
+                               static_cast<int>(params_.rigid_tolerance), params_.attach_reach, box, result.mask);
+      result.area = cv::countNonZero(result.mask(box));
+    }
     result.found = true;
     result.bounding_box = cv::boundingRect(result.mask(box)) + box.tl();
     after(box).copyTo(result.cutout(box), result.mask(box));
@@ -350,16 +472,16 @@ MotionSegmentation MotionSegmenter::segment(const cv::Mat& before, const cv::Mat
   if (stages) {
     stages->before = before.clone();
     stages->after = after.clone();
-    channel_max_difference(before, after, colour_difference_, stages->difference);  // the whole image
-    stages->compressed = blurred_.clone();
-    stages->refined = refined_.clone();
-    stages->line_frame_mask = line_frame_mask(half_width, columns);
+    channel_max_difference(before, after, scratch_.colour_difference, stages->difference);  // the whole image
+    stages->compressed = scratch_.blurred.clone();
+    stages->refined = scratch_.refined.clone();
+    stages->line_frame_mask = line_frame_mask(half_width, scratch_.blurred.cols);
     stages->mask = result.mask.clone();
     stages->cutout = result.cutout.clone();
     stages->line_before = line_before_in;
     stages->line_after = line_after;
-    stages->first_row = first_row;
-    stages->noise_floor = noise_floor;
+    stages->first_row = compressed.first_row;
+    stages->noise_floor = compressed.noise_floor;
   }
   return result;
 }

@@ -9,16 +9,16 @@
 //                    on the leading side of the motion is taken beyond the AFTER line, the half on
 //                    the trailing side beyond the BEFORE line, and the pixels between the lines are
 //                    dropped, so the two lines merge into one (column max_half_width);
-//   (e) refined      symmetric filling: in each row, every pixel out to the outermost pair of
-//                    moving pixels mirrored about the merged line gets that pair's (weaker)
-//                    strength. Motion whose mirror did not move (an arm, a hand, another object)
-//                    does not count;
+//   (e) refined      symmetric filling: in each row, a pair of pixels mirrored about the merged
+//                    line is as strong as its weaker side, and every pixel gets the strongest
+//                    pair at or beyond it. Motion whose mirror did not move (an arm, a hand,
+//                    another object) does not count;
 //   threshold        (e) >= threshold, rows shorter than min_vertical_run dropped, gaps up to
 //                    max_row_gap rows bridged, the largest run of rows kept: the object's mask in
 //                    the line frame;
-//   (f) result       the mask placed at the object's AFTER position, and the after image cut out.
-// The mask is symmetric about the after line by construction: asymmetric parts (a mug's handle)
-// are left out (docs/segmentation_geometry.md).
+//   (f) result       the mask placed at the object's AFTER position, plus the asymmetric parts
+//                    attached to it that moved rigidly with the lines (a mug's handle; an arm that
+//                    appeared in the after image does not), and the after image cut out.
 #include <opencv2/core.hpp>
 
 #include <string>
@@ -50,6 +50,14 @@ struct MotionParams {
   int min_area = 100;
   // The lines' orientations may differ by at most this much (the object turned in the image).
   double max_rotation_deg = 20;
+  // Asymmetric parts (a mug's handle): add the pixels within attach_reach px of the symmetric
+  // mask's box, connected to it, that moved rigidly with the lines: changed here, outside the
+  // symmetric mask moved back to the before position (the strip the object uncovered), and the
+  // after image here matches the before image where the lines' motion says the point came from,
+  // within rigid_tolerance grey levels (an arm that appeared does not).
+  bool attach_rigid_parts = true;
+  int attach_reach = 100;
+  double rigid_tolerance = 30;
 };
 
 // Throws std::invalid_argument naming the offending parameter.
@@ -63,8 +71,8 @@ struct MotionStages {
   cv::Mat difference;        // (c) CV_8U, image frame, noise floor not yet subtracted
   cv::Mat compressed;        // (d) CV_8U, line frame, noise floor subtracted, blurred
   cv::Mat refined;           // (e) CV_8U, line frame, symmetric filling
-  cv::Mat line_frame_mask;   // (e) thresholded, cleaned: CV_8U, 255 = object
-  cv::Mat mask;              // CV_8U, after image frame, 255 = object
+  cv::Mat line_frame_mask;   // (e) thresholded, cleaned: CV_8U, 255 = object (the symmetric part)
+  cv::Mat mask;              // CV_8U, after image frame, 255 = object (attached parts included)
   cv::Mat cutout;            // (f) the after image where mask, 0 elsewhere
   symmetry::Line line_before, line_after;
   int first_row = 0;
@@ -90,8 +98,15 @@ struct MotionSegmentation {
   double rotation = 0;
 };
 
-// Keeps its scratch images between calls (a 1280x960 pair allocates nothing after the first):
-// one instance per thread.
+namespace detail {
+// The images MotionSegmenter reuses between calls.
+struct MotionScratch {
+  cv::Mat colour_difference, difference, compressed, blurred, dilated, refined;
+};
+}  // namespace detail
+
+// Keeps its scratch images between calls (a 1280x960 pair allocates only its results after the
+// first): one instance per thread.
 class MotionSegmenter {
  public:
   explicit MotionSegmenter(MotionParams params = {});  // validates
@@ -104,7 +119,7 @@ class MotionSegmenter {
 
  private:
   MotionParams params_;
-  cv::Mat difference_, colour_difference_, compressed_, blurred_, dilated_, refined_;
+  detail::MotionScratch scratch_;
 };
 
 // One-shot convenience around MotionSegmenter.
