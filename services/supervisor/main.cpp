@@ -92,13 +92,13 @@ class RunLog {
       : path_(path), partial_(path + ".partial"), file_(std::make_unique<lcm::LogFile>(partial_, "w")) {
     if (!file_->good()) throw std::runtime_error(partial_ + ": cannot open the run's log for writing");
   }
-  void write(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+  void write(int64_t utime, const std::string& channel, const void* data, size_t size) {
     lcm::LogEvent event;
     event.eventnum = 0;
-    event.timestamp = rbuf->recv_utime;
+    event.timestamp = utime;
     event.channel = channel;
-    event.datalen = static_cast<int32_t>(rbuf->data_size);
-    event.data = rbuf->data;
+    event.datalen = static_cast<int32_t>(size);
+    event.data = const_cast<void*>(data);
     if (file_) file_->writeEvent(&event);
   }
   void close() {
@@ -112,6 +112,10 @@ class RunLog {
   std::string path_, partial_;
   std::unique_ptr<lcm::LogFile> file_;
 };
+
+// Published by the supervisor alone.
+const std::set<std::string> kOwnChannels = {"CANDIDATES_REQUEST", "CAMERA_SNAPSHOT_REQUEST", "ARM_COMMAND",
+                                            "SUPERVISOR_STATE", "SEGMENTATION"};
 
 class Shell {
  public:
@@ -165,7 +169,20 @@ class Shell {
 
  private:
   // ---- inputs ----
-  void record(const lcm::ReceiveBuffer* rbuf, const std::string& channel) { log_->write(rbuf, channel); }
+  // What the supervisor publishes is logged when published (the loop's own echo would come after
+  // the last message of a run, which the run does not wait for): skipped here.
+  void record(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+    if (kOwnChannels.count(channel)) return;
+    log_->write(rbuf->recv_utime, channel, rbuf->data, rbuf->data_size);
+  }
+
+  template <typename Msg>
+  void publish(const std::string& channel, const Msg& msg) {
+    service_.publish(channel, msg);
+    std::vector<uint8_t> bytes(msg.getEncodedSize());
+    msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+    log_->write(wall_utime(), channel, bytes.data(), bytes.size());
+  }
 
   void on_heartbeat(const heartbeat_t& m) {
     if (m.service == "supervisor" && m.pid != getpid() && !service_.input_is_log() && !started_ && !refused_) {
@@ -280,13 +297,13 @@ class Shell {
     m.utime = now_;
     m.frames = r.frames;
     m.lines_per_image = r.lines;
-    service_.publish("CANDIDATES_REQUEST", m);
+    publish("CANDIDATES_REQUEST", m);
   }
   void handle(const sv::SnapshotRequest&) {
     snapshot_request_t m{};
     m.utime = now_;
     m.cameras = snapshot_request_t::CAMERAS_RIGHT;
-    service_.publish("CAMERA_SNAPSHOT_REQUEST", m);
+    publish("CAMERA_SNAPSHOT_REQUEST", m);
   }
   void handle(const sv::NudgeCommand& c) {
     arm_command_t m{};
@@ -300,7 +317,7 @@ class Shell {
     m.height = opt_.arm.nudge.push_height;
     m.start_distance = opt_.arm.nudge.start_distance;
     m.stop_distance = opt_.arm.nudge.stop_distance;
-    service_.publish("ARM_COMMAND", m);
+    publish("ARM_COMMAND", m);
   }
   void handle(const sv::StopCommand& c) {
     arm_command_t m{};
@@ -308,7 +325,7 @@ class Shell {
     m.seq = c.seq;
     m.command = arm_command_t::COMMAND_STOP;
     m.target.orientation[0] = 1;
-    service_.publish("ARM_COMMAND", m);
+    publish("ARM_COMMAND", m);
     log::warn() << "arm stopped: " << c.reason;
   }
   void handle(const sv::StateReport& r) {
@@ -345,7 +362,7 @@ class Shell {
     m.segmented = r.segmented;
     m.failed_attempts = r.failed_attempts;
     m.rejected = r.rejected;
-    service_.publish("SUPERVISOR_STATE", m);
+    publish("SUPERVISOR_STATE", m);
   }
 
   void publish_segmentation(const sv::Attempt& a) {
@@ -359,7 +376,7 @@ class Shell {
     m.line_after = bus::to_message(*a.after_line);
     m.mask_pixels = cv::countNonZero(a.segmentation.mask);
     m.mask = bus::to_message(a.segmentation.mask, image_t::FORMAT_PNG, now_, a.number, "right");
-    service_.publish("SEGMENTATION", m);
+    publish("SEGMENTATION", m);
   }
 
   void write_summary(const std::string& end_reason) {

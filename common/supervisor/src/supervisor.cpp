@@ -100,7 +100,7 @@ void Supervisor::finish(State state, const std::string& reason, int64_t now) {
 
 // ---- the loop ----
 
-void Supervisor::survey(int64_t now) {
+void Supervisor::survey(int64_t now, const std::string& why) {
   if (summary_.attempts >= config_.max_attempts) {
     finish(State::Done, "attempt limit reached (" + std::to_string(config_.max_attempts) + " nudges)", now);
     return;
@@ -108,7 +108,8 @@ void Supervisor::survey(int64_t now) {
   ++summary_.surveys;
   request_time_ = now;
   for (auto& lines : survey_lines_) lines.clear();
-  enter(State::FindCandidates, now, "surveying: candidates from " + std::to_string(config_.survey_frames) + " stereo pairs");
+  enter(State::FindCandidates, now,
+        (why.empty() ? std::string() : why + "; ") + "surveying: candidates from " + std::to_string(config_.survey_frames) + " stereo pairs");
   outputs_.push_back(CandidatesRequest{config_.survey_frames, config_.survey_lines});
 }
 
@@ -249,10 +250,7 @@ void Supervisor::end_attempt(Outcome outcome, const std::string& reason, int64_t
   outputs_.push_back(AttemptEnded{std::shared_ptr<const Attempt>(attempt_.release())});
   watch_.reset();
   settled_axes_.clear();
-  report_.reason = reason;
-  survey(now);
-  // survey() reports FIND_CANDIDATES with its own reason: keep the attempt's outcome visible in it.
-  report_.reason = reason;
+  survey(now, "attempt " + std::to_string(a.number) + " " + to_string(outcome) + ": " + reason);
 }
 
 // ---- inputs ----

@@ -157,7 +157,7 @@ class Supervisor {
 
  private:
   void enter(State state, int64_t now, const std::string& reason);
-  void survey(int64_t now);
+  void survey(int64_t now, const std::string& why = "");
   void choose(int64_t now);
   void request_still(State state, int64_t now, const std::string& note = "");
   void start_nudge(int64_t now);
