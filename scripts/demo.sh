@@ -1,9 +1,13 @@
 #!/usr/bin/env bash
-# The main job: the simulated lab seen by the stereo pair, processed by the services as separate
-# processes over LCM: world (MuJoCo physics) -> camera (--source sim: renders every state) ->
-# symmetry -> monitor (draws the lines and the true axes into out/demo/, prints how well the
-# detected lines match the ground truth). The whole run is recorded to an LCM log under out/.
-#   scripts/demo.sh                       # the simulated world (NUDGE_DEMO_SCENE, default arm_three_objects.yaml)
+# The main job: the robot segments the objects on a simulated table by itself (thesis ch. 6).
+# Every service is its own process over LCM: world (MuJoCo physics, the PUMA 260) -> camera
+# (--source sim: renders every state, 1280x960 stills on request) -> symmetry -> triangulation
+# (candidates), the arm service, and the supervisor, which surveys, nudges each object, watches it
+# move, cuts it out of the stills and goes on until nothing is left, printing every state change.
+# It leaves in out/runs/<run>/ the run's LCM log, summary.json and per attempt the stills, the mask,
+# the cut-out, the fig. 6.6 picture and the fig. 6.7 stages.
+#   scripts/demo.sh                       # the loop (NUDGE_DEMO_SCENE, default arm_three_objects.yaml)
+#   scripts/demo.sh perception            # perception only: world -> camera -> symmetry -> monitor
 #   scripts/demo.sh 'images:/data/left/*.png' 'images:/data/right/*.png'   # recorded stereo data
 #   scripts/demo.sh synthetic             # the synthetic image sequence (generated into out/scenes)
 # NUDGE_DEMO_SECONDS (4) and NUDGE_DEMO_RATE (10 Hz) set the simulated run, NUDGE_DEMO_SYMMETRY_FLAGS
@@ -82,6 +86,25 @@ run_sim_pipeline() {
   return $status
 }
 export -f run_images_pipeline run_sim_pipeline
+
+# The autonomous segmentation loop (the default).
+if [ $# -eq 0 ]; then
+  scene=${NUDGE_DEMO_SCENE:-$NUDGE_ROOT/common/sim/scenes/arm_three_objects.yaml}
+  run="run-$(date +%Y%m%d-%H%M%S)"
+  export -f nudge_run_loop
+  nudge_log "autonomous segmentation of $(basename "$scene"): world, camera, symmetry, triangulation, arm and supervisor over LCM; run $run"
+  status=0
+  nudge_in_private_network bash -c 'nudge_run_loop "$@"' loop "$NUDGE_BUILD_DIR/bin" "$scene" \
+    "$NUDGE_ROOT/docs/results/calibration_sim.yaml" "$out/runs" "$run" || status=$?
+  dir="$out/runs/$run"
+  if [ -f "$dir/summary.json" ]; then
+    nudge_log "run $run: $(grep -o '"segmented":[0-9]*' "$dir/summary.json" | cut -d: -f2) objects segmented in $(grep -o '"attempts":[0-9]*' "$dir/summary.json" | cut -d: -f2) nudges"
+    nudge_log "files: $dir/ (LCM log $run.lcmlog, summary.json, attempt_NN/ with before/after stills, mask, cutout, workspace.png, stages/)"
+    nudge_log "replay the decisions: build/bin/nudge-supervisor --lcm-in 'file://$dir/$run.lcmlog?speed=0' --lcm-out 'file:///tmp/replay.lcmlog?mode=w' --calibration docs/results/calibration_sim.yaml --first-seq $(grep -o '"first_command_seq":[0-9]*' "$dir/summary.json" | cut -d: -f2)"
+  fi
+  exit $status
+fi
+[ "${1:-}" = perception ] && shift
 
 if [ $# -ge 2 ] || [ "${1:-}" = synthetic ]; then
   frames=${NUDGE_DEMO_FRAMES:-20}

@@ -13,6 +13,7 @@
 #include "nudge/sim/world.hpp"
 #include "nudge/sim_state_t.hpp"
 #include "nudge/snapshot_request_t.hpp"
+#include "nudge/bus/sim_convert.hpp"
 
 namespace nudge::camera_service {
 
@@ -23,27 +24,6 @@ constexpr const char* kSnapshotRequestChannel = "CAMERA_SNAPSHOT_REQUEST";
 constexpr const char* kChannels[2] = {"CAMERA_LEFT", "CAMERA_RIGHT"};
 constexpr const char* kSnapshotChannels[2] = {"SNAPSHOT_LEFT", "SNAPSHOT_RIGHT"};
 constexpr const char* kCameraNames[2] = {"left", "right"};
-
-Eigen::Vector3d position_of(const pose_t& pose) {
-  return {pose.position[0], pose.position[1], pose.position[2]};
-}
-Eigen::Quaterniond orientation_of(const pose_t& pose) {
-  return {pose.orientation[0], pose.orientation[1], pose.orientation[2], pose.orientation[3]};
-}
-
-sim::PoseSnapshot poses_of(const sim_state_t& state) {
-  if (state.num_objects != static_cast<int32_t>(state.objects.size()))
-    throw std::invalid_argument("num_objects disagrees with the objects sent");
-  sim::PoseSnapshot poses;
-  for (const object_state_t& o : state.objects)
-    poses.objects.push_back({o.name, position_of(o.pose), orientation_of(o.pose)});
-  poses.pusher_position = position_of(state.pusher);
-  poses.pusher_yaw = sim::yaw_of(orientation_of(state.pusher));
-  // The arm's joints as simulated (used only when the scene has an arm).
-  poses.arm_joints.emplace();
-  for (int j = 0; j < 6; ++j) (*poses.arm_joints)[j] = state.joints[j];
-  return poses;
-}
 
 }  // namespace
 
@@ -87,7 +67,7 @@ int run_sim_camera(bus::Service& service, const SimOptions& options) {
     return out;
   };
   service.subscriptions().subscribe<sim_state_t>(kStateChannel, [&](const sim_state_t& state, const std::string&) {
-    const sim::PoseSnapshot poses = poses_of(state);
+    const sim::PoseSnapshot poses = bus::poses_of(state);
     sim::apply_poses(world, poses);  // throws naming the object: counted, skipped
     last_state_utime = state.utime;
     // Both frames come from one set of poses and share the state's utime (a stereo pair).

@@ -33,7 +33,7 @@ struct ArmSetup {
 struct TargetParams {
   double object_radius = 0.045;   // the largest expected object (thesis: mugs, bottles)
   double travel = 0.04;           // how far a nudged object may slide beyond P2
-  double explored_radius = 0.03;  // a candidate this close to a place already explored is skipped
+  double explored_radius = 0.05;  // a candidate this close to a place already explored is skipped (two objects stand farther apart)
   double pad_half_width = 0.02;   // the sponge pad across the push direction
   // Two candidates closer than this cannot both be objects: one is the other seen through a stereo
   // mismatch (it lies along the same viewing ray). Neither is an obstacle to the other's push, and
