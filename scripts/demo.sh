@@ -103,7 +103,7 @@ else
   rate=${NUDGE_DEMO_RATE:-10}
   nudge_log "world ($(basename "$scene"), ${seconds} s in real time) -> camera (sim, $rate Hz) -> symmetry -> monitor over LCM; recording $log"
   pipeline=(run_sim_pipeline "$NUDGE_BUILD_DIR/bin" "$scene" "$log" "$out" "$seconds" "$rate"
-            "$NUDGE_ROOT/docs/results/calibration_sim.yaml")
+            "$NUDGE_ROOT/config/calibration_sim.yaml")
   drawn="detections drawn in out/demo/ (true axes dashed white)"
 fi
 if nudge_in_private_network bash -c '"$@"' demo "${pipeline[@]}"; then
