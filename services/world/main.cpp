@@ -14,6 +14,7 @@
 #include "nudge/bus/image.hpp"
 #include "nudge/bus/service.hpp"
 #include "nudge/log.hpp"
+#include "nudge/robot/workspace_flags.hpp"
 #include "nudge/sim/mjcf.hpp"
 #include "nudge/sim/state_sync.hpp"
 #include "nudge/sim/world.hpp"
@@ -265,6 +266,24 @@ class Pacer {
   int64_t slips_ = 0;
 };
 
+// The simulated arm stands where the workspace says: with a workspace file its shoulder height
+// replaces the scene's (the file is what every service shares). The simulated arm's base is not
+// turned: a workspace with a base yaw cannot be simulated.
+void place_arm(const robot::Workspace& workspace, bool from_file, sim::Scene* scene) {
+  if (!scene->arm.present) return;
+  if (workspace.base_yaw != 0.0)
+    throw FlagError("--workspace: base_yaw_deg must be 0 in simulation (the simulated arm is not turned)");
+  if (!from_file || workspace.shoulder_height == scene->arm.shoulder_height) return;
+  log::warn() << scene->source << ": arm.shoulder_height " << scene->arm.shoulder_height
+              << " m replaced by the workspace's " << workspace.shoulder_height << " m";
+  scene->arm.shoulder_height = workspace.shoulder_height;
+  try {
+    sim::validate(*scene);
+  } catch (const sim::SceneError& e) {
+    throw FlagError(std::string("--workspace: ") + e.what());
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -285,9 +304,8 @@ int main(int argc, char** argv) {
     f.add_double("duration", &duration, "stop after this many simulated seconds (0: run until stopped)");
     std::string tool = "pad";
     f.add_string("tool", &tool, "the arm's tool: pad (pushes) or gripper (grasps; fingers follow ARM_STATE.gripper)");
-    double tool_length = 0.15;
-    f.add_double("tool-length", &tool_length,
-                 "scenes with the arm: the tool point along the simulated flange's z axis, m (as nudge-arm's)");
+    // Scenes with the arm: its tool and shoulder height are the workspace's, as nudge-arm's.
+    const robot::WorkspaceFlags workspace_flags(f, {"tool-length"}, "scenes with the arm: ");
     double log_origin_s = -1;
     f.add_double("log-origin", &log_origin_s,
                  "input from a log: the utime (s) that is simulated time 0 (-1: automatic, docs/sim.md)");
@@ -298,7 +316,7 @@ int main(int argc, char** argv) {
     if (!(duration >= 0 && std::isfinite(duration))) throw FlagError("--duration must be >= 0");
     if (seed < -1) throw FlagError("--seed must be >= 0 (or -1 for the scene's)");
     if (tool != "pad" && tool != "gripper") throw FlagError("--tool must be pad or gripper, not '" + tool + "'");
-    if (!(tool_length >= 0 && tool_length < 0.5)) throw FlagError("--tool-length must lie in [0, 0.5) m");
+    const robot::Workspace workspace = workspace_flags.resolve();
     if (!(log_origin_s >= 0 || log_origin_s == -1)) throw FlagError("--log-origin must be >= 0 (or -1)");
     const int64_t log_origin = log_origin_s >= 0 ? std::llround(log_origin_s * 1e6) : -1;
     sim::Scene scene;
@@ -308,9 +326,10 @@ int main(int argc, char** argv) {
       throw FlagError(e.what());
     }
     if (seed >= 0) scene.seed = static_cast<uint64_t>(seed);
+    place_arm(workspace, !workspace_flags.file().empty(), &scene);
 
     service.start();
-    Simulation sim(service, scene, rate, tool == "gripper", tool_length);
+    Simulation sim(service, scene, rate, tool == "gripper", workspace.tool_length);
     if (duration > 0) sim.set_end_time(duration);
     const bool from_log = service.input_is_log();
     Inputs inputs(service, sim, from_log, log_origin >= 0 ? std::optional<int64_t>(log_origin) : std::nullopt);

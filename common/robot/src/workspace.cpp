@@ -3,6 +3,7 @@
 #include <opencv2/core.hpp>
 
 #include <cmath>
+#include <fstream>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -61,6 +62,8 @@ void validate(const Workspace& w) {
 }
 
 Workspace load_workspace(const std::string& path) {
+  // Checked first: OpenCV would log its own error for a missing file.
+  if (!std::ifstream(path).good()) throw std::runtime_error(path + ": cannot read the workspace file");
   cv::FileStorage fs;
   try {
     if (!fs.open(path, cv::FileStorage::READ)) throw std::runtime_error(path + ": cannot read the workspace file");
