@@ -17,6 +17,7 @@
 //         provider at speed=0 stamps events with the time it reads them, not with the log's
 //         timestamps, so those cannot serve.)
 #include <cmath>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,7 @@
 #include "nudge/arm_command_t.hpp"
 #include "nudge/arm_state_t.hpp"
 #include "nudge/bus/service.hpp"
+#include "nudge/bus_clock.hpp"
 #include "nudge/heartbeat_t.hpp"
 #include "nudge/log.hpp"
 #include "nudge/robot/kinematics.hpp"
@@ -32,20 +34,17 @@
 #include "nudge/robot/safety.hpp"
 #include "nudge/robot/workspace_flags.hpp"
 #include "nudge/sim_state_t.hpp"
-#include "nudge/timing.hpp"
 
 using namespace nudge;
 
 namespace {
 
-enum class ClockSource { Wall, Sim, Log };
-
-ClockSource parse_clock(const std::string& name, bool input_is_log) {
-  if (name == "auto") return input_is_log ? ClockSource::Log : ClockSource::Wall;
-  if (name == "wall") return ClockSource::Wall;
-  if (name == "sim") return ClockSource::Sim;
-  if (name == "log") return ClockSource::Log;
-  throw FlagError("--clock must be auto, wall, sim or log, not '" + name + "'");
+BusClock parse_clock(const std::string& name, bool input_is_log) {
+  try {
+    return BusClock(parse_clock_source(name, input_is_log));
+  } catch (const std::invalid_argument& e) {
+    throw FlagError(std::string("--clock: ") + e.what());
+  }
 }
 
 robot::JointVector initial_joints(const std::vector<double>& degrees, const robot::PlannerConfig& planner) {
@@ -101,7 +100,7 @@ int main(int argc, char** argv) {
     f.add_bool("require-supervisor", &config.require_supervisor, "refuse motions until a supervisor heartbeat arrives");
     if (!service.parse(argc, argv)) return 0;
 
-    const ClockSource clock = parse_clock(clock_name, service.input_is_log());
+    BusClock clock = parse_clock(clock_name, service.input_is_log());
     if (!(rate > 0 && rate <= 1000)) throw FlagError("--rate must lie in (0, 1000]");
     if (!(max_catch_up >= 0)) throw FlagError("--max-catch-up must not be negative");
     const robot::Workspace workspace = workspace_flags.resolve();
@@ -110,7 +109,7 @@ int main(int argc, char** argv) {
     planner.base = robot::BaseFrame::of(workspace);
     config.period_utime = std::llround(1e6 / rate);
     // A log replay wants every sample; live, a long jump (a paused world) is not worth a flood.
-    config.max_catch_up_utime = clock == ClockSource::Log ? -1 : std::llround(max_catch_up * 1e6);
+    config.max_catch_up_utime = clock.source() == ClockSource::Log ? -1 : std::llround(max_catch_up * 1e6);
     std::unique_ptr<arm::ArmController> controller;
     try {
       arm::validate(config);
@@ -133,13 +132,19 @@ int main(int argc, char** argv) {
       service.set_status(controller->describe());
     };
 
-    // Message time: a message moves the clock to its utime before it is acted on.
-    auto follow_message_time = [&](int64_t utime) {
-      if (clock == ClockSource::Log) controller->advance_with_watchdog(utime, publish);
+    // A message moves the clock (BusClock: wall time, or its utime on --clock log) before it is
+    // acted on. With the supervisor's deadlines on message time (a log) the watchdog moves with it.
+    auto follow = [&](int64_t utime, Stamp stamp) {
+      const std::optional<int64_t> now = clock.on_message(utime, stamp);
+      if (!now) return;
+      if (clock.deadlines_on_message_time()) {
+        controller->advance_with_watchdog(*now, publish);
+      } else {
+        controller->advance_to(*now, publish);
+      }
     };
     service.subscriptions().subscribe<arm_command_t>(command_channel, [&](const arm_command_t& command, const std::string&) {
-      if (clock == ClockSource::Wall) controller->advance_to(wall_utime(), publish);
-      follow_message_time(command.utime);
+      follow(command.utime, Stamp::Sender);
       const arm_state_t response = controller->handle(command);
       publish(response);
       if (response.motion == arm_state_t::MOTION_REFUSED) {
@@ -150,22 +155,21 @@ int main(int argc, char** argv) {
       after_event();
     });
     service.subscriptions().subscribe<heartbeat_t>(bus::kHeartbeatChannel, [&](const heartbeat_t& heartbeat, const std::string&) {
-      follow_message_time(heartbeat.utime);
-      const int64_t now = clock == ClockSource::Log ? controller->clock() : wall_utime();
-      if (controller->on_heartbeat(heartbeat, now)) {
+      follow(heartbeat.utime, Stamp::Sender);
+      if (controller->on_heartbeat(heartbeat, clock.deadline_time())) {
         publish(controller->state());
         log::warn() << controller->describe();
       }
       after_event();
     });
-    if (clock == ClockSource::Sim) {
+    if (clock.source() == ClockSource::Sim) {
       service.subscriptions().subscribe<sim_state_t>(sim_channel, [&](const sim_state_t& sim, const std::string&) {
-        controller->advance_to(sim.utime, publish);
+        follow(sim.utime, Stamp::Simulated);
       });
     }
-    if (clock == ClockSource::Wall) controller->advance_to(wall_utime(), publish);
-    if (clock != ClockSource::Log) publish(controller->state());  // the world places its pusher at once
-    log::info() << "backend " << backend_name << ", clock " << clock_name << ", " << command_channel << " -> "
+    if (const std::optional<int64_t> now = clock.on_timer()) controller->advance_to(*now, publish);
+    if (clock.source() != ClockSource::Log) publish(controller->state());  // the world places its pusher at once
+    log::info() << "backend " << backend_name << ", clock " << clock_source_name(clock.source()) << ", " << command_channel << " -> "
                 << state_channel << " at " << rate << " Hz; base " << planner.base.height << " m above the table, yaw "
                 << robot::rad_to_deg(planner.base.yaw) << " deg, tool " << workspace.tool_length << " m, ring "
                 << workspace.ring_inner << "-" << workspace.ring_outer << " m"
@@ -173,13 +177,12 @@ int main(int argc, char** argv) {
 
     const int wait_ms = std::max(1, static_cast<int>(500.0 / rate));  // two looks per period
     return service.run([&] {
-      if (clock == ClockSource::Log) return wait_ms;  // time moves only with the log
-      const int64_t now = wall_utime();
-      if (controller->check_supervisor(now)) {
+      if (clock.deadlines_on_message_time()) return wait_ms;  // time moves only with the log
+      if (controller->check_supervisor(clock.deadline_time())) {
         publish(controller->state());
         log::warn() << controller->describe();
       }
-      if (clock == ClockSource::Wall) controller->advance_to(now, publish);
+      if (const std::optional<int64_t> now = clock.on_timer()) controller->advance_to(*now, publish);
       after_event();
       return wait_ms;
     }, wait_ms);

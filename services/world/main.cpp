@@ -13,6 +13,7 @@
 #include "nudge/arm_state_t.hpp"
 #include "nudge/bus/image.hpp"
 #include "nudge/bus/service.hpp"
+#include "nudge/bus_clock.hpp"
 #include "nudge/log.hpp"
 #include "nudge/robot/workspace_flags.hpp"
 #include "nudge/sim/mjcf.hpp"
@@ -21,7 +22,6 @@
 #include "nudge/sim_state_t.hpp"
 #include "nudge/sim_truth_request_t.hpp"
 #include "nudge/sim_truth_t.hpp"
-#include "nudge/timing.hpp"
 
 using namespace nudge;
 
@@ -31,10 +31,6 @@ constexpr const char* kStateChannel = "SIM_STATE";
 constexpr const char* kTruthChannel = "SIM_TRUTH";
 constexpr const char* kTruthRequestChannel = "SIM_TRUTH_REQUEST";
 constexpr const char* kArmStateChannel = "ARM_STATE";
-// Utimes from here on are wall-clock stamps (2001 onwards), not simulated time since a start.
-constexpr int64_t kWallClockUtime = 1000000000LL * 1000000LL;
-// The longest simulated time a log may span (a day).
-constexpr double kMaxLogSeconds = 86400.0;
 
 pose_t to_pose(const Eigen::Vector3d& p, const Eigen::Quaterniond& q) {
   pose_t pose;
@@ -188,17 +184,16 @@ class Simulation {
   std::optional<arm_state_t> arm_;
 };
 
-// The world's inputs. Live, a message takes effect at the next physics step. From a log (the
-// file provider hands messages over as fast as they are read, stamped with the wall clock), a
-// message takes effect at simulated time = its utime minus an origin, the same way every run.
-// By default the origin is 0 when the first input message's utime looks like simulated time (an
-// arm on --clock sim stamps ARM_STATE with SIM_STATE's utime), else that first utime (wall-clock
-// stamps: the log replays as if the world had run in real time while it was recorded).
-// Bad messages are reported naming the channel, counted and skipped.
+// The world's inputs, on the world's BusClock. Live (wall), a message takes effect at the next
+// physics step. From a log (the file provider hands messages over as fast as they are read,
+// stamped with the wall clock), a message takes effect at simulated time = its utime minus the
+// log's origin (LogTimeline: 0 when the first input message's utime looks like simulated time,
+// as an arm on --clock sim stamps ARM_STATE with SIM_STATE's utime; else that first utime), the
+// same way every run. Bad messages are reported naming the channel, counted and skipped.
 class Inputs {
  public:
-  Inputs(bus::Service& service, Simulation& sim, bool from_log, std::optional<int64_t> log_origin)
-      : sim_(sim), from_log_(from_log), log_origin_(log_origin) {
+  Inputs(bus::Service& service, Simulation& sim, BusClock& clock, LogTimeline timeline)
+      : sim_(sim), clock_(clock), timeline_(timeline) {
     service.subscriptions().subscribe<arm_state_t>(kArmStateChannel, [this](const arm_state_t& msg, const std::string&) {
       catch_up(msg.utime);
       sim_.on_arm_state(msg);  // throws on a bad pose: counted, skipped
@@ -212,58 +207,18 @@ class Inputs {
 
  private:
   void catch_up(int64_t utime) {
-    if (!from_log_) return;
-    if (!log_origin_) log_origin_ = utime < kWallClockUtime ? 0 : utime;
-    const double seconds = 1e-6 * static_cast<double>(utime - *log_origin_);
-    // A stamp on another clock (wall-clock time after simulated time) would run the physics for
-    // years: refused (counted, skipped) instead.
-    if (seconds > kMaxLogSeconds)
-      throw std::invalid_argument("utime " + std::to_string(utime) + " is " + std::to_string(seconds) +
-                                  " s after the log's origin: not on the same clock");
-    sim_.advance_to(seconds);
+    if (clock_.source() != ClockSource::Log) return;  // live: the pacer moves simulated time
+    // A stamp on another clock would run the physics for years: refused (counted, skipped)
+    // before it moves the clock.
+    timeline_.seconds(utime);
+    if (const std::optional<int64_t> now = clock_.on_message(utime, Stamp::Sender)) {
+      sim_.advance_to(timeline_.seconds(*now));
+    }
   }
 
   Simulation& sim_;
-  bool from_log_;
-  std::optional<int64_t> log_origin_;
-};
-
-// Paces simulated time against the wall clock: sim time runs `factor` times as fast as wall time.
-// When the machine cannot keep up it falls behind, never skips physics steps, and re-anchors so
-// that it does not rush to catch up afterwards (it simply runs slower than asked).
-class Pacer {
- public:
-  explicit Pacer(double factor) : factor_(factor) {}
-  // The simulated time physics should have reached now.
-  double target(double sim_time) {
-    const int64_t now = wall_utime();
-    if (!anchored_) {
-      anchor_wall_ = now;
-      anchor_sim_ = sim_time;
-      anchored_ = true;
-    }
-    double t = anchor_sim_ + factor_ * 1e-6 * static_cast<double>(now - anchor_wall_);
-    if (t - sim_time > kMaxLag) {
-      ++slips_;
-      anchor_wall_ = now;
-      anchor_sim_ = sim_time;
-      t = sim_time;
-    }
-    return t;
-  }
-  // Milliseconds of wall time until simulated time `due` is reached.
-  int wait_ms(double due, double sim_target) const {
-    return static_cast<int>(std::clamp(std::ceil(1e3 * (due - sim_target) / factor_), 0.0, 20.0));
-  }
-  int64_t slips() const { return slips_; }
-
- private:
-  static constexpr double kMaxLag = 0.1;  // s of simulated time
-  double factor_;
-  bool anchored_ = false;
-  int64_t anchor_wall_ = 0;
-  double anchor_sim_ = 0;
-  int64_t slips_ = 0;
+  BusClock& clock_;
+  LogTimeline timeline_;
 };
 
 // The simulated arm stands where the workspace says: with a workspace file its shoulder height
@@ -332,14 +287,17 @@ int main(int argc, char** argv) {
     Simulation sim(service, scene, rate, tool == "gripper", workspace.tool_length);
     if (duration > 0) sim.set_end_time(duration);
     const bool from_log = service.input_is_log();
-    Inputs inputs(service, sim, from_log, log_origin >= 0 ? std::optional<int64_t>(log_origin) : std::nullopt);
+    // Message time from a log, else the wall clock (paced, or as fast as possible).
+    BusClock clock(from_log ? ClockSource::Log : ClockSource::Wall);
+    Inputs inputs(service, sim, clock, LogTimeline(log_origin >= 0 ? std::optional<int64_t>(log_origin) : std::nullopt));
     log::info() << scene_file << ": " << scene.objects.size() << " objects, seed " << scene.seed << ", "
                 << (from_log ? "input events applied at their log time"
                              : realtime_factor > 0 ? "realtime factor " + std::to_string(realtime_factor)
                                                    : std::string("as fast as possible"));
     service.publish(kStateChannel, sim.state_message());  // the state at t = 0
 
-    Pacer pacer(realtime_factor);
+    std::optional<Pacer> pacer;
+    if (realtime_factor > 0) pacer.emplace(realtime_factor);
     const int rc = service.run([&]() -> int {
       if (sim.finished()) {
         service.request_stop();
@@ -351,10 +309,10 @@ int main(int argc, char** argv) {
         sim.advance_to_next_state();
         return 0;
       }
-      const double target = pacer.target(sim.time());
+      const double target = pacer->target(sim.time());
       sim.advance_to(target);
-      service.set_status("t " + std::to_string(sim.time()) + " s, slowed " + std::to_string(pacer.slips()) + "x");
-      return pacer.wait_ms(sim.time() + sim.timestep(), target);
+      service.set_status("t " + std::to_string(sim.time()) + " s, slowed " + std::to_string(pacer->slips()) + "x");
+      return pacer->wait_ms(sim.time() + sim.timestep(), target);
     }, 20);
     // A log's events are all applied: simulate on to --duration, as fast as possible.
     if (from_log && rc == 0 && duration > 0) sim.advance_to(duration);
