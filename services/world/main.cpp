@@ -221,22 +221,17 @@ class Inputs {
   LogTimeline timeline_;
 };
 
-// The simulated arm stands where the workspace says: with a workspace file its shoulder height
-// replaces the scene's (the file is what every service shares). The simulated arm's base is not
-// turned: a workspace with a base yaw cannot be simulated.
-void place_arm(const robot::Workspace& workspace, bool from_file, sim::Scene* scene) {
-  if (!scene->arm.present) return;
+// The simulated arm must stand where the workspace the arm service plans with says. The scene
+// places it (the camera's sim backend renders the same scene), so a workspace file that
+// disagrees is a usage error rather than a silent choice; the simulated base is not turned.
+void check_arm_placement(const robot::Workspace& workspace, const std::string& workspace_file, const sim::Scene& scene) {
+  if (!scene.arm.present) return;
   if (workspace.base_yaw != 0.0)
     throw FlagError("--workspace: base_yaw_deg must be 0 in simulation (the simulated arm is not turned)");
-  if (!from_file || workspace.shoulder_height == scene->arm.shoulder_height) return;
-  log::warn() << scene->source << ": arm.shoulder_height " << scene->arm.shoulder_height
-              << " m replaced by the workspace's " << workspace.shoulder_height << " m";
-  scene->arm.shoulder_height = workspace.shoulder_height;
-  try {
-    sim::validate(*scene);
-  } catch (const sim::SceneError& e) {
-    throw FlagError(std::string("--workspace: ") + e.what());
-  }
+  if (workspace_file.empty() || std::abs(workspace.shoulder_height - scene.arm.shoulder_height) < 1e-9) return;
+  throw FlagError("--workspace " + workspace_file + ": shoulder_height " + std::to_string(workspace.shoulder_height) +
+                  " m but " + scene.source + ": arm.shoulder_height " + std::to_string(scene.arm.shoulder_height) +
+                  " m: the simulated arm must stand where the arm service plans for it");
 }
 
 }  // namespace
@@ -281,7 +276,7 @@ int main(int argc, char** argv) {
       throw FlagError(e.what());
     }
     if (seed >= 0) scene.seed = static_cast<uint64_t>(seed);
-    place_arm(workspace, !workspace_flags.file().empty(), &scene);
+    check_arm_placement(workspace, workspace_flags.file(), scene);
 
     service.start();
     Simulation sim(service, scene, rate, tool == "gripper", workspace.tool_length);
