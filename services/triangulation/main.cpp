@@ -70,7 +70,10 @@ class Triangulation {
     if (table_) frame_.emplace(*table_, arm_base_);
     log::info() << "rig " << opt.calibration << ": baseline " << rig_.T.norm() << " m; "
                 << (table_ ? "table frame output" : "no table plane: AXES in the right camera frame, no candidates")
-                << (table_ && !arm_base_ ? "; no arm base: candidates without the workspace ring" : "");
+                << (table_ && !arm_base_ ? "; no arm base: candidates without the workspace ring" : "")
+                << (table_ && arm_base_ ? "; candidates in the " + std::to_string(opt.locations.ring_inner_m) + "-" +
+                                              std::to_string(opt.locations.ring_outer_m) + " m workspace ring"
+                                        : std::string());
   }
 
   void subscribe() {

@@ -285,6 +285,9 @@ int main(int argc, char** argv) {
     // Message time from a log, else the wall clock (paced, or as fast as possible).
     BusClock clock(from_log ? ClockSource::Log : ClockSource::Wall);
     Inputs inputs(service, sim, clock, LogTimeline(log_origin >= 0 ? std::optional<int64_t>(log_origin) : std::nullopt));
+    if (scene.arm.present)
+      log::info() << "the PUMA 260 with its tool point " << workspace.tool_length << " m along the flange"
+                  << (workspace_flags.file().empty() ? "" : " (" + workspace_flags.file() + ")");
     log::info() << scene_file << ": " << scene.objects.size() << " objects, seed " << scene.seed << ", "
                 << (from_log ? "input events applied at their log time"
                              : realtime_factor > 0 ? "realtime factor " + std::to_string(realtime_factor)
