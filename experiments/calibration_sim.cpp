@@ -11,6 +11,7 @@
 // Writes the calibration file docs/results/calibration_sim.yaml (the nudge_geometry rig, its
 // table_plane and arm_base, and the arm -> right camera transform) and
 // docs/results/calibration_sim.{json,md} (translation_error_mm, rotation_error_deg, ...).
+// Results are outputs: the demo and the services read config/calibration_sim.yaml, a copy of it.
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>

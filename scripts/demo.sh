@@ -45,7 +45,7 @@ run_images_pipeline() {
 
 # The simulated world: world -> camera (sim) -> symmetry -> monitor (with the ground truth).
 run_sim_pipeline() {
-  local bin=$1 scene=$2 log=$3 out=$4 seconds=$5 rate=$6 calibration=$7
+  local bin=$1 scene=$2 log=$3 out=$4 seconds=$5 rate=$6 calibration=$7 workspace=$8
   local frames=$((seconds * rate + 1))  # the state at t = 0, then one per period
   local url="udpm://239.255.76.67:7667?ttl=0&recv_buf_size=16777216"
   rm -f "$out/demo"/*.log  # the start-up check below reads the services' fresh logs
@@ -61,10 +61,12 @@ run_sim_pipeline() {
     2>"$out/demo/monitor.log" & local mon=$!
   "$bin/nudge-camera" --lcm-url "$url" --source sim --scene "$scene" --snapshots 2>"$out/demo/camera.log" & local cam=$!
   # 3D axes (AXES, recorded in the log) when the triangulation service is built, with the rig and
-  # table found by the camera-arm calibration in simulation (nudge-exp-calibration-sim).
+  # table found by the camera-arm calibration in simulation (nudge-exp-calibration-sim), and the
+  # arm's workspace ring from the workspace file every service reads (docs/robot.md).
   local tri=
   if [ -x "$bin/nudge-triangulation" ] && [ -f "$calibration" ]; then
-    "$bin/nudge-triangulation" --lcm-url "$url" --calibration "$calibration" 2>"$out/demo/triangulation.log" & tri=$!
+    "$bin/nudge-triangulation" --lcm-url "$url" --calibration "$calibration" --workspace "$workspace" \
+      2>"$out/demo/triangulation.log" & tri=$!
   fi
   # Every subscriber listens before the first state: wait until each has started (the camera
   # builds its World first), at most 30 s.
@@ -73,8 +75,8 @@ run_sim_pipeline() {
     sleep 0.1
   done
   sleep 0.2
-  "$bin/nudge-world" --lcm-url "$url" --scene "$scene" --realtime-factor 1 --rate "$rate" --duration "$seconds" \
-    2>"$out/demo/world.log"
+  "$bin/nudge-world" --lcm-url "$url" --scene "$scene" --workspace "$workspace" --realtime-factor 1 --rate "$rate" \
+    --duration "$seconds" 2>"$out/demo/world.log"
   local status=0
   wait $mon || status=$?
   kill -INT $sym $cam $tri $logger 2>/dev/null || true
@@ -126,7 +128,7 @@ else
   rate=${NUDGE_DEMO_RATE:-10}
   nudge_log "world ($(basename "$scene"), ${seconds} s in real time) -> camera (sim, $rate Hz) -> symmetry -> monitor over LCM; recording $log"
   pipeline=(run_sim_pipeline "$NUDGE_BUILD_DIR/bin" "$scene" "$log" "$out" "$seconds" "$rate"
-            "$NUDGE_ROOT/docs/results/calibration_sim.yaml")
+            "$NUDGE_ROOT/config/calibration_sim.yaml" "$NUDGE_ROOT/config/workspace.yaml")
   drawn="detections drawn in out/demo/ (true axes dashed white)"
 fi
 if nudge_in_private_network bash -c '"$@"' demo "${pipeline[@]}"; then

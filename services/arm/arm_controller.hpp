@@ -7,8 +7,9 @@
 // periods, so the same inputs at the same times give the same states, sample for sample.
 //
 // Safety, whatever the backend: a command is planned and checked completely before anything
-// moves (IK reachability, joint limits, table clearance, the workspace ring, every joint-space
-// segment sampled densely); otherwise it is refused with the reason and the arm keeps still.
+// moves (robot::plan_command: IK reachability, joint limits, table clearance, the workspace ring,
+// every joint-space segment sampled densely); otherwise it is refused with the reason and the arm
+// keeps still.
 // One command runs at a time; while it runs, anything but COMMAND_STOP is refused ("busy").
 #include <Eigen/Geometry>
 
@@ -20,25 +21,16 @@
 #include <vector>
 
 #include "backends.hpp"
-#include "base_frame.hpp"
+#include "pose_message.hpp"
 #include "nudge/arm_command_t.hpp"
 #include "nudge/arm_state_t.hpp"
 #include "nudge/heartbeat_t.hpp"
-#include "nudge/robot/motions.hpp"
-#include "nudge/robot/puma260.hpp"
-#include "nudge/robot/safety.hpp"
+#include "nudge/robot/command_planner.hpp"
 
 namespace nudge::arm {
 
 struct ControllerConfig {
-  robot::ArmModel model = robot::puma260();
-  robot::SafetyConfig safety;  // table_z is set from `base` by the controller
-  BaseFrame base;
-  robot::NudgeParams nudge;    // defaults for the fields a COMMAND_NUDGE leaves at 0
-  robot::GraspParams grasp;
-  double speed_scale = 0.5;    // for commands that leave speed_scale at 0
-  double home_radius = 0.25;   // COMMAND_HOME: tool point this far out along base x,
-  double home_height = 0.32;   // this high above the table, pointing down
+  robot::PlannerConfig planner;  // model, safety, base frame, nudge/grasp/home defaults, speed
   int64_t period_utime = 10000;  // ARM_STATE period and backend step (100 Hz)
   // States more than this far behind a clock jump are not published (the backend still steps
   // through them); < 0: publish every period (log replay, where every sample is wanted).
@@ -89,27 +81,8 @@ class ArmController {
   std::string describe() const;
 
  private:
-  // One stage of a command's motion.
-  struct Step {
-    enum class Kind { Move, Path, OpenGripper, CloseGripper };
-    Kind kind = Kind::Move;
-    std::string what;                      // for reasons: "move to P0"
-    robot::JointVector goal;               // Move: trapezoidal profile from the current joints
-    std::vector<robot::JointVector> path;  // Path: timed waypoints (linear joint interpolation)
-    double speed_scale = 1.0;
-  };
-  struct Plan {
-    std::string reason;  // empty when accepted
-    std::vector<Step> steps;
-    bool malformed = false;
-  };
+  using Step = robot::MotionStep;
 
-  Plan plan(const arm_command_t& command, const robot::JointVector& current) const;
-  Plan plan_move(const robot::JointVector& goal, const std::string& what, double scale,
-                 const robot::JointVector& current, const robot::SafetyConfig& safety) const;
-  // Checks a whole step list from `current`, as the backend will execute it.
-  std::string check_steps(const std::vector<Step>& steps, const robot::JointVector& current,
-                          const robot::SafetyConfig& safety) const;
   arm_state_t refuse(const arm_command_t& command, const std::string& reason, bool malformed);
   void step_backend_to(int64_t utime);
   void update_motion();

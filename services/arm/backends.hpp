@@ -1,8 +1,8 @@
 #pragma once
 // The arm service's backends: whatever executes the checked joint targets (robot::ArmDriver).
 //
-//   sim   SimulatedArm: a kinematic arm inside this service that follows its targets exactly and
-//         opens/closes its gripper at a finite speed. The MuJoCo world follows the ARM_STATE the
+//   sim   robot::SimulatedArm: a kinematic arm inside this service that follows its targets exactly
+//         and opens/closes its gripper at a finite speed. The MuJoCo world follows the ARM_STATE the
 //         service publishes from it, so the simulated arm is exactly what the world shows.
 //   fake  robot::FakeDriver as it is (instant gripper): dry runs and tests.
 //
@@ -17,22 +17,6 @@
 #include "nudge/robot/puma260.hpp"
 
 namespace nudge::arm {
-
-class SimulatedArm : public robot::FakeDriver {
- public:
-  SimulatedArm(robot::JointLimits limits, const robot::JointVector& initial, double gripper_speed);
-
-  robot::JointState read_joint_state() override;  // `moving` also while the gripper travels
-  void stop() override;                            // the gripper halts too
-  std::string open_gripper() override;
-  std::string close_gripper() override;
-  void advance(double seconds);
-
- private:
-  double gripper_speed_;  // m/s
-  double gripper_opening_ = kGripperOpen;
-  double gripper_target_ = kGripperOpen;
-};
 
 struct Backend {
   std::string name;

@@ -17,6 +17,7 @@
 //         provider at speed=0 stamps events with the time it reads them, not with the log's
 //         timestamps, so those cannot serve.)
 #include <cmath>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,41 +26,39 @@
 #include "nudge/arm_command_t.hpp"
 #include "nudge/arm_state_t.hpp"
 #include "nudge/bus/service.hpp"
+#include "nudge/bus_clock.hpp"
 #include "nudge/heartbeat_t.hpp"
 #include "nudge/log.hpp"
 #include "nudge/robot/kinematics.hpp"
 #include "nudge/robot/motions.hpp"
 #include "nudge/robot/safety.hpp"
+#include "nudge/robot/workspace_flags.hpp"
 #include "nudge/sim_state_t.hpp"
-#include "nudge/timing.hpp"
 
 using namespace nudge;
 
 namespace {
 
-enum class ClockSource { Wall, Sim, Log };
-
-ClockSource parse_clock(const std::string& name, bool input_is_log) {
-  if (name == "auto") return input_is_log ? ClockSource::Log : ClockSource::Wall;
-  if (name == "wall") return ClockSource::Wall;
-  if (name == "sim") return ClockSource::Sim;
-  if (name == "log") return ClockSource::Log;
-  throw FlagError("--clock must be auto, wall, sim or log, not '" + name + "'");
+BusClock parse_clock(const std::string& name, bool input_is_log) {
+  try {
+    return BusClock(parse_clock_source(name, input_is_log));
+  } catch (const std::invalid_argument& e) {
+    throw FlagError(std::string("--clock: ") + e.what());
+  }
 }
 
-robot::JointVector initial_joints(const std::vector<double>& degrees,
-                                  const arm::ControllerConfig& config) {
+robot::JointVector initial_joints(const std::vector<double>& degrees, const robot::PlannerConfig& planner) {
   if (!degrees.empty()) {
     const robot::JointVector q = robot::joints_from_degrees(degrees[0], degrees[1], degrees[2],
                                                             degrees[3], degrees[4], degrees[5]);
-    const robot::CheckResult limits = robot::check_joint_limits(config.model, q);
+    const robot::CheckResult limits = robot::check_joint_limits(planner.model, q);
     if (!limits.ok()) throw FlagError("--initial-joints: " + limits.reason);
     return q;
   }
-  robot::SafetyConfig safety = config.safety;
-  safety.table_z = config.base.table_z();
+  robot::SafetyConfig safety = planner.safety;
+  safety.table_z = planner.base.table_z();
   const robot::IkResult home =
-      robot::home_configuration(config.model, safety, config.home_radius, config.home_height);
+      robot::home_configuration(planner.model, safety, planner.home_radius, planner.home_height);
   if (!home.ok()) throw FlagError("no home pose to start from: " + home.reason);
   return home.q;
 }
@@ -72,7 +71,8 @@ int main(int argc, char** argv) {
     arm::ControllerConfig config;
     std::string backend_name = "sim", clock_name = "auto";
     std::string command_channel = "ARM_COMMAND", state_channel = "ARM_STATE", sim_channel = "SIM_STATE";
-    double rate = 100, base_yaw_deg = 0, tool_length = config.model.tool.translation().z();
+    robot::PlannerConfig& planner = config.planner;
+    double rate = 100;
     double gripper_speed = 0.05, max_catch_up = 1.0;
     std::vector<double> initial_deg;
     auto& f = service.flags();
@@ -83,41 +83,38 @@ int main(int argc, char** argv) {
     f.add_string("sim-channel", &sim_channel, "sim_state_t input for --clock sim");
     f.add_double("rate", &rate, "ARM_STATE messages per second of the clock");
     f.add_double("max-catch-up", &max_catch_up, "after a clock jump publish at most this many seconds of states (wall, sim)");
-    f.add_double("base-height", &config.base.height, "shoulder (base frame origin) above the table top, m");
-    f.add_double("base-yaw-deg", &base_yaw_deg, "base x axis about the world z axis, degrees");
-    f.add_double("tool-length", &tool_length, "tool point (pad centre / gripper centre) along the flange z axis, m");
+    const robot::WorkspaceFlags workspace_flags(
+        f, {"base-height", "base-yaw-deg", "tool-length", "table-margin", "ring-inner", "ring-outer"});
     f.add_doubles("initial-joints", &initial_deg, 6, "joints at start, degrees (default: the home pose)");
-    f.add_double("speed-scale", &config.speed_scale, "fraction of the joint speed limits for commands that give 0");
-    f.add_double("home-radius", &config.home_radius, "COMMAND_HOME: tool point from the base axis, m");
-    f.add_double("home-height", &config.home_height, "COMMAND_HOME: tool point above the table, m");
-    f.add_double("approach-height", &config.nudge.approach_height, "nudge P0: tool above the table, m (default for 0)");
-    f.add_double("push-height", &config.nudge.push_height, "nudge P1/P2: tool above the table, m (default for 0)");
-    f.add_double("start-distance", &config.nudge.start_distance, "nudge Dmax: P1 before the target axis, m (default for 0)");
-    f.add_double("stop-distance", &config.nudge.stop_distance, "nudge Dmin: P2 before the target axis, m (default for 0)");
-    f.add_double("grasp-approach-height", &config.grasp.approach_height, "grasp/place: tool above the table before descending, m");
-    f.add_double("lift-height", &config.grasp.lift_height, "grasp: tool above the table after lifting, m");
-    f.add_double("table-margin", &config.safety.table_margin, "tool, wrist and elbow stay this far above the table, m");
-    f.add_double("ring-inner", &config.safety.ring_inner, "workspace ring: inner radius of the tool point, m");
-    f.add_double("ring-outer", &config.safety.ring_outer, "workspace ring: outer radius of the tool point, m");
+    f.add_double("speed-scale", &planner.speed_scale, "fraction of the joint speed limits for commands that give 0");
+    f.add_double("home-radius", &planner.home_radius, "COMMAND_HOME: tool point from the base axis, m");
+    f.add_double("home-height", &planner.home_height, "COMMAND_HOME: tool point above the table, m");
+    f.add_double("approach-height", &planner.nudge.approach_height, "nudge P0: tool above the table, m (default for 0)");
+    f.add_double("push-height", &planner.nudge.push_height, "nudge P1/P2: tool above the table, m (default for 0)");
+    f.add_double("start-distance", &planner.nudge.start_distance, "nudge Dmax: P1 before the target axis, m (default for 0)");
+    f.add_double("stop-distance", &planner.nudge.stop_distance, "nudge Dmin: P2 before the target axis, m (default for 0)");
+    f.add_double("grasp-approach-height", &planner.grasp.approach_height, "grasp/place: tool above the table before descending, m");
+    f.add_double("lift-height", &planner.grasp.lift_height, "grasp: tool above the table after lifting, m");
     f.add_double("gripper-speed", &gripper_speed, "sim backend: gripper finger speed, m/s");
     f.add_double("supervisor-timeout", &config.supervisor_timeout, "stop when a supervisor heartbeat, once heard, is missing this long, s");
     f.add_bool("require-supervisor", &config.require_supervisor, "refuse motions until a supervisor heartbeat arrives");
     if (!service.parse(argc, argv)) return 0;
 
-    const ClockSource clock = parse_clock(clock_name, service.input_is_log());
+    BusClock clock = parse_clock(clock_name, service.input_is_log());
     if (!(rate > 0 && rate <= 1000)) throw FlagError("--rate must lie in (0, 1000]");
     if (!(max_catch_up >= 0)) throw FlagError("--max-catch-up must not be negative");
-    if (!(tool_length >= 0 && tool_length < 0.5)) throw FlagError("--tool-length must lie in [0, 0.5) m");
-    config.model.tool.translation() = Eigen::Vector3d(0.0, 0.0, tool_length);
-    config.base.yaw = robot::deg_to_rad(base_yaw_deg);
+    const robot::Workspace workspace = workspace_flags.resolve();
+    robot::apply_workspace(workspace, &planner.model);
+    robot::apply_workspace(workspace, &planner.safety);
+    planner.base = robot::BaseFrame::of(workspace);
     config.period_utime = std::llround(1e6 / rate);
     // A log replay wants every sample; live, a long jump (a paused world) is not worth a flood.
-    config.max_catch_up_utime = clock == ClockSource::Log ? -1 : std::llround(max_catch_up * 1e6);
+    config.max_catch_up_utime = clock.source() == ClockSource::Log ? -1 : std::llround(max_catch_up * 1e6);
     std::unique_ptr<arm::ArmController> controller;
     try {
       arm::validate(config);
-      arm::Backend backend = arm::make_backend(backend_name, config.model,
-                                               initial_joints(initial_deg, config), gripper_speed);
+      arm::Backend backend = arm::make_backend(backend_name, planner.model,
+                                               initial_joints(initial_deg, planner), gripper_speed);
       controller = std::make_unique<arm::ArmController>(config, std::move(backend));
     } catch (const std::invalid_argument& e) {
       throw FlagError(e.what());
@@ -135,13 +132,19 @@ int main(int argc, char** argv) {
       service.set_status(controller->describe());
     };
 
-    // Message time: a message moves the clock to its utime before it is acted on.
-    auto follow_message_time = [&](int64_t utime) {
-      if (clock == ClockSource::Log) controller->advance_with_watchdog(utime, publish);
+    // A message moves the clock (BusClock: wall time, or its utime on --clock log) before it is
+    // acted on. With the supervisor's deadlines on message time (a log) the watchdog moves with it.
+    auto follow = [&](int64_t utime, Stamp stamp) {
+      const std::optional<int64_t> now = clock.on_message(utime, stamp);
+      if (!now) return;
+      if (clock.deadlines_on_message_time()) {
+        controller->advance_with_watchdog(*now, publish);
+      } else {
+        controller->advance_to(*now, publish);
+      }
     };
     service.subscriptions().subscribe<arm_command_t>(command_channel, [&](const arm_command_t& command, const std::string&) {
-      if (clock == ClockSource::Wall) controller->advance_to(wall_utime(), publish);
-      follow_message_time(command.utime);
+      follow(command.utime, Stamp::Sender);
       const arm_state_t response = controller->handle(command);
       publish(response);
       if (response.motion == arm_state_t::MOTION_REFUSED) {
@@ -152,34 +155,34 @@ int main(int argc, char** argv) {
       after_event();
     });
     service.subscriptions().subscribe<heartbeat_t>(bus::kHeartbeatChannel, [&](const heartbeat_t& heartbeat, const std::string&) {
-      follow_message_time(heartbeat.utime);
-      const int64_t now = clock == ClockSource::Log ? controller->clock() : wall_utime();
-      if (controller->on_heartbeat(heartbeat, now)) {
+      follow(heartbeat.utime, Stamp::Sender);
+      if (controller->on_heartbeat(heartbeat, clock.deadline_time())) {
         publish(controller->state());
         log::warn() << controller->describe();
       }
       after_event();
     });
-    if (clock == ClockSource::Sim) {
+    if (clock.source() == ClockSource::Sim) {
       service.subscriptions().subscribe<sim_state_t>(sim_channel, [&](const sim_state_t& sim, const std::string&) {
-        controller->advance_to(sim.utime, publish);
+        follow(sim.utime, Stamp::Simulated);
       });
     }
-    if (clock == ClockSource::Wall) controller->advance_to(wall_utime(), publish);
-    if (clock != ClockSource::Log) publish(controller->state());  // the world places its pusher at once
-    log::info() << "backend " << backend_name << ", clock " << clock_name << ", " << command_channel << " -> "
-                << state_channel << " at " << rate << " Hz; base " << config.base.height << " m above the table, yaw "
-                << base_yaw_deg << " deg";
+    if (const std::optional<int64_t> now = clock.on_timer()) controller->advance_to(*now, publish);
+    if (clock.source() != ClockSource::Log) publish(controller->state());  // the world places its pusher at once
+    log::info() << "backend " << backend_name << ", clock " << clock_source_name(clock.source()) << ", " << command_channel << " -> "
+                << state_channel << " at " << rate << " Hz; base " << planner.base.height << " m above the table, yaw "
+                << robot::rad_to_deg(planner.base.yaw) << " deg, tool " << workspace.tool_length << " m, ring "
+                << workspace.ring_inner << "-" << workspace.ring_outer << " m"
+                << (workspace_flags.file().empty() ? "" : " (" + workspace_flags.file() + ")");
 
     const int wait_ms = std::max(1, static_cast<int>(500.0 / rate));  // two looks per period
     return service.run([&] {
-      if (clock == ClockSource::Log) return wait_ms;  // time moves only with the log
-      const int64_t now = wall_utime();
-      if (controller->check_supervisor(now)) {
+      if (clock.deadlines_on_message_time()) return wait_ms;  // time moves only with the log
+      if (controller->check_supervisor(clock.deadline_time())) {
         publish(controller->state());
         log::warn() << controller->describe();
       }
-      if (clock == ClockSource::Wall) controller->advance_to(now, publish);
+      if (const std::optional<int64_t> now = clock.on_timer()) controller->advance_to(*now, publish);
       after_event();
       return wait_ms;
     }, wait_ms);

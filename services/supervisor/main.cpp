@@ -30,6 +30,7 @@
 #include "nudge/heartbeat_t.hpp"
 #include "nudge/image_t.hpp"
 #include "nudge/log.hpp"
+#include "nudge/robot/workspace_flags.hpp"
 #include "nudge/segmentation_t.hpp"
 #include "nudge/sim_state_t.hpp"
 #include "nudge/snapshot_request_t.hpp"
@@ -48,7 +49,6 @@ namespace {
 struct Options {
   std::string calibration, run_id, out_dir = "out/runs", clock = "sim", require;
   double service_timeout_s = 3.0;
-  double base_yaw_deg = 0;
   int first_seq = 0;
   bool keep_running = false;
   sv::Config config;
@@ -414,10 +414,6 @@ void add_flags(Flags& f, Options& o) {
   f.add_double("snapshot-timeout", &o.config.snapshot_timeout_s, "for a still, s of the task clock");
   f.add_double("candidates-timeout", &o.config.candidates_timeout_s, "for a CANDIDATES answer, s of the task clock");
   f.add_double("nudge-timeout", &o.config.nudge_timeout_s, "for the arm to finish a nudge, s of the task clock");
-  f.add_double("base-height", &o.arm.base_height, "arm shoulder above the table top, m (as nudge-arm's)");
-  f.add_double("base-yaw-deg", &o.base_yaw_deg, "arm base x axis about the world z axis, degrees (as nudge-arm's)");
-  f.add_double("ring-inner", &o.arm.safety.ring_inner, "workspace ring inner radius, m (as nudge-arm's)");
-  f.add_double("ring-outer", &o.arm.safety.ring_outer, "workspace ring outer radius, m (as nudge-arm's)");
   f.add_double("object-radius", &o.config.targets.object_radius, "largest expected object radius (push clearance), m");
   f.add_int("first-seq", &o.first_seq, "first ARM_COMMAND seq (default: from the wall clock; set it to replay a run)");
 }
@@ -431,14 +427,21 @@ int main(int argc, char** argv) {
                          "with nobody in the loop. Writes the run's LCM log and summary under --out.");
     Options opt;
     add_flags(service.flags(), opt);
+    // The arm's workspace, as nudge-arm reads it: the targets it chooses are nudges the arm accepts.
+    const robot::WorkspaceFlags workspace_flags(
+        service.flags(), {"base-height", "base-yaw-deg", "tool-length", "table-margin", "ring-inner", "ring-outer"});
     if (!service.parse(argc, argv)) return 0;
+    const robot::Workspace workspace = workspace_flags.resolve();
+    robot::apply_workspace(workspace, &opt.arm.model);
+    robot::apply_workspace(workspace, &opt.arm.safety);
+    opt.arm.base_height = workspace.shoulder_height;
+    opt.arm.base_yaw = workspace.base_yaw;
     if (opt.calibration.empty()) throw FlagError("--calibration FILE is required");
     if (opt.clock != "sim" && opt.clock != "wall") throw FlagError("--clock must be sim or wall, not '" + opt.clock + "'");
     if (opt.run_id.empty()) opt.run_id = default_run_id();
     if (opt.run_id.find('/') != std::string::npos) throw FlagError("--run-id must not contain '/'");
     if (opt.require.empty()) opt.require = std::string("camera,symmetry,triangulation,arm") + (opt.clock == "sim" ? ",world" : "");
     if (!(opt.service_timeout_s > 0)) throw FlagError("--service-timeout must be > 0");
-    opt.arm.base_yaw = opt.base_yaw_deg * M_PI / 180;
     Shell shell(service, opt);  // loads the calibration: a bad file ends here, naming the field
     service.start();
     shell.subscribe();

@@ -6,7 +6,9 @@
 // arm base's foot on the table, else below the right camera; x = the right camera's x projected
 // onto the table). Without one, AXES are in the right camera's frame with NaN table points.
 // The table plane and arm base come from --table-plane / --arm-base, else from the calibration
-// file's optional `table_plane` / `arm_base` fields (see nudge/geometry/workspace.hpp).
+// file's optional `table_plane` / `arm_base` fields (see nudge/geometry/workspace.hpp); the
+// workspace ring around the arm base from --workspace FILE (robot::Workspace, the arm's), with
+// --ring-inner / --ring-outer as overrides.
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -20,6 +22,7 @@
 #include "nudge/geometry/stereo_pairing.hpp"
 #include "nudge/geometry/workspace.hpp"
 #include "nudge/log.hpp"
+#include "nudge/robot/workspace_flags.hpp"
 #include "nudge/symmetry_lines_t.hpp"
 
 using namespace nudge;
@@ -67,7 +70,10 @@ class Triangulation {
     if (table_) frame_.emplace(*table_, arm_base_);
     log::info() << "rig " << opt.calibration << ": baseline " << rig_.T.norm() << " m; "
                 << (table_ ? "table frame output" : "no table plane: AXES in the right camera frame, no candidates")
-                << (table_ && !arm_base_ ? "; no arm base: candidates without the workspace ring" : "");
+                << (table_ && !arm_base_ ? "; no arm base: candidates without the workspace ring" : "")
+                << (table_ && arm_base_ ? "; candidates in the " + std::to_string(opt.locations.ring_inner_m) + "-" +
+                                              std::to_string(opt.locations.ring_outer_m) + " m workspace ring"
+                                        : std::string());
   }
 
   void subscribe() {
@@ -207,8 +213,6 @@ void add_flags(Flags& f, Options& o) {
   f.add_int("candidate-frames", &o.locations.frames, "CANDIDATES: stereo pairs gathered per request");
   f.add_int("candidate-lines", &o.locations.lines_per_image, "CANDIDATES: strongest lines per image");
   f.add_double("candidate-tilt", &o.locations.max_tilt_deg, "CANDIDATES: max angle from the table normal, degrees");
-  f.add_double("ring-inner", &o.locations.ring_inner_m, "CANDIDATES: workspace ring inner radius, m");
-  f.add_double("ring-outer", &o.locations.ring_outer_m, "CANDIDATES: workspace ring outer radius, m");
   f.add_double("cluster-radius", &o.locations.qt.radius, "CANDIDATES: QT cluster radius, m");
   f.add_double("cluster-min-fraction", &o.locations.qt.min_fraction, "CANDIDATES: smallest cluster, fraction of all");
 }
@@ -240,7 +244,12 @@ int main(int argc, char** argv) {
                          "object locations on request (sec. 6.2).");
     Options opt;
     add_flags(service.flags(), opt);
+    // CANDIDATES lie in the arm's workspace ring: the workspace file's, as the arm checks it.
+    const robot::WorkspaceFlags workspace_flags(service.flags(), {"ring-inner", "ring-outer"}, "CANDIDATES: ");
     if (!service.parse(argc, argv)) return 0;
+    const robot::Workspace workspace = workspace_flags.resolve();
+    opt.locations.ring_inner_m = workspace.ring_inner;
+    opt.locations.ring_outer_m = workspace.ring_outer;
     check(opt);
     opt.locations.max_range_m = opt.filter.max_range_m;
     Triangulation triangulation(service, opt);  // loads the rig: a bad file ends here, naming the field

@@ -13,14 +13,15 @@
 #include "nudge/arm_state_t.hpp"
 #include "nudge/bus/image.hpp"
 #include "nudge/bus/service.hpp"
+#include "nudge/bus_clock.hpp"
 #include "nudge/log.hpp"
+#include "nudge/robot/workspace_flags.hpp"
 #include "nudge/sim/mjcf.hpp"
 #include "nudge/sim/state_sync.hpp"
 #include "nudge/sim/world.hpp"
 #include "nudge/sim_state_t.hpp"
 #include "nudge/sim_truth_request_t.hpp"
 #include "nudge/sim_truth_t.hpp"
-#include "nudge/timing.hpp"
 
 using namespace nudge;
 
@@ -30,10 +31,6 @@ constexpr const char* kStateChannel = "SIM_STATE";
 constexpr const char* kTruthChannel = "SIM_TRUTH";
 constexpr const char* kTruthRequestChannel = "SIM_TRUTH_REQUEST";
 constexpr const char* kArmStateChannel = "ARM_STATE";
-// Utimes from here on are wall-clock stamps (2001 onwards), not simulated time since a start.
-constexpr int64_t kWallClockUtime = 1000000000LL * 1000000LL;
-// The longest simulated time a log may span (a day).
-constexpr double kMaxLogSeconds = 86400.0;
 
 pose_t to_pose(const Eigen::Vector3d& p, const Eigen::Quaterniond& q) {
   pose_t pose;
@@ -187,17 +184,16 @@ class Simulation {
   std::optional<arm_state_t> arm_;
 };
 
-// The world's inputs. Live, a message takes effect at the next physics step. From a log (the
-// file provider hands messages over as fast as they are read, stamped with the wall clock), a
-// message takes effect at simulated time = its utime minus an origin, the same way every run.
-// By default the origin is 0 when the first input message's utime looks like simulated time (an
-// arm on --clock sim stamps ARM_STATE with SIM_STATE's utime), else that first utime (wall-clock
-// stamps: the log replays as if the world had run in real time while it was recorded).
-// Bad messages are reported naming the channel, counted and skipped.
+// The world's inputs, on the world's BusClock. Live (wall), a message takes effect at the next
+// physics step. From a log (the file provider hands messages over as fast as they are read,
+// stamped with the wall clock), a message takes effect at simulated time = its utime minus the
+// log's origin (LogTimeline: 0 when the first input message's utime looks like simulated time,
+// as an arm on --clock sim stamps ARM_STATE with SIM_STATE's utime; else that first utime), the
+// same way every run. Bad messages are reported naming the channel, counted and skipped.
 class Inputs {
  public:
-  Inputs(bus::Service& service, Simulation& sim, bool from_log, std::optional<int64_t> log_origin)
-      : sim_(sim), from_log_(from_log), log_origin_(log_origin) {
+  Inputs(bus::Service& service, Simulation& sim, BusClock& clock, LogTimeline timeline)
+      : sim_(sim), clock_(clock), timeline_(timeline) {
     service.subscriptions().subscribe<arm_state_t>(kArmStateChannel, [this](const arm_state_t& msg, const std::string&) {
       catch_up(msg.utime);
       sim_.on_arm_state(msg);  // throws on a bad pose: counted, skipped
@@ -211,59 +207,32 @@ class Inputs {
 
  private:
   void catch_up(int64_t utime) {
-    if (!from_log_) return;
-    if (!log_origin_) log_origin_ = utime < kWallClockUtime ? 0 : utime;
-    const double seconds = 1e-6 * static_cast<double>(utime - *log_origin_);
-    // A stamp on another clock (wall-clock time after simulated time) would run the physics for
-    // years: refused (counted, skipped) instead.
-    if (seconds > kMaxLogSeconds)
-      throw std::invalid_argument("utime " + std::to_string(utime) + " is " + std::to_string(seconds) +
-                                  " s after the log's origin: not on the same clock");
-    sim_.advance_to(seconds);
+    if (clock_.source() != ClockSource::Log) return;  // live: the pacer moves simulated time
+    // A stamp on another clock would run the physics for years: refused (counted, skipped)
+    // before it moves the clock.
+    timeline_.seconds(utime);
+    if (const std::optional<int64_t> now = clock_.on_message(utime, Stamp::Sender)) {
+      sim_.advance_to(timeline_.seconds(*now));
+    }
   }
 
   Simulation& sim_;
-  bool from_log_;
-  std::optional<int64_t> log_origin_;
+  BusClock& clock_;
+  LogTimeline timeline_;
 };
 
-// Paces simulated time against the wall clock: sim time runs `factor` times as fast as wall time.
-// When the machine cannot keep up it falls behind, never skips physics steps, and re-anchors so
-// that it does not rush to catch up afterwards (it simply runs slower than asked).
-class Pacer {
- public:
-  explicit Pacer(double factor) : factor_(factor) {}
-  // The simulated time physics should have reached now.
-  double target(double sim_time) {
-    const int64_t now = wall_utime();
-    if (!anchored_) {
-      anchor_wall_ = now;
-      anchor_sim_ = sim_time;
-      anchored_ = true;
-    }
-    double t = anchor_sim_ + factor_ * 1e-6 * static_cast<double>(now - anchor_wall_);
-    if (t - sim_time > kMaxLag) {
-      ++slips_;
-      anchor_wall_ = now;
-      anchor_sim_ = sim_time;
-      t = sim_time;
-    }
-    return t;
-  }
-  // Milliseconds of wall time until simulated time `due` is reached.
-  int wait_ms(double due, double sim_target) const {
-    return static_cast<int>(std::clamp(std::ceil(1e3 * (due - sim_target) / factor_), 0.0, 20.0));
-  }
-  int64_t slips() const { return slips_; }
-
- private:
-  static constexpr double kMaxLag = 0.1;  // s of simulated time
-  double factor_;
-  bool anchored_ = false;
-  int64_t anchor_wall_ = 0;
-  double anchor_sim_ = 0;
-  int64_t slips_ = 0;
-};
+// The simulated arm must stand where the workspace the arm service plans with says. The scene
+// places it (the camera's sim backend renders the same scene), so a workspace file that
+// disagrees is a usage error rather than a silent choice; the simulated base is not turned.
+void check_arm_placement(const robot::Workspace& workspace, const std::string& workspace_file, const sim::Scene& scene) {
+  if (!scene.arm.present) return;
+  if (workspace.base_yaw != 0.0)
+    throw FlagError("--workspace: base_yaw_deg must be 0 in simulation (the simulated arm is not turned)");
+  if (workspace_file.empty() || std::abs(workspace.shoulder_height - scene.arm.shoulder_height) < 1e-9) return;
+  throw FlagError("--workspace " + workspace_file + ": shoulder_height " + std::to_string(workspace.shoulder_height) +
+                  " m but " + scene.source + ": arm.shoulder_height " + std::to_string(scene.arm.shoulder_height) +
+                  " m: the simulated arm must stand where the arm service plans for it");
+}
 
 }  // namespace
 
@@ -285,9 +254,8 @@ int main(int argc, char** argv) {
     f.add_double("duration", &duration, "stop after this many simulated seconds (0: run until stopped)");
     std::string tool = "pad";
     f.add_string("tool", &tool, "the arm's tool: pad (pushes) or gripper (grasps; fingers follow ARM_STATE.gripper)");
-    double tool_length = 0.15;
-    f.add_double("tool-length", &tool_length,
-                 "scenes with the arm: the tool point along the simulated flange's z axis, m (as nudge-arm's)");
+    // Scenes with the arm: its tool and shoulder height are the workspace's, as nudge-arm's.
+    const robot::WorkspaceFlags workspace_flags(f, {"tool-length"}, "scenes with the arm: ");
     double log_origin_s = -1;
     f.add_double("log-origin", &log_origin_s,
                  "input from a log: the utime (s) that is simulated time 0 (-1: automatic, docs/sim.md)");
@@ -298,7 +266,7 @@ int main(int argc, char** argv) {
     if (!(duration >= 0 && std::isfinite(duration))) throw FlagError("--duration must be >= 0");
     if (seed < -1) throw FlagError("--seed must be >= 0 (or -1 for the scene's)");
     if (tool != "pad" && tool != "gripper") throw FlagError("--tool must be pad or gripper, not '" + tool + "'");
-    if (!(tool_length >= 0 && tool_length < 0.5)) throw FlagError("--tool-length must lie in [0, 0.5) m");
+    const robot::Workspace workspace = workspace_flags.resolve();
     if (!(log_origin_s >= 0 || log_origin_s == -1)) throw FlagError("--log-origin must be >= 0 (or -1)");
     const int64_t log_origin = log_origin_s >= 0 ? std::llround(log_origin_s * 1e6) : -1;
     sim::Scene scene;
@@ -308,19 +276,26 @@ int main(int argc, char** argv) {
       throw FlagError(e.what());
     }
     if (seed >= 0) scene.seed = static_cast<uint64_t>(seed);
+    check_arm_placement(workspace, workspace_flags.file(), scene);
 
     service.start();
-    Simulation sim(service, scene, rate, tool == "gripper", tool_length);
+    Simulation sim(service, scene, rate, tool == "gripper", workspace.tool_length);
     if (duration > 0) sim.set_end_time(duration);
     const bool from_log = service.input_is_log();
-    Inputs inputs(service, sim, from_log, log_origin >= 0 ? std::optional<int64_t>(log_origin) : std::nullopt);
+    // Message time from a log, else the wall clock (paced, or as fast as possible).
+    BusClock clock(from_log ? ClockSource::Log : ClockSource::Wall);
+    Inputs inputs(service, sim, clock, LogTimeline(log_origin >= 0 ? std::optional<int64_t>(log_origin) : std::nullopt));
+    if (scene.arm.present)
+      log::info() << "the PUMA 260 with its tool point " << workspace.tool_length << " m along the flange"
+                  << (workspace_flags.file().empty() ? "" : " (" + workspace_flags.file() + ")");
     log::info() << scene_file << ": " << scene.objects.size() << " objects, seed " << scene.seed << ", "
                 << (from_log ? "input events applied at their log time"
                              : realtime_factor > 0 ? "realtime factor " + std::to_string(realtime_factor)
                                                    : std::string("as fast as possible"));
     service.publish(kStateChannel, sim.state_message());  // the state at t = 0
 
-    Pacer pacer(realtime_factor);
+    std::optional<Pacer> pacer;
+    if (realtime_factor > 0) pacer.emplace(realtime_factor);
     const int rc = service.run([&]() -> int {
       if (sim.finished()) {
         service.request_stop();
@@ -332,10 +307,10 @@ int main(int argc, char** argv) {
         sim.advance_to_next_state();
         return 0;
       }
-      const double target = pacer.target(sim.time());
+      const double target = pacer->target(sim.time());
       sim.advance_to(target);
-      service.set_status("t " + std::to_string(sim.time()) + " s, slowed " + std::to_string(pacer.slips()) + "x");
-      return pacer.wait_ms(sim.time() + sim.timestep(), target);
+      service.set_status("t " + std::to_string(sim.time()) + " s, slowed " + std::to_string(pacer->slips()) + "x");
+      return pacer->wait_ms(sim.time() + sim.timestep(), target);
     }, 20);
     // A log's events are all applied: simulate on to --duration, as fast as possible.
     if (from_log && rc == 0 && duration > 0) sim.advance_to(duration);

@@ -33,7 +33,7 @@ namespace {
 const std::string kBin = NUDGE_BIN_DIR;
 const std::string kSource = NUDGE_SOURCE_DIR;
 const std::string kUrl = "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=16777216";
-const std::string kCalibration = kSource + "/docs/results/calibration_sim.yaml";
+const std::string kCalibration = kSource + "/config/calibration_sim.yaml";
 
 std::string read_file(const std::string& path) {
   std::ifstream in(path);

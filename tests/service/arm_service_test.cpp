@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -452,6 +453,40 @@ TEST(ArmService, RequiredSupervisorAndBaseFrameFlags) {
   ASSERT_FALSE(second.empty());
   ASSERT_EQ(second.back().motion + 0, kDone) << second.back().last_error;
   EXPECT_LT((position(second.back()) - target).norm(), 1e-3);
+}
+
+// The workspace file sets the base and the ring; a flag given overrides its field.
+TEST(ArmService, WorkspaceFileAndItsOverrides) {
+  const std::string in = temp_path("arm_ws_in.lcmlog"), out = temp_path("arm_ws_out.lcmlog");
+  const std::string workspace = temp_path("arm_workspace.yaml");
+  {
+    std::ofstream file(workspace);
+    file << "%YAML:1.0\n---\nbase_yaw_deg: 90\nshoulder_height: 0.35\ntool_length: 0.15\n"
+            "ring_inner: 0.15\nring_outer: 0.27\ntable_margin: 0.005\n";
+  }
+  const Eigen::Vector3d target(0.0, 0.30, 0.10);  // world frame: 0.30 m from the base axis
+  {
+    InputLog log(in);
+    log.command(kStart, tool_down_pose_command(1, target, 0.0));
+    log.traffic(kStart + 100000, kStart + 10 * kSecond);
+  }
+  const Output narrow = run_service(in, out, " --workspace " + workspace);
+  const auto refused = of_command(narrow.states, 1);
+  ASSERT_FALSE(refused.empty());
+  EXPECT_EQ(refused.back().motion + 0, kRefused);
+  EXPECT_NE(refused.back().last_error.find("0.150-0.270 m workspace ring"), std::string::npos)
+      << refused.back().last_error;
+
+  const Output wider = run_service(in, out, " --workspace " + workspace + " --ring-outer 0.35");
+  const auto moved = of_command(wider.states, 1);
+  ASSERT_FALSE(moved.empty());
+  ASSERT_EQ(moved.back().motion + 0, kDone) << moved.back().last_error;
+  EXPECT_LT((position(moved.back()) - target).norm(), 1e-3);  // the file's turned, higher base
+
+  const std::string bin = std::string(NUDGE_BIN_DIR) + "/nudge-arm";
+  const int status = std::system((bin + " --workspace " + temp_path("no_such_workspace.yaml") + " 2>/dev/null").c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 2);
 }
 
 TEST(ArmService, ClockSimFollowsTheSimulatedTimeOfSimState) {

@@ -407,4 +407,10 @@ TEST(TriangulationService, BadCalibrationAndFlagsAreClearErrors) {
   EXPECT_EQ(run(service + " --calibration x --table-plane 0 0 0 1", &err), 2);
   EXPECT_NE(err.find("normal"), std::string::npos) << err;
   EXPECT_EQ(run(service + " --calibration x --ring-inner 0.4 --ring-outer 0.3", &err), 2);
+  // The ring comes from the workspace file the arm reads: a bad one is named, field and all.
+  const std::string workspace = scratch_dir() + "/triangulation_workspace.yaml";
+  std::ofstream(workspace) << "%YAML:1.0\n---\nbase_yaw_deg: 0\nshoulder_height: 0.33\ntool_length: 0.15\n"
+                              "ring_inner: 0.15\ntable_margin: 0.005\n";
+  EXPECT_EQ(run(service + " --calibration x --workspace " + workspace, &err), 2);
+  EXPECT_NE(err.find(workspace + ": ring_outer: missing"), std::string::npos) << err;
 }

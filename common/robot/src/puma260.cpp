@@ -1,5 +1,7 @@
 #include "nudge/robot/puma260.hpp"
 
+#include "nudge/robot/workspace.hpp"
+
 namespace nudge::robot {
 
 std::array<DhLink, kNumJoints> puma260_links() {
@@ -26,7 +28,7 @@ JointVector puma260_max_acceleration() { return joints_from_degrees(90, 90, 90, 
 
 Eigen::Isometry3d default_tool() {
   Eigen::Isometry3d tool = Eigen::Isometry3d::Identity();
-  tool.translation() = Eigen::Vector3d(0.0, 0.0, 0.15);
+  tool.translation() = Eigen::Vector3d(0.0, 0.0, Workspace{}.tool_length);
   return tool;
 }
 

@@ -68,7 +68,7 @@ struct World::Impl {
   int arm_qpos[6], arm_dof[6], arm_act[6];
   int flange_site = -1;
   bool tools_on_arm = false;         // the tools ride on the simulated flange
-  double tool_length = 0.15;
+  double tool_length = robot::Workspace{}.tool_length;
   double tool_yaw = 0;
   // Puts the tool point on the simulated flange (kinematics as of the last mj_step1/mj_forward).
   void follow_flange() {

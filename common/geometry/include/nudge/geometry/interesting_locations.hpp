@@ -13,6 +13,7 @@
 #include "nudge/geometry/qt_cluster.hpp"
 #include "nudge/geometry/stereo_rig.hpp"
 #include "nudge/geometry/triangulation.hpp"
+#include "nudge/robot/workspace.hpp"
 
 namespace nudge::geometry {
 
@@ -60,7 +61,8 @@ struct LocationParams {
   int lines_per_image = 3;   // top lines per image: 9 pairings per stereo pair (thesis: 3)
   double max_tilt_deg = 10;  // from the table normal (thesis ch. 6: 10 deg)
   double max_range_m = 1.2;  // from the right camera
-  double ring_inner_m = 0.150, ring_outer_m = 0.350;  // arm workspace ring (thesis: 150-350 mm)
+  // The arm's workspace ring (thesis: 150-350 mm), robot::Workspace's unless a service sets it.
+  double ring_inner_m = robot::Workspace{}.ring_inner, ring_outer_m = robot::Workspace{}.ring_outer;
   QtParams qt;               // radius 10 mm, clusters of at least 1/9 of all intersects
 };
 

@@ -9,6 +9,7 @@
 
 #include "nudge/geometry/outcome.hpp"
 #include "nudge/geometry/triangulation.hpp"
+#include "nudge/robot/workspace.hpp"
 
 namespace nudge::geometry {
 
@@ -42,9 +43,10 @@ struct PlaneFrame {
 struct AxisFilter {
   double max_tilt_deg = 15;   // from the table normal (thesis: 15 deg in ch. 4, 10 deg in ch. 6)
   double max_range_m = 1.2;   // table intersection farther from the (right) camera: out of reach
-  // Optional workspace ring on the table (ch. 6: 150-350 mm around the arm base).
+  // Optional workspace ring on the table (ch. 6: 150-350 mm around the arm base): the arm's
+  // (robot::Workspace) unless set.
   std::optional<Eigen::Vector3d> ring_centre;
-  double ring_inner_m = 0.150, ring_outer_m = 0.350;
+  double ring_inner_m = robot::Workspace{}.ring_inner, ring_outer_m = robot::Workspace{}.ring_outer;
 };
 
 struct TableHit {

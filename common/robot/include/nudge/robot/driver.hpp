@@ -78,4 +78,24 @@ class FakeDriver : public ArmDriver {
   int stop_count_ = 0;
 };
 
+// The simulated PUMA 260 of the arm service's `sim` backend: a FakeDriver whose gripper opens and
+// closes at a finite speed (`moving` while it travels), on the same advance() clock. The MuJoCo
+// world follows the joints and the opening the arm service publishes from it (docs/sim.md).
+class SimulatedArm : public FakeDriver {
+ public:
+  // Throws std::invalid_argument unless gripper_speed (m/s) is positive and finite.
+  SimulatedArm(JointLimits limits, const JointVector& initial, double gripper_speed);
+
+  JointState read_joint_state() override;  // `moving` also while the gripper travels
+  void stop() override;                    // the gripper halts too
+  std::string open_gripper() override;
+  std::string close_gripper() override;
+  void advance(double seconds);
+
+ private:
+  double gripper_speed_;  // m/s
+  double gripper_opening_ = kGripperOpen;
+  double gripper_target_ = kGripperOpen;
+};
+
 }  // namespace nudge::robot

@@ -49,8 +49,9 @@ JointLimits puma260_limits();
 JointVector puma260_max_speed();
 JointVector puma260_max_acceleration();
 
-// The default tool: a point 0.15 m along the flange z axis (gripper fingertips / sponge), with the
-// flange's orientation. Measure and configure it for a real effector.
+// The default tool: a point Workspace::tool_length (0.15 m) along the flange z axis (gripper
+// fingertips / sponge), with the flange's orientation. Measure and configure it for a real
+// effector (the workspace file, workspace.hpp).
 Eigen::Isometry3d default_tool();
 
 // Table B.1 links, the limits above, conservative speeds and the default tool.

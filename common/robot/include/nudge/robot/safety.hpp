@@ -11,16 +11,17 @@
 #include "nudge/robot/puma260.hpp"
 #include "nudge/robot/trajectory.hpp"
 #include "nudge/robot/types.hpp"
+#include "nudge/robot/workspace.hpp"
 
 namespace nudge::robot {
 
 struct SafetyConfig {
   // Height of the table plane in the base frame (the shoulder is the origin, so this is
-  // negative). Assumed: the arm stands on the table with its shoulder about 0.33 m above it.
-  double table_z = -0.33;
-  double table_margin = 0.005;  // tool point, wrist centre and elbow stay this far above the table
-  double ring_inner = 0.150;    // tool point's distance from the joint 1 axis, metres
-  double ring_outer = 0.350;
+  // negative). The table, margin and ring default to the Workspace's (apply_workspace()).
+  double table_z = -Workspace{}.shoulder_height;
+  double table_margin = Workspace{}.table_margin;  // tool point, wrist centre and elbow stay this far above the table
+  double ring_inner = Workspace{}.ring_inner;      // tool point's distance from the joint 1 axis, metres
+  double ring_outer = Workspace{}.ring_outer;
   bool enforce_ring = true;     // the arm service may lift this for parking poses outside the ring
   double path_step = deg_to_rad(1.0);  // largest joint change between checked path samples
   // Self-collision: the links as capsules (a segment and a radius), metres. Assumed sizes of a

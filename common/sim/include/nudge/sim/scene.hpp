@@ -8,6 +8,8 @@
 // x from the arm base towards the workspace and the cameras, y to the left seen from the arm.
 #include <Eigen/Core>
 
+#include "nudge/robot/workspace.hpp"
+
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -100,7 +102,7 @@ struct PhysicsSpec {
 // push objects aside. Its DH frame 0 is the world frame lifted to the shoulder.
 struct ArmSpec {
   bool present = false;
-  double shoulder_height = 0.33;  // the shoulder above the table top, m (SafetyConfig::table_z = -this)
+  double shoulder_height = robot::Workspace{}.shoulder_height;  // the shoulder above the table top, m
   std::array<double, 6> joints{{0, M_PI / 2, -M_PI / 2, 0, 0, 0}};  // start pose, rad: straight up
 };
 

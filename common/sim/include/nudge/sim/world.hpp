@@ -141,7 +141,7 @@ class World {
   // arm really is (servo lag included). set_pusher()/set_end_effector() positions are then
   // overridden at the next step; set_gripper_opening() picks the gripper and its opening.
   // Throws SimError without an arm.
-  void mount_tools_on_arm(double tool_length = 0.15);
+  void mount_tools_on_arm(double tool_length = robot::Workspace{}.tool_length);
   bool tools_on_arm() const;
   // The gripper in use, opening towards `opening` (m, clamped), the tool point where it is.
   void set_gripper_opening(double opening);

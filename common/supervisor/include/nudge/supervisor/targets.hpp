@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "nudge/robot/motions.hpp"
+#include "nudge/robot/workspace.hpp"
 
 namespace nudge::supervisor {
 
@@ -18,7 +19,7 @@ struct ArmSetup {
   robot::ArmModel model = robot::puma260();
   robot::SafetyConfig safety;
   robot::NudgeParams nudge;
-  double base_height = 0.33;
+  double base_height = robot::Workspace{}.shoulder_height;  // the workspace file's, in the service
   double base_yaw = 0.0;
 
   // The safety checks with the table where the base height puts it.
