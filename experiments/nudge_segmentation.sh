@@ -10,7 +10,7 @@ nudge_install_packages
 nudge_build
 scenes_dir="$NUDGE_ROOT/experiments/scenes/nudge_segmentation"
 runs_dir="$NUDGE_ROOT/out/experiments/nudge_segmentation"
-calibration="$NUDGE_ROOT/docs/results/calibration_sim.yaml"
+calibration="$NUDGE_ROOT/config/calibration_sim.yaml"
 names=("$@")
 if [ ${#names[@]} -eq 0 ]; then
   for f in "$scenes_dir"/*.yaml; do names+=("$(basename "$f" .yaml)"); done
@@ -24,7 +24,7 @@ for name in "${names[@]}"; do
   start=$(date +%s)
   status=0
   nudge_in_private_network bash -c 'nudge_run_loop "$@"' loop "$NUDGE_BUILD_DIR/bin" "$scenes_dir/$name.yaml" \
-    "$calibration" "$runs_dir/$name" "$name" --first-seq 1000 2>"$runs_dir/$name/supervisor.log" || status=$?
+    "$calibration" "$NUDGE_ROOT/config/workspace.yaml" "$runs_dir/$name" "$name" --first-seq 1000 2>"$runs_dir/$name/supervisor.log" || status=$?
   [ -d "$runs_dir/$name/$name" ] && echo $(($(date +%s) - start)) > "$runs_dir/$name/$name/wall_seconds.txt"
   nudge_log "[$i/${#names[@]}] $name: $(grep -h "ended:" "$runs_dir/$name/supervisor.log" | sed 's/^.*ended: //') (exit $status)"
 done

@@ -66,13 +66,13 @@ nudge_in_private_network() {
 # The autonomous segmentation loop on a simulated scene, every service its own process over LCM
 # (run it inside nudge_in_private_network): world -> camera (sim, stills) -> symmetry ->
 # triangulation, the arm on the simulated clock, and the supervisor, which ends the run by itself.
-#   nudge_run_loop BIN_DIR SCENE CALIBRATION OUT_DIR RUN_ID [supervisor flags...]
+#   nudge_run_loop BIN_DIR SCENE CALIBRATION WORKSPACE OUT_DIR RUN_ID [supervisor flags...]
 # The run's files land in OUT_DIR/RUN_ID/ (LCM log, summary.json, attempt_NN/), the services' logs
 # in OUT_DIR/RUN_ID/services/. Returns the supervisor's exit code. NUDGE_LOOP_RATE (10 Hz) and
 # NUDGE_LOOP_REALTIME (1) set the world's pace, NUDGE_LOOP_TIMEOUT (900 s) bounds the run.
 nudge_run_loop() {
-  local bin=$1 scene=$2 calibration=$3 out=$4 run=$5
-  shift 5
+  local bin=$1 scene=$2 calibration=$3 workspace=$4 out=$5 run=$6
+  shift 6
   local url="udpm://239.255.76.67:7667?ttl=0&recv_buf_size=16777216"
   local logs="$out/$run/services"
   mkdir -p "$logs"
@@ -80,18 +80,19 @@ nudge_run_loop() {
   "$bin/nudge-symmetry" --lcm-url "$url" --lines 5 --theta-min -25 --theta-max 25 --once-per-row \
     --mirror-tolerance 15 2>"$logs/symmetry.log" & pids+=($!)
   "$bin/nudge-camera" --lcm-url "$url" --source sim --scene "$scene" --snapshots 2>"$logs/camera.log" & pids+=($!)
-  "$bin/nudge-triangulation" --lcm-url "$url" --calibration "$calibration" 2>"$logs/triangulation.log" & pids+=($!)
-  "$bin/nudge-arm" --lcm-url "$url" --backend sim --clock sim 2>"$logs/arm.log" & pids+=($!)
+  "$bin/nudge-triangulation" --lcm-url "$url" --calibration "$calibration" --workspace "$workspace" \
+    2>"$logs/triangulation.log" & pids+=($!)
+  "$bin/nudge-arm" --lcm-url "$url" --backend sim --clock sim --workspace "$workspace" 2>"$logs/arm.log" & pids+=($!)
   # Every subscriber listens before the world's first state (the camera builds its scene first).
   for _ in $(seq 300); do
     [ "$(grep -l "started:" "$logs"/{symmetry,camera,triangulation,arm}.log 2>/dev/null | wc -l)" -eq 4 ] && break
     sleep 0.1
   done
-  "$bin/nudge-world" --lcm-url "$url" --scene "$scene" --realtime-factor "${NUDGE_LOOP_REALTIME:-1}" \
+  "$bin/nudge-world" --lcm-url "$url" --scene "$scene" --workspace "$workspace" --realtime-factor "${NUDGE_LOOP_REALTIME:-1}" \
     --rate "${NUDGE_LOOP_RATE:-10}" 2>"$logs/world.log" & pids+=($!)
   local status=0
   timeout -s INT "${NUDGE_LOOP_TIMEOUT:-900}" "$bin/nudge-supervisor" --lcm-url "$url" --calibration "$calibration" \
-    --out "$out" --run-id "$run" "$@" || status=$?
+    --workspace "$workspace" --out "$out" --run-id "$run" "$@" || status=$?
   kill -INT "${pids[@]}" 2>/dev/null || true
   wait "${pids[@]}" 2>/dev/null || true
   return $status
