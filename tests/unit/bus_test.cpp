@@ -2,7 +2,10 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "nudge/bus/decode.hpp"
 #include "nudge/bus/image.hpp"
+#include "nudge/bus/subscribe.hpp"
+#include "nudge/heartbeat_t.hpp"
 
 using namespace nudge;
 
@@ -80,3 +83,113 @@ TEST(Image, MalformedImagesAreClearErrorsNamingTheImage) {
   EXPECT_THROW(bus::format_from_name("tiff"), bus::ImageError);
 }
 
+
+// ---- malformed bytes on the bus (issue 12) ---------------------------------------------------
+
+namespace {
+
+using Bytes = std::vector<uint8_t>;
+
+template <typename Msg>
+Bytes encode(const Msg& msg) {
+  Bytes bytes(msg.getEncodedSize());
+  msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  return bytes;
+}
+
+void put_int32(Bytes* bytes, size_t offset, int32_t value) {
+  for (int i = 0; i < 4; ++i) (*bytes)[offset + i] = static_cast<uint8_t>(static_cast<uint32_t>(value) >> (24 - 8 * i));
+}
+
+// A small grey image_t from camera "left" (string length 5 with its NUL) and the offsets of the
+// lengths it declares: fingerprint 8, utime 8, frame_id 8, then the camera's length.
+constexpr size_t kCameraLengthOffset = 24;
+constexpr size_t kSizeOffset = kCameraLengthOffset + 4 + 5 + 4 + 4 + 4 + 1;
+
+Bytes small_image_bytes() {
+  const image_t msg = bus::to_message(cv::Mat(4, 6, CV_8UC1, cv::Scalar(9)), image_t::FORMAT_GRAY8, 1, 2, "left");
+  return encode(msg);
+}
+
+Bytes image_bytes_with(size_t offset, int32_t value) {
+  Bytes bytes = small_image_bytes();
+  put_int32(&bytes, offset, value);
+  return bytes;
+}
+
+}  // namespace
+
+TEST(Decode, WellFormedImageDecodes) {
+  const Bytes bytes = small_image_bytes();
+  image_t msg;
+  EXPECT_EQ(bus::decode_message(bytes.data(), static_cast<int>(bytes.size()), &msg), "");
+  EXPECT_EQ(msg.camera, "left");
+  EXPECT_EQ(msg.size, 24);
+}
+
+TEST(Decode, ImageLengthsBeyondTheBytesAreRefusedBeforeDecoding) {
+  for (int32_t size : {-1, 25, 2000000000}) {
+    const Bytes bytes = image_bytes_with(kSizeOffset, size);
+    const std::string problem = bus::check_encoded_image(bytes.data(), static_cast<int>(bytes.size()));
+    EXPECT_NE(problem.find("size declares " + std::to_string(size)), std::string::npos) << problem;
+    image_t msg;
+    EXPECT_EQ(bus::decode_message(bytes.data(), static_cast<int>(bytes.size()), &msg), problem);
+    EXPECT_TRUE(msg.data.empty()) << "nothing allocated for size " << size;
+  }
+  for (int32_t camera_length : {0, -7, 1000}) {
+    const Bytes bytes = image_bytes_with(kCameraLengthOffset, camera_length);
+    const std::string problem = bus::check_encoded_image(bytes.data(), static_cast<int>(bytes.size()));
+    EXPECT_NE(problem.find("camera declares " + std::to_string(camera_length)), std::string::npos) << problem;
+  }
+  Bytes truncated = small_image_bytes();
+  truncated.resize(kSizeOffset + 2);
+  EXPECT_NE(bus::check_encoded_image(truncated.data(), static_cast<int>(truncated.size())).find("too short"),
+            std::string::npos);
+}
+
+TEST(Decode, ExceptionsInsideDecodeBecomeErrors) {
+  // A heartbeat whose first string declares length 0: LCM 1.3.1's decode() throws (it assigns
+  // length - 1 characters); no pre-decode check covers heartbeat_t, so the catch must.
+  heartbeat_t hb{};
+  hb.service = "symmetry";
+  Bytes bytes = encode(hb);
+  put_int32(&bytes, 8 + 8, 0);  // fingerprint, utime, then the service string's length
+  heartbeat_t msg;
+  const std::string problem = bus::decode_message(bytes.data(), static_cast<int>(bytes.size()), &msg);
+  EXPECT_NE(problem.find("do not decode as heartbeat_t"), std::string::npos) << problem;
+}
+
+TEST(Subscriptions, MalformedMessagesAreCountedAndSkippedNamingTheChannel) {
+  lcm::LCM lcm("memq://");
+  ASSERT_TRUE(lcm.good());
+  bus::Counters counters;
+  bus::Subscriptions subscriptions(lcm, counters);
+  int images = 0, heartbeats = 0;
+  subscriptions.subscribe<image_t>("CAMERA_TEST", [&](const image_t&, const std::string&) { ++images; });
+  subscriptions.subscribe<heartbeat_t>("HEARTBEAT_TEST", [&](const heartbeat_t&, const std::string&) { ++heartbeats; });
+
+  Bytes bad_heartbeat = encode(heartbeat_t{});
+  put_int32(&bad_heartbeat, 16, -1);
+  const std::vector<std::pair<std::string, Bytes>> sent = {
+      {"CAMERA_TEST", small_image_bytes()},
+      {"CAMERA_TEST", image_bytes_with(kCameraLengthOffset, 0)},
+      {"CAMERA_TEST", image_bytes_with(kSizeOffset, -1)},
+      {"CAMERA_TEST", image_bytes_with(kSizeOffset, 2000000000)},
+      {"CAMERA_TEST", Bytes{1, 2, 3}},
+      {"HEARTBEAT_TEST", bad_heartbeat},
+      {"CAMERA_TEST", small_image_bytes()},
+  };
+  testing::internal::CaptureStderr();
+  for (const auto& [channel, bytes] : sent) {
+    lcm.publish(channel, bytes.data(), static_cast<unsigned int>(bytes.size()));
+    ASSERT_GT(lcm.handleTimeout(1000), 0) << "memq delivers at once";
+  }
+  const std::string log = testing::internal::GetCapturedStderr();
+
+  EXPECT_EQ(images, 2);
+  EXPECT_EQ(heartbeats, 0);
+  EXPECT_EQ(counters.messages_in, 7);
+  EXPECT_EQ(counters.errors, 5);
+  EXPECT_NE(log.find("skipped a malformed message on CAMERA_TEST: image_t of"), std::string::npos) << log;
+  EXPECT_NE(log.find("skipped a malformed message on HEARTBEAT_TEST"), std::string::npos) << log;
+}
