@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "nudge/bus/pose_convert.hpp"
 #include "nudge/robot/kinematics.hpp"
 #include "nudge/robot/trajectory.hpp"
 
@@ -303,7 +304,7 @@ ArmController::Plan ArmController::plan(const arm_command_t& command,
     }
     case arm_command_t::COMMAND_MOVE_POSE: {
       Eigen::Isometry3d world_pose;
-      if (!from_message(command.target, &world_pose)) {
+      if (!bus::from_message(command.target, &world_pose)) {
         return malformed("target is not finite or its quaternion is not of unit length");
       }
       const robot::IkResult ik =
@@ -351,9 +352,9 @@ ArmController::Plan ArmController::plan(const arm_command_t& command,
       pose_t orientation_only{};
       std::copy(std::begin(command.target.orientation), std::end(command.target.orientation),
                 std::begin(orientation_only.orientation));
-      if (!is_unset(orientation_only)) {
+      if (!bus::is_unset(orientation_only)) {
         Eigen::Isometry3d pose;
-        if (!from_message(orientation_only, &pose)) {
+        if (!bus::from_message(orientation_only, &pose)) {
           return malformed("target quaternion is not of unit length");
         }
         const Eigen::Vector3d x = pose.linear().col(0);
@@ -473,7 +474,7 @@ arm_state_t ArmController::state() const {
   for (int j = 0; j < robot::kNumJoints; ++j) s.joints[j] = joints.position[j];
   s.gripper = joints.gripper_opening;
   s.end_effector =
-      to_message(config_.base.to_world(robot::forward_kinematics(config_.model, joints.position)));
+      bus::to_message(config_.base.to_world(robot::forward_kinematics(config_.model, joints.position)));
   s.motion = motion_;
   s.command_seq = command_seq_;
   s.last_error = last_error_;

@@ -1,13 +1,11 @@
 #pragma once
-// Where the arm stands in the world (table) frame, and pose_t conversions.
+// Where the arm stands in the world (table) frame.
 //
 // The robot library works in the arm's BASE frame (DH frame 0: origin at the shoulder, z up along
 // joint 1). Everything on the bus is in the WORLD frame of docs/sim.md: origin on the arm base's
 // vertical axis at table-top height, z up, metres. The base therefore sits on the world z axis,
 // `height` above the table top, turned by `yaw` about z (0: base x along world x).
 #include <Eigen/Geometry>
-
-#include "nudge/pose_t.hpp"
 
 namespace nudge::arm {
 
@@ -23,14 +21,5 @@ struct BaseFrame {
   // The table plane z = 0 of the world, in the base frame.
   double table_z() const { return -height; }
 };
-
-pose_t to_message(const Eigen::Isometry3d& pose);
-
-// The pose a pose_t describes. False when a number is not finite or the quaternion (w, x, y, z)
-// is not of unit length (within 1e-3; it is then normalised exactly).
-bool from_message(const pose_t& message, Eigen::Isometry3d* pose);
-
-// Whether every number of the pose_t is zero (a sender that left the field unset).
-bool is_unset(const pose_t& message);
 
 }  // namespace nudge::arm

@@ -24,6 +24,7 @@
 #include "backends.hpp"
 #include "nudge/arm_command_t.hpp"
 #include "nudge/arm_state_t.hpp"
+#include "nudge/bus/channels.hpp"
 #include "nudge/bus/service.hpp"
 #include "nudge/heartbeat_t.hpp"
 #include "nudge/log.hpp"
@@ -71,7 +72,8 @@ int main(int argc, char** argv) {
     bus::Service service("arm", "PUMA 260 arm: checked moves, nudges and grasps (thesis ch. 6-7, App. B).");
     arm::ControllerConfig config;
     std::string backend_name = "sim", clock_name = "auto";
-    std::string command_channel = "ARM_COMMAND", state_channel = "ARM_STATE", sim_channel = "SIM_STATE";
+    std::string command_channel = bus::channel::ARM_COMMAND, state_channel = bus::channel::ARM_STATE,
+                sim_channel = bus::channel::SIM_STATE;
     double rate = 100, base_yaw_deg = 0, tool_length = config.model.tool.translation().z();
     double gripper_speed = 0.05, max_catch_up = 1.0;
     std::vector<double> initial_deg;
@@ -151,7 +153,7 @@ int main(int argc, char** argv) {
       }
       after_event();
     });
-    service.subscriptions().subscribe<heartbeat_t>(bus::kHeartbeatChannel, [&](const heartbeat_t& heartbeat, const std::string&) {
+    service.subscriptions().subscribe<heartbeat_t>(bus::channel::HEARTBEAT, [&](const heartbeat_t& heartbeat, const std::string&) {
       follow_message_time(heartbeat.utime);
       const int64_t now = clock == ClockSource::Log ? controller->clock() : wall_utime();
       if (controller->on_heartbeat(heartbeat, now)) {

@@ -7,7 +7,9 @@
 
 #include <optional>
 
+#include "nudge/bus/channels.hpp"
 #include "nudge/bus/image.hpp"
+#include "nudge/bus/pose_convert.hpp"
 #include "nudge/log.hpp"
 #include "nudge/sim/state_sync.hpp"
 #include "nudge/sim/world.hpp"
@@ -18,27 +20,18 @@ namespace nudge::camera_service {
 
 namespace {
 
-constexpr const char* kStateChannel = "SIM_STATE";
-constexpr const char* kSnapshotRequestChannel = "CAMERA_SNAPSHOT_REQUEST";
-constexpr const char* kChannels[2] = {"CAMERA_LEFT", "CAMERA_RIGHT"};
-constexpr const char* kSnapshotChannels[2] = {"SNAPSHOT_LEFT", "SNAPSHOT_RIGHT"};
+constexpr const char* kChannels[2] = {bus::channel::CAMERA_LEFT, bus::channel::CAMERA_RIGHT};
+constexpr const char* kSnapshotChannels[2] = {bus::channel::SNAPSHOT_LEFT, bus::channel::SNAPSHOT_RIGHT};
 constexpr const char* kCameraNames[2] = {"left", "right"};
-
-Eigen::Vector3d position_of(const pose_t& pose) {
-  return {pose.position[0], pose.position[1], pose.position[2]};
-}
-Eigen::Quaterniond orientation_of(const pose_t& pose) {
-  return {pose.orientation[0], pose.orientation[1], pose.orientation[2], pose.orientation[3]};
-}
 
 sim::PoseSnapshot poses_of(const sim_state_t& state) {
   if (state.num_objects != static_cast<int32_t>(state.objects.size()))
     throw std::invalid_argument("num_objects disagrees with the objects sent");
   sim::PoseSnapshot poses;
   for (const object_state_t& o : state.objects)
-    poses.objects.push_back({o.name, position_of(o.pose), orientation_of(o.pose)});
-  poses.pusher_position = position_of(state.pusher);
-  poses.pusher_yaw = sim::yaw_of(orientation_of(state.pusher));
+    poses.objects.push_back({o.name, bus::position_of(o.pose), bus::orientation_of(o.pose)});
+  poses.pusher_position = bus::position_of(state.pusher);
+  poses.pusher_yaw = sim::yaw_of(bus::orientation_of(state.pusher));
   // The arm's joints as simulated (used only when the scene has an arm).
   poses.arm_joints.emplace();
   for (int j = 0; j < 6; ++j) (*poses.arm_joints)[j] = state.joints[j];
@@ -86,7 +79,7 @@ int run_sim_camera(bus::Service& service, const SimOptions& options) {
     sum.convertTo(out, CV_8UC3);
     return out;
   };
-  service.subscriptions().subscribe<sim_state_t>(kStateChannel, [&](const sim_state_t& state, const std::string&) {
+  service.subscriptions().subscribe<sim_state_t>(bus::channel::SIM_STATE, [&](const sim_state_t& state, const std::string&) {
     const sim::PoseSnapshot poses = poses_of(state);
     sim::apply_poses(world, poses);  // throws naming the object: counted, skipped
     last_state_utime = state.utime;
@@ -102,7 +95,7 @@ int run_sim_camera(bus::Service& service, const SimOptions& options) {
   });
   if (options.snapshots) {
     service.subscriptions().subscribe<snapshot_request_t>(
-        kSnapshotRequestChannel, [&](const snapshot_request_t& request, const std::string&) {
+        bus::channel::CAMERA_SNAPSHOT_REQUEST, [&](const snapshot_request_t& request, const std::string&) {
           if (!last_state_utime) throw std::runtime_error("no SIM_STATE rendered yet: nothing to snapshot");
           if (request.cameras < snapshot_request_t::CAMERAS_BOTH || request.cameras > snapshot_request_t::CAMERAS_RIGHT)
             throw std::invalid_argument("snapshot request: unknown cameras value " + std::to_string(request.cameras));

@@ -11,7 +11,9 @@
 #include <string>
 
 #include "nudge/arm_state_t.hpp"
+#include "nudge/bus/channels.hpp"
 #include "nudge/bus/image.hpp"
+#include "nudge/bus/pose_convert.hpp"
 #include "nudge/bus/service.hpp"
 #include "nudge/log.hpp"
 #include "nudge/sim/mjcf.hpp"
@@ -26,24 +28,10 @@ using namespace nudge;
 
 namespace {
 
-constexpr const char* kStateChannel = "SIM_STATE";
-constexpr const char* kTruthChannel = "SIM_TRUTH";
-constexpr const char* kTruthRequestChannel = "SIM_TRUTH_REQUEST";
-constexpr const char* kArmStateChannel = "ARM_STATE";
 // Utimes from here on are wall-clock stamps (2001 onwards), not simulated time since a start.
 constexpr int64_t kWallClockUtime = 1000000000LL * 1000000LL;
 // The longest simulated time a log may span (a day).
 constexpr double kMaxLogSeconds = 86400.0;
-
-pose_t to_pose(const Eigen::Vector3d& p, const Eigen::Quaterniond& q) {
-  pose_t pose;
-  for (int i = 0; i < 3; ++i) pose.position[i] = p[i];
-  pose.orientation[0] = q.w();
-  pose.orientation[1] = q.x();
-  pose.orientation[2] = q.y();
-  pose.orientation[3] = q.z();
-  return pose;
-}
 
 // The world's physics, its pusher (driven by the arm) and what it publishes, on simulated time.
 class Simulation {
@@ -74,7 +62,7 @@ class Simulation {
   void step() {
     world_.step();
     ++step_;
-    if (step_ % steps_per_state_ == 0) service_.publish(kStateChannel, state_message());
+    if (step_ % steps_per_state_ == 0) service_.publish(bus::channel::SIM_STATE, state_message());
   }
   // Simulated time never goes past this (--duration).
   void set_end_time(double seconds) { end_time_ = seconds; }
@@ -95,11 +83,11 @@ class Simulation {
   // while that axis points straight up or down); the gripper's fingers close across it, towards
   // the opening ARM_STATE.gripper.
   void on_arm_state(const arm_state_t& msg) {
-    const Eigen::Vector3d p(msg.end_effector.position[0], msg.end_effector.position[1], msg.end_effector.position[2]);
-    const Eigen::Quaterniond q(msg.end_effector.orientation[0], msg.end_effector.orientation[1],
-                               msg.end_effector.orientation[2], msg.end_effector.orientation[3]);
-    if (!p.allFinite() || !q.coeffs().allFinite() || std::abs(q.norm() - 1.0) > 1e-3)
+    Eigen::Isometry3d tool;
+    if (!bus::from_message(msg.end_effector, &tool))
       throw std::invalid_argument("end_effector: position must be finite and orientation a unit quaternion");
+    const Eigen::Vector3d p = tool.translation();
+    const Eigen::Quaterniond q(tool.linear());
     if (!std::isfinite(msg.gripper)) throw std::invalid_argument("gripper: not finite");
     for (double j : msg.joints)
       if (!std::isfinite(j)) throw std::invalid_argument("joints: not finite");
@@ -142,7 +130,7 @@ class Simulation {
         mask.pixel_format = image_t::FORMAT_GRAY8;
       }
     }
-    service_.publish(kTruthChannel, truth);
+    service_.publish(bus::channel::SIM_TRUTH, truth);
   }
 
   sim_state_t state_message() const {
@@ -159,7 +147,7 @@ class Simulation {
       const sim::Axis3d axis = world_.axis(i);
       object_state_t o;
       o.name = st.name;
-      o.pose = to_pose(st.position, st.orientation);
+      o.pose = bus::to_message(st.position, st.orientation);
       for (int k = 0; k < 3; ++k) {
         o.axis_point[k] = axis.base[k];
         o.axis_direction[k] = axis.direction[k];
@@ -172,7 +160,7 @@ class Simulation {
       o.theta_right = right.valid ? static_cast<float>(right.theta) : nan;
       msg.objects.push_back(o);
     }
-    msg.pusher = to_pose(world_.pusher_position(), sim::yaw_rotation(pusher_yaw_));
+    msg.pusher = bus::to_message(world_.pusher_position(), sim::yaw_rotation(pusher_yaw_));
     return msg;
   }
 
@@ -198,12 +186,12 @@ class Inputs {
  public:
   Inputs(bus::Service& service, Simulation& sim, bool from_log, std::optional<int64_t> log_origin)
       : sim_(sim), from_log_(from_log), log_origin_(log_origin) {
-    service.subscriptions().subscribe<arm_state_t>(kArmStateChannel, [this](const arm_state_t& msg, const std::string&) {
+    service.subscriptions().subscribe<arm_state_t>(bus::channel::ARM_STATE, [this](const arm_state_t& msg, const std::string&) {
       catch_up(msg.utime);
       sim_.on_arm_state(msg);  // throws on a bad pose: counted, skipped
     });
     service.subscriptions().subscribe<sim_truth_request_t>(
-        kTruthRequestChannel, [this](const sim_truth_request_t& msg, const std::string&) {
+        bus::channel::SIM_TRUTH_REQUEST, [this](const sim_truth_request_t& msg, const std::string&) {
           catch_up(msg.utime);
           sim_.on_truth_request(!msg.without_masks);
         });
@@ -318,7 +306,7 @@ int main(int argc, char** argv) {
                 << (from_log ? "input events applied at their log time"
                              : realtime_factor > 0 ? "realtime factor " + std::to_string(realtime_factor)
                                                    : std::string("as fast as possible"));
-    service.publish(kStateChannel, sim.state_message());  // the state at t = 0
+    service.publish(bus::channel::SIM_STATE, sim.state_message());  // the state at t = 0
 
     Pacer pacer(realtime_factor);
     const int rc = service.run([&]() -> int {

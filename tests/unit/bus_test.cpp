@@ -2,8 +2,10 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "nudge/bus/channels.hpp"
 #include "nudge/bus/decode.hpp"
 #include "nudge/bus/image.hpp"
+#include "nudge/bus/pose_convert.hpp"
 #include "nudge/bus/subscribe.hpp"
 #include "nudge/heartbeat_t.hpp"
 
@@ -192,4 +194,72 @@ TEST(Subscriptions, MalformedMessagesAreCountedAndSkippedNamingTheChannel) {
   EXPECT_EQ(counters.errors, 5);
   EXPECT_NE(log.find("skipped a malformed message on CAMERA_TEST: image_t of"), std::string::npos) << log;
   EXPECT_NE(log.find("skipped a malformed message on HEARTBEAT_TEST"), std::string::npos) << log;
+}
+
+// ---- channel names ----------------------------------------------------------------------------
+
+TEST(Channels, CameraChannelsNameTheirResults) {
+  namespace channel = bus::channel;
+  EXPECT_EQ(channel::derived(channel::CAMERA_LEFT, channel::SYMMETRY), channel::SYMMETRY_LEFT);
+  EXPECT_EQ(channel::derived(channel::CAMERA_RIGHT, channel::SYMMETRY), channel::SYMMETRY_RIGHT);
+  EXPECT_EQ(channel::derived(channel::CAMERA_LEFT, channel::CONTOURS), channel::CONTOURS_LEFT);
+  EXPECT_EQ(channel::derived(channel::CAMERA_RIGHT, channel::TRACK), channel::TRACK_RIGHT);
+  EXPECT_EQ(channel::derived(channel::CAMERA, channel::SYMMETRY), channel::SYMMETRY);
+  EXPECT_EQ(channel::derived("LEFT_EYE", channel::TRACK), "TRACK_LEFT_EYE");
+}
+
+TEST(Channels, ResultsNameTheirCamera) {
+  namespace channel = bus::channel;
+  EXPECT_EQ(channel::camera_of(channel::SYMMETRY_LEFT, channel::SYMMETRY), channel::CAMERA_LEFT);
+  EXPECT_EQ(channel::camera_of(channel::SYMMETRY, channel::SYMMETRY), channel::CAMERA);
+  EXPECT_EQ(channel::camera_of(channel::TRACK_RIGHT, channel::TRACK), channel::CAMERA_RIGHT);
+  for (const char* camera : {channel::CAMERA_LEFT, channel::CAMERA_RIGHT, channel::CAMERA})
+    EXPECT_EQ(channel::camera_of(channel::derived(camera, channel::CONTOURS), channel::CONTOURS), camera);
+  try {
+    channel::camera_of("AXES", channel::SYMMETRY);
+    ADD_FAILURE() << "AXES is not a symmetry channel";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("AXES"), std::string::npos) << e.what();
+  }
+}
+
+// ---- pose_t <-> Eigen ------------------------------------------------------------------------
+
+TEST(PoseConvert, IsometryRoundTrips) {
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = (Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(-1.2, Eigen::Vector3d::UnitX()))
+                      .toRotationMatrix();
+  pose.translation() = Eigen::Vector3d(0.25, -0.1, 0.42);
+  const pose_t msg = bus::to_message(pose);
+  EXPECT_DOUBLE_EQ(msg.position[2], 0.42);
+  Eigen::Isometry3d back;
+  ASSERT_TRUE(bus::from_message(msg, &back));
+  EXPECT_LT((back.matrix() - pose.matrix()).norm(), 1e-12);
+  EXPECT_FALSE(bus::is_unset(msg));
+}
+
+TEST(PoseConvert, PositionAndQuaternionRoundTripAsSent) {
+  const Eigen::Quaterniond q(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()));
+  const pose_t msg = bus::to_message(Eigen::Vector3d(1, 2, 3), q);
+  EXPECT_DOUBLE_EQ(msg.orientation[0], q.w());  // (w, x, y, z)
+  EXPECT_DOUBLE_EQ(msg.orientation[3], q.z());
+  EXPECT_EQ(bus::position_of(msg), Eigen::Vector3d(1, 2, 3));
+  EXPECT_EQ(bus::orientation_of(msg).coeffs(), q.coeffs());
+}
+
+TEST(PoseConvert, BadPosesAreRefused) {
+  Eigen::Isometry3d pose;
+  pose_t unset{};
+  EXPECT_TRUE(bus::is_unset(unset));
+  EXPECT_FALSE(bus::from_message(unset, &pose)) << "a zero quaternion is no rotation";
+  pose_t not_unit = bus::to_message(Eigen::Isometry3d::Identity());
+  not_unit.orientation[0] = 2;
+  EXPECT_FALSE(bus::from_message(not_unit, &pose));
+  pose_t nan = bus::to_message(Eigen::Isometry3d::Identity());
+  nan.position[1] = std::nan("");
+  EXPECT_FALSE(bus::from_message(nan, &pose));
+  pose_t nearly_unit = bus::to_message(Eigen::Isometry3d::Identity());
+  nearly_unit.orientation[0] = 1.0005;  // within 1e-3: normalised
+  ASSERT_TRUE(bus::from_message(nearly_unit, &pose));
+  EXPECT_LT((pose.linear() - Eigen::Matrix3d::Identity()).norm(), 1e-12);
 }
