@@ -11,6 +11,7 @@
 #include <string>
 
 #include "nudge/arm_state_t.hpp"
+#include "nudge/bus/arm_convert.hpp"
 #include "nudge/bus/channels.hpp"
 #include "nudge/bus/image.hpp"
 #include "nudge/bus/pose_convert.hpp"
@@ -83,17 +84,12 @@ class Simulation {
   // while that axis points straight up or down); the gripper's fingers close across it, towards
   // the opening ARM_STATE.gripper.
   void on_arm_state(const arm_state_t& msg) {
-    Eigen::Isometry3d tool;
-    if (!bus::from_message(msg.end_effector, &tool))
-      throw std::invalid_argument("end_effector: position must be finite and orientation a unit quaternion");
-    const Eigen::Vector3d p = tool.translation();
-    const Eigen::Quaterniond q(tool.linear());
-    if (!std::isfinite(msg.gripper)) throw std::invalid_argument("gripper: not finite");
-    for (double j : msg.joints)
-      if (!std::isfinite(j)) throw std::invalid_argument("joints: not finite");
+    const bus::ArmState arm = bus::from_message(msg);  // throws naming a bad field
+    const Eigen::Vector3d p = arm.tool_in_world.translation();
+    const Eigen::Quaterniond q(arm.tool_in_world.linear());
     if (world_.has_arm()) {  // the simulated PUMA's servos follow the arm's joints
       std::array<double, 6> joints;
-      std::copy(std::begin(msg.joints), std::end(msg.joints), joints.begin());
+      std::copy(arm.joints.begin(), arm.joints.end(), joints.begin());
       world_.set_arm_targets(joints);
     }
     if (world_.tools_on_arm()) {  // the tool is where the simulated arm puts it
