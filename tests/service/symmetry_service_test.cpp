@@ -33,6 +33,15 @@ struct Truth {
   double r, theta;
 };
 
+// Offsets of the lengths an encoded image_t from camera "mono" declares (fingerprint 8, utime 8,
+// frame_id 8, the camera's length, "mono" and its NUL, width, height, row_stride, pixel_format).
+constexpr size_t kCameraLengthOffset = 24;
+constexpr size_t kSizeOffset = kCameraLengthOffset + 4 + 5 + 4 + 4 + 4 + 1;
+
+void put_int32(std::vector<uint8_t>* bytes, size_t offset, int32_t value) {
+  for (int i = 0; i < 4; ++i) (*bytes)[offset + i] = static_cast<uint8_t>(static_cast<uint32_t>(value) >> (24 - 8 * i));
+}
+
 // Frames with one upright bottle each, at known axes.
 std::map<int64_t, Truth> write_input_log(const std::string& path) {
   lcm::LogFile log(path, "w");
@@ -48,6 +57,17 @@ std::map<int64_t, Truth> write_input_log(const std::string& path) {
     if (i == 2) {  // a truncated message: must be reported and skipped
       auto bytes = encode(nudge::bus::to_message(img, nudge::image_t::FORMAT_GRAY8, utime + 1, 99, "mono"));
       bytes.resize(bytes.size() / 2);
+      write_event(log, utime + 1, channel::CAMERA, bytes);
+    }
+    if (i == 3) {  // the camera string declares length 0: LCM 1.3.1's decode() throws on it
+      auto bytes = encode(nudge::bus::to_message(img, nudge::image_t::FORMAT_GRAY8, utime + 1, 97, "mono"));
+      put_int32(&bytes, kCameraLengthOffset, 0);
+      write_event(log, utime + 1, channel::CAMERA, bytes);
+    }
+    if (i == 5) {  // 114 bytes declaring a 2 GB image: refused before anything is allocated
+      auto bytes = encode(nudge::bus::to_message(img, nudge::image_t::FORMAT_GRAY8, utime + 1, 96, "mono"));
+      bytes.resize(114);
+      put_int32(&bytes, kSizeOffset, 2000000000);
       write_event(log, utime + 1, channel::CAMERA, bytes);
     }
     if (i == 4) {  // an unknown pixel format
@@ -90,7 +110,8 @@ TEST(SymmetryService, LogInLogOutMatchesTheKnownAxesAndSkipsBadMessages) {
     }
   }
   ASSERT_EQ(results.size(), truth.size()) << "one SYMMETRY message per good frame";
-  EXPECT_EQ(errors_reported, 2) << "the truncated and the unknown-format messages are counted";
+  EXPECT_EQ(errors_reported, 4)
+      << "the truncated, zero-length camera, 2 GB and unknown-format messages are counted";
   for (const auto& [utime, t] : truth) {
     const auto& msg = results.at(utime);
     ASSERT_GE(msg.num_lines, 1);
