@@ -47,8 +47,11 @@ inline constexpr const char* SIM_TRUTH_REQUEST = "SIM_TRUTH_REQUEST";  // sim_tr
 // Every service.
 inline constexpr const char* HEARTBEAT = "HEARTBEAT";  // heartbeat_t
 
-// For the services still to come (issue 9): the supervisor's state machine and recognition.
-inline constexpr const char* SUPERVISOR_STATE = "SUPERVISOR_STATE";    // supervisor_state_t
+// The supervisor's state machine and what it segments.
+inline constexpr const char* SUPERVISOR_STATE = "SUPERVISOR_STATE";  // supervisor_state_t
+inline constexpr const char* SEGMENTATION = "SEGMENTATION";          // segmentation_t
+
+// For the services still to come (issue 9): recognition.
 inline constexpr const char* RECOGNIZE_REQUEST = "RECOGNIZE_REQUEST";
 inline constexpr const char* RECOGNITION = "RECOGNITION";
 
