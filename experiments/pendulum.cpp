@@ -34,6 +34,7 @@
 #include "nudge/json.hpp"
 #include "nudge/sim/world.hpp"
 #include "nudge/symmetry/detector.hpp"
+#include "nudge/symmetry/line.hpp"
 #include "nudge/timing.hpp"
 #include "nudge/tracking/block_motion.hpp"
 #include "nudge/tracking/tracker.hpp"
@@ -299,14 +300,6 @@ std::vector<double> absolute(std::vector<double> v) {
   return v;
 }
 
-// Line error in the form of the estimate nearer the reference (R px, theta rad).
-std::pair<double, double> line_diff(double r, double theta, double ref_r, double ref_theta) {
-  double d = theta - ref_theta;
-  while (d > M_PI / 2) { d -= M_PI; r = -r; }
-  while (d <= -M_PI / 2) { d += M_PI; r = -r; }
-  return {r - ref_r, d};
-}
-
 BackgroundResult run_background(const std::string& name, int frames) {
   BackgroundResult res;
   res.name = name;
@@ -446,22 +439,22 @@ BackgroundResult run_background(const std::string& name, int frames) {
     const FrameRecord& f = rec[k];
     if (!f.scored) continue;
     ++res.scored;
-    const auto gx = line_diff(f.gt_r, f.gt_theta, f.exact.r, f.exact.theta);
-    gx_r.push_back(std::abs(gx.first));
-    gx_t.push_back(std::abs(gx.second));
+    const auto gx = sym::line_difference(f.gt_r, f.gt_theta, f.exact.r, f.exact.theta);
+    gx_r.push_back(std::abs(gx.r));
+    gx_t.push_back(std::abs(gx.theta));
     if (f.detected) {
       ++res.detected;
-      const auto d = line_diff(f.det_r, f.det_theta, f.gt_r, f.gt_theta);
-      er.push_back(d.first);
-      et.push_back(d.second);
-      const auto dx = line_diff(f.det_r, f.det_theta, f.exact.r, f.exact.theta);
-      er_exact.push_back(std::abs(dx.first));
-      et_exact.push_back(std::abs(dx.second));
+      const auto d = sym::line_difference(f.det_r, f.det_theta, f.gt_r, f.gt_theta);
+      er.push_back(d.r);
+      et.push_back(d.theta);
+      const auto dx = sym::line_difference(f.det_r, f.det_theta, f.exact.r, f.exact.theta);
+      er_exact.push_back(std::abs(dx.r));
+      et_exact.push_back(std::abs(dx.theta));
       if (k < 400) {
         plot_k.push_back(k);
-        plot_er.push_back(d.first);
+        plot_er.push_back(d.r);
         plot_k_t.push_back(k);
-        plot_et.push_back(d.second * 180 / M_PI);
+        plot_et.push_back(d.theta * 180 / M_PI);
       }
     }
     if (f.colour) {

@@ -18,6 +18,7 @@
 #include <map>
 #include <sstream>
 
+#include "nudge/bus/channels.hpp"
 #include "nudge/bus/image.hpp"
 #include "nudge/flags.hpp"
 #include "nudge/json.hpp"
@@ -85,7 +86,7 @@ std::vector<double> lcm_latencies(const std::vector<cv::Mat>& frames, std::strin
   const std::string tracker = own_directory() + "/nudge-tracker";
   const pid_t child = fork();
   if (child == 0) {
-    execl(tracker.c_str(), tracker.c_str(), "--lcm-url", url.c_str(), "--inputs", "CAMERA_LEFT", nullptr);
+    execl(tracker.c_str(), tracker.c_str(), "--lcm-url", url.c_str(), "--inputs", bus::channel::CAMERA_LEFT, nullptr);
     _exit(127);
   }
   lcm::LCM lcm(url);
@@ -96,14 +97,14 @@ std::vector<double> lcm_latencies(const std::vector<cv::Mat>& frames, std::strin
       (*received)[msg->frame_id] = wall_utime();
     }
   } receiver{&received};
-  lcm.subscribe("TRACK_LEFT", &Receiver::on_track, &receiver);
+  lcm.subscribe(bus::channel::TRACK_LEFT, &Receiver::on_track, &receiver);
   usleep(800000);  // let the tracker subscribe
   int64_t next = wall_utime();
   for (size_t i = 0; i < frames.size(); ++i) {
     const int64_t now = wall_utime();
     const image_t msg = bus::to_message(frames[i], image_t::FORMAT_GRAY8, now, static_cast<int64_t>(i), "left");
     sent[static_cast<int64_t>(i)] = now;
-    lcm.publish("CAMERA_LEFT", &msg);
+    lcm.publish(bus::channel::CAMERA_LEFT, &msg);
     next += 40000;
     while (wall_utime() < next) lcm.handleTimeout(std::max<int>(1, static_cast<int>((next - wall_utime()) / 1000)));
   }

@@ -392,20 +392,6 @@ Video render_video(const Scenario& scenario, int camera, int max_frames) {
   return video;
 }
 
-LineError line_error(double r, double theta, const sim::ImageLine& truth) {
-  double d = theta - truth.theta;
-  double re = r;
-  while (d > M_PI / 2) {
-    d -= M_PI;
-    re = -re;
-  }
-  while (d <= -M_PI / 2) {
-    d += M_PI;
-    re = -re;
-  }
-  return {re - truth.r, d};
-}
-
 double distance_to_line(const cv::Point2d& p, const sim::ImageLine& truth, int width, int height) {
   return std::abs(sim::signed_distance(truth, Eigen::Vector2d(p.x, p.y), width, height));
 }

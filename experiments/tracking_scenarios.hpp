@@ -49,13 +49,6 @@ std::vector<Scenario> tracking_scenarios();
 // Renders a scenario from camera `camera` (0 = left). max_frames > 0 shortens the video.
 Video render_video(const Scenario& scenario, int camera = 0, int max_frames = 0);
 
-// Difference between an estimated line and the true one, (R px, theta rad), with the estimate
-// taken in whichever of its two forms (R, theta) / (-R, theta +- pi) lies nearer the truth.
-struct LineError {
-  double r = 0, theta = 0;
-};
-LineError line_error(double r, double theta, const sim::ImageLine& truth);
-
 // Distance (px) from an image point to the true line.
 double distance_to_line(const cv::Point2d& p, const sim::ImageLine& truth, int width, int height);
 

@@ -18,6 +18,7 @@
 
 #include "nudge/flags.hpp"
 #include "nudge/json.hpp"
+#include "nudge/symmetry/line.hpp"
 #include "nudge/timing.hpp"
 #include "nudge/tracking/tracker.hpp"
 #include "report.hpp"
@@ -102,7 +103,7 @@ VideoResult run_video(const Scenario& sc, int camera, int max_frames, const std:
     if (tracking) {
       ++res.tracked;
       if (!s.measurement_used) ++res.predicted;
-      const LineError e = line_error(s.line.r, s.line.theta, f.truth);
+      const symmetry::LineDifference e = symmetry::line_difference(s.line.r, s.line.theta, f.truth.r, f.truth.theta);
       r_abs.push_back(std::abs(e.r));
       t_abs.push_back(std::abs(e.theta) * 180 / M_PI);
       if (r_abs.back() > kDivergeR || t_abs.back() > kDivergeThetaDeg) ++res.diverged_frames;

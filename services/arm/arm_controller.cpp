@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include "nudge/bus/arm_convert.hpp"
+#include "nudge/bus/pose_convert.hpp"
 #include "nudge/robot/kinematics.hpp"
 #include "nudge/robot/trajectory.hpp"
 
@@ -282,16 +284,15 @@ void ArmController::lose_supervisor(const std::string& reason) {
 
 arm_state_t ArmController::state() const {
   const robot::JointState joints = backend_.driver->read_joint_state();
-  arm_state_t s{};
+  bus::ArmState s;
   s.utime = clock_;
-  for (int j = 0; j < robot::kNumJoints; ++j) s.joints[j] = joints.position[j];
-  s.gripper = joints.gripper_opening;
-  s.end_effector =
-      to_message(config_.planner.base.to_world(robot::forward_kinematics(config_.planner.model, joints.position)));
+  s.joints = joints.position;
+  s.gripper_opening = joints.gripper_opening;
+  s.tool_in_world = config_.planner.base.to_world(robot::forward_kinematics(config_.planner.model, joints.position));
   s.motion = motion_;
   s.command_seq = command_seq_;
   s.last_error = last_error_;
-  return s;
+  return bus::to_message(s);
 }
 
 std::string ArmController::describe() const {

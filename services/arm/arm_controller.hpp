@@ -21,7 +21,7 @@
 #include <vector>
 
 #include "backends.hpp"
-#include "pose_message.hpp"
+#include "nudge/bus/pose_convert.hpp"
 #include "nudge/arm_command_t.hpp"
 #include "nudge/arm_state_t.hpp"
 #include "nudge/heartbeat_t.hpp"

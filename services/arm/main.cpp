@@ -25,6 +25,7 @@
 #include "backends.hpp"
 #include "nudge/arm_command_t.hpp"
 #include "nudge/arm_state_t.hpp"
+#include "nudge/bus/channels.hpp"
 #include "nudge/bus/service.hpp"
 #include "nudge/bus_clock.hpp"
 #include "nudge/heartbeat_t.hpp"
@@ -70,7 +71,7 @@ int main(int argc, char** argv) {
     bus::Service service("arm", "PUMA 260 arm: checked moves, nudges and grasps (thesis ch. 6-7, App. B).");
     arm::ControllerConfig config;
     std::string backend_name = "sim", clock_name = "auto";
-    std::string command_channel = "ARM_COMMAND", state_channel = "ARM_STATE", sim_channel = "SIM_STATE";
+    std::string command_channel = bus::channel::ARM_COMMAND, state_channel = bus::channel::ARM_STATE, sim_channel = bus::channel::SIM_STATE;
     robot::PlannerConfig& planner = config.planner;
     double rate = 100;
     double gripper_speed = 0.05, max_catch_up = 1.0;
@@ -154,7 +155,7 @@ int main(int argc, char** argv) {
       }
       after_event();
     });
-    service.subscriptions().subscribe<heartbeat_t>(bus::kHeartbeatChannel, [&](const heartbeat_t& heartbeat, const std::string&) {
+    service.subscriptions().subscribe<heartbeat_t>(bus::channel::HEARTBEAT, [&](const heartbeat_t& heartbeat, const std::string&) {
       follow(heartbeat.utime, Stamp::Sender);
       if (controller->on_heartbeat(heartbeat, clock.deadline_time())) {
         publish(controller->state());

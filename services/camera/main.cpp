@@ -4,6 +4,7 @@
 #include <sstream>
 #include <thread>
 
+#include "nudge/bus/channels.hpp"
 #include "nudge/bus/image.hpp"
 #include "nudge/bus/service.hpp"
 #include "nudge/camera/source.hpp"
@@ -28,7 +29,7 @@ int main(int argc, char** argv) {
                          "Publishes camera frames. Sources: images:GLOB, video:PATH, device:N.\n"
                          "Mono: --source SRC [--channel CAMERA]. Stereo: --left SRC --right SRC.\n"
                          "Simulation: --source sim --scene FILE renders every SIM_STATE as a stereo pair.");
-    std::string source_spec, left_spec, right_spec, channel = "CAMERA", format = "gray";
+    std::string source_spec, left_spec, right_spec, channel = bus::channel::CAMERA, format = "gray";
     double rate = 25.0;
     bool loop = false;
     int count = 0, jpeg_quality = 90;
@@ -70,8 +71,8 @@ int main(int argc, char** argv) {
       if (left_spec.empty() || right_spec.empty() || !source_spec.empty()) {
         throw FlagError("stereo needs both --left and --right (and no --source)");
       }
-      streams.push_back({camera::open_source(left_spec), "CAMERA_LEFT", "left"});
-      streams.push_back({camera::open_source(right_spec), "CAMERA_RIGHT", "right"});
+      streams.push_back({camera::open_source(left_spec), bus::channel::CAMERA_LEFT, "left"});
+      streams.push_back({camera::open_source(right_spec), bus::channel::CAMERA_RIGHT, "right"});
     } else {
       if (source_spec.empty()) throw FlagError("give --source SRC, or --left SRC --right SRC");
       streams.push_back({camera::open_source(source_spec), channel, "mono"});

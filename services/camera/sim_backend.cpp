@@ -7,7 +7,9 @@
 
 #include <optional>
 
+#include "nudge/bus/channels.hpp"
 #include "nudge/bus/image.hpp"
+#include "nudge/bus/pose_convert.hpp"
 #include "nudge/log.hpp"
 #include "nudge/sim/state_sync.hpp"
 #include "nudge/sim/world.hpp"
@@ -19,10 +21,8 @@ namespace nudge::camera_service {
 
 namespace {
 
-constexpr const char* kStateChannel = "SIM_STATE";
-constexpr const char* kSnapshotRequestChannel = "CAMERA_SNAPSHOT_REQUEST";
-constexpr const char* kChannels[2] = {"CAMERA_LEFT", "CAMERA_RIGHT"};
-constexpr const char* kSnapshotChannels[2] = {"SNAPSHOT_LEFT", "SNAPSHOT_RIGHT"};
+constexpr const char* kChannels[2] = {bus::channel::CAMERA_LEFT, bus::channel::CAMERA_RIGHT};
+constexpr const char* kSnapshotChannels[2] = {bus::channel::SNAPSHOT_LEFT, bus::channel::SNAPSHOT_RIGHT};
 constexpr const char* kCameraNames[2] = {"left", "right"};
 
 }  // namespace
@@ -66,7 +66,7 @@ int run_sim_camera(bus::Service& service, const SimOptions& options) {
     sum.convertTo(out, CV_8UC3);
     return out;
   };
-  service.subscriptions().subscribe<sim_state_t>(kStateChannel, [&](const sim_state_t& state, const std::string&) {
+  service.subscriptions().subscribe<sim_state_t>(bus::channel::SIM_STATE, [&](const sim_state_t& state, const std::string&) {
     const sim::PoseSnapshot poses = bus::poses_of(state);
     sim::apply_poses(world, poses);  // throws naming the object: counted, skipped
     last_state_utime = state.utime;
@@ -82,7 +82,7 @@ int run_sim_camera(bus::Service& service, const SimOptions& options) {
   });
   if (options.snapshots) {
     service.subscriptions().subscribe<snapshot_request_t>(
-        kSnapshotRequestChannel, [&](const snapshot_request_t& request, const std::string&) {
+        bus::channel::CAMERA_SNAPSHOT_REQUEST, [&](const snapshot_request_t& request, const std::string&) {
           if (!last_state_utime) throw std::runtime_error("no SIM_STATE rendered yet: nothing to snapshot");
           if (request.cameras < snapshot_request_t::CAMERAS_BOTH || request.cameras > snapshot_request_t::CAMERAS_RIGHT)
             throw std::invalid_argument("snapshot request: unknown cameras value " + std::to_string(request.cameras));

@@ -12,6 +12,7 @@
 #include <sstream>
 #include <sys/stat.h>
 
+#include "nudge/bus/channels.hpp"
 #include "nudge/bus/image.hpp"
 #include "nudge/bus/service.hpp"
 #include "nudge/bus/symmetry_convert.hpp"
@@ -22,10 +23,6 @@
 using namespace nudge;
 
 namespace {
-
-std::string camera_channel_for(const std::string& symmetry_channel) {
-  return "CAMERA" + symmetry_channel.substr(std::string("SYMMETRY").size());
-}
 
 constexpr double kDeg = M_PI / 180.0;
 
@@ -39,10 +36,10 @@ struct TruthStats {
 // The true (R, theta) of an object in the camera of a SYMMETRY_LEFT / _RIGHT channel; false for
 // other channels and for axes that do not project (NaN).
 bool true_line(const object_state_t& o, const std::string& channel, double* r, double* theta) {
-  if (channel == "SYMMETRY_LEFT") {
+  if (channel == bus::channel::SYMMETRY_LEFT) {
     *r = o.r_left;
     *theta = o.theta_left;
-  } else if (channel == "SYMMETRY_RIGHT") {
+  } else if (channel == bus::channel::SYMMETRY_RIGHT) {
     *r = o.r_right;
     *theta = o.theta_right;
   } else {
@@ -56,7 +53,7 @@ bool true_line(const object_state_t& o, const std::string& channel, double* r, d
 int main(int argc, char** argv) {
   return bus::guarded_main("monitor", [&] {
     bus::Service service("monitor", "Prints and draws symmetry detections; checks that every frame got lines.");
-    std::string channels = "SYMMETRY_LEFT,SYMMETRY_RIGHT", draw_dir;
+    std::string channels = std::string(bus::channel::SYMMETRY_LEFT) + "," + bus::channel::SYMMETRY_RIGHT, draw_dir;
     int expect_frames = 0;
     double timeout_s = 0;
     auto& f = service.flags();
@@ -80,13 +77,14 @@ int main(int argc, char** argv) {
     std::map<int64_t, sim_state_t> states;                            // utime -> state (recent ones)
     std::map<std::string, std::map<std::string, TruthStats>> stats;  // channel -> object -> stats
     if (truth) {
-      service.subscriptions().subscribe<sim_state_t>("SIM_STATE", [&](const sim_state_t& msg, const std::string&) {
+      service.subscriptions().subscribe<sim_state_t>(bus::channel::SIM_STATE, [&](const sim_state_t& msg, const std::string&) {
         states[msg.utime] = msg;
         while (states.size() > 200) states.erase(states.begin());  // keep memory bounded
       });
     }
     for (const auto& channel : list) {
-      const std::string cam = camera_channel_for(channel);
+      // the images the lines were found in, only needed to draw them
+      const std::string cam = draw_dir.empty() ? "" : bus::channel::camera_of(channel, bus::channel::SYMMETRY);
       if (!draw_dir.empty()) {
         service.subscriptions().subscribe<image_t>(cam, [&, cam](const image_t& msg, const std::string&) {
           auto& store = frames[cam];
@@ -111,7 +109,8 @@ int main(int argc, char** argv) {
             ++st.frames;
             double best = INFINITY, best_r = 0, best_theta = 0;
             for (const auto& l : msg.lines) {
-              const double dr = std::abs(l.r - r), dtheta = std::abs(l.theta - theta);
+              const symmetry::LineDifference d = symmetry::line_difference(l.r, l.theta, r, theta);
+              const double dr = std::abs(d.r), dtheta = std::abs(d.theta);
               if (dr + dtheta / kDeg < best) {
                 best = dr + dtheta / kDeg;
                 best_r = dr;

@@ -22,6 +22,7 @@
 #include "nudge/arm_state_t.hpp"
 #include "nudge/atomic_file.hpp"
 #include "nudge/axes_t.hpp"
+#include "nudge/bus/channels.hpp"
 #include "nudge/bus/image.hpp"
 #include "nudge/bus/service.hpp"
 #include "nudge/bus/symmetry_convert.hpp"
@@ -114,8 +115,9 @@ class RunLog {
 };
 
 // Published by the supervisor alone.
-const std::set<std::string> kOwnChannels = {"CANDIDATES_REQUEST", "CAMERA_SNAPSHOT_REQUEST", "ARM_COMMAND",
-                                            "SUPERVISOR_STATE", "SEGMENTATION"};
+const std::set<std::string> kOwnChannels = {bus::channel::CANDIDATES_REQUEST, bus::channel::CAMERA_SNAPSHOT_REQUEST,
+                                            bus::channel::ARM_COMMAND, bus::channel::SUPERVISOR_STATE,
+                                            bus::channel::SEGMENTATION};
 
 class Shell {
  public:
@@ -134,15 +136,15 @@ class Shell {
     auto& in = service_.input();
     in.subscribe(".*", &Shell::record, this);
     auto& subs = service_.subscriptions();
-    subs.subscribe<heartbeat_t>("HEARTBEAT", [this](const heartbeat_t& m, const std::string&) { on_heartbeat(m); });
-    subs.subscribe<sim_state_t>("SIM_STATE", [this](const sim_state_t& m, const std::string&) { on_sim_state(m); });
-    subs.subscribe<candidates_t>("CANDIDATES", [this](const candidates_t& m, const std::string&) { on_candidates(m); });
-    subs.subscribe<arm_state_t>("ARM_STATE", [this](const arm_state_t& m, const std::string&) { on_arm_state(m); });
-    subs.subscribe<axes_t>("AXES", [this](const axes_t& m, const std::string&) { on_axes(m); });
-    subs.subscribe<symmetry_lines_t>("SYMMETRY_LEFT", [this](const symmetry_lines_t& m, const std::string&) { on_lines(true, m); });
-    subs.subscribe<symmetry_lines_t>("SYMMETRY_RIGHT", [this](const symmetry_lines_t& m, const std::string&) { on_lines(false, m); });
-    subs.subscribe<image_t>("CAMERA_RIGHT", [this](const image_t& m, const std::string&) { on_frame(m); });
-    subs.subscribe<image_t>("SNAPSHOT_RIGHT", [this](const image_t& m, const std::string&) { on_still(m); });
+    subs.subscribe<heartbeat_t>(bus::channel::HEARTBEAT, [this](const heartbeat_t& m, const std::string&) { on_heartbeat(m); });
+    subs.subscribe<sim_state_t>(bus::channel::SIM_STATE, [this](const sim_state_t& m, const std::string&) { on_sim_state(m); });
+    subs.subscribe<candidates_t>(bus::channel::CANDIDATES, [this](const candidates_t& m, const std::string&) { on_candidates(m); });
+    subs.subscribe<arm_state_t>(bus::channel::ARM_STATE, [this](const arm_state_t& m, const std::string&) { on_arm_state(m); });
+    subs.subscribe<axes_t>(bus::channel::AXES, [this](const axes_t& m, const std::string&) { on_axes(m); });
+    subs.subscribe<symmetry_lines_t>(bus::channel::SYMMETRY_LEFT, [this](const symmetry_lines_t& m, const std::string&) { on_lines(true, m); });
+    subs.subscribe<symmetry_lines_t>(bus::channel::SYMMETRY_RIGHT, [this](const symmetry_lines_t& m, const std::string&) { on_lines(false, m); });
+    subs.subscribe<image_t>(bus::channel::CAMERA_RIGHT, [this](const image_t& m, const std::string&) { on_frame(m); });
+    subs.subscribe<image_t>(bus::channel::SNAPSHOT_RIGHT, [this](const image_t& m, const std::string&) { on_still(m); });
   }
 
   // Wall-clock duties: the task clock (--clock wall), the 1 Hz state, the heartbeat watchdog live.
@@ -297,13 +299,13 @@ class Shell {
     m.utime = now_;
     m.frames = r.frames;
     m.lines_per_image = r.lines;
-    publish("CANDIDATES_REQUEST", m);
+    publish(bus::channel::CANDIDATES_REQUEST, m);
   }
   void handle(const sv::SnapshotRequest&) {
     snapshot_request_t m{};
     m.utime = now_;
     m.cameras = snapshot_request_t::CAMERAS_RIGHT;
-    publish("CAMERA_SNAPSHOT_REQUEST", m);
+    publish(bus::channel::CAMERA_SNAPSHOT_REQUEST, m);
   }
   void handle(const sv::NudgeCommand& c) {
     arm_command_t m{};
@@ -317,7 +319,7 @@ class Shell {
     m.height = opt_.arm.nudge.push_height;
     m.start_distance = opt_.arm.nudge.start_distance;
     m.stop_distance = opt_.arm.nudge.stop_distance;
-    publish("ARM_COMMAND", m);
+    publish(bus::channel::ARM_COMMAND, m);
   }
   void handle(const sv::StopCommand& c) {
     arm_command_t m{};
@@ -325,7 +327,7 @@ class Shell {
     m.seq = c.seq;
     m.command = arm_command_t::COMMAND_STOP;
     m.target.orientation[0] = 1;
-    publish("ARM_COMMAND", m);
+    publish(bus::channel::ARM_COMMAND, m);
     log::warn() << "arm stopped: " << c.reason;
   }
   void handle(const sv::StateReport& r) {
@@ -362,7 +364,7 @@ class Shell {
     m.segmented = r.segmented;
     m.failed_attempts = r.failed_attempts;
     m.rejected = r.rejected;
-    publish("SUPERVISOR_STATE", m);
+    publish(bus::channel::SUPERVISOR_STATE, m);
   }
 
   void publish_segmentation(const sv::Attempt& a) {
@@ -376,7 +378,7 @@ class Shell {
     m.line_after = bus::to_message(*a.after_line);
     m.mask_pixels = cv::countNonZero(a.segmentation.mask);
     m.mask = bus::to_message(a.segmentation.mask, image_t::FORMAT_PNG, now_, a.number, "right");
-    publish("SEGMENTATION", m);
+    publish(bus::channel::SEGMENTATION, m);
   }
 
   void write_summary(const std::string& end_reason) {

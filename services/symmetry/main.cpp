@@ -3,6 +3,7 @@
 // --contours N also the object contours of the top N lines on CONTOURS_* (thesis sec. 4.2).
 #include <sstream>
 
+#include "nudge/bus/channels.hpp"
 #include "nudge/bus/image.hpp"
 #include "nudge/bus/service.hpp"
 #include "nudge/bus/symmetry_convert.hpp"
@@ -16,13 +17,6 @@
 using namespace nudge;
 
 namespace {
-
-// CAMERA_LEFT -> SYMMETRY_LEFT (or CONTOURS_LEFT); other names get the prefix.
-std::string output_channel(const std::string& input, const std::string& kind) {
-  const std::string prefix = "CAMERA";
-  if (input.rfind(prefix, 0) == 0) return kind + input.substr(prefix.size());
-  return kind + "_" + input;
-}
 
 // The contour of each of the first `count` lines, as a message (thesis sec. 4.2).
 contours_t contours_message(const symmetry::EdgeSet& edges, const std::vector<symmetry::Line>& lines, int count,
@@ -60,7 +54,7 @@ int main(int argc, char** argv) {
     symmetry::Params params;
     symmetry::EdgeParams edge;
     edge.blur_sigma = 1.0;  // thesis: Gaussian blur first on camera images
-    std::string inputs = "CAMERA_LEFT,CAMERA_RIGHT";
+    std::string inputs = std::string(bus::channel::CAMERA_LEFT) + "," + bus::channel::CAMERA_RIGHT;
     std::vector<double> canny = {edge.canny_low, edge.canny_high};
     auto& f = service.flags();
     f.add_string("inputs", &inputs, "comma-separated image channels");
@@ -96,8 +90,8 @@ int main(int argc, char** argv) {
     const segmentation::Segmenter segmenter(segment_params);
     service.start();
     for (const auto& channel : split_list(inputs)) {
-      const std::string out = output_channel(channel, "SYMMETRY");
-      const std::string contours_out = output_channel(channel, "CONTOURS");
+      const std::string out = bus::channel::derived(channel, bus::channel::SYMMETRY);
+      const std::string contours_out = bus::channel::derived(channel, bus::channel::CONTOURS);
       service.subscriptions().subscribe<image_t>(channel, [&, out, contours_out](const image_t& msg, const std::string&) {
         const cv::Mat image = bus::to_mat(msg);  // throws ImageError naming the image: counted, skipped
         Stopwatch watch;

@@ -6,9 +6,10 @@
 #include <memory>
 #include <sstream>
 
+#include "nudge/bus/channels.hpp"
 #include "nudge/bus/image.hpp"
 #include "nudge/bus/service.hpp"
-#include "nudge/bus/symmetry_convert.hpp"
+#include "nudge/bus/track_convert.hpp"
 #include "nudge/image_t.hpp"
 #include "nudge/log.hpp"
 #include "nudge/timing.hpp"
@@ -20,12 +21,6 @@ using namespace nudge;
 
 namespace {
 
-std::string default_output(const std::string& input) {
-  const std::string prefix = "CAMERA";
-  if (input.rfind(prefix, 0) == 0) return "TRACK" + input.substr(prefix.size());
-  return "TRACK_" + input;
-}
-
 // One camera's tracker and what the heartbeat reports about it.
 struct Stream {
   std::string input, output;
@@ -35,30 +30,6 @@ struct Stream {
   Stream(std::string in, std::string out, const tracking::TrackerParams& params)
       : input(std::move(in)), output(std::move(out)), tracker(params) {}
 };
-
-track_t to_message(const tracking::TrackState& s, const image_t& image) {
-  track_t m{};
-  m.utime = image.utime;
-  m.frame_id = image.frame_id;
-  m.camera = image.camera;
-  m.status = static_cast<int8_t>(s.status);
-  m.reason = s.reason;
-  m.line = bus::to_message(s.line);  // zeros when there is no estimate
-  for (int i = 0; i < 2; ++i)
-    for (int j = 0; j < 2; ++j) m.covariance[i][j] = static_cast<float>(s.covariance(i, j));
-  for (int i = 0; i < 4; ++i) {
-    m.box[i][0] = s.has_box ? static_cast<float>(s.box[i].x) : 0.f;
-    m.box[i][1] = s.has_box ? static_cast<float>(s.box[i].y) : 0.f;
-  }
-  m.block_size = s.block_size;
-  m.blocks_w = s.blocks.cols;
-  m.blocks_h = s.blocks.rows;
-  m.num_blocks = static_cast<int32_t>(s.blocks.total());
-  m.motion_mask.reserve(m.num_blocks);
-  for (int y = 0; y < s.blocks.rows; ++y)
-    for (int x = 0; x < s.blocks.cols; ++x) m.motion_mask.push_back(s.blocks.at<uint8_t>(y, x) ? 1 : 0);
-  return m;
-}
 
 // "TRACK_LEFT tracking; TRACK_RIGHT idle, CAMERA_RIGHT stopped 3.0 s ago".
 std::string describe(const std::vector<std::unique_ptr<Stream>>& streams, double stale_s) {
@@ -84,7 +55,8 @@ int main(int argc, char** argv) {
   return bus::guarded_main("tracker", [&] {
     bus::Service service("tracker", "Real-time symmetry tracking (thesis ch. 5) of one object per camera.");
     tracking::TrackerParams params;
-    std::string inputs = "CAMERA_LEFT,CAMERA_RIGHT", outputs, command_channel = "TRACKER_COMMAND";
+    std::string inputs = std::string(bus::channel::CAMERA_LEFT) + "," + bus::channel::CAMERA_RIGHT, outputs,
+                command_channel = bus::channel::TRACKER_COMMAND;
     double stale_s = 1.0;
     bool no_mask = false;
     auto& f = service.flags();
@@ -117,7 +89,7 @@ int main(int argc, char** argv) {
       throw FlagError("--outputs must name one channel per input");
     if (!(stale_s > 0)) throw FlagError("--stale must be > 0 seconds");
     if (out_channels.empty())
-      for (const auto& c : in_channels) out_channels.push_back(default_output(c));
+      for (const auto& c : in_channels) out_channels.push_back(bus::channel::derived(c, bus::channel::TRACK));
     std::vector<std::unique_ptr<Stream>> streams;
     try {
       for (size_t i = 0; i < in_channels.size(); ++i)
@@ -134,7 +106,7 @@ int main(int argc, char** argv) {
         ++s->frames;
         const cv::Mat image = bus::to_mat(msg);  // throws ImageError naming the image: counted, skipped
         const tracking::TrackState state = s->tracker.feed(image, msg.utime);
-        track_t out = to_message(state, msg);
+        track_t out = bus::to_message(state, msg.utime, msg.frame_id, msg.camera);
         if (!send_mask) {
           out.num_blocks = 0;
           out.motion_mask.clear();

@@ -14,6 +14,8 @@
 #include <optional>
 
 #include "nudge/axes_t.hpp"
+#include "nudge/bus/axes_convert.hpp"
+#include "nudge/bus/channels.hpp"
 #include "nudge/bus/service.hpp"
 #include "nudge/bus/symmetry_convert.hpp"
 #include "nudge/candidates_request_t.hpp"
@@ -31,7 +33,8 @@ namespace geo = nudge::geometry;
 namespace {
 
 struct Options {
-  std::string calibration, left_channel = "SYMMETRY_LEFT", right_channel = "SYMMETRY_RIGHT";
+  std::string calibration, left_channel = bus::channel::SYMMETRY_LEFT,
+              right_channel = bus::channel::SYMMETRY_RIGHT;
   std::vector<double> table_plane, arm_base;
   int lines = 0, buffer = 16;
   geo::AxisFilter filter;             // AXES: thesis ch. 4 (15 deg, within reach)
@@ -54,10 +57,6 @@ geo::Workspace workspace_of(const Options& opt) {
   if (!opt.table_plane.empty()) workspace.table = plane_from_flag(opt.table_plane);
   if (!opt.arm_base.empty()) workspace.arm_base = Eigen::Vector3d(opt.arm_base[0], opt.arm_base[1], opt.arm_base[2]);
   return workspace;
-}
-
-void copy3(const Eigen::Vector3d& v, double out[3]) {
-  for (int i = 0; i < 3; ++i) out[i] = v(i);
 }
 
 class Triangulation {
@@ -84,7 +83,7 @@ class Triangulation {
     subs.subscribe<symmetry_lines_t>(opt_.right_channel, [this](const symmetry_lines_t& m, const std::string& ch) {
       on_lines(geo::Side::Right, m, ch);
     });
-    subs.subscribe<candidates_request_t>("CANDIDATES_REQUEST",
+    subs.subscribe<candidates_request_t>(bus::channel::CANDIDATES_REQUEST,
                                          [this](const candidates_request_t& m, const std::string&) { on_request(m); });
   }
 
@@ -126,31 +125,9 @@ class Triangulation {
     const geo::PairingResult result = geo::triangulate_pairings(rig_, left, right, table_ ? &*table_ : nullptr,
                                                                 opt_.filter, opt_.triangulation, opt_.lines);
     for (const auto& why : result.rejections) log::debug() << "utime " << utime << ": " << why;
-    axes_t msg;
-    msg.utime = utime;
-    msg.num_pairings = result.pairings;
-    for (const geo::PairedAxis& a : result.axes) msg.axes.push_back(to_message(a));
-    msg.num_axes = static_cast<int32_t>(msg.axes.size());
-    service_.publish("AXES", msg);
+    const axes_t msg = bus::to_message(result, utime, frame_ ? &*frame_ : nullptr);
+    service_.publish(bus::channel::AXES, msg);
     log::debug() << "utime " << utime << ": " << msg.num_axes << " of " << msg.num_pairings << " pairings valid";
-  }
-
-  axis3d_t to_message(const geo::PairedAxis& a) const {
-    axis3d_t m;
-    m.left_index = a.left_index;
-    m.right_index = a.right_index;
-    if (!frame_) {
-      copy3(a.axis.a, m.point_a);
-      copy3(a.axis.b, m.point_b);
-      copy3(Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN()), m.table_point);
-      m.angle_to_normal = std::numeric_limits<double>::quiet_NaN();
-      return m;
-    }
-    copy3(frame_->to_table(a.axis.a), m.point_a);
-    copy3(frame_->to_table(a.axis.b), m.point_b);
-    copy3(frame_->to_table(a.hit->point), m.table_point);
-    m.angle_to_normal = a.hit->tilt_deg * M_PI / 180.0;
-    return m;
   }
 
   void on_request(const candidates_request_t& request) {
@@ -179,7 +156,7 @@ class Triangulation {
       msg.cluster_size.push_back(loc.support);
     }
     msg.num_candidates = static_cast<int32_t>(msg.position.size());
-    service_.publish("CANDIDATES", msg);
+    service_.publish(bus::channel::CANDIDATES, msg);
     log::info() << "candidates: " << msg.num_candidates << " locations from " << msg.intersects << " intersects over "
                 << msg.frames_used << " stereo pairs";
     finder_.reset();

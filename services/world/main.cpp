@@ -11,7 +11,10 @@
 #include <string>
 
 #include "nudge/arm_state_t.hpp"
+#include "nudge/bus/arm_convert.hpp"
+#include "nudge/bus/channels.hpp"
 #include "nudge/bus/image.hpp"
+#include "nudge/bus/pose_convert.hpp"
 #include "nudge/bus/service.hpp"
 #include "nudge/bus_clock.hpp"
 #include "nudge/log.hpp"
@@ -27,20 +30,6 @@ using namespace nudge;
 
 namespace {
 
-constexpr const char* kStateChannel = "SIM_STATE";
-constexpr const char* kTruthChannel = "SIM_TRUTH";
-constexpr const char* kTruthRequestChannel = "SIM_TRUTH_REQUEST";
-constexpr const char* kArmStateChannel = "ARM_STATE";
-
-pose_t to_pose(const Eigen::Vector3d& p, const Eigen::Quaterniond& q) {
-  pose_t pose;
-  for (int i = 0; i < 3; ++i) pose.position[i] = p[i];
-  pose.orientation[0] = q.w();
-  pose.orientation[1] = q.x();
-  pose.orientation[2] = q.y();
-  pose.orientation[3] = q.z();
-  return pose;
-}
 
 // The world's physics, its pusher (driven by the arm) and what it publishes, on simulated time.
 class Simulation {
@@ -71,7 +60,7 @@ class Simulation {
   void step() {
     world_.step();
     ++step_;
-    if (step_ % steps_per_state_ == 0) service_.publish(kStateChannel, state_message());
+    if (step_ % steps_per_state_ == 0) service_.publish(bus::channel::SIM_STATE, state_message());
   }
   // Simulated time never goes past this (--duration).
   void set_end_time(double seconds) { end_time_ = seconds; }
@@ -92,17 +81,12 @@ class Simulation {
   // while that axis points straight up or down); the gripper's fingers close across it, towards
   // the opening ARM_STATE.gripper.
   void on_arm_state(const arm_state_t& msg) {
-    const Eigen::Vector3d p(msg.end_effector.position[0], msg.end_effector.position[1], msg.end_effector.position[2]);
-    const Eigen::Quaterniond q(msg.end_effector.orientation[0], msg.end_effector.orientation[1],
-                               msg.end_effector.orientation[2], msg.end_effector.orientation[3]);
-    if (!p.allFinite() || !q.coeffs().allFinite() || std::abs(q.norm() - 1.0) > 1e-3)
-      throw std::invalid_argument("end_effector: position must be finite and orientation a unit quaternion");
-    if (!std::isfinite(msg.gripper)) throw std::invalid_argument("gripper: not finite");
-    for (double j : msg.joints)
-      if (!std::isfinite(j)) throw std::invalid_argument("joints: not finite");
+    const bus::ArmState arm = bus::from_message(msg);  // throws naming a bad field
+    const Eigen::Vector3d p = arm.tool_in_world.translation();
+    const Eigen::Quaterniond q(arm.tool_in_world.linear());
     if (world_.has_arm()) {  // the simulated PUMA's servos follow the arm's joints
       std::array<double, 6> joints;
-      std::copy(std::begin(msg.joints), std::end(msg.joints), joints.begin());
+      std::copy(arm.joints.begin(), arm.joints.end(), joints.begin());
       world_.set_arm_targets(joints);
     }
     if (world_.tools_on_arm()) {  // the tool is where the simulated arm puts it
@@ -139,7 +123,7 @@ class Simulation {
         mask.pixel_format = image_t::FORMAT_GRAY8;
       }
     }
-    service_.publish(kTruthChannel, truth);
+    service_.publish(bus::channel::SIM_TRUTH, truth);
   }
 
   sim_state_t state_message() const {
@@ -156,7 +140,7 @@ class Simulation {
       const sim::Axis3d axis = world_.axis(i);
       object_state_t o;
       o.name = st.name;
-      o.pose = to_pose(st.position, st.orientation);
+      o.pose = bus::to_message(st.position, st.orientation);
       for (int k = 0; k < 3; ++k) {
         o.axis_point[k] = axis.base[k];
         o.axis_direction[k] = axis.direction[k];
@@ -169,7 +153,7 @@ class Simulation {
       o.theta_right = right.valid ? static_cast<float>(right.theta) : nan;
       msg.objects.push_back(o);
     }
-    msg.pusher = to_pose(world_.pusher_position(), sim::yaw_rotation(pusher_yaw_));
+    msg.pusher = bus::to_message(world_.pusher_position(), sim::yaw_rotation(pusher_yaw_));
     return msg;
   }
 
@@ -194,12 +178,12 @@ class Inputs {
  public:
   Inputs(bus::Service& service, Simulation& sim, BusClock& clock, LogTimeline timeline)
       : sim_(sim), clock_(clock), timeline_(timeline) {
-    service.subscriptions().subscribe<arm_state_t>(kArmStateChannel, [this](const arm_state_t& msg, const std::string&) {
+    service.subscriptions().subscribe<arm_state_t>(bus::channel::ARM_STATE, [this](const arm_state_t& msg, const std::string&) {
       catch_up(msg.utime);
       sim_.on_arm_state(msg);  // throws on a bad pose: counted, skipped
     });
     service.subscriptions().subscribe<sim_truth_request_t>(
-        kTruthRequestChannel, [this](const sim_truth_request_t& msg, const std::string&) {
+        bus::channel::SIM_TRUTH_REQUEST, [this](const sim_truth_request_t& msg, const std::string&) {
           catch_up(msg.utime);
           sim_.on_truth_request(!msg.without_masks);
         });
@@ -292,7 +276,7 @@ int main(int argc, char** argv) {
                 << (from_log ? "input events applied at their log time"
                              : realtime_factor > 0 ? "realtime factor " + std::to_string(realtime_factor)
                                                    : std::string("as fast as possible"));
-    service.publish(kStateChannel, sim.state_message());  // the state at t = 0
+    service.publish(bus::channel::SIM_STATE, sim.state_message());  // the state at t = 0
 
     std::optional<Pacer> pacer;
     if (realtime_factor > 0) pacer.emplace(realtime_factor);

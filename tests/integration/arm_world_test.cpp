@@ -27,8 +27,12 @@
 
 #include "nudge/arm_command_t.hpp"
 #include "nudge/arm_state_t.hpp"
+#include "nudge/bus/channels.hpp"
+#include "nudge/bus/pose_convert.hpp"
 #include "nudge/sim_state_t.hpp"
 #include "process.hpp"
+
+namespace channel = nudge::bus::channel;
 
 namespace {
 
@@ -45,8 +49,8 @@ struct Watch {
 };
 
 double tilt_of(const nudge::pose_t& pose) {
-  const Eigen::Quaterniond q(pose.orientation[0], pose.orientation[1], pose.orientation[2], pose.orientation[3]);
-  return std::acos(std::clamp((q.normalized() * Eigen::Vector3d::UnitZ()).z(), -1.0, 1.0));
+  const Eigen::Quaterniond q = nudge::bus::orientation_of(pose).normalized();
+  return std::acos(std::clamp((q * Eigen::Vector3d::UnitZ()).z(), -1.0, 1.0));
 }
 
 }  // namespace
@@ -64,8 +68,8 @@ TEST(ArmWorld, TheArmServiceNudgesACupWithTheSimulatedPuma) {
   lcm::LCM lcm(kUrl);
   ASSERT_TRUE(lcm.good());
   Watch watch;
-  lcm.subscribe("SIM_STATE", &Watch::on_sim, &watch);
-  lcm.subscribe("ARM_STATE", &Watch::on_arm, &watch);
+  lcm.subscribe(channel::SIM_STATE, &Watch::on_sim, &watch);
+  lcm.subscribe(channel::ARM_STATE, &Watch::on_arm, &watch);
 
   Process arm({kBin + "/nudge-arm", "--lcm-url", kUrl, "--backend", "sim", "--clock", "sim", "--speed-scale", "1"},
               dir + "/arm_world_arm.log");
@@ -93,7 +97,7 @@ TEST(ArmWorld, TheArmServiceNudgesACupWithTheSimulatedPuma) {
   nudge.target.position[0] = 0.25;  // the cup's axis on the table, world frame
   nudge.target.orientation[0] = 1;
   nudge.direction[1] = 1;           // pushed along +y, across the cameras' view
-  lcm.publish("ARM_COMMAND", &nudge);
+  lcm.publish(channel::ARM_COMMAND, &nudge);
   ASSERT_TRUE(handle_until([&] { return watch.arm->command_seq == 1 && watch.arm->motion != nudge::arm_state_t::MOTION_MOVING &&
                                         watch.arm->motion != nudge::arm_state_t::MOTION_IDLE; }, 45))
       << "the nudge did not finish";

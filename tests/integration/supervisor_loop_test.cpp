@@ -21,12 +21,14 @@
 #include <vector>
 
 #include "nudge/arm_command_t.hpp"
+#include "nudge/bus/channels.hpp"
 #include "nudge/sim_state_t.hpp"
 #include "nudge/supervisor/scene.hpp"
 #include "nudge/supervisor_state_t.hpp"
 #include "process.hpp"
 
 using nudge::testing::Process;
+namespace channel = nudge::bus::channel;
 
 namespace {
 
@@ -60,12 +62,12 @@ Decisions read_decisions(const std::string& log_path) {
   lcm::LogFile log(log_path, "r");
   EXPECT_TRUE(log.good()) << log_path;
   while (const lcm::LogEvent* e = log.readNextEvent()) {
-    if (e->channel == "SUPERVISOR_STATE") {
+    if (e->channel == channel::SUPERVISOR_STATE) {
       nudge::supervisor_state_t m;
       if (m.decode(e->data, 0, e->datalen) < 0) continue;
       const std::string text = m.state_name + " #" + std::to_string(m.attempt) + ": " + m.reason;
       if (d.states.empty() || d.states.back() != text) d.states.push_back(text);
-    } else if (e->channel == "ARM_COMMAND") {
+    } else if (e->channel == channel::ARM_COMMAND) {
       nudge::arm_command_t m;
       if (m.decode(e->data, 0, e->datalen) < 0) continue;
       char text[160];
@@ -73,7 +75,7 @@ Decisions read_decisions(const std::string& log_path) {
                     static_cast<long long>(m.seq), m.command, m.target.position[0], m.target.position[1],
                     m.direction[0], m.direction[1]);
       d.commands.push_back(text);
-    } else if (e->channel == "SIM_STATE") {
+    } else if (e->channel == channel::SIM_STATE) {
       nudge::sim_state_t m;
       if (m.decode(e->data, 0, e->datalen) >= 0) d.last_sim = m;
     }

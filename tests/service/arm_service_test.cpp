@@ -14,12 +14,16 @@
 
 #include "nudge/arm_command_t.hpp"
 #include "nudge/arm_state_t.hpp"
+#include "nudge/bus/channels.hpp"
+#include "nudge/bus/pose_convert.hpp"
 #include "nudge/heartbeat_t.hpp"
 #include "nudge/robot/kinematics.hpp"
 #include "nudge/robot/motions.hpp"
 #include "nudge/robot/puma260.hpp"
 #include "nudge/sim_state_t.hpp"
 #include "lcm_log.hpp"
+
+namespace channel = nudge::bus::channel;
 
 namespace {
 
@@ -57,7 +61,7 @@ class InputLog {
   void command(int64_t utime, arm_command_t cmd) {
     cmd.utime = utime;
     cmd.num_joints = static_cast<int32_t>(cmd.joints.size());
-    raw(utime, "ARM_COMMAND", encode(cmd));
+    raw(utime, channel::ARM_COMMAND, encode(cmd));
   }
   void heartbeat(int64_t utime, const std::string& service, int8_t state = heartbeat_t::STATE_RUNNING) {
     heartbeat_t hb{};
@@ -65,7 +69,7 @@ class InputLog {
     hb.service = service;
     hb.instance = service;
     hb.state = state;
-    raw(utime, "HEARTBEAT", encode(hb));
+    raw(utime, channel::HEARTBEAT, encode(hb));
   }
   // Other services' heartbeats every 100 ms over [from, to): traffic that moves the log clock.
   void traffic(int64_t from, int64_t to, const std::string& service = "world") {
@@ -91,11 +95,11 @@ Output run_service(const std::string& in, const std::string& out, const std::str
   lcm::LogFile log(out, "r");
   EXPECT_TRUE(log.good()) << out;
   for (const lcm::LogEvent* ev = log.readNextEvent(); ev; ev = log.readNextEvent()) {
-    if (ev->channel == "ARM_STATE") {
+    if (ev->channel == channel::ARM_STATE) {
       arm_state_t s;
       EXPECT_GE(s.decode(ev->data, 0, ev->datalen), 0);
       output.states.push_back(s);
-    } else if (ev->channel == "HEARTBEAT") {
+    } else if (ev->channel == channel::HEARTBEAT) {
       heartbeat_t hb;
       EXPECT_GE(hb.decode(ev->data, 0, ev->datalen), 0);
       output.errors = hb.errors;
@@ -112,7 +116,7 @@ std::vector<arm_state_t> of_command(const std::vector<arm_state_t>& states, int6
 }
 
 Eigen::Vector3d position(const arm_state_t& s) {
-  return {s.end_effector.position[0], s.end_effector.position[1], s.end_effector.position[2]};
+  return nudge::bus::position_of(s.end_effector);
 }
 
 // The tool point from the published joints, by the robot library's kinematics, in the world.
@@ -127,12 +131,7 @@ arm_command_t tool_down_pose_command(int64_t seq, const Eigen::Vector3d& p, doub
   arm_command_t c{};
   c.seq = seq;
   c.command = arm_command_t::COMMAND_MOVE_POSE;
-  const Eigen::Quaterniond q(nudge::robot::tool_down_orientation(yaw));
-  for (int i = 0; i < 3; ++i) c.target.position[i] = p[i];
-  c.target.orientation[0] = q.w();
-  c.target.orientation[1] = q.x();
-  c.target.orientation[2] = q.y();
-  c.target.orientation[3] = q.z();
+  c.target = nudge::bus::to_message(p, Eigen::Quaterniond(nudge::robot::tool_down_orientation(yaw)));
   return c;
 }
 
@@ -169,7 +168,7 @@ TEST(ArmService, MovesNudgesRefusesAndSkipsMalformedCommands) {
     folded.command = arm_command_t::COMMAND_MOVE_JOINTS;
     for (double deg : {0.0, 0.0, -215.0, 90.0, -90.0, 0.0}) folded.joints.push_back(deg * M_PI / 180);
     log.command(kStart + 40 * kSecond - 10, folded);
-    log.raw(kStart + 40 * kSecond, "ARM_COMMAND", {1, 2, 3});  // does not decode
+    log.raw(kStart + 40 * kSecond, channel::ARM_COMMAND, {1, 2, 3});  // does not decode
     arm_command_t three_joints{};
     three_joints.seq = 6;
     three_joints.command = arm_command_t::COMMAND_MOVE_JOINTS;
@@ -398,7 +397,7 @@ TEST(ArmService, GraspsRotatesPlacesAndParksOnTheSimBackend) {
   std::vector<arm_state_t> states;
   lcm::LogFile log(out, "r");
   for (const lcm::LogEvent* ev = log.readNextEvent(); ev; ev = log.readNextEvent()) {
-    if (ev->channel != "ARM_STATE") continue;
+    if (ev->channel != channel::ARM_STATE) continue;
     arm_state_t s;
     ASSERT_GE(s.decode(ev->data, 0, ev->datalen), 0);
     states.push_back(s);
@@ -500,10 +499,10 @@ TEST(ArmService, ClockSimFollowsTheSimulatedTimeOfSimState) {
   {
     InputLog log(in);
     // Log timestamps far apart from the simulated times: only SIM_STATE's utime counts.
-    log.raw(kStart, "SIM_STATE", encode(sim_state(0)));
+    log.raw(kStart, channel::SIM_STATE, encode(sim_state(0)));
     log.command(kStart + 1, tool_down_pose_command(1, target, 0.5));
-    for (int i = 1; i <= 150; ++i) log.raw(kStart + 1 + i, "SIM_STATE", encode(sim_state(i * kSecond / 30)));
-    log.raw(kStart + 200, "SIM_STATE", encode(sim_state(60 * kSecond)));  // the world jumps a minute
+    for (int i = 1; i <= 150; ++i) log.raw(kStart + 1 + i, channel::SIM_STATE, encode(sim_state(i * kSecond / 30)));
+    log.raw(kStart + 200, channel::SIM_STATE, encode(sim_state(60 * kSecond)));  // the world jumps a minute
   }
   const Output output = run_service(in, out, " --clock sim");
   const auto move = of_command(output.states, 1);

@@ -10,6 +10,7 @@
 #include <map>
 #include <string>
 
+#include "nudge/bus/channels.hpp"
 #include "nudge/bus/image.hpp"
 #include "nudge/contours_t.hpp"
 #include "nudge/heartbeat_t.hpp"
@@ -19,6 +20,7 @@
 #include "lcm_log.hpp"
 
 namespace syn = nudge::symmetry::synthetic;
+namespace channel = nudge::bus::channel;
 
 namespace {
 
@@ -31,6 +33,15 @@ struct Truth {
   double r, theta;
 };
 
+// Offsets of the lengths an encoded image_t from camera "mono" declares (fingerprint 8, utime 8,
+// frame_id 8, the camera's length, "mono" and its NUL, width, height, row_stride, pixel_format).
+constexpr size_t kCameraLengthOffset = 24;
+constexpr size_t kSizeOffset = kCameraLengthOffset + 4 + 5 + 4 + 4 + 4 + 1;
+
+void put_int32(std::vector<uint8_t>* bytes, size_t offset, int32_t value) {
+  for (int i = 0; i < 4; ++i) (*bytes)[offset + i] = static_cast<uint8_t>(static_cast<uint32_t>(value) >> (24 - 8 * i));
+}
+
 // Frames with one upright bottle each, at known axes.
 std::map<int64_t, Truth> write_input_log(const std::string& path) {
   lcm::LogFile log(path, "w");
@@ -41,17 +52,28 @@ std::map<int64_t, Truth> write_input_log(const std::string& path) {
     syn::draw_shape(img, syn::bottle_profile(160, 30), t.r, t.theta, 0, cv::Scalar(40, 60, 90));
     const int64_t utime = 1000000 + 40000 * i;
     const int8_t format = i % 2 ? nudge::image_t::FORMAT_PNG : nudge::image_t::FORMAT_GRAY8;
-    write_event(log, utime, "CAMERA", encode(nudge::bus::to_message(img, format, utime, i, "mono")));
+    write_event(log, utime, channel::CAMERA, encode(nudge::bus::to_message(img, format, utime, i, "mono")));
     truth[utime] = t;
     if (i == 2) {  // a truncated message: must be reported and skipped
       auto bytes = encode(nudge::bus::to_message(img, nudge::image_t::FORMAT_GRAY8, utime + 1, 99, "mono"));
       bytes.resize(bytes.size() / 2);
-      write_event(log, utime + 1, "CAMERA", bytes);
+      write_event(log, utime + 1, channel::CAMERA, bytes);
+    }
+    if (i == 3) {  // the camera string declares length 0: LCM 1.3.1's decode() throws on it
+      auto bytes = encode(nudge::bus::to_message(img, nudge::image_t::FORMAT_GRAY8, utime + 1, 97, "mono"));
+      put_int32(&bytes, kCameraLengthOffset, 0);
+      write_event(log, utime + 1, channel::CAMERA, bytes);
+    }
+    if (i == 5) {  // 114 bytes declaring a 2 GB image: refused before anything is allocated
+      auto bytes = encode(nudge::bus::to_message(img, nudge::image_t::FORMAT_GRAY8, utime + 1, 96, "mono"));
+      bytes.resize(114);
+      put_int32(&bytes, kSizeOffset, 2000000000);
+      write_event(log, utime + 1, channel::CAMERA, bytes);
     }
     if (i == 4) {  // an unknown pixel format
       auto bad = nudge::bus::to_message(img, nudge::image_t::FORMAT_GRAY8, utime + 2, 98, "mono");
       bad.pixel_format = 42;
-      write_event(log, utime + 2, "CAMERA", encode(bad));
+      write_event(log, utime + 2, channel::CAMERA, encode(bad));
     }
   }
   return truth;
@@ -77,18 +99,19 @@ TEST(SymmetryService, LogInLogOutMatchesTheKnownAxesAndSkipsBadMessages) {
   std::map<int64_t, nudge::symmetry_lines_t> results;
   int64_t errors_reported = -1;
   for (const lcm::LogEvent* ev = log.readNextEvent(); ev; ev = log.readNextEvent()) {
-    if (ev->channel == "SYMMETRY") {
+    if (ev->channel == channel::SYMMETRY) {
       nudge::symmetry_lines_t msg;
       ASSERT_GE(msg.decode(ev->data, 0, ev->datalen), 0);
       results[msg.utime] = msg;
-    } else if (ev->channel == "HEARTBEAT") {
+    } else if (ev->channel == channel::HEARTBEAT) {
       nudge::heartbeat_t hb;
       ASSERT_GE(hb.decode(ev->data, 0, ev->datalen), 0);
       errors_reported = hb.errors;
     }
   }
   ASSERT_EQ(results.size(), truth.size()) << "one SYMMETRY message per good frame";
-  EXPECT_EQ(errors_reported, 2) << "the truncated and the unknown-format messages are counted";
+  EXPECT_EQ(errors_reported, 4)
+      << "the truncated, zero-length camera, 2 GB and unknown-format messages are counted";
   for (const auto& [utime, t] : truth) {
     const auto& msg = results.at(utime);
     ASSERT_GE(msg.num_lines, 1);
@@ -111,7 +134,7 @@ TEST(SymmetryService, ContoursOfTheTopLinesOnRequest) {
   lcm::LogFile log(out, "r");
   int frames = 0;
   for (const lcm::LogEvent* ev = log.readNextEvent(); ev; ev = log.readNextEvent()) {
-    if (ev->channel != "CONTOURS") continue;
+    if (ev->channel != channel::CONTOURS) continue;
     nudge::contours_t msg;
     ASSERT_GE(msg.decode(ev->data, 0, ev->datalen), 0);
     ++frames;

@@ -15,10 +15,12 @@
 #include <regex>
 #include <string>
 
+#include "nudge/bus/channels.hpp"
 #include "nudge/bus/image.hpp"
 #include "nudge/symmetry/synthetic.hpp"
 
 namespace syn = nudge::symmetry::synthetic;
+namespace channel = nudge::bus::channel;
 
 namespace {
 
@@ -67,10 +69,10 @@ TEST(CameraService, StereoPairsShareUtimeAndFrameIds) {
   int64_t expected_id = 0;
   for (const auto& [utime, pair] : by_utime) {
     ASSERT_EQ(pair.size(), 2u) << "left and right share utime " << utime;
-    EXPECT_EQ(pair.at("CAMERA_LEFT").frame_id, expected_id);
-    EXPECT_EQ(pair.at("CAMERA_RIGHT").frame_id, expected_id);
-    EXPECT_EQ(nudge::bus::to_mat(pair.at("CAMERA_LEFT")).at<cv::Vec3b>(0, 0)[0], expected_id);
-    EXPECT_EQ(nudge::bus::to_mat(pair.at("CAMERA_RIGHT")).at<cv::Vec3b>(0, 0)[1], expected_id);
+    EXPECT_EQ(pair.at(channel::CAMERA_LEFT).frame_id, expected_id);
+    EXPECT_EQ(pair.at(channel::CAMERA_RIGHT).frame_id, expected_id);
+    EXPECT_EQ(nudge::bus::to_mat(pair.at(channel::CAMERA_LEFT)).at<cv::Vec3b>(0, 0)[0], expected_id);
+    EXPECT_EQ(nudge::bus::to_mat(pair.at(channel::CAMERA_RIGHT)).at<cv::Vec3b>(0, 0)[1], expected_id);
     ++expected_id;
   }
 }

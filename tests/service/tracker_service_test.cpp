@@ -12,6 +12,7 @@
 #include <map>
 #include <string>
 
+#include "nudge/bus/channels.hpp"
 #include "nudge/bus/image.hpp"
 #include "nudge/heartbeat_t.hpp"
 #include "nudge/symmetry/synthetic.hpp"
@@ -20,6 +21,7 @@
 #include "lcm_log.hpp"
 
 namespace syn = nudge::symmetry::synthetic;
+namespace channel = nudge::bus::channel;
 
 namespace {
 
@@ -61,19 +63,19 @@ void write_input_log(const std::string& path) {
   for (int i = 0; i < kFrames; ++i) {
     const int64_t utime = kStart + kPeriod * i;
     const auto image = nudge::bus::to_message(frame(i), nudge::image_t::FORMAT_GRAY8, utime, i, "left");
-    write_event(log, utime, "CAMERA_LEFT", encode(image));
+    write_event(log, utime, channel::CAMERA_LEFT, encode(image));
     if (i == 10) {  // a truncated image: reported, counted and skipped
       auto bytes = encode(image);
       bytes.resize(bytes.size() / 3);
-      write_event(log, utime + 1, "CAMERA_LEFT", bytes);
+      write_event(log, utime + 1, channel::CAMERA_LEFT, bytes);
     }
     if (i == kRestartAfter) {
       nudge::tracker_command_t cmd{};
       cmd.utime = utime + 2;
-      cmd.channel = "TRACK_LEFT";
+      cmd.channel = channel::TRACK_LEFT;
       cmd.command = nudge::tracker_command_t::COMMAND_RESTART;
       cmd.reason = "operator restart";
-      write_event(log, utime + 2, "TRACKER_COMMAND", encode(cmd));
+      write_event(log, utime + 2, channel::TRACKER_COMMAND, encode(cmd));
     }
   }
 }
@@ -98,14 +100,14 @@ TEST(TrackerService, LogInLogOutTracksTheMovingBottleAndRestartsOnRequest) {
   std::map<int64_t, nudge::track_t> tracks;
   nudge::heartbeat_t last_heartbeat{};
   for (const lcm::LogEvent* ev = log.readNextEvent(); ev; ev = log.readNextEvent()) {
-    if (ev->channel == "TRACK_LEFT") {
+    if (ev->channel == channel::TRACK_LEFT) {
       nudge::track_t msg;
       ASSERT_GE(msg.decode(ev->data, 0, ev->datalen), 0);
       tracks[msg.frame_id] = msg;
-    } else if (ev->channel == "HEARTBEAT") {
+    } else if (ev->channel == channel::HEARTBEAT) {
       ASSERT_GE(last_heartbeat.decode(ev->data, 0, ev->datalen), 0);
     }
-    EXPECT_NE(ev->channel, "TRACK_RIGHT") << "no right frames, no right tracks";
+    EXPECT_NE(ev->channel, channel::TRACK_RIGHT) << "no right frames, no right tracks";
   }
   ASSERT_EQ(tracks.size(), static_cast<size_t>(kFrames)) << "one TRACK_LEFT per good frame";
   EXPECT_EQ(last_heartbeat.errors, 1) << "the truncated image";
@@ -163,12 +165,12 @@ TEST(TrackerService, AStoppedStreamIsReportedInTheHeartbeat) {
     for (int i = 0; i < 5; ++i) {
       cv::Mat small;
       cv::resize(frame(i), small, cv::Size(160, 120));
-      write_event(log, kStart + kPeriod * i, "CAMERA_LEFT",
+      write_event(log, kStart + kPeriod * i, channel::CAMERA_LEFT,
                   encode(nudge::bus::to_message(small, nudge::image_t::FORMAT_GRAY8, kStart + kPeriod * i, i, "left")));
     }
     nudge::tracker_command_t cmd{};
     cmd.command = nudge::tracker_command_t::COMMAND_RESTART;
-    write_event(log, kStart + kPeriod * 5 + 2500000, "TRACKER_COMMAND", encode(cmd));
+    write_event(log, kStart + kPeriod * 5 + 2500000, channel::TRACKER_COMMAND, encode(cmd));
   }
   ASSERT_EQ(run(" --inputs CAMERA_LEFT --stale 0.5 --lcm-in 'file://" + in + "?speed=1' --lcm-out 'file://" + out +
                 "?mode=w'"),
@@ -177,7 +179,7 @@ TEST(TrackerService, AStoppedStreamIsReportedInTheHeartbeat) {
   ASSERT_TRUE(log.good());
   bool reported = false;
   for (const lcm::LogEvent* ev = log.readNextEvent(); ev; ev = log.readNextEvent()) {
-    if (ev->channel != "HEARTBEAT") continue;
+    if (ev->channel != channel::HEARTBEAT) continue;
     nudge::heartbeat_t hb;
     ASSERT_GE(hb.decode(ev->data, 0, ev->datalen), 0);
     reported = reported || hb.status.find("CAMERA_LEFT stopped") != std::string::npos;

@@ -20,6 +20,7 @@
 #include <string>
 
 #include "nudge/axes_t.hpp"
+#include "nudge/bus/channels.hpp"
 #include "nudge/bus/symmetry_convert.hpp"
 #include "nudge/candidates_request_t.hpp"
 #include "nudge/candidates_t.hpp"
@@ -32,6 +33,7 @@
 
 namespace geo = nudge::geometry;
 namespace sym = nudge::symmetry;
+namespace channel = nudge::bus::channel;
 
 namespace {
 
@@ -184,7 +186,7 @@ void write_input_log(const Scene& scene, const std::string& path) {
   request.utime = kStart - 1;
   request.frames = 20;
   request.lines_per_image = 3;
-  write_event(log, request.utime, "CANDIDATES_REQUEST", encode(request));
+  write_event(log, request.utime, channel::CANDIDATES_REQUEST, encode(request));
   for (int f = 0; f < kFrames; ++f) {
     const int64_t utime = kStart + f * kPeriod;
     std::vector<sym::Line> left, right(3);
@@ -201,14 +203,14 @@ void write_input_log(const Scene& scene, const std::string& path) {
     if (f == 12) right_msg.width = 320;
     const auto left_bytes = encode(lines_message(left, utime, "left")), right_bytes = encode(right_msg);
     if (f % 2) {  // either half may arrive first
-      write_event(log, utime, "SYMMETRY_LEFT", left_bytes);
-      write_event(log, utime + 10, "SYMMETRY_RIGHT", right_bytes);
+      write_event(log, utime, channel::SYMMETRY_LEFT, left_bytes);
+      write_event(log, utime + 10, channel::SYMMETRY_RIGHT, right_bytes);
     } else {
-      write_event(log, utime, "SYMMETRY_RIGHT", right_bytes);
-      write_event(log, utime + 10, "SYMMETRY_LEFT", left_bytes);
+      write_event(log, utime, channel::SYMMETRY_RIGHT, right_bytes);
+      write_event(log, utime + 10, channel::SYMMETRY_LEFT, left_bytes);
     }
   }
-  write_event(log, kStart + kFrames * kPeriod, "SYMMETRY_LEFT",
+  write_event(log, kStart + kFrames * kPeriod, channel::SYMMETRY_LEFT,
               encode(lines_message({scene.objects[0].left}, kStart + kFrames * kPeriod, "left")));
 }
 
@@ -224,15 +226,15 @@ Output read_output(const std::string& path) {
   lcm::LogFile log(path, "r");
   EXPECT_TRUE(log.good()) << path;
   for (const lcm::LogEvent* ev = log.readNextEvent(); ev; ev = log.readNextEvent()) {
-    if (ev->channel == "AXES") {
+    if (ev->channel == channel::AXES) {
       nudge::axes_t m;
       EXPECT_GE(m.decode(ev->data, 0, ev->datalen), 0);
       out.axes[m.utime] = m;
-    } else if (ev->channel == "CANDIDATES") {
+    } else if (ev->channel == channel::CANDIDATES) {
       nudge::candidates_t m;
       EXPECT_GE(m.decode(ev->data, 0, ev->datalen), 0);
       out.candidates.push_back(m);
-    } else if (ev->channel == "HEARTBEAT") {
+    } else if (ev->channel == channel::HEARTBEAT) {
       nudge::heartbeat_t hb;
       EXPECT_GE(hb.decode(ev->data, 0, ev->datalen), 0);
       out.errors = hb.errors;

@@ -24,7 +24,9 @@
 #include <vector>
 
 #include "nudge/arm_state_t.hpp"
+#include "nudge/bus/channels.hpp"
 #include "nudge/bus/image.hpp"
+#include "nudge/bus/pose_convert.hpp"
 #include "nudge/heartbeat_t.hpp"
 #include "nudge/image_t.hpp"
 #include "nudge/sim_state_t.hpp"
@@ -33,7 +35,10 @@
 #include "nudge/snapshot_request_t.hpp"
 #include "nudge/robot/kinematics.hpp"
 #include "nudge/symmetry/detector.hpp"
+#include "nudge/symmetry/line.hpp"
 #include "lcm_log.hpp"
+
+namespace channel = nudge::bus::channel;
 
 namespace {
 
@@ -97,7 +102,7 @@ std::string write_scene(const std::string& name, const std::string& objects) {
 int64_t last_heartbeat_errors(const std::vector<Event>& events) {
   int64_t errors = -1;
   for (const Event& e : events)
-    if (e.channel == "HEARTBEAT") errors = decode<nudge::heartbeat_t>(e).errors;
+    if (e.channel == channel::HEARTBEAT) errors = decode<nudge::heartbeat_t>(e).errors;
   return errors;
 }
 
@@ -121,20 +126,20 @@ TEST(WorldCamera, EveryStateBecomesAStereoPairWhoseBottleAxisTheDetectorFinds) {
   std::vector<Event> world_events = read_log(world_log), camera_input;
   for (const Event& e : world_events) {
     camera_input.push_back(e);
-    if (e.channel != "SIM_STATE") continue;
+    if (e.channel != channel::SIM_STATE) continue;
     const auto state = decode<nudge::sim_state_t>(e);
     states[state.utime] = state;
     if (states.size() == 10) {
       nudge::snapshot_request_t request;
       request.utime = e.timestamp;
       request.cameras = nudge::snapshot_request_t::CAMERAS_BOTH;
-      camera_input.push_back({e.timestamp + 1, "CAMERA_SNAPSHOT_REQUEST", encode(request)});
+      camera_input.push_back({e.timestamp + 1, channel::CAMERA_SNAPSHOT_REQUEST, encode(request)});
     }
     if (states.size() == 5) {  // a state of another scene: reported, counted, no frames
       nudge::sim_state_t other = state;
       other.utime = 999;
       other.objects[0].name = "teapot";
-      camera_input.push_back({e.timestamp + 2, "SIM_STATE", encode(other)});
+      camera_input.push_back({e.timestamp + 2, channel::SIM_STATE, encode(other)});
     }
   }
   ASSERT_EQ(states.size(), 26u) << "25 Hz over 1 s of simulated time, plus the state at t = 0";
@@ -148,10 +153,10 @@ TEST(WorldCamera, EveryStateBecomesAStereoPairWhoseBottleAxisTheDetectorFinds) {
   std::map<int64_t, cv::Mat> left, right;
   std::vector<nudge::image_t> snapshots;
   for (const Event& e : read_log(camera_log)) {
-    if (e.channel == "CAMERA_LEFT" || e.channel == "CAMERA_RIGHT") {
+    if (e.channel == channel::CAMERA_LEFT || e.channel == channel::CAMERA_RIGHT) {
       const auto img = decode<nudge::image_t>(e);
-      (e.channel == "CAMERA_LEFT" ? left : right)[img.utime] = nudge::bus::to_mat(img);
-    } else if (e.channel == "SNAPSHOT_LEFT" || e.channel == "SNAPSHOT_RIGHT") {
+      (e.channel == channel::CAMERA_LEFT ? left : right)[img.utime] = nudge::bus::to_mat(img);
+    } else if (e.channel == channel::SNAPSHOT_LEFT || e.channel == channel::SNAPSHOT_RIGHT) {
       snapshots.push_back(decode<nudge::image_t>(e));
     }
   }
@@ -192,15 +197,15 @@ TEST(WorldCamera, EveryStateBecomesAStereoPairWhoseBottleAxisTheDetectorFinds) {
       const double r = cam == 0 ? bottle->r_left : bottle->r_right;
       const double theta = cam == 0 ? bottle->theta_left : bottle->theta_right;
       const auto result = detector.detect(cam == 0 ? left.at(utime) : right.at(utime));
-      double best_r = 1e9, best_theta = 1e9;
+      // the detected line nearest the true one, by |dR| px + |dtheta| deg
+      nudge::symmetry::LineDifference best{1e9, 1e9};
+      auto size = [](const nudge::symmetry::LineDifference& d) { return std::abs(d.r) + std::abs(d.theta) / kDeg; };
       for (const auto& line : result.lines) {
-        if (std::abs(line.r - r) + std::abs(line.theta - theta) / kDeg < std::abs(best_r - r) + std::abs(best_theta - theta) / kDeg) {
-          best_r = line.r;
-          best_theta = line.theta;
-        }
+        const auto d = nudge::symmetry::line_difference(line.r, line.theta, r, theta);
+        if (size(d) < size(best)) best = d;
       }
-      EXPECT_NEAR(best_r, r, 2.0) << "camera " << cam << " utime " << utime;
-      EXPECT_NEAR(best_theta, theta, 1.0 * kDeg) << "camera " << cam << " utime " << utime;
+      EXPECT_NEAR(best.r, 0.0, 2.0) << "camera " << cam << " utime " << utime;
+      EXPECT_NEAR(best.theta, 0.0, 1.0 * kDeg) << "camera " << cam << " utime " << utime;
     }
   }
 }
@@ -217,12 +222,12 @@ TEST(WorldCamera, MotionBlurSmearsAnObjectThatMovedDuringTheFrame) {
   // Two states: the bottle, then the same bottle 6 cm to the side one frame later.
   std::vector<Event> input;
   for (const Event& e : read_log(world_log)) {
-    if (e.channel != "SIM_STATE" || !input.empty()) continue;
+    if (e.channel != channel::SIM_STATE || !input.empty()) continue;
     auto state = decode<nudge::sim_state_t>(e);
-    input.push_back({e.timestamp, "SIM_STATE", encode(state)});
+    input.push_back({e.timestamp, channel::SIM_STATE, encode(state)});
     state.utime += 40000;
     state.objects[0].pose.position[1] += 0.06;
-    input.push_back({e.timestamp + 40000, "SIM_STATE", encode(state)});
+    input.push_back({e.timestamp + 40000, channel::SIM_STATE, encode(state)});
   }
   ASSERT_EQ(input.size(), 2u);
   write_log(camera_in, input);
@@ -234,7 +239,7 @@ TEST(WorldCamera, MotionBlurSmearsAnObjectThatMovedDuringTheFrame) {
               0);
     std::vector<cv::Mat> frames;
     for (const Event& e : read_log(out))
-      if (e.channel == "CAMERA_LEFT") frames.push_back(nudge::bus::to_mat(decode<nudge::image_t>(e)));
+      if (e.channel == channel::CAMERA_LEFT) frames.push_back(nudge::bus::to_mat(decode<nudge::image_t>(e)));
     return frames;
   };
   const auto sharp = left_frames(""), blurred = left_frames("--motion-blur 6");
@@ -259,29 +264,23 @@ TEST(World, ArmStateDrivesThePusherTruthIsAnsweredAndTheRunIsDeterministic) {
   nudge::sim_truth_request_t request;
   request.utime = t0;
   request.without_masks = false;
-  input.push_back({t0, "SIM_TRUTH_REQUEST", encode(request)});
+  input.push_back({t0, channel::SIM_TRUTH_REQUEST, encode(request)});
   // The tool's x axis along +y: the pad sweeps 9 cm along +y, 2 cm above the table, from 10 cm
   // before the cup's axis to 1 cm before it (the cup's base radius is ~3 cm), at 4.5 cm/s.
   const Eigen::Quaterniond tool(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()));
   nudge::arm_state_t arm{};
   for (int k = 0; k <= 200; ++k) {
     arm.utime = t0 + 500000 + 10000 * k;
-    arm.end_effector.position[0] = 0.25;
-    arm.end_effector.position[1] = -0.10 + 0.09 * k / 200.0;
-    arm.end_effector.position[2] = 0.02;
-    arm.end_effector.orientation[0] = tool.w();
-    arm.end_effector.orientation[1] = tool.x();
-    arm.end_effector.orientation[2] = tool.y();
-    arm.end_effector.orientation[3] = tool.z();
+    arm.end_effector = nudge::bus::to_message(Eigen::Vector3d(0.25, -0.10 + 0.09 * k / 200.0, 0.02), tool);
     arm.joints[0] = 0.1 * k;
     arm.gripper = 0.03;
-    input.push_back({arm.utime, "ARM_STATE", encode(arm)});
+    input.push_back({arm.utime, channel::ARM_STATE, encode(arm)});
   }
   nudge::arm_state_t bad = arm;  // refused: not a pose
   bad.end_effector.position[2] = std::nan("");
-  input.push_back({t0 + 2600000, "ARM_STATE", encode(bad)});
+  input.push_back({t0 + 2600000, channel::ARM_STATE, encode(bad)});
   request.utime = t0 + 3000000;
-  input.push_back({t0 + 3000000, "SIM_TRUTH_REQUEST", encode(request)});
+  input.push_back({t0 + 3000000, channel::SIM_TRUTH_REQUEST, encode(request)});
   write_log(in, input);
 
   std::vector<std::vector<Event>> runs;
@@ -298,11 +297,11 @@ TEST(World, ArmStateDrivesThePusherTruthIsAnsweredAndTheRunIsDeterministic) {
   std::map<int64_t, nudge::sim_state_t> states;
   std::vector<nudge::sim_truth_t> truths;
   for (const Event& e : runs[0]) {
-    if (e.channel == "SIM_STATE") {
+    if (e.channel == channel::SIM_STATE) {
       const auto s = decode<nudge::sim_state_t>(e);
       states[s.utime] = s;
     }
-    if (e.channel == "SIM_TRUTH") truths.push_back(decode<nudge::sim_truth_t>(e));
+    if (e.channel == channel::SIM_TRUTH) truths.push_back(decode<nudge::sim_truth_t>(e));
   }
   ASSERT_EQ(states.size(), 3.6 * 25 + 1);
   // Parked (behind the backdrop) until the first ARM_STATE at t = 0.5 s.
@@ -312,8 +311,7 @@ TEST(World, ArmStateDrivesThePusherTruthIsAnsweredAndTheRunIsDeterministic) {
   const auto& later = states.at(1000000);
   EXPECT_NEAR(later.pusher.position[0], 0.25, 1e-9);
   EXPECT_NEAR(later.pusher.position[2], 0.02, 1e-9);
-  const Eigen::Quaterniond pad(later.pusher.orientation[0], later.pusher.orientation[1], later.pusher.orientation[2],
-                               later.pusher.orientation[3]);
+  const Eigen::Quaterniond pad = nudge::bus::orientation_of(later.pusher);
   EXPECT_NEAR(pad.angularDistance(tool), 0.0, 1e-9);
   EXPECT_DOUBLE_EQ(later.gripper, 0.03);
   // It stays at the last good pose: the NaN one is skipped.
@@ -343,9 +341,9 @@ TEST(World, ArmStateDrivesThePusherTruthIsAnsweredAndTheRunIsDeterministic) {
   // Deterministic: the same scene, seed and input give the same states and truth, bit for bit.
   std::vector<const Event*> a, b;
   for (const Event& e : runs[0])
-    if (e.channel != "HEARTBEAT") a.push_back(&e);
+    if (e.channel != channel::HEARTBEAT) a.push_back(&e);
   for (const Event& e : runs[1])
-    if (e.channel != "HEARTBEAT") b.push_back(&e);
+    if (e.channel != channel::HEARTBEAT) b.push_back(&e);
   ASSERT_EQ(a.size(), b.size());
   for (size_t i = 0; i < a.size(); ++i) {
     ASSERT_EQ(a[i]->channel, b[i]->channel) << i;
@@ -371,7 +369,7 @@ TEST(World, WithTheGripperToolArmStateGraspsAndLiftsABottle) {
     // 0-1 s: down from 0.25 to 0.06 m, open; 1-2 s: close; 2-3 s: up 5 cm.
     arm.end_effector.position[2] = t < 1 ? 0.25 - 0.19 * t : t < 2 ? 0.06 : 0.06 + 0.05 * (t - 2);
     arm.gripper = t < 1 ? 0.10 : t < 2 ? 0.10 * (2 - t) : 0.0;
-    input.push_back({arm.utime, "ARM_STATE", encode(arm)});
+    input.push_back({arm.utime, channel::ARM_STATE, encode(arm)});
   }
   write_log(in, input);
   std::vector<std::vector<uint8_t>> outputs[2];  // SIM_STATE messages of two runs
@@ -382,12 +380,12 @@ TEST(World, WithTheGripperToolArmStateGraspsAndLiftsABottle) {
                   "?speed=0' --lcm-out 'file://" + out + "?mode=w'"),
               0);
     for (const Event& e : read_log(out))
-      if (e.channel == "SIM_STATE") outputs[r].push_back(e.data);
+      if (e.channel == channel::SIM_STATE) outputs[r].push_back(e.data);
   }
   EXPECT_EQ(outputs[0], outputs[1]) << "deterministic";
   std::map<int64_t, nudge::sim_state_t> states;
   for (const auto& data : outputs[0]) {
-    const auto s = decode<nudge::sim_state_t>(Event{0, "SIM_STATE", data});
+    const auto s = decode<nudge::sim_state_t>(Event{0, channel::SIM_STATE, data});
     states[s.utime] = s;
   }
   ASSERT_EQ(states.size(), 4 * 25 + 1);
@@ -429,12 +427,12 @@ TEST(World, InputStampedInSimulatedTimeActsAtThatTimeAndOtherClocksAreRefused) {
   std::vector<Event> input;
   for (int k = 0; k < 10; ++k) {
     arm.utime = 500000 + 10000 * k;
-    input.push_back({1700000000000000 + k, "ARM_STATE", encode(arm)});
+    input.push_back({1700000000000000 + k, channel::ARM_STATE, encode(arm)});
   }
   nudge::sim_truth_request_t wall_clock;  // a wall-clock stamp among simulated ones: refused
   wall_clock.utime = 1700000000000000;
   wall_clock.without_masks = true;
-  input.push_back({1700000000000100, "SIM_TRUTH_REQUEST", encode(wall_clock)});
+  input.push_back({1700000000000100, channel::SIM_TRUTH_REQUEST, encode(wall_clock)});
   write_log(in, input);
   ASSERT_EQ(run(kBin + "/nudge-world --scene " + scene + " --duration 1 --lcm-in 'file://" + in +
                 "?speed=0' --lcm-out 'file://" + out + "?mode=w' 2>/dev/null"),
@@ -442,8 +440,8 @@ TEST(World, InputStampedInSimulatedTimeActsAtThatTimeAndOtherClocksAreRefused) {
   const auto events = read_log(out);
   std::map<int64_t, nudge::sim_state_t> states;
   for (const Event& e : events) {
-    EXPECT_NE(e.channel, "SIM_TRUTH") << "the wall-clock request is not answered";
-    if (e.channel == "SIM_STATE") {
+    EXPECT_NE(e.channel, channel::SIM_TRUTH) << "the wall-clock request is not answered";
+    if (e.channel == channel::SIM_STATE) {
       const auto s = decode<nudge::sim_state_t>(e);
       states[s.utime] = s;
     }
@@ -468,7 +466,7 @@ TEST(World, ArmJointsDriveTheSimulatedPumaWhichTheCameraDraws) {
   arm.end_effector.position[0] = -1.0;  // the tool pad parked far away: only the joints matter here
   arm.end_effector.orientation[0] = 1;
   for (int j = 0; j < 6; ++j) arm.joints[j] = target[j];
-  write_log(in, {{arm.utime, "ARM_STATE", encode(arm)}});
+  write_log(in, {{arm.utime, channel::ARM_STATE, encode(arm)}});
   const std::string out = dir + "/world_arm_out.lcmlog";
   std::remove(out.c_str());
   ASSERT_EQ(run(kBin + "/nudge-world --scene " + scene + " --duration 2.5 --rate 10 --lcm-in 'file://" + in +
@@ -476,7 +474,7 @@ TEST(World, ArmJointsDriveTheSimulatedPumaWhichTheCameraDraws) {
             0);
   std::vector<nudge::sim_state_t> states;
   for (const Event& e : read_log(out))
-    if (e.channel == "SIM_STATE") states.push_back(decode<nudge::sim_state_t>(e));
+    if (e.channel == channel::SIM_STATE) states.push_back(decode<nudge::sim_state_t>(e));
   ASSERT_GE(states.size(), 20u);
   EXPECT_NEAR(states.front().joints[1], 90 * kDeg, 1e-6) << "straight up before the command";
   for (int j = 0; j < 6; ++j) EXPECT_NEAR(states.back().joints[j], target[j], 0.1 * kDeg) << "joint " << j + 1;
@@ -506,7 +504,7 @@ TEST(World, ArmJointsDriveTheSimulatedPumaWhichTheCameraDraws) {
               0);
     cv::Mat last;
     for (const Event& e : read_log(frames))
-      if (e.channel == "CAMERA_RIGHT") last = nudge::bus::to_mat(decode<nudge::image_t>(e));
+      if (e.channel == channel::CAMERA_RIGHT) last = nudge::bus::to_mat(decode<nudge::image_t>(e));
     return last;
   };
   const cv::Mat with = render_last(scene, "arm"), without = render_last(armless, "no_arm");

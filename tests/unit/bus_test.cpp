@@ -2,7 +2,12 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "nudge/bus/channels.hpp"
+#include "nudge/bus/decode.hpp"
 #include "nudge/bus/image.hpp"
+#include "nudge/bus/pose_convert.hpp"
+#include "nudge/bus/subscribe.hpp"
+#include "nudge/heartbeat_t.hpp"
 
 using namespace nudge;
 
@@ -80,3 +85,181 @@ TEST(Image, MalformedImagesAreClearErrorsNamingTheImage) {
   EXPECT_THROW(bus::format_from_name("tiff"), bus::ImageError);
 }
 
+
+// ---- malformed bytes on the bus (issue 12) ---------------------------------------------------
+
+namespace {
+
+using Bytes = std::vector<uint8_t>;
+
+template <typename Msg>
+Bytes encode(const Msg& msg) {
+  Bytes bytes(msg.getEncodedSize());
+  msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  return bytes;
+}
+
+void put_int32(Bytes* bytes, size_t offset, int32_t value) {
+  for (int i = 0; i < 4; ++i) (*bytes)[offset + i] = static_cast<uint8_t>(static_cast<uint32_t>(value) >> (24 - 8 * i));
+}
+
+// A small grey image_t from camera "left" (string length 5 with its NUL) and the offsets of the
+// lengths it declares: fingerprint 8, utime 8, frame_id 8, then the camera's length.
+constexpr size_t kCameraLengthOffset = 24;
+constexpr size_t kSizeOffset = kCameraLengthOffset + 4 + 5 + 4 + 4 + 4 + 1;
+
+Bytes small_image_bytes() {
+  const image_t msg = bus::to_message(cv::Mat(4, 6, CV_8UC1, cv::Scalar(9)), image_t::FORMAT_GRAY8, 1, 2, "left");
+  return encode(msg);
+}
+
+Bytes image_bytes_with(size_t offset, int32_t value) {
+  Bytes bytes = small_image_bytes();
+  put_int32(&bytes, offset, value);
+  return bytes;
+}
+
+}  // namespace
+
+TEST(Decode, WellFormedImageDecodes) {
+  const Bytes bytes = small_image_bytes();
+  image_t msg;
+  EXPECT_EQ(bus::decode_message(bytes.data(), static_cast<int>(bytes.size()), &msg), "");
+  EXPECT_EQ(msg.camera, "left");
+  EXPECT_EQ(msg.size, 24);
+}
+
+TEST(Decode, ImageLengthsBeyondTheBytesAreRefusedBeforeDecoding) {
+  for (int32_t size : {-1, 25, 2000000000}) {
+    const Bytes bytes = image_bytes_with(kSizeOffset, size);
+    const std::string problem = bus::check_encoded_image(bytes.data(), static_cast<int>(bytes.size()));
+    EXPECT_NE(problem.find("size declares " + std::to_string(size)), std::string::npos) << problem;
+    image_t msg;
+    EXPECT_EQ(bus::decode_message(bytes.data(), static_cast<int>(bytes.size()), &msg), problem);
+    EXPECT_TRUE(msg.data.empty()) << "nothing allocated for size " << size;
+  }
+  for (int32_t camera_length : {0, -7, 1000}) {
+    const Bytes bytes = image_bytes_with(kCameraLengthOffset, camera_length);
+    const std::string problem = bus::check_encoded_image(bytes.data(), static_cast<int>(bytes.size()));
+    EXPECT_NE(problem.find("camera declares " + std::to_string(camera_length)), std::string::npos) << problem;
+  }
+  Bytes truncated = small_image_bytes();
+  truncated.resize(kSizeOffset + 2);
+  EXPECT_NE(bus::check_encoded_image(truncated.data(), static_cast<int>(truncated.size())).find("too short"),
+            std::string::npos);
+}
+
+TEST(Decode, ExceptionsInsideDecodeBecomeErrors) {
+  // A heartbeat whose first string declares length 0: LCM 1.3.1's decode() throws (it assigns
+  // length - 1 characters); no pre-decode check covers heartbeat_t, so the catch must.
+  heartbeat_t hb{};
+  hb.service = "symmetry";
+  Bytes bytes = encode(hb);
+  put_int32(&bytes, 8 + 8, 0);  // fingerprint, utime, then the service string's length
+  heartbeat_t msg;
+  const std::string problem = bus::decode_message(bytes.data(), static_cast<int>(bytes.size()), &msg);
+  EXPECT_NE(problem.find("do not decode as heartbeat_t"), std::string::npos) << problem;
+}
+
+TEST(Subscriptions, MalformedMessagesAreCountedAndSkippedNamingTheChannel) {
+  lcm::LCM lcm("memq://");
+  ASSERT_TRUE(lcm.good());
+  bus::Counters counters;
+  bus::Subscriptions subscriptions(lcm, counters);
+  int images = 0, heartbeats = 0;
+  subscriptions.subscribe<image_t>("CAMERA_TEST", [&](const image_t&, const std::string&) { ++images; });
+  subscriptions.subscribe<heartbeat_t>("HEARTBEAT_TEST", [&](const heartbeat_t&, const std::string&) { ++heartbeats; });
+
+  Bytes bad_heartbeat = encode(heartbeat_t{});
+  put_int32(&bad_heartbeat, 16, -1);
+  const std::vector<std::pair<std::string, Bytes>> sent = {
+      {"CAMERA_TEST", small_image_bytes()},
+      {"CAMERA_TEST", image_bytes_with(kCameraLengthOffset, 0)},
+      {"CAMERA_TEST", image_bytes_with(kSizeOffset, -1)},
+      {"CAMERA_TEST", image_bytes_with(kSizeOffset, 2000000000)},
+      {"CAMERA_TEST", Bytes{1, 2, 3}},
+      {"HEARTBEAT_TEST", bad_heartbeat},
+      {"CAMERA_TEST", small_image_bytes()},
+  };
+  testing::internal::CaptureStderr();
+  for (const auto& [channel, bytes] : sent) {
+    lcm.publish(channel, bytes.data(), static_cast<unsigned int>(bytes.size()));
+    ASSERT_GT(lcm.handleTimeout(1000), 0) << "memq delivers at once";
+  }
+  const std::string log = testing::internal::GetCapturedStderr();
+
+  EXPECT_EQ(images, 2);
+  EXPECT_EQ(heartbeats, 0);
+  EXPECT_EQ(counters.messages_in, 7);
+  EXPECT_EQ(counters.errors, 5);
+  EXPECT_NE(log.find("skipped a malformed message on CAMERA_TEST: image_t of"), std::string::npos) << log;
+  EXPECT_NE(log.find("skipped a malformed message on HEARTBEAT_TEST"), std::string::npos) << log;
+}
+
+// ---- channel names ----------------------------------------------------------------------------
+
+TEST(Channels, CameraChannelsNameTheirResults) {
+  namespace channel = bus::channel;
+  EXPECT_EQ(channel::derived(channel::CAMERA_LEFT, channel::SYMMETRY), channel::SYMMETRY_LEFT);
+  EXPECT_EQ(channel::derived(channel::CAMERA_RIGHT, channel::SYMMETRY), channel::SYMMETRY_RIGHT);
+  EXPECT_EQ(channel::derived(channel::CAMERA_LEFT, channel::CONTOURS), channel::CONTOURS_LEFT);
+  EXPECT_EQ(channel::derived(channel::CAMERA_RIGHT, channel::TRACK), channel::TRACK_RIGHT);
+  EXPECT_EQ(channel::derived(channel::CAMERA, channel::SYMMETRY), channel::SYMMETRY);
+  EXPECT_EQ(channel::derived("LEFT_EYE", channel::TRACK), "TRACK_LEFT_EYE");
+}
+
+TEST(Channels, ResultsNameTheirCamera) {
+  namespace channel = bus::channel;
+  EXPECT_EQ(channel::camera_of(channel::SYMMETRY_LEFT, channel::SYMMETRY), channel::CAMERA_LEFT);
+  EXPECT_EQ(channel::camera_of(channel::SYMMETRY, channel::SYMMETRY), channel::CAMERA);
+  EXPECT_EQ(channel::camera_of(channel::TRACK_RIGHT, channel::TRACK), channel::CAMERA_RIGHT);
+  for (const char* camera : {channel::CAMERA_LEFT, channel::CAMERA_RIGHT, channel::CAMERA})
+    EXPECT_EQ(channel::camera_of(channel::derived(camera, channel::CONTOURS), channel::CONTOURS), camera);
+  try {
+    channel::camera_of("AXES", channel::SYMMETRY);
+    ADD_FAILURE() << "AXES is not a symmetry channel";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("AXES"), std::string::npos) << e.what();
+  }
+}
+
+// ---- pose_t <-> Eigen ------------------------------------------------------------------------
+
+TEST(PoseConvert, IsometryRoundTrips) {
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = (Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(-1.2, Eigen::Vector3d::UnitX()))
+                      .toRotationMatrix();
+  pose.translation() = Eigen::Vector3d(0.25, -0.1, 0.42);
+  const pose_t msg = bus::to_message(pose);
+  EXPECT_DOUBLE_EQ(msg.position[2], 0.42);
+  Eigen::Isometry3d back;
+  ASSERT_TRUE(bus::from_message(msg, &back));
+  EXPECT_LT((back.matrix() - pose.matrix()).norm(), 1e-12);
+  EXPECT_FALSE(bus::is_unset(msg));
+}
+
+TEST(PoseConvert, PositionAndQuaternionRoundTripAsSent) {
+  const Eigen::Quaterniond q(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()));
+  const pose_t msg = bus::to_message(Eigen::Vector3d(1, 2, 3), q);
+  EXPECT_DOUBLE_EQ(msg.orientation[0], q.w());  // (w, x, y, z)
+  EXPECT_DOUBLE_EQ(msg.orientation[3], q.z());
+  EXPECT_EQ(bus::position_of(msg), Eigen::Vector3d(1, 2, 3));
+  EXPECT_EQ(bus::orientation_of(msg).coeffs(), q.coeffs());
+}
+
+TEST(PoseConvert, BadPosesAreRefused) {
+  Eigen::Isometry3d pose;
+  pose_t unset{};
+  EXPECT_TRUE(bus::is_unset(unset));
+  EXPECT_FALSE(bus::from_message(unset, &pose)) << "a zero quaternion is no rotation";
+  pose_t not_unit = bus::to_message(Eigen::Isometry3d::Identity());
+  not_unit.orientation[0] = 2;
+  EXPECT_FALSE(bus::from_message(not_unit, &pose));
+  pose_t nan = bus::to_message(Eigen::Isometry3d::Identity());
+  nan.position[1] = std::nan("");
+  EXPECT_FALSE(bus::from_message(nan, &pose));
+  pose_t nearly_unit = bus::to_message(Eigen::Isometry3d::Identity());
+  nearly_unit.orientation[0] = 1.0005;  // within 1e-3: normalised
+  ASSERT_TRUE(bus::from_message(nearly_unit, &pose));
+  EXPECT_LT((pose.linear() - Eigen::Matrix3d::Identity()).norm(), 1e-12);
+}

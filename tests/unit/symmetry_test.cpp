@@ -8,6 +8,7 @@
 #include "nudge/symmetry/corner_cutting.hpp"
 #include "nudge/symmetry/detector.hpp"
 #include "nudge/symmetry/gst.hpp"
+#include "nudge/symmetry/line.hpp"
 #include "nudge/symmetry/loy_eklundh.hpp"
 #include "nudge/symmetry/photo.hpp"
 #include "nudge/symmetry/synthetic.hpp"
@@ -19,19 +20,11 @@ namespace {
 
 constexpr double kDeg = M_PI / 180.0;
 
-// Difference of two lines' angles, folded into [0, 90] degrees.
-double angle_diff_deg(double a, double b) {
-  double d = std::fabs(a - b) / kDeg;
-  d = std::fmod(d, 180.0);
-  return std::min(d, 180.0 - d);
-}
+// |theta difference| of two lines, degrees in [0, 90] (line.hpp: across the +-90 deg wrap).
+double angle_diff_deg(double a, double b) { return std::fabs(line_difference(0.0, a, 0.0, b).theta) / kDeg; }
 
-// Distance in R between two lines, allowing for (R, theta) == (-R, theta +- 180).
-double r_diff(const Line& l, double r, double theta) {
-  const double direct = std::fabs(l.r - r);
-  const double flipped = std::fabs(l.r + r);
-  return std::fabs(l.theta - theta) > M_PI / 2 ? flipped : direct;
-}
+// |R difference| of a line from (r, theta), allowing for (R, theta) == (-R, theta +- 180).
+double r_diff(const Line& l, double r, double theta) { return std::fabs(line_difference(l.r, l.theta, r, theta).r); }
 
 cv::Mat blank(int w = 320, int h = 240, int grey = 220) { return cv::Mat(h, w, CV_8UC1, cv::Scalar(grey)); }
 
@@ -557,4 +550,50 @@ TEST(SymmetryEdges, ColourEdgesSeeOutlinesOfEqualBrightness) {
   EXPECT_EQ(detect_edges(img, e).points.size(), 0u);
   e.colour = true;
   EXPECT_GT(detect_edges(img, e).points.size(), 200u);
+}
+
+// ---- line.hpp: the difference of two lines --------------------------------------------------
+
+TEST(LineDifference, SameFormIsPlainSubtraction) {
+  const LineDifference d = line_difference(12.0, 10 * kDeg, 10.0, 4 * kDeg);
+  EXPECT_NEAR(d.r, 2.0, 1e-12);
+  EXPECT_NEAR(d.theta, 6 * kDeg, 1e-12);
+}
+
+TEST(LineDifference, WrapsAcrossNinetyDegreesWithRNegated) {
+  // (R 30, 89 deg) and (R -30, -89 deg) are 2 degrees apart: -89 deg is the line (30, 91 deg).
+  const LineDifference d = line_difference(-30.0, -89 * kDeg, 30.0, 89 * kDeg);
+  EXPECT_NEAR(d.r, 0.0, 1e-9);
+  EXPECT_NEAR(d.theta, 2 * kDeg, 1e-12);
+  const LineDifference back = line_difference(30.0, 89 * kDeg, -30.0, -89 * kDeg);
+  EXPECT_NEAR(back.r, 0.0, 1e-9);
+  EXPECT_NEAR(back.theta, -2 * kDeg, 1e-12);
+  // Not negating R would call them 60 px apart.
+  EXPECT_NEAR(line_difference(-25.0, -89 * kDeg, 30.0, 89 * kDeg).r, -5.0, 1e-9);
+}
+
+TEST(LineDifference, ThetaStaysWithinAQuarterTurnEitherWay) {
+  for (double a = -179.0; a <= 179.0; a += 7.0) {
+    for (double b = -89.0; b <= 90.0; b += 11.0) {
+      const LineDifference d = line_difference(5.0, a * kDeg, 5.0, b * kDeg);
+      EXPECT_GT(d.theta, -M_PI / 2) << a << " " << b;
+      EXPECT_LE(d.theta, M_PI / 2 + 1e-12) << a << " " << b;
+      // a differs from b by a whole number of half-turns plus d.theta; R flips with odd ones.
+      const double half_turns = (a * kDeg - b * kDeg - d.theta) / M_PI;
+      EXPECT_NEAR(half_turns, std::round(half_turns), 1e-9);
+      const bool odd = std::lround(half_turns) % 2 != 0;
+      EXPECT_NEAR(d.r, odd ? -10.0 : 0.0, 1e-9) << a << " " << b;
+    }
+  }
+}
+
+TEST(LineDifference, OfLinesMatchesTheirParameters) {
+  Line a, b;
+  a.r = -40;
+  a.theta = 88 * kDeg;
+  b.r = 41;
+  b.theta = -87 * kDeg;
+  const LineDifference d = line_difference(a, b);
+  EXPECT_NEAR(d.r, 40 - 41, 1e-9);  // a taken as (40, -92 deg), 5 deg from b
+  EXPECT_NEAR(d.theta, -5 * kDeg, 1e-12);
 }

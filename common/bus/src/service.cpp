@@ -6,6 +6,7 @@
 #include <csignal>
 #include <iostream>
 
+#include "nudge/bus/channels.hpp"
 #include "nudge/heartbeat_t.hpp"
 #include "nudge/log.hpp"
 #include "nudge/timing.hpp"
@@ -71,7 +72,7 @@ void Service::publish_heartbeat(int8_t state) {
   hb.messages_out = counters_.messages_out;
   hb.errors = counters_.errors;
   hb.status = status_;
-  output().publish(kHeartbeatChannel, &hb);
+  output().publish(channel::HEARTBEAT, &hb);
 }
 
 int Service::run(const std::function<int()>& tick, int wait_ms) {

@@ -2,16 +2,9 @@
 
 #include <stdexcept>
 
+#include "nudge/bus/pose_convert.hpp"
+
 namespace nudge::bus {
-
-namespace {
-
-Eigen::Vector3d position_of(const pose_t& pose) { return {pose.position[0], pose.position[1], pose.position[2]}; }
-Eigen::Quaterniond orientation_of(const pose_t& pose) {
-  return {pose.orientation[0], pose.orientation[1], pose.orientation[2], pose.orientation[3]};
-}
-
-}  // namespace
 
 sim::PoseSnapshot poses_of(const sim_state_t& state) {
   if (state.num_objects != static_cast<int32_t>(state.objects.size()))

@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "nudge/symmetry/detector.hpp"
+#include "nudge/symmetry/line.hpp"
 
 namespace nudge::segmentation::detail {
 

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "nudge/symmetry/line.hpp"
+
 namespace nudge::supervisor {
 
 std::optional<symmetry::Line> find_line_near(const cv::Mat& image, const symmetry::Line& predicted,
@@ -27,10 +29,8 @@ std::optional<symmetry::Line> find_line_near(const cv::Mat& image, const symmetr
   std::optional<symmetry::Line> best;
   double best_offset = params.window_px;
   for (const symmetry::Line& line : result.lines) {
-    // Compare in the form nearer the prediction: (R, theta) equals (-R, theta +- 180 deg).
-    const double same = std::abs(line.r - predicted.r), flipped = std::abs(line.r + predicted.r);
-    const bool wrapped = std::abs(line.theta - predicted.theta) > M_PI / 2;
-    const double offset = wrapped ? flipped : same;
+    // In the form nearer the prediction: (R, theta) equals (-R, theta +- 180 deg).
+    const double offset = std::abs(symmetry::line_difference(line, predicted).r);
     if (offset <= best_offset) {
       best_offset = offset;
       best = line;

@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "nudge/geometry/workspace.hpp"
+#include "nudge/symmetry/line.hpp"
 
 namespace nudge::supervisor {
 
@@ -70,13 +71,9 @@ std::optional<symmetry::Line> SceneGeometry::left_axis_line(const Eigen::Vector3
 }
 
 bool lines_agree(const symmetry::Line& detected, const symmetry::Line& predicted, double max_angle, double max_offset) {
-  double angle = std::abs(detected.theta - predicted.theta);
-  double offset = std::abs(detected.r - predicted.r);
-  if (angle > M_PI / 2) {  // (R, theta) is (-R, theta -+ pi)
-    angle = M_PI - angle;
-    offset = std::abs(detected.r + predicted.r);
-  }
-  return angle <= max_angle && offset <= max_offset;
+  // wrapped: (R, theta) is (-R, theta -+ pi)
+  const symmetry::LineDifference d = symmetry::line_difference(detected, predicted);
+  return std::abs(d.theta) <= max_angle && std::abs(d.r) <= max_offset;
 }
 
 std::optional<symmetry::Line> SceneGeometry::right_axis_line(const Eigen::Vector3d& foot, double height,

@@ -187,29 +187,6 @@ EdgeSet detect_edges(const cv::Mat& image, const EdgeParams& params, cv::Mat* ed
   return set;
 }
 
-void border_endpoints(double r, double theta, int width, int height, cv::Point2d* p1, cv::Point2d* p2) {
-  const double cx = 0.5 * (width - 1), cy = 0.5 * (height - 1);
-  const cv::Point2d pivot(r * std::cos(theta) + cx, r * std::sin(theta) + cy);
-  const cv::Point2d dir(-std::sin(theta), std::cos(theta));
-  // Liang-Barsky clip of the infinite line against [0, w-1] x [0, h-1].
-  double t0 = -1e12, t1 = 1e12;
-  auto clip = [&](double p, double q) {  // p t <= q
-    if (std::fabs(p) < 1e-12) return q >= 0;
-    const double t = q / p;
-    if (p < 0) t0 = std::max(t0, t);
-    else t1 = std::min(t1, t);
-    return true;
-  };
-  const bool ok = clip(-dir.x, pivot.x) && clip(dir.x, (width - 1) - pivot.x) && clip(-dir.y, pivot.y) &&
-                  clip(dir.y, (height - 1) - pivot.y) && t0 <= t1;
-  if (!ok) {  // the line misses the image: report the pivot twice
-    *p1 = *p2 = pivot;
-    return;
-  }
-  *p1 = pivot + t0 * dir;
-  *p2 = pivot + t1 * dir;
-}
-
 Line map_line(const Line& line, cv::Size from, cv::Size to) {
   const double sx = static_cast<double>(to.width) / from.width, sy = static_cast<double>(to.height) / from.height;
   auto map_point = [&](cv::Point2d p) { return cv::Point2d((p.x + 0.5) * sx - 0.5, (p.y + 0.5) * sy - 0.5); };

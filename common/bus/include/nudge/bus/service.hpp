@@ -1,6 +1,6 @@
 #pragma once
 // The shell every service runs in: flags (--lcm-url, --lcm-in, --lcm-out, --instance, --verbose),
-// LCM set-up, a heartbeat on HEARTBEAT once a second, and a loop that ends cleanly on SIGINT or
+// LCM set-up, a heartbeat on channel::HEARTBEAT once a second, and a loop that ends cleanly on SIGINT or
 // SIGTERM, or when an input log (file:// provider) is exhausted.
 #include <lcm/lcm-cpp.hpp>
 
@@ -13,7 +13,6 @@
 
 namespace nudge::bus {
 
-constexpr const char* kHeartbeatChannel = "HEARTBEAT";
 // ttl=0 keeps default traffic on this host; override with --lcm-url for a real network.
 constexpr const char* kDefaultLcmUrl = "udpm://239.255.76.67:7667?ttl=0";
 

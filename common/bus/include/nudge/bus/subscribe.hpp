@@ -1,7 +1,8 @@
 #pragma once
 // Typed LCM subscriptions for Debian's LCM 1.3.1, which has no lambda subscribe.
-// A message that fails to decode (wrong size, truncated) or whose handler throws is reported
-// naming the channel, counted, and skipped; the service keeps running.
+// A message that fails to decode (wrong size, truncated, lengths that decode() throws on or that
+// exceed the bytes sent: decode.hpp) or whose handler throws is reported naming the channel,
+// counted, and skipped; the service keeps running.
 #include <lcm/lcm-cpp.hpp>
 
 #include <atomic>
@@ -10,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "nudge/bus/decode.hpp"
 #include "nudge/log.hpp"
 
 namespace nudge::bus {
@@ -49,10 +51,10 @@ class Subscriptions {
     void on_raw(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
       ++counters.messages_in;
       Msg msg;
-      if (msg.decode(rbuf->data, 0, rbuf->data_size) < 0) {
+      const std::string problem = decode_message(rbuf->data, static_cast<int>(rbuf->data_size), &msg);
+      if (!problem.empty()) {
         ++counters.errors;
-        log::error() << "skipped a malformed message on " << channel << ": " << rbuf->data_size
-                     << " bytes do not decode as " << Msg::getTypeName();
+        log::error() << "skipped a malformed message on " << channel << ": " << problem;
         return;
       }
       try {

@@ -8,7 +8,7 @@
 
 #include "nudge/geometry/outcome.hpp"
 #include "nudge/geometry/stereo_rig.hpp"
-#include "nudge/symmetry/detector.hpp"
+#include "nudge/symmetry/line.hpp"
 
 namespace nudge::geometry {
 

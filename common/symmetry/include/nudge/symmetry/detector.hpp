@@ -1,14 +1,15 @@
 #pragma once
 // Fast bilateral symmetry detection (Li 2008, ch. 3, Algorithm 1).
 //
-// Conventions (SPEC.md): a line is (R, theta) about the image centre ((w-1)/2, (h-1)/2);
-// (cos theta, sin theta) is its normal, so theta = 0 is a vertical line; theta in (-90, 90] deg.
+// Lines follow the conventions of line.hpp: (R, theta) about the image centre, theta in (-90, 90] deg.
 // The Hough accumulator has 180 theta bins of 1 degree (bin k <-> theta = k - 89 deg) and 1 px R bins.
 #include <opencv2/core.hpp>
 
 #include <cstdint>
 #include <string>
 #include <vector>
+
+#include "nudge/symmetry/line.hpp"
 
 namespace nudge::symmetry {
 
@@ -67,16 +68,6 @@ struct EdgeSet {
 // An angle (radians) as EdgeSet::orientation units, modulo 180 deg.
 int16_t orientation_units(double radians);
 
-struct Line {
-  double r = 0;          // px
-  double theta = 0;      // radians
-  double votes = 0;      // accumulator value at the (discrete) peak
-  double skew = 0;       // radians; 0 for bilateral symmetry
-  cv::Point2d end1, end2;// where the line meets the image border
-  cv::Point2d seg1, seg2;// extent along the line covered by the voting edge pairs
-  int r_bin = 0, theta_bin = 0, skew_index = 0;  // the discrete peak
-};
-
 struct Timing {
   double edges_ms = 0, vote_ms = 0, peaks_ms = 0;
   double total_ms() const { return edges_ms + vote_ms + peaks_ms; }
@@ -115,9 +106,6 @@ EdgeSet edges_from_mask(const cv::Mat& mask);  // non-zero pixels of an 8-bit ma
 // map as x_to = (x_from + 0.5) * to.width / from.width - 0.5, and likewise in y. Meant for
 // isotropic resizing; border endpoints and the support segment are mapped too.
 Line map_line(const Line& line, cv::Size from, cv::Size to);
-
-// Where the line meets the border of a w x h image.
-void border_endpoints(double r, double theta, int width, int height, cv::Point2d* p1, cv::Point2d* p2);
 
 class Detector {
  public:

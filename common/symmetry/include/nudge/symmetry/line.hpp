@@ -1,0 +1,37 @@
+#pragma once
+// A symmetry line in an image, and how far apart two lines are.
+//
+// Conventions (SPEC.md): a line is (R, theta) about the image centre ((w-1)/2, (h-1)/2);
+// (cos theta, sin theta) is its normal, so theta = 0 is a vertical line; theta in (-90, 90] deg.
+// (R, theta) and (-R, theta + 180 deg) are the same line, which is why differences must wrap.
+#include <opencv2/core/types.hpp>
+
+namespace nudge::symmetry {
+
+struct Line {
+  double r = 0;          // px
+  double theta = 0;      // radians
+  double votes = 0;      // accumulator value at the (discrete) peak
+  double skew = 0;       // radians; 0 for bilateral symmetry
+  cv::Point2d end1, end2;// where the line meets the image border
+  cv::Point2d seg1, seg2;// extent along the line covered by the voting edge pairs
+  int r_bin = 0, theta_bin = 0, skew_index = 0;  // the discrete peak
+};
+
+// Where the line meets the border of a w x h image (the point of the line nearest the image,
+// twice, when it misses the image).
+void border_endpoints(double r, double theta, int width, int height, cv::Point2d* p1, cv::Point2d* p2);
+
+// line - reference, in (R px, theta rad), with the line taken in whichever of its forms
+// (R + 0, theta + k 180 deg, R negated for odd k) is nearest the reference in theta: theta in
+// (-90, 90] deg, so lines either side of the +-90 deg wrap come out a few degrees apart.
+struct LineDifference {
+  double r = 0;      // px
+  double theta = 0;  // radians, (-pi/2, pi/2]
+};
+LineDifference line_difference(double r, double theta, double reference_r, double reference_theta);
+inline LineDifference line_difference(const Line& line, const Line& reference) {
+  return line_difference(line.r, line.theta, reference.r, reference.theta);
+}
+
+}  // namespace nudge::symmetry

@@ -1,0 +1,41 @@
+#include "nudge/symmetry/line.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace nudge::symmetry {
+
+void border_endpoints(double r, double theta, int width, int height, cv::Point2d* p1, cv::Point2d* p2) {
+  const double cx = 0.5 * (width - 1), cy = 0.5 * (height - 1);
+  const cv::Point2d pivot(r * std::cos(theta) + cx, r * std::sin(theta) + cy);
+  const cv::Point2d dir(-std::sin(theta), std::cos(theta));
+  // Liang-Barsky clip of the infinite line against [0, w-1] x [0, h-1].
+  double t0 = -1e12, t1 = 1e12;
+  auto clip = [&](double p, double q) {  // p t <= q
+    if (std::fabs(p) < 1e-12) return q >= 0;
+    const double t = q / p;
+    if (p < 0) t0 = std::max(t0, t);
+    else t1 = std::min(t1, t);
+    return true;
+  };
+  const bool ok = clip(-dir.x, pivot.x) && clip(dir.x, (width - 1) - pivot.x) && clip(-dir.y, pivot.y) &&
+                  clip(dir.y, (height - 1) - pivot.y) && t0 <= t1;
+  if (!ok) {  // the line misses the image: report the pivot twice
+    *p1 = *p2 = pivot;
+    return;
+  }
+  *p1 = pivot + t0 * dir;
+  *p2 = pivot + t1 * dir;
+}
+
+LineDifference line_difference(double r, double theta, double reference_r, double reference_theta) {
+  if (!std::isfinite(theta) || !std::isfinite(reference_theta)) return {r - reference_r, theta - reference_theta};
+  // Half-turns that bring the line's theta within (-90, 90] deg of the reference's; each one
+  // turns the normal around, so R changes sign.
+  const double half_turns = std::ceil((theta - reference_theta) / M_PI - 0.5);
+  const double d_theta = theta - reference_theta - half_turns * M_PI;
+  const bool odd = std::fmod(std::fabs(half_turns), 2.0) == 1.0;
+  return {(odd ? -r : r) - reference_r, d_theta};
+}
+
+}  // namespace nudge::symmetry
