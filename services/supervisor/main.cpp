@@ -307,13 +307,18 @@ class Shell {
     m.cameras = snapshot_request_t::CAMERAS_RIGHT;
     publish(bus::channel::CAMERA_SNAPSHOT_REQUEST, m);
   }
-  void handle(const sv::NudgeCommand& c) {
+  // A command with the fields every command shares (an identity orientation: a valid pose_t).
+  arm_command_t arm_command(int64_t seq, int8_t command) const {
     arm_command_t m{};
     m.utime = now_;
-    m.seq = c.seq;
-    m.command = arm_command_t::COMMAND_NUDGE;
-    copy3(c.target, m.target.position);
+    m.seq = seq;
+    m.command = command;
     m.target.orientation[0] = 1;
+    return m;
+  }
+  void handle(const sv::NudgeCommand& c) {
+    arm_command_t m = arm_command(c.seq, arm_command_t::COMMAND_NUDGE);
+    copy3(c.target, m.target.position);
     copy3(c.direction, m.direction);
     m.approach_height = opt_.arm.nudge.approach_height;
     m.height = opt_.arm.nudge.push_height;
@@ -322,12 +327,7 @@ class Shell {
     publish(bus::channel::ARM_COMMAND, m);
   }
   void handle(const sv::StopCommand& c) {
-    arm_command_t m{};
-    m.utime = now_;
-    m.seq = c.seq;
-    m.command = arm_command_t::COMMAND_STOP;
-    m.target.orientation[0] = 1;
-    publish(bus::channel::ARM_COMMAND, m);
+    publish(bus::channel::ARM_COMMAND, arm_command(c.seq, arm_command_t::COMMAND_STOP));
     log::warn() << "arm stopped: " << c.reason;
   }
   void handle(const sv::StateReport& r) {
