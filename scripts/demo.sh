@@ -100,7 +100,7 @@ if [ $# -eq 0 ]; then
     "$NUDGE_ROOT/config/calibration_sim.yaml" "$NUDGE_ROOT/config/workspace.yaml" "$out/runs" "$run" || status=$?
   dir="$out/runs/$run"
   if [ -f "$dir/summary.json" ]; then
-    nudge_log "run $run: $(grep -o '"segmented":[0-9]*' "$dir/summary.json" | cut -d: -f2) objects segmented in $(grep -o '"attempts":[0-9]*' "$dir/summary.json" | cut -d: -f2) nudges"
+    nudge_log "run $run: $(grep -o '"segmented":[0-9]*' "$dir/summary.json" | head -1 | cut -d: -f2) objects segmented in $(grep -o '"attempts":[0-9]*' "$dir/summary.json" | head -1 | cut -d: -f2) nudges"
     nudge_log "files: $dir/ (LCM log $run.lcmlog, summary.json, attempt_NN/ with before/after stills, mask, cutout, workspace.png, stages/)"
     nudge_log "replay the decisions: build/bin/nudge-supervisor --lcm-in 'file://$dir/$run.lcmlog?speed=0' --lcm-out 'file:///tmp/replay.lcmlog?mode=w' --calibration config/calibration_sim.yaml --first-seq $(grep -o '"first_command_seq":[0-9]*' "$dir/summary.json" | cut -d: -f2)"
   fi

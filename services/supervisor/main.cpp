@@ -51,6 +51,8 @@ struct Options {
   std::string calibration, run_id, out_dir = "out/runs", clock = "sim", require;
   double service_timeout_s = 3.0;
   int first_seq = 0;
+  // A gentle push: tall objects (bottles) tip when the pad meets them at the arm's usual speed.
+  double nudge_speed_scale = 0.25;
   bool keep_running = false;
   sv::Config config;
   sv::ArmSetup arm;
@@ -318,6 +320,7 @@ class Shell {
   }
   void handle(const sv::NudgeCommand& c) {
     arm_command_t m = arm_command(c.seq, arm_command_t::COMMAND_NUDGE);
+    m.speed_scale = opt_.nudge_speed_scale;
     copy3(c.target, m.target.position);
     copy3(c.direction, m.direction);
     m.approach_height = opt_.arm.nudge.approach_height;
@@ -416,6 +419,7 @@ void add_flags(Flags& f, Options& o) {
   f.add_double("snapshot-timeout", &o.config.snapshot_timeout_s, "for a still, s of the task clock");
   f.add_double("candidates-timeout", &o.config.candidates_timeout_s, "for a CANDIDATES answer, s of the task clock");
   f.add_double("nudge-timeout", &o.config.nudge_timeout_s, "for the arm to finish a nudge, s of the task clock");
+  f.add_double("nudge-speed", &o.nudge_speed_scale, "nudges at this fraction of the arm's joint speed limits (0.01-1)");
   f.add_double("object-radius", &o.config.targets.object_radius, "largest expected object radius (push clearance), m");
   f.add_int("first-seq", &o.first_seq, "first ARM_COMMAND seq (default: from the wall clock; set it to replay a run)");
 }
@@ -444,6 +448,7 @@ int main(int argc, char** argv) {
     if (opt.run_id.find('/') != std::string::npos) throw FlagError("--run-id must not contain '/'");
     if (opt.require.empty()) opt.require = std::string("camera,symmetry,triangulation,arm") + (opt.clock == "sim" ? ",world" : "");
     if (!(opt.service_timeout_s > 0)) throw FlagError("--service-timeout must be > 0");
+    if (!(opt.nudge_speed_scale >= 0.01 && opt.nudge_speed_scale <= 1)) throw FlagError("--nudge-speed must lie in [0.01, 1]");
     Shell shell(service, opt);  // loads the calibration: a bad file ends here, naming the field
     service.start();
     shell.subscribe();
