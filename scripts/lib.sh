@@ -79,7 +79,8 @@ nudge_run_loop() {
   local pids=()
   "$bin/nudge-symmetry" --lcm-url "$url" --lines 5 --theta-min -25 --theta-max 25 --once-per-row \
     --mirror-tolerance 15 2>"$logs/symmetry.log" & pids+=($!)
-  "$bin/nudge-camera" --lcm-url "$url" --source sim --scene "$scene" --snapshots 2>"$logs/camera.log" & pids+=($!)
+  "$bin/nudge-camera" --lcm-url "$url" --source sim --scene "$scene" --snapshots --snapshot-format png \
+    2>"$logs/camera.log" & pids+=($!)
   "$bin/nudge-triangulation" --lcm-url "$url" --calibration "$calibration" --workspace "$workspace" \
     2>"$logs/triangulation.log" & pids+=($!)
   "$bin/nudge-arm" --lcm-url "$url" --backend sim --clock sim --workspace "$workspace" 2>"$logs/arm.log" & pids+=($!)

@@ -90,7 +90,7 @@ int run_sim_camera(bus::Service& service, const SimOptions& options) {
             const int8_t this_camera = c == 0 ? snapshot_request_t::CAMERAS_LEFT : snapshot_request_t::CAMERAS_RIGHT;
             if (request.cameras != snapshot_request_t::CAMERAS_BOTH && request.cameras != this_camera) continue;
             service.publish(kSnapshotChannels[c],
-                            bus::to_message(world.render_snapshot(c), options.pixel_format, *last_state_utime,
+                            bus::to_message(world.render_snapshot(c), options.snapshot_format, *last_state_utime,
                                             snapshot_id, kCameraNames[c], options.jpeg_quality));
           }
           ++snapshot_id;

@@ -12,6 +12,7 @@ struct SimOptions {
   double noise_sigma = -1;  // Gaussian pixel noise in grey levels; < 0: the scene's
   bool snapshots = false;   // answer CAMERA_SNAPSHOT_REQUEST with 1280x960 stills
   int8_t pixel_format = 0;  // image_t::FORMAT_* of the published frames
+  int8_t snapshot_format = 0;  // and of the stills
   int jpeg_quality = 90;
   int count = 0;            // stop after this many stereo pairs; 0 = no limit
   int motion_blur = 0;      // > 1: average this many renders across the interval since the last

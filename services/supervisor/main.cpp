@@ -146,6 +146,7 @@ class Shell {
     subs.subscribe<symmetry_lines_t>(bus::channel::SYMMETRY_LEFT, [this](const symmetry_lines_t& m, const std::string&) { on_lines(true, m); });
     subs.subscribe<symmetry_lines_t>(bus::channel::SYMMETRY_RIGHT, [this](const symmetry_lines_t& m, const std::string&) { on_lines(false, m); });
     subs.subscribe<image_t>(bus::channel::CAMERA_RIGHT, [this](const image_t& m, const std::string&) { on_frame(m); });
+    subs.subscribe<image_t>(bus::channel::CAMERA_LEFT, [this](const image_t& m, const std::string&) { on_left_frame(m); });
     subs.subscribe<image_t>(bus::channel::SNAPSHOT_RIGHT, [this](const image_t& m, const std::string&) { on_still(m); });
   }
 
@@ -244,9 +245,16 @@ class Shell {
     supervisor_.on_lines(left, lines, now_);
   }
 
+  // Decoding costs: frames are decoded only while the loop watches the nudge and the object settle.
+  bool watching() const { return supervisor_.state() == sv::State::Nudge || supervisor_.state() == sv::State::Track; }
   void on_frame(const image_t& m) {
-    if (supervisor_.state() != sv::State::Nudge) return;  // decoding costs: only while watching
-    supervisor_.on_right_frame(bus::to_mat(m), now_);
+    if (!watching()) return;
+    supervisor_.on_right_frame(bus::to_mat(m), m.utime);
+    drain();
+  }
+  void on_left_frame(const image_t& m) {
+    if (!watching()) return;
+    supervisor_.on_left_frame(bus::to_mat(m), m.utime);
     drain();
   }
 

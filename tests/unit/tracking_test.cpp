@@ -413,6 +413,37 @@ TEST(Tracker, FollowsAMovingRotatingBottleFromTheAutomaticStart) {
   EXPECT_LT(last.limits.max_deg - last.limits.min_deg, 60) << "narrowed by the prediction";
 }
 
+// Started at a line known from elsewhere (the supervisor's target as it starts to move): tracking
+// from the first frame of motion, no automatic start needed; started at a wrong line (nothing
+// symmetric there), the track is lost with its reason instead of jumping to the object.
+TEST(Tracker, StartsAtAGivenLineAndFollowsTheObject) {
+  const Video video;
+  SymmetryTracker tracker;
+  for (int i = 0; i < video.still_frames; ++i) tracker.feed(video.frame(i), i * kFramePeriodUs);
+  nudge::symmetry::Line start;
+  start.r = video.truth(video.still_frames).r + 3;  // a few px off, as a projection from 3D is
+  start.theta = video.truth(video.still_frames).theta;
+  tracker.start_at(start);
+  EXPECT_EQ(tracker.status(), TrackStatus::Tracking);
+  double worst_r = 0;
+  for (int i = video.still_frames; i < 40; ++i) {
+    const TrackState s = tracker.feed(video.frame(i), i * kFramePeriodUs);
+    ASSERT_EQ(s.status, TrackStatus::Tracking) << i << ": " << s.reason;
+    if (i >= video.still_frames + 5) worst_r = std::max(worst_r, std::fabs(s.line.r - video.truth(i).r));
+  }
+  EXPECT_LT(worst_r, 3.0);
+
+  SymmetryTracker wrong;
+  for (int i = 0; i < video.still_frames; ++i) wrong.feed(video.frame(i), i * kFramePeriodUs);
+  nudge::symmetry::Line nowhere;
+  nowhere.r = 250;  // far right of the moving bottle, in empty background
+  wrong.start_at(nowhere);
+  TrackState last;
+  for (int i = video.still_frames; i < 40; ++i) last = wrong.feed(video.frame(i), i * kFramePeriodUs);
+  EXPECT_NE(last.status, TrackStatus::Tracking);
+  EXPECT_FALSE(last.reason.empty());
+}
+
 // The thesis' pendulum setting (sec. 5.4), harder: a shaded bottle swings at up to 11 px/frame in
 // front of a cluttered indoor scene with static symmetric objects, with fresh sensor noise in
 // every frame. Its inner shading bands give secondary symmetry lines about 12 px from the axis.

@@ -23,11 +23,15 @@ SceneGeometry SceneGeometry::load(const std::string& path) {
 }
 
 Eigen::Vector3d SceneGeometry::table_to_world(const Eigen::Vector3d& table_point) const {
-  return arm_to_right_.inverse().apply(table_frame_.to_camera(table_point));
+  return right_to_world(table_frame_.to_camera(table_point));
 }
 
 Eigen::Vector3d SceneGeometry::world_to_right(const Eigen::Vector3d& world_point) const {
   return arm_to_right_.apply(world_point);
+}
+
+Eigen::Vector3d SceneGeometry::right_to_world(const Eigen::Vector3d& right_point) const {
+  return arm_to_right_.inverse().apply(right_point);
 }
 
 Eigen::Vector3d SceneGeometry::right_camera_in_world() const { return arm_to_right_.inverse().t; }

@@ -52,6 +52,7 @@ const char* to_string(Outcome outcome) {
     case Outcome::ArmFailed: return "arm failed";
     case Outcome::Aborted: return "aborted";
     case Outcome::SegmentationFailed: return "segmentation failed";
+    case Outcome::TrackerLost: return "tracker lost";
   }
   return "?";
 }
@@ -164,6 +165,16 @@ void Supervisor::start_nudge(int64_t now) {
   }
   watch_ = std::make_unique<MotionWatch>(*line, *ahead - *foot, static_cast<int>(std::min(top->y, foot->y)) - 8,
                                          static_cast<int>(std::max(top->y, foot->y)) + 8, config_.frame_size, config_.motion);
+  target_lines_[0] = scene_.left_axis_line(a.target.position, config_.object_height_m, config_.frame_size);
+  target_lines_[1] = line;
+  tracking_started_ = false;
+  for (int camera = 0; camera < 2; ++camera) {
+    trackers_[camera].reset();
+    last_track_[camera] = tracking::TrackState{};
+    track_lost_[camera].clear();
+    track_done_[camera] = false;
+    if (config_.track && target_lines_[camera]) trackers_[camera] = std::make_unique<tracking::SymmetryTracker>(config_.tracker);
+  }
   nudge_seq_ = next_seq_++;
   enter(State::Nudge, now, "nudging candidate " + std::to_string(a.target.index) + " at " + millimetres(a.target.position));
   outputs_.push_back(NudgeCommand{nudge_seq_, a.target.position, a.direction});
@@ -177,6 +188,55 @@ void Supervisor::verify(int64_t now) {
     end_attempt(Outcome::NoMotion, "no motion after nudge: nothing stood there (phantom candidate)", now);
     return;
   }
+  const bool placed = tracking_started_ ? verify_by_tracking(now) : verify_by_axes(now);
+  if (!placed) return;  // the attempt has ended with its reason
+  const double moved = (*a.rest - a.target.position).head<2>().norm();
+  if (moved < config_.min_displacement_m) {
+    end_attempt(Outcome::NoMotion, "the object moved only " + std::to_string(static_cast<int>(std::lround(moved * 1e3))) + " mm", now);
+    return;
+  }
+  request_still(State::SnapshotAfter, now);
+}
+
+// The thesis' check: both trackers still on the object, their lines triangulated to an upright
+// axis on the table; its foot is where the object came to rest.
+bool Supervisor::verify_by_tracking(int64_t now) {
+  Attempt& a = *attempt_;
+  static const char* kCameraNames[2] = {"left", "right"};
+  for (int camera = 0; camera < 2; ++camera) {
+    const tracking::TrackState& t = last_track_[camera];
+    if (!track_lost_[camera].empty() || !t.has_estimate) {
+      end_attempt(Outcome::TrackerLost, std::string("tracker lost in the ") + kCameraNames[camera] + " camera: " +
+                                            (track_lost_[camera].empty() ? "no estimate" : track_lost_[camera]), now);
+      return false;
+    }
+    a.tracked[camera] = t.line;
+  }
+  geometry::AxisFilter any_tilt;
+  any_tilt.max_tilt_deg = 90;  // judged below, with the reason
+  any_tilt.max_range_m = 10;
+  const geometry::PairingResult pair =
+      geometry::triangulate_pairings(scene_.rig(), {*a.tracked[0]}, {*a.tracked[1]}, &scene_.table(), any_tilt);
+  if (pair.axes.empty() || !pair.axes[0].hit) {
+    end_attempt(Outcome::TrackerLost, "the tracked lines do not meet in an axis on the table" +
+                                          (pair.rejections.empty() ? std::string() : ": " + pair.rejections[0]), now);
+    return false;
+  }
+  const geometry::TableHit& hit = *pair.axes[0].hit;
+  if (hit.tilt_deg > config_.upright_max_tilt_deg) {
+    char text[96];
+    std::snprintf(text, sizeof text, "object tipped: its tracked axis leans %.1f deg after the nudge", hit.tilt_deg);
+    end_attempt(Outcome::Tipped, text, now);
+    return false;
+  }
+  const Eigen::Vector3d foot = scene_.right_to_world(hit.point);
+  a.rest = Eigen::Vector3d(foot.x(), foot.y(), 0.0);
+  return true;
+}
+
+// Without trackers: the settled AXES near the push line (upright, by the triangulation service).
+bool Supervisor::verify_by_axes(int64_t now) {
+  Attempt& a = *attempt_;
   std::vector<double> xs, ys, tilts;
   for (const Axis& axis : settled_axes_) {
     const Eigen::Vector3d offset = axis.foot - a.target.position;
@@ -190,22 +250,17 @@ void Supervisor::verify(int64_t now) {
   if (static_cast<int>(xs.size()) < config_.min_axes) {
     end_attempt(Outcome::Tipped, "object tipped or lost: " + std::to_string(xs.size()) +
                                      " upright axes near the push line after the nudge", now);
-    return;
+    return false;
   }
   const double tilt_deg = median(tilts) * 180 / M_PI;
   if (tilt_deg > config_.upright_max_tilt_deg) {
     char text[96];
     std::snprintf(text, sizeof text, "object tipped: its axis leans %.1f deg after the nudge", tilt_deg);
     end_attempt(Outcome::Tipped, text, now);
-    return;
+    return false;
   }
   a.rest = Eigen::Vector3d(median(xs), median(ys), 0.0);
-  const double moved = (*a.rest - a.target.position).head<2>().norm();
-  if (moved < config_.min_displacement_m) {
-    end_attempt(Outcome::NoMotion, "the object moved only " + std::to_string(static_cast<int>(std::lround(moved * 1e3))) + " mm", now);
-    return;
-  }
-  request_still(State::SnapshotAfter, now);
+  return true;
 }
 
 void Supervisor::segment(int64_t now) {
@@ -249,6 +304,8 @@ void Supervisor::end_attempt(Outcome outcome, const std::string& reason, int64_t
   if (outcome == Outcome::SnapshotLost && a.before.empty()) explored_.push_back(a.target.position);
   outputs_.push_back(AttemptEnded{std::shared_ptr<const Attempt>(attempt_.release())});
   watch_.reset();
+  for (auto& tracker : trackers_) tracker.reset();
+  tracking_started_ = false;
   settled_axes_.clear();
   survey(now, "attempt " + std::to_string(a.number) + " " + to_string(outcome) + ": " + reason);
 }
@@ -304,6 +361,8 @@ void Supervisor::on_services(const std::set<std::string>& silent, int64_t now) {
   } else if (silent_.empty() && was_silent && state_ == State::Paused) {
     if (in_attempt()) {
       watch_.reset();
+      for (auto& tracker : trackers_) tracker.reset();
+      tracking_started_ = false;
       settled_axes_.clear();
       Attempt& a = *attempt_;
       const bool touched = paused_from_ != State::SnapshotBefore;
@@ -351,10 +410,33 @@ void Supervisor::on_arm_state(const ArmStatus& arm, int64_t now) {
   }
 }
 
-void Supervisor::on_right_frame(const cv::Mat& frame, int64_t now) {
-  (void)now;
-  if (state_ == State::Nudge && watch_) watch_->feed(frame);
+void Supervisor::feed_tracker(int camera, const cv::Mat& frame, int64_t utime) {
+  if (!trackers_[camera] || track_done_[camera] || (state_ != State::Nudge && state_ != State::Track)) return;
+  const tracking::TrackState state = trackers_[camera]->feed(frame, utime);
+  if (state.status == tracking::TrackStatus::Tracking && state.has_estimate) {
+    last_track_[camera] = state;
+  } else if (tracking_started_ && state.status != tracking::TrackStatus::Tracking) {
+    // A track that ends while it holds a still object has done its work (the object came to rest:
+    // thesis sec. 6.3.2, "tracking stops after the nudge ... the object ceases all motion"); one
+    // that ends while the object moved lost it.
+    track_done_[camera] = true;
+    if (!last_track_[camera].holding) track_lost_[camera] = state.reason.empty() ? "track ended" : state.reason;
+  }
 }
+
+void Supervisor::on_right_frame(const cv::Mat& frame, int64_t utime) {
+  if (state_ == State::Nudge && watch_) {
+    watch_->feed(frame);
+    // Motion at the target starts the trackers, at the target's line in each camera.
+    if (watch_->moved() && !tracking_started_ && trackers_[0] && trackers_[1]) {
+      tracking_started_ = true;
+      for (int camera = 0; camera < 2; ++camera) trackers_[camera]->start_at(*target_lines_[camera]);
+    }
+  }
+  feed_tracker(1, frame, utime);
+}
+
+void Supervisor::on_left_frame(const cv::Mat& frame, int64_t utime) { feed_tracker(0, frame, utime); }
 
 void Supervisor::on_right_still(const cv::Mat& still, int64_t utime, int64_t now) {
   if (utime < request_time_) return;  // taken before we asked

@@ -214,6 +214,19 @@ void SymmetryTracker::restart(const std::string& reason) {
   reset(track_active(status_) ? TrackStatus::Lost : TrackStatus::Idle, reason);
 }
 
+void SymmetryTracker::start_at(const symmetry::Line& line) {
+  LineMeasurement start;
+  start.r = line.r;
+  start.theta_deg = line.theta * kDegPerRad;
+  kalman_.initialise(normalise(start));
+  status_ = TrackStatus::Tracking;
+  reason_.clear();
+  missed_ = 0;
+  start_window_.clear();
+  start_frames_ = 0;
+  object_blocks_.release();  // the first frame's motion about the line becomes the object's
+}
+
 TrackState SymmetryTracker::feed(const cv::Mat& frame, int64_t utime) {
   TrackState state;
   state.utime = utime;

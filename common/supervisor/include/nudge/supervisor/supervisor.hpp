@@ -26,6 +26,7 @@
 #include "nudge/supervisor/motion_watch.hpp"
 #include "nudge/supervisor/scene.hpp"
 #include "nudge/supervisor/targets.hpp"
+#include "nudge/tracking/tracker.hpp"
 
 namespace nudge::supervisor {
 
@@ -58,6 +59,11 @@ struct Config {
   double agreement_offset_px = 6;    // and this R (at frame_size)
   TargetParams targets;
   MotionWatchParams motion;
+  // Thesis sec. 6.3.2: motion at the target starts one symmetry tracker per camera at the target's
+  // line; when the object has stopped, the two tracked lines are triangulated (upright? where?)
+  // and a lost tracker ends the attempt. Off: the settled AXES near the push line decide instead.
+  bool track = true;
+  tracking::TrackerParams tracker;
   LineSearchParams line_search;
 };
 
@@ -99,7 +105,7 @@ struct StateReport {
   int segmented = 0, failed_attempts = 0, rejected = 0;
 };
 
-enum class Outcome { Segmented, NoMotion, Tipped, Refused, SnapshotLost, ArmFailed, Aborted, SegmentationFailed };
+enum class Outcome { Segmented, NoMotion, Tipped, Refused, SnapshotLost, ArmFailed, Aborted, SegmentationFailed, TrackerLost };
 const char* to_string(Outcome outcome);
 
 struct Attempt {
@@ -113,6 +119,7 @@ struct Attempt {
   std::string reason;
   int64_t started = 0, ended = 0;          // task clock, us
   int motion_frames = 0, motion_blocks = 0;
+  std::optional<symmetry::Line> tracked[2];  // [left, right]: the trackers' last lines (640x480)
   std::optional<Eigen::Vector3d> rest;     // where the object came to rest
   cv::Mat before, after;                   // right stills
   std::optional<symmetry::Line> before_line, after_line;  // in the stills
@@ -142,7 +149,10 @@ class Supervisor {
   void on_services(const std::set<std::string>& silent, int64_t now);
   void on_candidates(const std::vector<Candidate>& candidates, int64_t utime, int64_t now);
   void on_arm_state(const ArmStatus& arm, int64_t now);
-  void on_right_frame(const cv::Mat& frame, int64_t now);
+  // Camera frames (CAMERA_RIGHT / CAMERA_LEFT, frame_size) with their own utime, while nudging and
+  // settling: motion beyond the line (right) and the trackers (both).
+  void on_right_frame(const cv::Mat& frame, int64_t utime);
+  void on_left_frame(const cv::Mat& frame, int64_t utime);
   void on_right_still(const cv::Mat& still, int64_t utime, int64_t now);
   void on_axes(const std::vector<Axis>& axes, int64_t now);
   // One camera's symmetry lines (SYMMETRY_LEFT / SYMMETRY_RIGHT, 640x480) during a survey: they
@@ -185,6 +195,15 @@ class Supervisor {
   std::set<std::string> silent_;
   std::unique_ptr<Attempt> attempt_;
   std::unique_ptr<MotionWatch> watch_;
+  std::unique_ptr<tracking::SymmetryTracker> trackers_[2];  // [left, right], during an attempt
+  std::optional<symmetry::Line> target_lines_[2];           // the target's line in each camera
+  tracking::TrackState last_track_[2];  // each tracker's last estimate while it tracked
+  std::string track_lost_[2];           // why a tracker lost the object while it moved
+  bool track_done_[2] = {false, false}; // no more frames for this tracker (lost, or the object stopped)
+  bool tracking_started_ = false;
+  void feed_tracker(int camera, const cv::Mat& frame, int64_t utime);
+  bool verify_by_tracking(int64_t now);
+  bool verify_by_axes(int64_t now);
   StateReport report_;
   Summary summary_;
 };

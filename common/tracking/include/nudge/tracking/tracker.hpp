@@ -138,6 +138,11 @@ class SymmetryTracker {
   TrackState feed(const cv::Mat& frame, int64_t utime);
   // Ends any track and waits for new motion (the service's restart request).
   void restart(const std::string& reason = "restart requested");
+  // Starts a track at a line known from elsewhere (R px, theta rad in this camera's frames), at
+  // rest, instead of waiting for the automatic start: the supervisor knows where the object it
+  // nudges stands (thesis sec. 6.3.2: motion at the target starts one tracker per camera). The
+  // next frame predicts from it and measures as in any track.
+  void start_at(const symmetry::Line& line);
 
   const TrackerParams& params() const { return params_; }
   TrackStatus status() const { return status_; }
