@@ -420,6 +420,9 @@ void add_flags(Flags& f, Options& o) {
   f.add_string("require", &o.require, "services whose heartbeats the loop needs, comma-separated (default: camera,symmetry,triangulation,arm, plus world with --clock sim)");
   f.add_double("service-timeout", &o.service_timeout_s, "a required service silent this long pauses the run and stops the arm, s");
   f.add_bool("keep-running", &o.keep_running, "stay up after the run ends (default: exit)");
+  f.add_bool("track", &o.config.track,
+             "start a symmetry tracker per camera at the target's line when it moves and judge the result by the "
+             "tracked lines (thesis 6.3.2; default: by the settled AXES, docs/supervisor.md)");
   f.add_int("survey-frames", &o.config.survey_frames, "stereo pairs per candidate survey (thesis 25)");
   f.add_int("survey-lines", &o.config.survey_lines, "lines per image in a survey (thesis 3)");
   f.add_int("max-attempts", &o.config.max_attempts, "nudges per run");

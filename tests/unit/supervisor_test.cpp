@@ -219,7 +219,9 @@ TEST(Targets, NearestTheCameraFirstAndEveryPassOverHasAReason) {
 }
 
 TEST_F(SupervisorTest, SegmentsTheObjectThenFindsNothingLeftToNudge) {
-  sv::Supervisor s = make();
+  sv::Config with_trackers;
+  with_trackers.track = true;
+  sv::Supervisor s = make(with_trackers);
   const Eigen::Vector3d object(0.28, -0.05, 0);
   auto out = start_with(s, {object});
   ASSERT_EQ(outputs_of<sv::SnapshotRequest>(out).size(), 1u);
@@ -327,9 +329,7 @@ TEST_F(SupervisorTest, APhantomCandidateShowsNoMotionAndIsRecordedAsSuch) {
 }
 
 TEST_F(SupervisorTest, ATippedObjectIsReportedNotSegmented) {
-  sv::Config without_trackers;
-  without_trackers.track = false;  // the settled AXES decide
-  sv::Supervisor s = make(without_trackers);
+  sv::Supervisor s = make();  // without trackers: the settled AXES decide
   const Eigen::Vector3d object(0.28, -0.05, 0);
   start_with(s, {object});
   s.on_right_still(draw_scene(scene_, {1280, 960}, {object}), now_, now_);
@@ -425,7 +425,9 @@ TEST_F(SupervisorTest, SameInputsSameOutputs) {
 }
 
 TEST_F(SupervisorTest, WhatTheTrackersSawDecidesNotTheSettledAxes) {
-  sv::Supervisor s = make();
+  sv::Config with_trackers;
+  with_trackers.track = true;
+  sv::Supervisor s = make(with_trackers);
   const Eigen::Vector3d object(0.28, -0.05, 0);
   start_with(s, {object});
   s.on_right_still(draw_scene(scene_, {1280, 960}, {object}), now_, now_);

@@ -91,6 +91,15 @@ std::string attempt_json(const Attempt& a) {
     j.raw("null");
   }
   j.field("motion_frames", a.motion_frames).field("motion_blocks", a.motion_blocks);
+  j.field("tracking_started_s", a.tracking_started / 1e6);
+  j.key("track_trace").begin_object();
+  for (int camera = 0; camera < 2; ++camera) {
+    j.key(camera == 0 ? "left" : "right").begin_array();
+    for (const Attempt::TrackSample& t : a.track_trace[camera])
+      j.begin_array().value(t.utime / 1e6).value(t.status).value(t.r).value(t.theta).value(t.measured).value(t.holding).end_array();
+    j.end_array();
+  }
+  j.end_object();
   write_line(j, "line_before", a.before_line);
   write_line(j, "line_after", a.after_line);
   j.field("mask_pixels", a.segmentation.mask.empty() ? 0 : cv::countNonZero(a.segmentation.mask));

@@ -157,7 +157,7 @@ void Supervisor::start_nudge(int64_t now) {
   const Attempt& a = *attempt_;
   const auto line = scene_.right_axis_line(a.target.position, config_.object_height_m, config_.frame_size);
   const auto foot = scene_.project_right(a.target.position, config_.frame_size);
-  const auto top = scene_.project_right(a.target.position + Eigen::Vector3d(0, 0, config_.object_height_m), config_.frame_size);
+  const auto top = scene_.project_right(a.target.position + Eigen::Vector3d(0, 0, config_.motion_rows_height_m), config_.frame_size);
   const auto ahead = scene_.project_right(a.target.position + 0.03 * a.direction, config_.frame_size);
   if (!line || !foot || !top || !ahead) {
     end_attempt(Outcome::Refused, "the target is not in the right camera's view", now);
@@ -413,6 +413,9 @@ void Supervisor::on_arm_state(const ArmStatus& arm, int64_t now) {
 void Supervisor::feed_tracker(int camera, const cv::Mat& frame, int64_t utime) {
   if (!trackers_[camera] || track_done_[camera] || (state_ != State::Nudge && state_ != State::Track)) return;
   const tracking::TrackState state = trackers_[camera]->feed(frame, utime);
+  if (tracking_started_ && attempt_)
+    attempt_->track_trace[camera].push_back({utime, static_cast<int>(state.status), state.line.r, state.line.theta,
+                                             state.measurement_used, state.holding});
   if (state.status == tracking::TrackStatus::Tracking && state.has_estimate) {
     last_track_[camera] = state;
   } else if (tracking_started_ && state.status != tracking::TrackStatus::Tracking) {
@@ -430,6 +433,7 @@ void Supervisor::on_right_frame(const cv::Mat& frame, int64_t utime) {
     // Motion at the target starts the trackers, at the target's line in each camera.
     if (watch_->moved() && !tracking_started_ && trackers_[0] && trackers_[1]) {
       tracking_started_ = true;
+      attempt_->tracking_started = utime;
       for (int camera = 0; camera < 2; ++camera) trackers_[camera]->start_at(*target_lines_[camera]);
     }
   }

@@ -63,6 +63,12 @@ void LineKalman::initialise(const LineMeasurement& first) {
   for (int i = 0; i < 6; ++i) p_(i, i) = params_.initial_variance[i];
 }
 
+void LineKalman::initialise_at_rest(const LineMeasurement& first) {
+  initialise(first);
+  const std::array<double, 4> at_rest = {4.0, 1.0, 1.0, 0.25};  // R', theta', R'', theta''
+  for (int i = 0; i < 4; ++i) p_(i + 2, i + 2) = at_rest[i];
+}
+
 void LineKalman::predict() {
   const auto& a = transition();
   x_ = a * x_;

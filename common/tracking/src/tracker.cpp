@@ -218,7 +218,7 @@ void SymmetryTracker::start_at(const symmetry::Line& line) {
   LineMeasurement start;
   start.r = line.r;
   start.theta_deg = line.theta * kDegPerRad;
-  kalman_.initialise(normalise(start));
+  kalman_.initialise_at_rest(normalise(start));
   status_ = TrackStatus::Tracking;
   reason_.clear();
   missed_ = 0;

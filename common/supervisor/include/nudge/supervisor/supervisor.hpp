@@ -52,7 +52,10 @@ struct Config {
   double max_lateral_m = 0.03;       // and how far off the push line
   double upright_max_tilt_deg = 12;  // median tilt; thesis ch. 6 keeps candidates within 10 deg, a settled axis gets 2 deg for noise
   double min_displacement_m = 0.004; // a smaller slide gives no difference to segment
-  double object_height_m = 0.25;     // rows watched for motion: table to this height
+  double object_height_m = 0.25;     // the tallest expected object (lines drawn up to it)
+  // Rows watched for motion: from the table to this height. The object's foot moves when it is
+  // pushed; the arm's links, higher up, may pass beyond the line in the image, the pad never does.
+  double motion_rows_height_m = 0.06;
   cv::Size frame_size{640, 480};     // CAMERA_RIGHT
   cv::Size still_size{1280, 960};    // SNAPSHOT_RIGHT
   double agreement_angle_deg = 3;    // a detected line is a candidate's: within this angle
@@ -61,8 +64,10 @@ struct Config {
   MotionWatchParams motion;
   // Thesis sec. 6.3.2: motion at the target starts one symmetry tracker per camera at the target's
   // line; when the object has stopped, the two tracked lines are triangulated (upright? where?)
-  // and a lost tracker ends the attempt. Off: the settled AXES near the push line decide instead.
-  bool track = true;
+  // and a lost tracker ends the attempt. Off (default): the settled AXES near the push line decide.
+  // Off because, measured in the simulated lab (docs/supervisor.md), the trackers lose the object
+  // while the pad touches it: block motion then covers the pad too and the lines drift.
+  bool track = false;
   tracking::TrackerParams tracker;
   LineSearchParams line_search;
 };
@@ -120,6 +125,14 @@ struct Attempt {
   int64_t started = 0, ended = 0;          // task clock, us
   int motion_frames = 0, motion_blocks = 0;
   std::optional<symmetry::Line> tracked[2];  // [left, right]: the trackers' last lines (640x480)
+  int64_t tracking_started = 0;              // frame utime at which motion started the trackers
+  struct TrackSample {
+    int64_t utime = 0;
+    int status = 0;                          // tracking::TrackStatus
+    double r = 0, theta = 0;                 // px, rad
+    bool measured = false, holding = false;
+  };
+  std::vector<TrackSample> track_trace[2];   // every frame the trackers saw after the start
   std::optional<Eigen::Vector3d> rest;     // where the object came to rest
   cv::Mat before, after;                   // right stills
   std::optional<symmetry::Line> before_line, after_line;  // in the stills

@@ -57,6 +57,10 @@ class LineKalman {
 
   const KalmanParams& params() const { return params_; }
   void initialise(const LineMeasurement& first);
+  // A state known to stand still (a track started at a line known from elsewhere, before the
+  // object moves): velocities and accelerations zero with a small variance (sigma 2 px / 1 deg per
+  // frame, 1 px / 0.5 deg per frame^2), so the first frames' gate stays narrow about the line.
+  void initialise_at_rest(const LineMeasurement& first);
   void predict();
   // The object is seen to stand still (no motion where it is): velocities and accelerations are
   // set to zero and decoupled from R and theta, whose estimate and covariance stay as they are.
