@@ -337,6 +337,9 @@ class Shell {
     m.stop_distance = opt_.arm.nudge.stop_distance;
     publish(bus::channel::ARM_COMMAND, m);
   }
+  void handle(const sv::HomeCommand& c) {
+    publish(bus::channel::ARM_COMMAND, arm_command(c.seq, arm_command_t::COMMAND_HOME));  // the arm's usual speed
+  }
   void handle(const sv::StopCommand& c) {
     publish(bus::channel::ARM_COMMAND, arm_command(c.seq, arm_command_t::COMMAND_STOP));
     log::warn() << "arm stopped: " << c.reason;

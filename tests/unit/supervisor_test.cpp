@@ -114,7 +114,14 @@ class SupervisorTest : public ::testing::Test {
     s.on_services({}, now_);
     return answer_survey(s, candidates);
   }
+  // After a nudge the arm parks first (HOME); the test's arm reports it parked.
+  void park(sv::Supervisor& s) {
+    if (s.state() != sv::State::Home) return;
+    now_ += kSecond;
+    s.on_arm_state(arm(sv::ArmStatus::Motion::Done, s.awaited_arm_seq()), now_);
+  }
   std::vector<sv::Output> answer_survey(sv::Supervisor& s, const std::vector<Eigen::Vector3d>& candidates) {
+    park(s);
     s.take_outputs();
     EXPECT_EQ(s.state(), sv::State::FindCandidates);
     now_ += 3 * kSecond;
@@ -259,6 +266,14 @@ TEST_F(SupervisorTest, SegmentsTheObjectThenFindsNothingLeftToNudge) {
   EXPECT_NEAR(a.tracked[1]->r, scene_.right_axis_line(rest, 0.2, {640, 480})->r, 4.0);
   EXPECT_NEAR(a.tracked[0]->r, scene_.left_axis_line(rest, 0.2, {640, 480})->r, 4.0);
   EXPECT_GT(std::abs(a.after_line->r - a.before_line->r), 25.0);
+  // The arm parks (COMMAND_HOME) before the next survey.
+  const auto homes = outputs_of<sv::HomeCommand>(out);
+  ASSERT_EQ(homes.size(), 1u);
+  EXPECT_EQ(s.state(), sv::State::Home);
+  EXPECT_EQ(s.awaited_arm_seq(), homes[0].seq);
+  s.on_arm_state(arm(sv::ArmStatus::Motion::Moving, homes[0].seq), now_ += kSecond);
+  EXPECT_EQ(s.state(), sv::State::Home);
+  s.on_arm_state(arm(sv::ArmStatus::Motion::Done, homes[0].seq), now_ += kSecond);
   EXPECT_EQ(s.state(), sv::State::FindCandidates);
   // The same place again (and the object's new place): nothing new to nudge.
   out = answer_survey(s, {object, rest});
@@ -325,6 +340,8 @@ TEST_F(SupervisorTest, APhantomCandidateShowsNoMotionAndIsRecordedAsSuch) {
   ASSERT_EQ(ended.size(), 1u);
   EXPECT_EQ(ended[0].attempt->outcome, sv::Outcome::NoMotion);
   EXPECT_NE(ended[0].attempt->reason.find("phantom"), std::string::npos);
+  EXPECT_EQ(s.state(), sv::State::Home);  // the arm parks before the next survey
+  park(s);
   EXPECT_EQ(s.state(), sv::State::FindCandidates);
 }
 
@@ -387,7 +404,9 @@ TEST_F(SupervisorTest, AServiceDyingMidNudgeStopsTheArmPausesAndResumesWithASurv
   const auto ended = outputs_of<sv::AttemptEnded>(out);
   ASSERT_EQ(ended.size(), 1u);
   EXPECT_EQ(ended[0].attempt->outcome, sv::Outcome::Aborted);
-  EXPECT_EQ(outputs_of<sv::CandidatesRequest>(out).size(), 1u);
+  EXPECT_EQ(outputs_of<sv::HomeCommand>(out).size(), 1u);  // the arm stopped somewhere: park it first
+  park(s);
+  EXPECT_EQ(outputs_of<sv::CandidatesRequest>(s.take_outputs()).size(), 1u);
   EXPECT_EQ(s.state(), sv::State::FindCandidates);
 }
 
@@ -455,7 +474,7 @@ TEST_F(SupervisorTest, WhatTheTrackersSawDecidesNotTheSettledAxes) {
   }
   s.on_arm_state(arm(sv::ArmStatus::Motion::Done, nudge.seq), now_);
   settle_with_axes(s, {object + 0.03 * nudge.direction});  // AXES would say "fine": the trackers decide
-  ASSERT_EQ(s.state(), sv::State::FindCandidates) << sv::to_string(s.state()) << ": " << s.report().reason;
+  ASSERT_EQ(s.state(), sv::State::Home) << sv::to_string(s.state()) << ": " << s.report().reason;
   const auto ended = outputs_of<sv::AttemptEnded>(s.take_outputs());
   ASSERT_EQ(ended.size(), 1u);
   // Lost, or what they held no longer makes an upright axis: either way no segmentation.

@@ -38,6 +38,7 @@ const char* to_string(State state) {
     case State::SnapshotBefore: return "SNAPSHOT_BEFORE";
     case State::SnapshotAfter: return "SNAPSHOT_AFTER";
     case State::Choose: return "CHOOSE";
+    case State::Home: return "HOME";
   }
   return "?";
 }
@@ -129,6 +130,7 @@ void Supervisor::choose(int64_t now) {
     finish(State::Done, why, now);
     return;
   }
+  nudge_seq_ = 0;  // set when the nudge is commanded: an attempt that ends before needs no homing
   attempt_ = std::make_unique<Attempt>();
   attempt_->number = ++summary_.attempts;
   attempt_->target = choice.target;
@@ -307,7 +309,23 @@ void Supervisor::end_attempt(Outcome outcome, const std::string& reason, int64_t
   for (auto& tracker : trackers_) tracker.reset();
   tracking_started_ = false;
   settled_axes_.clear();
-  survey(now, "attempt " + std::to_string(a.number) + " " + to_string(outcome) + ": " + reason);
+  const std::string why = "attempt " + std::to_string(a.number) + " " + to_string(outcome) + ": " + reason;
+  if (nudge_seq_ == 0) {
+    survey(now, why);
+    return;
+  }
+  // The arm has moved: park it before looking again.
+  nudge_seq_ = 0;
+  home_seq_ = next_seq_++;
+  after_home_ = why;
+  enter(State::Home, now, why + "; parking the arm");
+  outputs_.push_back(HomeCommand{home_seq_});
+}
+
+int64_t Supervisor::awaited_arm_seq() const {
+  if (state_ == State::Nudge) return nudge_seq_;
+  if (state_ == State::Home) return home_seq_;
+  return 0;
 }
 
 // ---- inputs ----
@@ -337,6 +355,9 @@ void Supervisor::on_time(int64_t now) {
       break;
     case State::Track:
       if (static_cast<double>(now - arm_done_time_) >= config_.settle_s * kMicro) verify(now);
+      break;
+    case State::Home:
+      if (timed_out(config_.nudge_timeout_s, now)) survey(now, after_home_ + "; the arm did not report parking in time");
       break;
     default:
       break;
@@ -392,9 +413,17 @@ void Supervisor::on_candidates(const std::vector<Candidate>& candidates, int64_t
 
 void Supervisor::on_arm_state(const ArmStatus& arm, int64_t now) {
   joints_ = arm.joints;
+  if (state_ == State::Home && arm.command_seq == home_seq_ && arm.motion != ArmStatus::Motion::Moving &&
+      arm.motion != ArmStatus::Motion::Idle) {
+    // Parked, or not (refused, stopped): the survey goes ahead either way, saying so.
+    const bool parked = arm.motion == ArmStatus::Motion::Done;
+    survey(now, after_home_ + (parked ? "" : "; the arm did not park (" + arm.last_error + ")"));
+    return;
+  }
   if (state_ != State::Nudge || arm.command_seq != nudge_seq_) return;  // not about our nudge
   switch (arm.motion) {
     case ArmStatus::Motion::Refused:
+      nudge_seq_ = 0;  // nothing moved: no need to park
       end_attempt(Outcome::Refused, "arm refused the nudge: " + arm.last_error, now);
       break;
     case ArmStatus::Motion::Stopped:

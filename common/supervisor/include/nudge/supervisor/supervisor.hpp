@@ -33,7 +33,7 @@ namespace nudge::supervisor {
 // Values mirror supervisor_state_t's STATE_* constants.
 enum class State : int8_t {
   Idle = 0, FindCandidates = 1, Nudge = 2, Track = 3, Segment = 4, Done = 9, Failed = 10,
-  WaitServices = 11, Paused = 12, SnapshotBefore = 13, SnapshotAfter = 14, Choose = 15,
+  WaitServices = 11, Paused = 12, SnapshotBefore = 13, SnapshotAfter = 14, Choose = 15, Home = 16,
 };
 const char* to_string(State state);
 
@@ -100,6 +100,9 @@ struct CandidatesRequest { int frames = 25, lines = 3; };
 struct SnapshotRequest {};
 struct NudgeCommand { int64_t seq = 0; Eigen::Vector3d target, direction; };
 struct StopCommand { int64_t seq = 0; std::string reason; };
+// The arm parks at its home pose (COMMAND_HOME) after a nudge, before the next survey: at the end
+// of a nudge it stands above the table, where its links' symmetry lines would crowd the survey.
+struct HomeCommand { int64_t seq = 0; };
 struct StateReport {
   State state = State::Idle;
   int attempt = 0;                 // 1-based; 0 before the first
@@ -148,7 +151,7 @@ struct Summary {
 };
 struct Finished { Summary summary; };
 
-using Output = std::variant<CandidatesRequest, SnapshotRequest, NudgeCommand, StopCommand, StateReport,
+using Output = std::variant<CandidatesRequest, SnapshotRequest, NudgeCommand, StopCommand, HomeCommand, StateReport,
                             AttemptEnded, Finished>;
 
 class Supervisor {
@@ -177,6 +180,8 @@ class Supervisor {
   const StateReport& report() const { return report_; }
   const Summary& summary() const { return summary_; }
   bool finished() const { return state_ == State::Done || state_ == State::Failed; }
+  // The seq of the arm command the loop waits for (a nudge or the homing after it), 0 if none.
+  int64_t awaited_arm_seq() const;
 
  private:
   void enter(State state, int64_t now, const std::string& reason);
@@ -198,7 +203,8 @@ class Supervisor {
   std::vector<Output> outputs_;
   State state_ = State::Idle;
   State paused_from_ = State::Idle;
-  int64_t entered_ = 0, request_time_ = 0, arm_done_time_ = 0, next_seq_ = 1, nudge_seq_ = 0;
+  int64_t entered_ = 0, request_time_ = 0, arm_done_time_ = 0, next_seq_ = 1, nudge_seq_ = 0, home_seq_ = 0;
+  std::string after_home_;  // why the survey after homing happens
   std::vector<Candidate> candidates_;
   std::vector<Eigen::Vector3d> explored_, empty_;
   std::vector<Axis> settled_axes_;
