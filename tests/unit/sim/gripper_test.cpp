@@ -1,7 +1,6 @@
 // The gripper: lift, turn and put back a bottle; determinism.
 #include "sim_test_helpers.hpp"
 
-
 using namespace nudge::sim;
 using namespace nudge::sim::test;
 

@@ -3,8 +3,6 @@
 
 #include <filesystem>
 
-#include "nudge/sim/mjcf.hpp"
-
 using namespace nudge::sim;
 using namespace nudge::sim::test;
 

@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include "nudge/sim/camera.hpp"
+#include "nudge/sim/mjcf.hpp"
 #include "nudge/sim/objects.hpp"
 #include "nudge/sim/scene.hpp"
 #include "nudge/sim/world.hpp"
