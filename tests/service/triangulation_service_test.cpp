@@ -4,7 +4,6 @@
 // with NaNs, an image size that disagrees with the calibration, a message without a partner.
 #include <gtest/gtest.h>
 #include <sys/stat.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <Eigen/Geometry>
@@ -29,6 +28,7 @@
 #include "nudge/heartbeat_t.hpp"
 #include "nudge/symmetry_lines_t.hpp"
 #include "nudge/test/lcm_log.hpp"
+#include "nudge/test/run_service.hpp"
 
 namespace geo = nudge::geometry;
 namespace sym = nudge::symmetry;
@@ -147,16 +147,11 @@ std::string scratch_dir() {
 
 std::string bin(const std::string& name) { return std::string(NUDGE_BIN_DIR) + "/" + name; }
 
+// Runs a command; its standard error into *err. Returns the exit code (-1 if killed).
 int run(const std::string& cmd, std::string* err = nullptr) {
-  // One file per test: ctest runs the tests of this binary in parallel.
-  const std::string err_path = scratch_dir() + "/triangulation_stderr_" +
-                               testing::UnitTest::GetInstance()->current_test_info()->name() + ".txt";
-  const int status = std::system((cmd + " 2>" + err_path).c_str());
-  if (err) {
-    std::ifstream in(err_path);
-    err->assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  }
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  const auto result = nudge::test::run_capturing(cmd);
+  if (err) *err = result.err;
+  return result.exit_code;
 }
 
 struct Scene {

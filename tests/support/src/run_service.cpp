@@ -4,8 +4,12 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <array>
+#include <atomic>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
+#include <iterator>
 
 namespace nudge::test {
 
@@ -18,6 +22,22 @@ std::string temp_path(const std::string& name) {
 int run_command(const std::string& command) {
   const int status = std::system(command.c_str());
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+CommandOutput run_capturing(const std::string& command) {
+  static std::atomic<int> counter{0};
+  const std::string err_path = temp_path("stderr_" + std::to_string(counter++) + ".txt");
+  CommandOutput result;
+  FILE* pipe = ::popen((command + " 2>" + err_path).c_str(), "r");
+  if (!pipe) throw std::runtime_error("cannot run " + command);
+  std::array<char, 4096> buf{};
+  for (size_t n; (n = std::fread(buf.data(), 1, buf.size(), pipe)) > 0;) result.out.append(buf.data(), n);
+  const int status = ::pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  std::ifstream err(err_path);
+  result.err.assign(std::istreambuf_iterator<char>(err), std::istreambuf_iterator<char>());
+  std::remove(err_path.c_str());
+  return result;
 }
 
 LogRun run_from_log(const std::string& program, const std::string& args, const std::string& in,

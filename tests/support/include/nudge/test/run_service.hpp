@@ -16,6 +16,15 @@ std::string temp_path(const std::string& name);
 // Runs a shell command. Returns its exit code, or -1 when it did not exit (killed by a signal).
 int run_command(const std::string& command);
 
+struct CommandOutput {
+  int exit_code = -1;  // -1 when the command did not exit (killed by a signal)
+  std::string out;     // its standard output
+  std::string err;     // its standard error
+};
+// Runs a shell command capturing its standard output and error (the command must not redirect
+// them itself).
+CommandOutput run_capturing(const std::string& command);
+
 struct LogRun {
   std::string command;  // what ran, for failure messages
   int exit_code = -1;
