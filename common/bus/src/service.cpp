@@ -50,6 +50,7 @@ void Service::start() {
 
 void Service::start(const std::string& in_url, const std::string& requested_out_url) {
   const std::string out_url = requested_out_url.empty() ? in_url : requested_out_url;
+  subscriptions_.reset();  // before a previous start()'s LCM goes: they unsubscribe from it
   owned_in_ = std::make_unique<lcm::LCM>(in_url);
   if (!owned_in_->good()) throw std::runtime_error("cannot open LCM input '" + in_url + "'");
   if (out_url != in_url) {
@@ -71,7 +72,7 @@ void Service::start(lcm::LCM& input, lcm::LCM* output) {
 
 void Service::attach(lcm::LCM& input, lcm::LCM& output) {
   if (instance_.empty()) instance_ = name_;  // parse() was not called: no command line
-  subscriptions_.reset();  // unsubscribes from a previous input
+  subscriptions_.reset();  // unsubscribes from a previous start()'s input
   in_ = &input;
   out_ = &output;
   subscriptions_ = std::make_unique<Subscriptions>(*in_, counters_);
