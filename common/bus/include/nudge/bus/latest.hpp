@@ -40,7 +40,8 @@ class Latest {
     require_message();
     return state_->message;
   }
-  // LCM's receive time of the newest message (the log's timestamp when reading a log).
+  // LCM's receive time of the newest message: wall-clock microseconds, also when the input is a
+  // log (the file provider stamps events as it plays them, not with their logged time).
   int64_t receive_utime() const {
     std::lock_guard<std::mutex> lock(state_->mutex);
     require_message();

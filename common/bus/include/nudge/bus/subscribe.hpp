@@ -40,8 +40,9 @@ class Subscriptions {
     });
   }
 
-  // handler(msg, channel, receive_utime): LCM's receive time, which is the event's timestamp when
-  // the input is a log (so handlers that keep it stay deterministic) and wall time on a live bus.
+  // handler(msg, channel, receive_utime): LCM's receive time, wall-clock microseconds on every
+  // provider (a played log's events are stamped as they are read). Logic that must replay
+  // deterministically uses the message's own utime instead.
   template <typename Msg>
   void subscribe_timed(const std::string& channel,
                        std::function<void(const Msg&, const std::string& channel, int64_t receive_utime)> handler) {
