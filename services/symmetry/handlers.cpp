@@ -53,12 +53,6 @@ segmentation::SegmentParams segment_params_for(const Options& options) {
 
 }  // namespace
 
-std::string output_channel(const std::string& input, const std::string& kind) {
-  const std::string prefix = "CAMERA";
-  if (input.rfind(prefix, 0) == 0) return kind + input.substr(prefix.size());
-  return kind + "_" + input;
-}
-
 Handlers::Handlers(bus::Service& service, const Options& options)
     : service_(service),
       options_(options),
@@ -66,8 +60,8 @@ Handlers::Handlers(bus::Service& service, const Options& options)
       segmenter_(segment_params_for(options)) {
   options_.edge = edge_params_for(options);
   for (const auto& channel : options_.inputs) {
-    const std::string out = output_channel(channel, "SYMMETRY");
-    const std::string contours_out = output_channel(channel, "CONTOURS");
+    const std::string out = bus::channel::derived(channel, bus::channel::SYMMETRY);
+    const std::string contours_out = bus::channel::derived(channel, bus::channel::CONTOURS);
     service_.subscriptions().subscribe<image_t>(
         channel, [this, out, contours_out](const image_t& msg, const std::string&) { on_image(msg, out, contours_out); });
     log::info() << channel << " -> " << out;

@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "nudge/bus/channels.hpp"
 #include "nudge/bus/service.hpp"
 #include "nudge/image_t.hpp"
 #include "nudge/segmentation/segment.hpp"
@@ -14,12 +15,9 @@ namespace nudge::symmetry_service {
 struct Options {
   symmetry::Params params;
   symmetry::EdgeParams edge;
-  std::vector<std::string> inputs = {"CAMERA_LEFT", "CAMERA_RIGHT"};
+  std::vector<std::string> inputs = {bus::channel::CAMERA_LEFT, bus::channel::CAMERA_RIGHT};
   int contours = 0;  // also segment the contours of the top N lines; 0: off
 };
-
-// CAMERA_LEFT -> SYMMETRY_LEFT (or CONTOURS_LEFT); other names get the prefix.
-std::string output_channel(const std::string& input, const std::string& kind);
 
 // Subscribes the started `service` to every input channel: each image's symmetry lines go out on
 // its SYMMETRY_* channel, with Options::contours > 0 also the contours on CONTOURS_*. A bad image

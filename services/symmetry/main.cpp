@@ -2,6 +2,7 @@
 // them on the matching SYMMETRY_* channel (CAMERA_LEFT -> SYMMETRY_LEFT, CAMERA -> SYMMETRY); with
 // --contours N also the object contours of the top N lines on CONTOURS_* (thesis sec. 4.2).
 #include "handlers.hpp"
+#include "nudge/bus/channels.hpp"
 #include "nudge/bus/service.hpp"
 #include "nudge/flags.hpp"
 

@@ -64,13 +64,6 @@ struct InProcess {
 
 }  // namespace
 
-TEST(SymmetryHandlers, OutputChannelsFollowTheCameraChannels) {
-  using nudge::symmetry_service::output_channel;
-  EXPECT_EQ(output_channel("CAMERA_LEFT", "SYMMETRY"), "SYMMETRY_LEFT");
-  EXPECT_EQ(output_channel("CAMERA", "CONTOURS"), "CONTOURS");
-  EXPECT_EQ(output_channel("FRONT", "SYMMETRY"), "SYMMETRY_FRONT");
-}
-
 TEST(SymmetryHandlers, EveryImageGetsItsLinesAtTheKnownAxis) {
   InProcess run(mono_options());
   for (int i = 0; i < 3; ++i) {

@@ -51,17 +51,28 @@ std::map<int64_t, Truth> write_input_log(const std::string& path) {
     syn::draw_shape(img, syn::bottle_profile(160, 30), t.r, t.theta, 0, cv::Scalar(40, 60, 90));
     const int64_t utime = 1000000 + 40000 * i;
     const int8_t format = i % 2 ? nudge::image_t::FORMAT_PNG : nudge::image_t::FORMAT_GRAY8;
-    log.write(utime, "CAMERA", nudge::bus::to_message(img, format, utime, i, "mono"));
+    log.write(utime, channel::CAMERA, nudge::bus::to_message(img, format, utime, i, "mono"));
     truth[utime] = t;
     if (i == 2) {  // a truncated message: must be reported and skipped
       auto bytes = encode(nudge::bus::to_message(img, nudge::image_t::FORMAT_GRAY8, utime + 1, 99, "mono"));
       bytes.resize(bytes.size() / 2);
-      log.raw(utime + 1, "CAMERA", bytes);
+      log.raw(utime + 1, channel::CAMERA, bytes);
+    }
+    if (i == 3) {  // the camera string declares length 0: LCM 1.3.1's decode() throws on it
+      auto bytes = encode(nudge::bus::to_message(img, nudge::image_t::FORMAT_GRAY8, utime + 1, 97, "mono"));
+      put_int32(&bytes, kCameraLengthOffset, 0);
+      log.raw(utime + 1, channel::CAMERA, bytes);
+    }
+    if (i == 5) {  // 114 bytes declaring a 2 GB image: refused before anything is allocated
+      auto bytes = encode(nudge::bus::to_message(img, nudge::image_t::FORMAT_GRAY8, utime + 1, 96, "mono"));
+      bytes.resize(114);
+      put_int32(&bytes, kSizeOffset, 2000000000);
+      log.raw(utime + 1, channel::CAMERA, bytes);
     }
     if (i == 4) {  // an unknown pixel format
       auto bad = nudge::bus::to_message(img, nudge::image_t::FORMAT_GRAY8, utime + 2, 98, "mono");
       bad.pixel_format = 42;
-      log.write(utime + 2, "CAMERA", bad);
+      log.write(utime + 2, channel::CAMERA, bad);
     }
   }
   return truth;
@@ -77,7 +88,7 @@ TEST(SymmetryService, LogInLogOutMatchesTheKnownAxesAndSkipsBadMessages) {
                                 in, nudge::test::temp_path("symmetry_out.lcmlog"));
   ASSERT_EQ(run.exit_code, 0) << run.command;
   std::map<int64_t, nudge::symmetry_lines_t> results;
-  for (const auto& msg : nudge::test::messages_on<nudge::symmetry_lines_t>(run.output, "SYMMETRY"))
+  for (const auto& msg : nudge::test::messages_on<nudge::symmetry_lines_t>(run.output, channel::SYMMETRY))
     results[msg.utime] = msg;
   const int64_t errors_reported = nudge::test::last_heartbeat_errors(run.output);
   ASSERT_EQ(results.size(), truth.size()) << "one SYMMETRY message per good frame";
@@ -102,7 +113,7 @@ TEST(SymmetryService, ContoursOfTheTopLinesOnRequest) {
                                 in, nudge::test::temp_path("contours_out.lcmlog"));
   ASSERT_EQ(run.exit_code, 0) << run.command;
   int frames = 0;
-  for (const auto& msg : nudge::test::messages_on<nudge::contours_t>(run.output, "CONTOURS")) {
+  for (const auto& msg : nudge::test::messages_on<nudge::contours_t>(run.output, channel::CONTOURS)) {
     ++frames;
     ASSERT_EQ(msg.num_contours, 1);
     const auto& c = msg.contours[0];

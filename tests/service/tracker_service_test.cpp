@@ -63,11 +63,11 @@ void write_input_log(const std::string& path) {
   for (int i = 0; i < kFrames; ++i) {
     const int64_t utime = kStart + kPeriod * i;
     const auto image = nudge::bus::to_message(frame(i), nudge::image_t::FORMAT_GRAY8, utime, i, "left");
-    log.write(utime, "CAMERA_LEFT", image);
+    log.write(utime, channel::CAMERA_LEFT, image);
     if (i == 10) {  // a truncated image: reported, counted and skipped
       auto bytes = encode(image);
       bytes.resize(bytes.size() / 3);
-      log.raw(utime + 1, "CAMERA_LEFT", bytes);
+      log.raw(utime + 1, channel::CAMERA_LEFT, bytes);
     }
     if (i == kRestartAfter) {
       nudge::tracker_command_t cmd{};
@@ -75,7 +75,7 @@ void write_input_log(const std::string& path) {
       cmd.channel = channel::TRACK_LEFT;
       cmd.command = nudge::tracker_command_t::COMMAND_RESTART;
       cmd.reason = "operator restart";
-      log.write(utime + 2, "TRACKER_COMMAND", cmd);
+      log.write(utime + 2, channel::TRACKER_COMMAND, cmd);
     }
   }
 }
@@ -91,10 +91,10 @@ TEST(TrackerService, LogInLogOutTracksTheMovingBottleAndRestartsOnRequest) {
   ASSERT_EQ(run.exit_code, 0) << run.command;
 
   std::map<int64_t, nudge::track_t> tracks;
-  for (const auto& msg : nudge::test::messages_on<nudge::track_t>(run.output, "TRACK_LEFT")) tracks[msg.frame_id] = msg;
-  EXPECT_TRUE(nudge::test::messages_on<nudge::track_t>(run.output, "TRACK_RIGHT").empty())
+  for (const auto& msg : nudge::test::messages_on<nudge::track_t>(run.output, channel::TRACK_LEFT)) tracks[msg.frame_id] = msg;
+  EXPECT_TRUE(nudge::test::messages_on<nudge::track_t>(run.output, channel::TRACK_RIGHT).empty())
       << "no right frames, no right tracks";
-  const auto heartbeats = nudge::test::messages_on<nudge::heartbeat_t>(run.output, "HEARTBEAT");
+  const auto heartbeats = nudge::test::messages_on<nudge::heartbeat_t>(run.output, channel::HEARTBEAT);
   ASSERT_FALSE(heartbeats.empty());
   const nudge::heartbeat_t& last_heartbeat = heartbeats.back();
   ASSERT_EQ(tracks.size(), static_cast<size_t>(kFrames)) << "one TRACK_LEFT per good frame";
@@ -153,18 +153,18 @@ TEST(TrackerService, AStoppedStreamIsReportedInTheHeartbeat) {
     for (int i = 0; i < 5; ++i) {
       cv::Mat small;
       cv::resize(frame(i), small, cv::Size(160, 120));
-      log.write(kStart + kPeriod * i, "CAMERA_LEFT",
+      log.write(kStart + kPeriod * i, channel::CAMERA_LEFT,
                 nudge::bus::to_message(small, nudge::image_t::FORMAT_GRAY8, kStart + kPeriod * i, i, "left"));
     }
     nudge::tracker_command_t cmd{};
     cmd.command = nudge::tracker_command_t::COMMAND_RESTART;
-    log.write(kStart + kPeriod * 5 + 2500000, "TRACKER_COMMAND", cmd);
+    log.write(kStart + kPeriod * 5 + 2500000, channel::TRACKER_COMMAND, cmd);
   }
   ASSERT_EQ(run(" --inputs CAMERA_LEFT --stale 0.5 --lcm-in 'file://" + in + "?speed=1' --lcm-out 'file://" + out +
                 "?mode=w'"),
             0);
   bool reported = false;
-  for (const auto& hb : nudge::test::read_messages<nudge::heartbeat_t>(out, "HEARTBEAT"))
+  for (const auto& hb : nudge::test::read_messages<nudge::heartbeat_t>(out, channel::HEARTBEAT))
     reported = reported || hb.status.find("CAMERA_LEFT stopped") != std::string::npos;
   EXPECT_TRUE(reported) << "a heartbeat during the silence names the stopped stream";
 }

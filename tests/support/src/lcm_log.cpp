@@ -1,5 +1,6 @@
 #include "nudge/test/lcm_log.hpp"
 
+#include "nudge/bus/channels.hpp"
 #include "nudge/heartbeat_t.hpp"
 
 namespace nudge::test {
@@ -43,7 +44,7 @@ std::vector<Event> read_log(const std::string& path) {
 }
 
 int64_t last_heartbeat_errors(const std::vector<Event>& events) {
-  const auto heartbeats = messages_on<heartbeat_t>(events, "HEARTBEAT");
+  const auto heartbeats = messages_on<heartbeat_t>(events, bus::channel::HEARTBEAT);
   return heartbeats.empty() ? -1 : heartbeats.back().errors;
 }
 

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "nudge/bus/channels.hpp"
 #include "nudge/bus/latest.hpp"
 #include "nudge/bus/service.hpp"
 #include "nudge/heartbeat_t.hpp"
@@ -40,7 +41,7 @@ void install_echo(Service& service) {
 // The test's end of the bus: what the service publishes.
 struct Probe {
   explicit Probe(lcm::LCM& lcm) : subscriptions(lcm, counters), out(subscriptions, "OUT"),
-                                   heartbeats(subscriptions, nudge::bus::kHeartbeatChannel) {}
+                                   heartbeats(subscriptions, nudge::bus::channel::HEARTBEAT) {}
   nudge::bus::Counters counters;
   Subscriptions subscriptions;
   Latest<heartbeat_t> out, heartbeats;
