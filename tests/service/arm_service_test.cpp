@@ -2,12 +2,8 @@
 // the log's timestamps). Input logs hold ARM_COMMAND requests and HEARTBEAT traffic that moves
 // the clock; the output's ARM_STATE stream is checked against the robot library's kinematics.
 #include <gtest/gtest.h>
-#include <lcm/lcm-cpp.hpp>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <cmath>
-#include <cstdlib>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -21,13 +17,16 @@
 #include "nudge/robot/motions.hpp"
 #include "nudge/robot/puma260.hpp"
 #include "nudge/sim_state_t.hpp"
-#include "lcm_log.hpp"
+#include "nudge/test/lcm_log.hpp"
+#include "nudge/test/run_service.hpp"
 
 namespace channel = nudge::bus::channel;
 
 namespace {
 
 using nudge::test::encode;
+using nudge::test::run_from_log;
+using nudge::test::temp_path;
 
 using nudge::arm_command_t;
 using nudge::arm_state_t;
@@ -40,28 +39,18 @@ constexpr int64_t kSecond = 1000000;
 constexpr int kMoving = arm_state_t::MOTION_MOVING, kDone = arm_state_t::MOTION_DONE,
               kRefused = arm_state_t::MOTION_REFUSED, kStopped = arm_state_t::MOTION_STOPPED;
 
-// Per-process names: several build trees may run their tests at the same time.
-std::string temp_path(const std::string& name) {
-  return testing::TempDir() + "/" + std::to_string(getpid()) + "_" + name;
-}
-
 // An input log under construction: events must be added in time order.
 class InputLog {
  public:
-  explicit InputLog(const std::string& path) : log_(path, "w") {}
+  explicit InputLog(const std::string& path) : log_(path) {}
 
   void raw(int64_t utime, const std::string& channel, const std::vector<uint8_t>& bytes) {
-    lcm::LogEvent ev{};
-    ev.timestamp = utime;
-    ev.channel = channel;
-    ev.datalen = static_cast<int32_t>(bytes.size());
-    ev.data = const_cast<uint8_t*>(bytes.data());
-    ASSERT_EQ(log_.writeEvent(&ev), 0);
+    log_.raw(utime, channel, bytes);
   }
   void command(int64_t utime, arm_command_t cmd) {
     cmd.utime = utime;
     cmd.num_joints = static_cast<int32_t>(cmd.joints.size());
-    raw(utime, channel::ARM_COMMAND, encode(cmd));
+    log_.write(utime, "ARM_COMMAND", cmd);
   }
   void heartbeat(int64_t utime, const std::string& service, int8_t state = heartbeat_t::STATE_RUNNING) {
     heartbeat_t hb{};
@@ -69,7 +58,7 @@ class InputLog {
     hb.service = service;
     hb.instance = service;
     hb.state = state;
-    raw(utime, channel::HEARTBEAT, encode(hb));
+    log_.write(utime, "HEARTBEAT", hb);
   }
   // Other services' heartbeats every 100 ms over [from, to): traffic that moves the log clock.
   void traffic(int64_t from, int64_t to, const std::string& service = "world") {
@@ -77,7 +66,7 @@ class InputLog {
   }
 
  private:
-  lcm::LogFile log_;
+  nudge::test::LogWriter log_;
 };
 
 struct Output {
@@ -86,26 +75,9 @@ struct Output {
 };
 
 Output run_service(const std::string& in, const std::string& out, const std::string& flags = "") {
-  std::remove(out.c_str());
-  const std::string cmd = std::string(NUDGE_BIN_DIR) + "/nudge-arm --backend fake" + flags +
-                          " --lcm-in 'file://" + in + "?speed=0' --lcm-out 'file://" + out + "?mode=w'";
-  const int status = std::system(cmd.c_str());
-  Output output;
-  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << cmd;
-  lcm::LogFile log(out, "r");
-  EXPECT_TRUE(log.good()) << out;
-  for (const lcm::LogEvent* ev = log.readNextEvent(); ev; ev = log.readNextEvent()) {
-    if (ev->channel == channel::ARM_STATE) {
-      arm_state_t s;
-      EXPECT_GE(s.decode(ev->data, 0, ev->datalen), 0);
-      output.states.push_back(s);
-    } else if (ev->channel == channel::HEARTBEAT) {
-      heartbeat_t hb;
-      EXPECT_GE(hb.decode(ev->data, 0, ev->datalen), 0);
-      output.errors = hb.errors;
-    }
-  }
-  return output;
+  const auto run = run_from_log("nudge-arm", "--backend fake" + flags, in, out);
+  EXPECT_EQ(run.exit_code, 0) << run.command;
+  return {nudge::test::messages_on<arm_state_t>(run.output, "ARM_STATE"), nudge::test::last_heartbeat_errors(run.output)};
 }
 
 std::vector<arm_state_t> of_command(const std::vector<arm_state_t>& states, int64_t seq) {
@@ -390,18 +362,9 @@ TEST(ArmService, GraspsRotatesPlacesAndParksOnTheSimBackend) {
     log.command(kStart + 45 * kSecond, simple_command(4, arm_command_t::COMMAND_HOME));
     log.traffic(kStart + 45 * kSecond + 100000, kStart + 55 * kSecond);
   }
-  std::remove(out.c_str());
-  const std::string cmd = std::string(NUDGE_BIN_DIR) + "/nudge-arm --backend sim --lcm-in 'file://" + in +
-                          "?speed=0' --lcm-out 'file://" + out + "?mode=w'";
-  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
-  std::vector<arm_state_t> states;
-  lcm::LogFile log(out, "r");
-  for (const lcm::LogEvent* ev = log.readNextEvent(); ev; ev = log.readNextEvent()) {
-    if (ev->channel != channel::ARM_STATE) continue;
-    arm_state_t s;
-    ASSERT_GE(s.decode(ev->data, 0, ev->datalen), 0);
-    states.push_back(s);
-  }
+  const auto run = run_from_log("nudge-arm", "--backend sim", in, out);
+  ASSERT_EQ(run.exit_code, 0) << run.command;
+  const auto states = nudge::test::messages_on<arm_state_t>(run.output, "ARM_STATE");
   const nudge::robot::GraspParams grasp_params;
 
   const auto grasp = of_command(states, 1);
@@ -482,10 +445,8 @@ TEST(ArmService, WorkspaceFileAndItsOverrides) {
   ASSERT_EQ(moved.back().motion + 0, kDone) << moved.back().last_error;
   EXPECT_LT((position(moved.back()) - target).norm(), 1e-3);  // the file's turned, higher base
 
-  const std::string bin = std::string(NUDGE_BIN_DIR) + "/nudge-arm";
-  const int status = std::system((bin + " --workspace " + temp_path("no_such_workspace.yaml") + " 2>/dev/null").c_str());
-  ASSERT_TRUE(WIFEXITED(status));
-  EXPECT_EQ(WEXITSTATUS(status), 2);
+  const std::string bin = nudge::test::bin_dir() + "/nudge-arm";
+  EXPECT_EQ(nudge::test::run_command(bin + " --workspace " + temp_path("no_such_workspace.yaml") + " 2>/dev/null"), 2);
 }
 
 TEST(ArmService, ClockSimFollowsTheSimulatedTimeOfSimState) {
@@ -521,11 +482,9 @@ TEST(ArmService, ClockSimFollowsTheSimulatedTimeOfSimState) {
 }
 
 TEST(ArmService, BadFlagsAreRefusedWithAUsageError) {
-  const std::string bin = std::string(NUDGE_BIN_DIR) + "/nudge-arm";
+  const std::string bin = nudge::test::bin_dir() + "/nudge-arm";
   for (const std::string args : {" --backend hardware", " --clock moon", " --rate 0", " --speed-scale 2",
                                  " --initial-joints 0 0 0 0 0 400", " --base-height -1", " --no-such-flag"}) {
-    const int status = std::system((bin + args + " 2>/dev/null").c_str());
-    ASSERT_TRUE(WIFEXITED(status));
-    EXPECT_EQ(WEXITSTATUS(status), 2) << args;
+    EXPECT_EQ(nudge::test::run_command(bin + args + " 2>/dev/null"), 2) << args;
   }
 }

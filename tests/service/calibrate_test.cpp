@@ -3,7 +3,6 @@
 // so its absence is a broken set-up and fails the test rather than skipping it.
 #include <gtest/gtest.h>
 #include <sys/stat.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <opencv2/calib3d.hpp>
@@ -17,6 +16,7 @@
 
 #include "nudge/geometry/stereo_rig.hpp"
 #include "nudge/geometry/workspace.hpp"
+#include "nudge/test/run_service.hpp"
 
 namespace {
 
@@ -33,19 +33,10 @@ std::string scratch_dir(const std::string& name) {
 
 // Runs a command; stdout into *out, stderr into *err. Returns the exit code (-1 if killed).
 int run(const std::string& cmd, std::string* out, std::string* err) {
-  // One file per test: ctest runs the tests of this binary in parallel.
-  const std::string err_path = scratch_dir("calibrate_stderr") + "/" +
-                               testing::UnitTest::GetInstance()->current_test_info()->name() + ".txt";
-  FILE* pipe = popen((cmd + " 2>" + err_path).c_str(), "r");
-  if (!pipe) return -1;
-  std::array<char, 4096> buf{};
-  std::string text;
-  while (fgets(buf.data(), buf.size(), pipe)) text += buf.data();
-  const int status = pclose(pipe);
-  *out = text;
-  std::ifstream in(err_path);
-  err->assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  const auto result = nudge::test::run_capturing(cmd);
+  *out = result.out;
+  *err = result.err;
+  return result.exit_code;
 }
 
 void require_opencv_doc() {

@@ -3,7 +3,6 @@
 // while the others still run.
 #include <gtest/gtest.h>
 #include <sys/stat.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <opencv2/imgcodecs.hpp>
@@ -17,20 +16,17 @@
 #include <string>
 
 #include "nudge/symmetry/synthetic.hpp"
+#include "nudge/test/run_service.hpp"
 
 namespace syn = nudge::symmetry::synthetic;
 
 namespace {
 
+// Runs a command; its standard output into *out. Returns the exit code.
 int run(const std::string& cmd, std::string* out) {
-  FILE* pipe = popen(cmd.c_str(), "r");
-  if (!pipe) return -1;
-  std::array<char, 4096> buf{};
-  std::string text;
-  while (fgets(buf.data(), buf.size(), pipe)) text += buf.data();
-  const int status = pclose(pipe);
-  *out = text;
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  const auto result = nudge::test::run_capturing(cmd);
+  *out = result.out;
+  return result.exit_code;
 }
 
 // The [[x, y], ...] array after "key": in a JSON text.
@@ -63,7 +59,7 @@ TEST(SegmentTool, BottleContourFollowsTheOutline) {
   std::string out;
   const std::string cmd = std::string(NUDGE_BIN_DIR) + "/nudge-segment " + dir + "/bottle.png " + dir +
                           "/broken.png --lines 1 --dmin 10 --dmax 0 --theta-min -30 --theta-max 30 --canny 30 90" +
-                          " --blur 1 --draw " + picture + " 2>/dev/null";
+                          " --blur 1 --draw " + picture;
   EXPECT_EQ(run(cmd, &out), 1) << "the unreadable image makes the exit code 1";
   ASSERT_EQ(std::count(out.begin(), out.end(), '\n'), 1) << "one JSON line, for the readable image: " << out;
 
@@ -91,6 +87,6 @@ TEST(SegmentTool, BadFlagsAreUsageErrors) {
   std::string out;
   const std::string bin = std::string(NUDGE_BIN_DIR) + "/nudge-segment";
   for (const std::string args : {" x.png --max-mid 0", " x.png --max-width 1", " x.png --canny 90", " --lines 2"}) {
-    EXPECT_EQ(run(bin + args + " 2>/dev/null", &out), 2) << args;
+    EXPECT_EQ(run(bin + args, &out), 2) << args;
   }
 }

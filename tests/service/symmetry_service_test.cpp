@@ -2,11 +2,8 @@
 // provider (file://in?speed=0 in, file://out?mode=w out). The input log holds synthetic frames
 // with known axes, a truncated message and an image with an unknown pixel format.
 #include <gtest/gtest.h>
-#include <lcm/lcm-cpp.hpp>
-#include <sys/wait.h>
 
 #include <cmath>
-#include <cstdlib>
 #include <map>
 #include <string>
 
@@ -17,7 +14,8 @@
 #include "nudge/symmetry/detector.hpp"
 #include "nudge/symmetry/synthetic.hpp"
 #include "nudge/symmetry_lines_t.hpp"
-#include "lcm_log.hpp"
+#include "nudge/test/lcm_log.hpp"
+#include "nudge/test/run_service.hpp"
 
 namespace syn = nudge::symmetry::synthetic;
 namespace channel = nudge::bus::channel;
@@ -25,7 +23,8 @@ namespace channel = nudge::bus::channel;
 namespace {
 
 using nudge::test::encode;
-using nudge::test::write_event;
+using nudge::test::LogWriter;
+using nudge::test::run_from_log;
 
 constexpr double kDeg = M_PI / 180.0;
 
@@ -44,7 +43,7 @@ void put_int32(std::vector<uint8_t>* bytes, size_t offset, int32_t value) {
 
 // Frames with one upright bottle each, at known axes.
 std::map<int64_t, Truth> write_input_log(const std::string& path) {
-  lcm::LogFile log(path, "w");
+  LogWriter log(path);
   std::map<int64_t, Truth> truth;
   for (int i = 0; i < 6; ++i) {
     cv::Mat img(240, 320, CV_8UC3, cv::Scalar(200, 210, 220));
@@ -52,28 +51,28 @@ std::map<int64_t, Truth> write_input_log(const std::string& path) {
     syn::draw_shape(img, syn::bottle_profile(160, 30), t.r, t.theta, 0, cv::Scalar(40, 60, 90));
     const int64_t utime = 1000000 + 40000 * i;
     const int8_t format = i % 2 ? nudge::image_t::FORMAT_PNG : nudge::image_t::FORMAT_GRAY8;
-    write_event(log, utime, channel::CAMERA, encode(nudge::bus::to_message(img, format, utime, i, "mono")));
+    log.write(utime, channel::CAMERA, nudge::bus::to_message(img, format, utime, i, "mono"));
     truth[utime] = t;
     if (i == 2) {  // a truncated message: must be reported and skipped
       auto bytes = encode(nudge::bus::to_message(img, nudge::image_t::FORMAT_GRAY8, utime + 1, 99, "mono"));
       bytes.resize(bytes.size() / 2);
-      write_event(log, utime + 1, channel::CAMERA, bytes);
+      log.raw(utime + 1, channel::CAMERA, bytes);
     }
     if (i == 3) {  // the camera string declares length 0: LCM 1.3.1's decode() throws on it
       auto bytes = encode(nudge::bus::to_message(img, nudge::image_t::FORMAT_GRAY8, utime + 1, 97, "mono"));
       put_int32(&bytes, kCameraLengthOffset, 0);
-      write_event(log, utime + 1, channel::CAMERA, bytes);
+      log.raw(utime + 1, channel::CAMERA, bytes);
     }
     if (i == 5) {  // 114 bytes declaring a 2 GB image: refused before anything is allocated
       auto bytes = encode(nudge::bus::to_message(img, nudge::image_t::FORMAT_GRAY8, utime + 1, 96, "mono"));
       bytes.resize(114);
       put_int32(&bytes, kSizeOffset, 2000000000);
-      write_event(log, utime + 1, channel::CAMERA, bytes);
+      log.raw(utime + 1, channel::CAMERA, bytes);
     }
     if (i == 4) {  // an unknown pixel format
       auto bad = nudge::bus::to_message(img, nudge::image_t::FORMAT_GRAY8, utime + 2, 98, "mono");
       bad.pixel_format = 42;
-      write_event(log, utime + 2, channel::CAMERA, encode(bad));
+      log.write(utime + 2, channel::CAMERA, bad);
     }
   }
   return truth;
@@ -82,33 +81,16 @@ std::map<int64_t, Truth> write_input_log(const std::string& path) {
 }  // namespace
 
 TEST(SymmetryService, LogInLogOutMatchesTheKnownAxesAndSkipsBadMessages) {
-  const std::string dir = testing::TempDir();
-  const std::string in = dir + "/symmetry_in.lcmlog", out = dir + "/symmetry_out.lcmlog";
-  std::remove(out.c_str());
+  const std::string in = nudge::test::temp_path("symmetry_in.lcmlog");
   const auto truth = write_input_log(in);
 
-  const std::string cmd = std::string(NUDGE_BIN_DIR) + "/nudge-symmetry --inputs CAMERA --lines 3 --dmin 10 --dmax 0" +
-                          " --theta-min -30 --theta-max 30 --lcm-in 'file://" + in + "?speed=0'" +
-                          " --lcm-out 'file://" + out + "?mode=w'";
-  const int status = std::system(cmd.c_str());
-  ASSERT_TRUE(WIFEXITED(status)) << cmd;
-  ASSERT_EQ(WEXITSTATUS(status), 0) << cmd;
-
-  lcm::LogFile log(out, "r");
-  ASSERT_TRUE(log.good());
+  const auto run = run_from_log("nudge-symmetry", "--inputs CAMERA --lines 3 --dmin 10 --dmax 0 --theta-min -30 --theta-max 30",
+                                in, nudge::test::temp_path("symmetry_out.lcmlog"));
+  ASSERT_EQ(run.exit_code, 0) << run.command;
   std::map<int64_t, nudge::symmetry_lines_t> results;
-  int64_t errors_reported = -1;
-  for (const lcm::LogEvent* ev = log.readNextEvent(); ev; ev = log.readNextEvent()) {
-    if (ev->channel == channel::SYMMETRY) {
-      nudge::symmetry_lines_t msg;
-      ASSERT_GE(msg.decode(ev->data, 0, ev->datalen), 0);
-      results[msg.utime] = msg;
-    } else if (ev->channel == channel::HEARTBEAT) {
-      nudge::heartbeat_t hb;
-      ASSERT_GE(hb.decode(ev->data, 0, ev->datalen), 0);
-      errors_reported = hb.errors;
-    }
-  }
+  for (const auto& msg : nudge::test::messages_on<nudge::symmetry_lines_t>(run.output, channel::SYMMETRY))
+    results[msg.utime] = msg;
+  const int64_t errors_reported = nudge::test::last_heartbeat_errors(run.output);
   ASSERT_EQ(results.size(), truth.size()) << "one SYMMETRY message per good frame";
   EXPECT_EQ(errors_reported, 4)
       << "the truncated, zero-length camera, 2 GB and unknown-format messages are counted";
@@ -123,20 +105,15 @@ TEST(SymmetryService, LogInLogOutMatchesTheKnownAxesAndSkipsBadMessages) {
 }
 
 TEST(SymmetryService, ContoursOfTheTopLinesOnRequest) {
-  const std::string dir = testing::TempDir();
-  const std::string in = dir + "/contours_in.lcmlog", out = dir + "/contours_out.lcmlog";
-  std::remove(out.c_str());
+  const std::string in = nudge::test::temp_path("contours_in.lcmlog");
   const auto truth = write_input_log(in);
-  const std::string cmd = std::string(NUDGE_BIN_DIR) + "/nudge-symmetry --inputs CAMERA --lines 1 --dmin 10 --dmax 0" +
-                          " --theta-min -30 --theta-max 30 --contours 1 --lcm-in 'file://" + in + "?speed=0'" +
-                          " --lcm-out 'file://" + out + "?mode=w' 2>/dev/null";
-  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
-  lcm::LogFile log(out, "r");
+  const auto run = run_from_log("nudge-symmetry",
+                                "--inputs CAMERA --lines 1 --dmin 10 --dmax 0 --theta-min -30 --theta-max 30"
+                                " --contours 1 2>/dev/null",
+                                in, nudge::test::temp_path("contours_out.lcmlog"));
+  ASSERT_EQ(run.exit_code, 0) << run.command;
   int frames = 0;
-  for (const lcm::LogEvent* ev = log.readNextEvent(); ev; ev = log.readNextEvent()) {
-    if (ev->channel != channel::CONTOURS) continue;
-    nudge::contours_t msg;
-    ASSERT_GE(msg.decode(ev->data, 0, ev->datalen), 0);
+  for (const auto& msg : nudge::test::messages_on<nudge::contours_t>(run.output, channel::CONTOURS)) {
     ++frames;
     ASSERT_EQ(msg.num_contours, 1);
     const auto& c = msg.contours[0];
@@ -156,10 +133,7 @@ TEST(SymmetryService, ContoursOfTheTopLinesOnRequest) {
 }
 
 TEST(SymmetryService, BadFlagsAreRefusedWithAUsageError) {
-  const std::string bin = std::string(NUDGE_BIN_DIR) + "/nudge-symmetry";
-  for (const std::string args : {" --dmin 300 --dmax 100", " --theta-min -200", " --lines x", " --no-such-flag"}) {
-    const int status = std::system((bin + args + " 2>/dev/null").c_str());
-    ASSERT_TRUE(WIFEXITED(status));
-    EXPECT_EQ(WEXITSTATUS(status), 2) << args;
-  }
+  const std::string bin = nudge::test::bin_dir() + "/nudge-symmetry";
+  for (const std::string args : {" --dmin 300 --dmax 100", " --theta-min -200", " --lines x", " --no-such-flag"})
+    EXPECT_EQ(nudge::test::run_command(bin + args + " 2>/dev/null"), 2) << args;
 }

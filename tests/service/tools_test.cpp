@@ -2,9 +2,7 @@
 // an LCM log (file provider) so stereo pairing can be checked without a network; nudge-detect is
 // run on image files with known axes and on an unreadable one.
 #include <gtest/gtest.h>
-#include <lcm/lcm-cpp.hpp>
 #include <sys/stat.h>
-#include <sys/wait.h>
 
 #include <opencv2/imgcodecs.hpp>
 
@@ -18,6 +16,7 @@
 #include "nudge/bus/channels.hpp"
 #include "nudge/bus/image.hpp"
 #include "nudge/symmetry/synthetic.hpp"
+#include "nudge/test/run_service.hpp"
 
 namespace syn = nudge::symmetry::synthetic;
 namespace channel = nudge::bus::channel;
@@ -26,15 +25,11 @@ namespace {
 
 std::string bin(const std::string& name) { return std::string(NUDGE_BIN_DIR) + "/" + name; }
 
+// Runs a command; its standard output and then its standard error into *out. Returns the exit code.
 int run(const std::string& cmd, std::string* out = nullptr) {
-  FILE* pipe = popen(cmd.c_str(), "r");
-  if (!pipe) return -1;
-  std::array<char, 4096> buf{};
-  std::string text;
-  while (fgets(buf.data(), buf.size(), pipe)) text += buf.data();
-  const int status = pclose(pipe);
-  if (out) *out = text;
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  const auto result = nudge::test::run_capturing(cmd);
+  if (out) *out = result.out + result.err;
+  return result.exit_code;
 }
 
 std::string scratch_dir(const std::string& name) {
@@ -54,17 +49,12 @@ TEST(CameraService, StereoPairsShareUtimeAndFrameIds) {
   const std::string log_path = dir + "/camera.lcmlog";
   std::remove(log_path.c_str());
   const std::string cmd = bin("nudge-camera") + " --left 'images:" + dir + "/l*.png' --right 'images:" + dir +
-                          "/r*.png' --rate 0 --format bgr --lcm-url 'file://" + log_path + "?mode=w' 2>/dev/null";
+                          "/r*.png' --rate 0 --format bgr --lcm-url 'file://" + log_path + "?mode=w'";
   ASSERT_EQ(run(cmd), 0) << cmd;
-  lcm::LogFile log(log_path, "r");
-  ASSERT_TRUE(log.good());
   std::map<int64_t, std::map<std::string, nudge::image_t>> by_utime;
-  for (const lcm::LogEvent* ev = log.readNextEvent(); ev; ev = log.readNextEvent()) {
-    if (ev->channel.rfind("CAMERA_", 0) != 0) continue;
-    nudge::image_t img;
-    ASSERT_GE(img.decode(ev->data, 0, ev->datalen), 0);
-    by_utime[img.utime][ev->channel] = img;
-  }
+  const auto events = nudge::test::read_log(log_path);
+  for (const std::string channel : {"CAMERA_LEFT", "CAMERA_RIGHT"})
+    for (const auto& img : nudge::test::messages_on<nudge::image_t>(events, channel)) by_utime[img.utime][channel] = img;
   ASSERT_EQ(by_utime.size(), 4u) << "four captures";
   int64_t expected_id = 0;
   for (const auto& [utime, pair] : by_utime) {
@@ -79,9 +69,9 @@ TEST(CameraService, StereoPairsShareUtimeAndFrameIds) {
 
 TEST(CameraService, BadSourcesAreRefused) {
   std::string out;
-  EXPECT_NE(run(bin("nudge-camera") + " --source 'images:/nonexistent/*.png' 2>&1", &out), 0);
+  EXPECT_NE(run(bin("nudge-camera") + " --source 'images:/nonexistent/*.png'", &out), 0);
   EXPECT_NE(out.find("matches no files"), std::string::npos) << out;
-  EXPECT_EQ(run(bin("nudge-camera") + " --left images:/a 2>&1", &out), 2);
+  EXPECT_EQ(run(bin("nudge-camera") + " --left images:/a", &out), 2);
 }
 
 TEST(DetectTool, FindsKnownAxesAndReportsUnreadableFiles) {
@@ -102,7 +92,7 @@ TEST(DetectTool, FindsKnownAxesAndReportsUnreadableFiles) {
   }
   std::string out;
   const int rc = run(bin("nudge-detect") + " --lines 1 --theta-min -45 --theta-max 45 --draw " + dir +
-                         "/drawn.png" + args + " 2>/dev/null",
+                         "/drawn.png" + args,
                      &out);
   EXPECT_EQ(rc, 1) << "a missing file makes the exit code non-zero";
   const std::regex line_re(R"re(\{"image":"([^"]+)".*?"lines":\[\{"r":([-0-9.e]+),"theta_deg":([-0-9.e]+))re");

@@ -2,13 +2,11 @@
 // The input log holds synthetic 640x480 frames of a bottle that rests, then moves and rotates in
 // front of a static scene, a truncated image and a restart request; the output must track it.
 #include <gtest/gtest.h>
-#include <lcm/lcm-cpp.hpp>
-#include <sys/wait.h>
 
 #include <opencv2/imgproc.hpp>
 
 #include <cmath>
-#include <cstdlib>
+#include <cstdio>
 #include <map>
 #include <string>
 
@@ -18,7 +16,8 @@
 #include "nudge/symmetry/synthetic.hpp"
 #include "nudge/track_t.hpp"
 #include "nudge/tracker_command_t.hpp"
-#include "lcm_log.hpp"
+#include "nudge/test/lcm_log.hpp"
+#include "nudge/test/run_service.hpp"
 
 namespace syn = nudge::symmetry::synthetic;
 namespace channel = nudge::bus::channel;
@@ -26,7 +25,8 @@ namespace channel = nudge::bus::channel;
 namespace {
 
 using nudge::test::encode;
-using nudge::test::write_event;
+using nudge::test::LogWriter;
+using nudge::test::run_from_log;
 
 constexpr double kDeg = M_PI / 180.0;
 constexpr int64_t kStart = 1000000, kPeriod = 40000;  // 25 fps
@@ -59,15 +59,15 @@ cv::Mat frame(int i) {
 }
 
 void write_input_log(const std::string& path) {
-  lcm::LogFile log(path, "w");
+  LogWriter log(path);
   for (int i = 0; i < kFrames; ++i) {
     const int64_t utime = kStart + kPeriod * i;
     const auto image = nudge::bus::to_message(frame(i), nudge::image_t::FORMAT_GRAY8, utime, i, "left");
-    write_event(log, utime, channel::CAMERA_LEFT, encode(image));
+    log.write(utime, channel::CAMERA_LEFT, image);
     if (i == 10) {  // a truncated image: reported, counted and skipped
       auto bytes = encode(image);
       bytes.resize(bytes.size() / 3);
-      write_event(log, utime + 1, channel::CAMERA_LEFT, bytes);
+      log.raw(utime + 1, channel::CAMERA_LEFT, bytes);
     }
     if (i == kRestartAfter) {
       nudge::tracker_command_t cmd{};
@@ -75,40 +75,28 @@ void write_input_log(const std::string& path) {
       cmd.channel = channel::TRACK_LEFT;
       cmd.command = nudge::tracker_command_t::COMMAND_RESTART;
       cmd.reason = "operator restart";
-      write_event(log, utime + 2, channel::TRACKER_COMMAND, encode(cmd));
+      log.write(utime + 2, channel::TRACKER_COMMAND, cmd);
     }
   }
 }
 
-int run(const std::string& args) {
-  const std::string cmd = std::string(NUDGE_BIN_DIR) + "/nudge-tracker" + args;
-  const int status = std::system(cmd.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
+int run(const std::string& args) { return nudge::test::run_command(nudge::test::bin_dir() + "/nudge-tracker" + args); }
 
 }  // namespace
 
 TEST(TrackerService, LogInLogOutTracksTheMovingBottleAndRestartsOnRequest) {
-  const std::string dir = testing::TempDir();
-  const std::string in = dir + "/tracker_in.lcmlog", out = dir + "/tracker_out.lcmlog";
-  std::remove(out.c_str());
+  const std::string in = nudge::test::temp_path("tracker_in.lcmlog");
   write_input_log(in);
-  ASSERT_EQ(run(" --lcm-in 'file://" + in + "?speed=0' --lcm-out 'file://" + out + "?mode=w'"), 0);
+  const auto run = run_from_log("nudge-tracker", "", in, nudge::test::temp_path("tracker_out.lcmlog"));
+  ASSERT_EQ(run.exit_code, 0) << run.command;
 
-  lcm::LogFile log(out, "r");
-  ASSERT_TRUE(log.good());
   std::map<int64_t, nudge::track_t> tracks;
-  nudge::heartbeat_t last_heartbeat{};
-  for (const lcm::LogEvent* ev = log.readNextEvent(); ev; ev = log.readNextEvent()) {
-    if (ev->channel == channel::TRACK_LEFT) {
-      nudge::track_t msg;
-      ASSERT_GE(msg.decode(ev->data, 0, ev->datalen), 0);
-      tracks[msg.frame_id] = msg;
-    } else if (ev->channel == channel::HEARTBEAT) {
-      ASSERT_GE(last_heartbeat.decode(ev->data, 0, ev->datalen), 0);
-    }
-    EXPECT_NE(ev->channel, channel::TRACK_RIGHT) << "no right frames, no right tracks";
-  }
+  for (const auto& msg : nudge::test::messages_on<nudge::track_t>(run.output, channel::TRACK_LEFT)) tracks[msg.frame_id] = msg;
+  EXPECT_TRUE(nudge::test::messages_on<nudge::track_t>(run.output, channel::TRACK_RIGHT).empty())
+      << "no right frames, no right tracks";
+  const auto heartbeats = nudge::test::messages_on<nudge::heartbeat_t>(run.output, channel::HEARTBEAT);
+  ASSERT_FALSE(heartbeats.empty());
+  const nudge::heartbeat_t& last_heartbeat = heartbeats.back();
   ASSERT_EQ(tracks.size(), static_cast<size_t>(kFrames)) << "one TRACK_LEFT per good frame";
   EXPECT_EQ(last_heartbeat.errors, 1) << "the truncated image";
   EXPECT_NE(last_heartbeat.status.find("TRACK_RIGHT idle, no frames on CAMERA_RIGHT yet"), std::string::npos)
@@ -157,33 +145,27 @@ TEST(TrackerService, LogInLogOutTracksTheMovingBottleAndRestartsOnRequest) {
 
 TEST(TrackerService, AStoppedStreamIsReportedInTheHeartbeat) {
   // Played at recorded speed: five frames, then 2.5 s of silence before the log's last event.
-  const std::string dir = testing::TempDir();
-  const std::string in = dir + "/tracker_stale_in.lcmlog", out = dir + "/tracker_stale_out.lcmlog";
+  const std::string in = nudge::test::temp_path("tracker_stale_in.lcmlog"),
+                    out = nudge::test::temp_path("tracker_stale_out.lcmlog");
   std::remove(out.c_str());
   {
-    lcm::LogFile log(in, "w");
+    LogWriter log(in);
     for (int i = 0; i < 5; ++i) {
       cv::Mat small;
       cv::resize(frame(i), small, cv::Size(160, 120));
-      write_event(log, kStart + kPeriod * i, channel::CAMERA_LEFT,
-                  encode(nudge::bus::to_message(small, nudge::image_t::FORMAT_GRAY8, kStart + kPeriod * i, i, "left")));
+      log.write(kStart + kPeriod * i, channel::CAMERA_LEFT,
+                nudge::bus::to_message(small, nudge::image_t::FORMAT_GRAY8, kStart + kPeriod * i, i, "left"));
     }
     nudge::tracker_command_t cmd{};
     cmd.command = nudge::tracker_command_t::COMMAND_RESTART;
-    write_event(log, kStart + kPeriod * 5 + 2500000, channel::TRACKER_COMMAND, encode(cmd));
+    log.write(kStart + kPeriod * 5 + 2500000, channel::TRACKER_COMMAND, cmd);
   }
   ASSERT_EQ(run(" --inputs CAMERA_LEFT --stale 0.5 --lcm-in 'file://" + in + "?speed=1' --lcm-out 'file://" + out +
                 "?mode=w'"),
             0);
-  lcm::LogFile log(out, "r");
-  ASSERT_TRUE(log.good());
   bool reported = false;
-  for (const lcm::LogEvent* ev = log.readNextEvent(); ev; ev = log.readNextEvent()) {
-    if (ev->channel != channel::HEARTBEAT) continue;
-    nudge::heartbeat_t hb;
-    ASSERT_GE(hb.decode(ev->data, 0, ev->datalen), 0);
+  for (const auto& hb : nudge::test::read_messages<nudge::heartbeat_t>(out, channel::HEARTBEAT))
     reported = reported || hb.status.find("CAMERA_LEFT stopped") != std::string::npos;
-  }
   EXPECT_TRUE(reported) << "a heartbeat during the silence names the stopped stream";
 }
 

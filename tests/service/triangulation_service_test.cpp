@@ -3,9 +3,7 @@
 // verged rig with lens distortion (cv::projectPoints), a candidates request, and bad input: a line
 // with NaNs, an image size that disagrees with the calibration, a message without a partner.
 #include <gtest/gtest.h>
-#include <lcm/lcm-cpp.hpp>
 #include <sys/stat.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <Eigen/Geometry>
@@ -29,7 +27,8 @@
 #include "nudge/geometry/workspace.hpp"
 #include "nudge/heartbeat_t.hpp"
 #include "nudge/symmetry_lines_t.hpp"
-#include "lcm_log.hpp"
+#include "nudge/test/lcm_log.hpp"
+#include "nudge/test/run_service.hpp"
 
 namespace geo = nudge::geometry;
 namespace sym = nudge::symmetry;
@@ -38,7 +37,7 @@ namespace channel = nudge::bus::channel;
 namespace {
 
 using nudge::test::encode;
-using nudge::test::write_event;
+using nudge::test::LogWriter;
 
 constexpr double kDeg = M_PI / 180.0;
 constexpr int kWidth = 640, kHeight = 480;
@@ -148,16 +147,11 @@ std::string scratch_dir() {
 
 std::string bin(const std::string& name) { return std::string(NUDGE_BIN_DIR) + "/" + name; }
 
+// Runs a command; its standard error into *err. Returns the exit code (-1 if killed).
 int run(const std::string& cmd, std::string* err = nullptr) {
-  // One file per test: ctest runs the tests of this binary in parallel.
-  const std::string err_path = scratch_dir() + "/triangulation_stderr_" +
-                               testing::UnitTest::GetInstance()->current_test_info()->name() + ".txt";
-  const int status = std::system((cmd + " 2>" + err_path).c_str());
-  if (err) {
-    std::ifstream in(err_path);
-    err->assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  }
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  const auto result = nudge::test::run_capturing(cmd);
+  if (err) *err = result.err;
+  return result.exit_code;
 }
 
 struct Scene {
@@ -181,12 +175,12 @@ int right_order(int frame, int k) { return (k + frame) % 3; }
 // The good frames; frame 7's left lines also carry a NaN line; frame 12's right image has the wrong
 // size (skipped, so its left partner goes unmatched); a lone left message at the end.
 void write_input_log(const Scene& scene, const std::string& path) {
-  lcm::LogFile log(path, "w");
+  LogWriter log(path);
   nudge::candidates_request_t request;
   request.utime = kStart - 1;
   request.frames = 20;
   request.lines_per_image = 3;
-  write_event(log, request.utime, channel::CANDIDATES_REQUEST, encode(request));
+  log.raw(request.utime, "CANDIDATES_REQUEST", encode(request));
   for (int f = 0; f < kFrames; ++f) {
     const int64_t utime = kStart + f * kPeriod;
     std::vector<sym::Line> left, right(3);
@@ -203,14 +197,14 @@ void write_input_log(const Scene& scene, const std::string& path) {
     if (f == 12) right_msg.width = 320;
     const auto left_bytes = encode(lines_message(left, utime, "left")), right_bytes = encode(right_msg);
     if (f % 2) {  // either half may arrive first
-      write_event(log, utime, channel::SYMMETRY_LEFT, left_bytes);
-      write_event(log, utime + 10, channel::SYMMETRY_RIGHT, right_bytes);
+      log.raw(utime, "SYMMETRY_LEFT", left_bytes);
+      log.raw(utime + 10, "SYMMETRY_RIGHT", right_bytes);
     } else {
-      write_event(log, utime, channel::SYMMETRY_RIGHT, right_bytes);
-      write_event(log, utime + 10, channel::SYMMETRY_LEFT, left_bytes);
+      log.raw(utime, "SYMMETRY_RIGHT", right_bytes);
+      log.raw(utime + 10, "SYMMETRY_LEFT", left_bytes);
     }
   }
-  write_event(log, kStart + kFrames * kPeriod, channel::SYMMETRY_LEFT,
+  log.raw(kStart + kFrames * kPeriod, "SYMMETRY_LEFT",
               encode(lines_message({scene.objects[0].left}, kStart + kFrames * kPeriod, "left")));
 }
 
@@ -222,24 +216,14 @@ struct Output {
 };
 
 Output read_output(const std::string& path) {
+  const auto events = nudge::test::read_log(path);
   Output out;
-  lcm::LogFile log(path, "r");
-  EXPECT_TRUE(log.good()) << path;
-  for (const lcm::LogEvent* ev = log.readNextEvent(); ev; ev = log.readNextEvent()) {
-    if (ev->channel == channel::AXES) {
-      nudge::axes_t m;
-      EXPECT_GE(m.decode(ev->data, 0, ev->datalen), 0);
-      out.axes[m.utime] = m;
-    } else if (ev->channel == channel::CANDIDATES) {
-      nudge::candidates_t m;
-      EXPECT_GE(m.decode(ev->data, 0, ev->datalen), 0);
-      out.candidates.push_back(m);
-    } else if (ev->channel == channel::HEARTBEAT) {
-      nudge::heartbeat_t hb;
-      EXPECT_GE(hb.decode(ev->data, 0, ev->datalen), 0);
-      out.errors = hb.errors;
-      out.status = hb.status;
-    }
+  for (const auto& m : nudge::test::messages_on<nudge::axes_t>(events, "AXES")) out.axes[m.utime] = m;
+  out.candidates = nudge::test::messages_on<nudge::candidates_t>(events, "CANDIDATES");
+  const auto heartbeats = nudge::test::messages_on<nudge::heartbeat_t>(events, "HEARTBEAT");
+  if (!heartbeats.empty()) {
+    out.errors = heartbeats.back().errors;
+    out.status = heartbeats.back().status;
   }
   return out;
 }

@@ -9,8 +9,6 @@
 //    stamped in simulated time acts at that time;
 //  - bad scenes and flags are usage errors (exit 2) naming the file and field.
 #include <gtest/gtest.h>
-#include <lcm/lcm-cpp.hpp>
-#include <sys/wait.h>
 
 #include <Eigen/Geometry>
 #include <opencv2/imgproc.hpp>
@@ -35,59 +33,24 @@
 #include "nudge/snapshot_request_t.hpp"
 #include "nudge/robot/kinematics.hpp"
 #include "nudge/symmetry/detector.hpp"
-#include "nudge/symmetry/line.hpp"
-#include "lcm_log.hpp"
+#include "nudge/test/lcm_log.hpp"
+#include "nudge/test/run_service.hpp"
 
 namespace channel = nudge::bus::channel;
 
 namespace {
 
+using nudge::test::decode;
 using nudge::test::encode;
+using nudge::test::Event;
+using nudge::test::last_heartbeat_errors;
+using nudge::test::read_log;
+using nudge::test::write_log;
 
 constexpr double kDeg = M_PI / 180.0;
-const std::string kBin = NUDGE_BIN_DIR;
+const std::string kBin = nudge::test::bin_dir();
 
-struct Event {
-  int64_t timestamp;
-  std::string channel;
-  std::vector<uint8_t> data;
-};
-
-std::vector<Event> read_log(const std::string& path) {
-  lcm::LogFile log(path, "r");
-  EXPECT_TRUE(log.good()) << path;
-  std::vector<Event> events;
-  for (const lcm::LogEvent* ev = log.readNextEvent(); ev; ev = log.readNextEvent()) {
-    const auto* p = static_cast<const uint8_t*>(ev->data);
-    events.push_back({ev->timestamp, ev->channel, std::vector<uint8_t>(p, p + ev->datalen)});
-  }
-  return events;
-}
-
-void write_log(const std::string& path, const std::vector<Event>& events) {
-  lcm::LogFile log(path, "w");
-  ASSERT_TRUE(log.good()) << path;
-  for (const Event& e : events) {
-    lcm::LogEvent ev{};
-    ev.timestamp = e.timestamp;
-    ev.channel = e.channel;
-    ev.datalen = static_cast<int32_t>(e.data.size());
-    ev.data = const_cast<uint8_t*>(e.data.data());
-    ASSERT_EQ(log.writeEvent(&ev), 0);
-  }
-}
-
-template <typename Msg>
-Msg decode(const Event& e) {
-  Msg msg;
-  EXPECT_GE(msg.decode(e.data.data(), 0, static_cast<int>(e.data.size())), 0) << e.channel;
-  return msg;
-}
-
-int run(const std::string& cmd) {
-  const int status = std::system(cmd.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
+int run(const std::string& cmd) { return nudge::test::run_command(cmd); }
 
 std::string write_scene(const std::string& name, const std::string& objects) {
   const std::string path = testing::TempDir() + "/" + name + ".yaml";
@@ -97,13 +60,6 @@ std::string write_scene(const std::string& name, const std::string& objects) {
                       << "objects:\n"
                       << objects;
   return path;
-}
-
-int64_t last_heartbeat_errors(const std::vector<Event>& events) {
-  int64_t errors = -1;
-  for (const Event& e : events)
-    if (e.channel == channel::HEARTBEAT) errors = decode<nudge::heartbeat_t>(e).errors;
-  return errors;
 }
 
 }  // namespace

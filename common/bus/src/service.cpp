@@ -45,18 +45,50 @@ bool Service::input_is_log() const {
 }
 
 void Service::start() {
-  const std::string in_url = lcm_in_.empty() ? lcm_url_ : lcm_in_;
-  const std::string out_url = lcm_out_.empty() ? lcm_url_ : lcm_out_;
-  in_ = std::make_unique<lcm::LCM>(in_url);
-  if (!in_->good()) throw std::runtime_error("cannot open LCM input '" + in_url + "'");
+  start(lcm_in_.empty() ? lcm_url_ : lcm_in_, lcm_out_.empty() ? lcm_url_ : lcm_out_);
+}
+
+void Service::start(const std::string& in_url, const std::string& requested_out_url) {
+  const std::string out_url = requested_out_url.empty() ? in_url : requested_out_url;
+  subscriptions_.reset();  // before a previous start()'s LCM goes: they unsubscribe from it
+  owned_in_ = std::make_unique<lcm::LCM>(in_url);
+  if (!owned_in_->good()) throw std::runtime_error("cannot open LCM input '" + in_url + "'");
   if (out_url != in_url) {
-    out_ = std::make_unique<lcm::LCM>(out_url);
-    if (!out_->good()) throw std::runtime_error("cannot open LCM output '" + out_url + "'");
+    owned_out_ = std::make_unique<lcm::LCM>(out_url);
+    if (!owned_out_->good()) throw std::runtime_error("cannot open LCM output '" + out_url + "'");
   }
-  subscriptions_ = std::make_unique<Subscriptions>(*in_, counters_);
+  attach(*owned_in_, owned_out_ ? *owned_out_ : *owned_in_);
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   log::info() << "started: in " << in_url << ", out " << out_url;
+}
+
+void Service::start(lcm::LCM& input, lcm::LCM* output) {
+  if (!input.good()) throw std::runtime_error("the LCM input given to service " + name_ + " is not open");
+  if (output && !output->good()) throw std::runtime_error("the LCM output given to service " + name_ + " is not open");
+  attach(input, output ? *output : input);
+  log::info() << "started on the caller's LCM";
+}
+
+void Service::attach(lcm::LCM& input, lcm::LCM& output) {
+  if (instance_.empty()) instance_ = name_;  // parse() was not called: no command line
+  subscriptions_.reset();  // unsubscribes from a previous start()'s input
+  in_ = &input;
+  out_ = &output;
+  subscriptions_ = std::make_unique<Subscriptions>(*in_, counters_);
+}
+
+int Service::handle_pending(int max_messages) {
+  int handled = 0;
+  while (handled < max_messages && spin_once(0)) ++handled;
+  return handled;
+}
+
+bool Service::spin_once(int timeout_ms) {
+  if (!in_) throw std::logic_error("service " + name_ + ": spin_once() before start()");
+  const int rc = in_->handleTimeout(std::max(0, timeout_ms));
+  if (rc < 0) throw std::runtime_error("service " + name_ + ": LCM input failed");
+  return rc > 0;
 }
 
 bool Service::stop_requested() const { return stop_requested_ || g_signalled; }

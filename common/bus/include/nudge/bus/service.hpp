@@ -2,6 +2,10 @@
 // The shell every service runs in: flags (--lcm-url, --lcm-in, --lcm-out, --instance, --verbose),
 // LCM set-up, a heartbeat on channel::HEARTBEAT once a second, and a loop that ends cleanly on SIGINT or
 // SIGTERM, or when an input log (file:// provider) is exhausted.
+//
+// The transport is injectable so that a test can run a service's handlers in its own process:
+// start(lcm) on an lcm::LCM the test owns (LCM's in-process "memq://" provider: no sockets), then
+// publish to it and pump with handle_pending() instead of run()'s wall-clock loop.
 #include <lcm/lcm-cpp.hpp>
 
 #include <functional>
@@ -10,6 +14,7 @@
 
 #include "nudge/bus/subscribe.hpp"
 #include "nudge/flags.hpp"
+#include "nudge/heartbeat_t.hpp"
 
 namespace nudge::bus {
 
@@ -24,11 +29,16 @@ class Service {
   Flags& flags() { return flags_; }
   // Parses the command line. Returns false when --help was printed. Throws FlagError.
   bool parse(int argc, char** argv);
-  // Opens the LCM input and output. Throws std::runtime_error naming a bad URL.
+  // Opens the LCM input and output the flags name. Throws std::runtime_error naming a bad URL.
   void start();
+  // Opens these URLs instead of the flags' (an empty out_url: the input's). E.g. "memq://".
+  void start(const std::string& in_url, const std::string& out_url);
+  // Runs on transports the caller owns, which must outlive the service (output: null for the
+  // input's). Installs no signal handlers: the caller's process is not a service binary.
+  void start(lcm::LCM& input, lcm::LCM* output = nullptr);
 
   lcm::LCM& input() { return *in_; }
-  lcm::LCM& output() { return out_ ? *out_ : *in_; }
+  lcm::LCM& output() { return *out_; }
   Subscriptions& subscriptions() { return *subscriptions_; }
   Counters& counters() { return counters_; }
   const std::string& name() const { return name_; }
@@ -44,18 +54,34 @@ class Service {
   // long) and may call request_stop(); a tick returning a shorter wait shortens the next one.
   // Returns the process exit code.
   int run(const std::function<int()>& tick = {}, int wait_ms = 20);
+  // Handles the messages already queued on the input, without waiting, so a test pumps the bus
+  // deterministically. Messages the handlers publish to a shared memq:// bus are handled in the
+  // same call when the service subscribes to them. Stops after max_messages (a handler that feeds
+  // itself cannot loop forever). Returns how many were handled. Throws std::runtime_error when
+  // the input fails.
+  int handle_pending(int max_messages = 10000);
+  // Waits up to timeout_ms for one message and handles it. Returns whether one was handled.
+  bool spin_once(int timeout_ms = 0);
+  // Publishes a heartbeat with the current counters and status (run() does once a second).
+  void publish_heartbeat() {
+    publish_heartbeat(counters_.errors > 0 ? heartbeat_t::STATE_DEGRADED : heartbeat_t::STATE_RUNNING);
+  }
+
   void request_stop() { stop_requested_ = true; }
   bool stop_requested() const;
   void set_status(const std::string& status) { status_ = status; }
 
  private:
   void publish_heartbeat(int8_t state);
+  void attach(lcm::LCM& input, lcm::LCM& output);
 
   std::string name_;
   Flags flags_;
   std::string lcm_url_ = kDefaultLcmUrl, lcm_in_, lcm_out_, instance_;
   bool verbose_ = false;
-  std::unique_ptr<lcm::LCM> in_, out_;
+  std::unique_ptr<lcm::LCM> owned_in_, owned_out_;  // when start() opened the URLs itself
+  lcm::LCM* in_ = nullptr;
+  lcm::LCM* out_ = nullptr;
   std::unique_ptr<Subscriptions> subscriptions_;
   Counters counters_;
   std::string status_;

@@ -31,10 +31,21 @@ class Subscriptions {
     for (auto& h : handlers_) lcm_.unsubscribe(h->subscription);
   }
 
-  // handler(msg, channel, receive_utime). Returns nothing; errors are logged and counted.
+  // handler(msg, channel). Returns nothing; errors are logged and counted.
   template <typename Msg>
   void subscribe(const std::string& channel,
                  std::function<void(const Msg&, const std::string& channel)> handler) {
+    subscribe_timed<Msg>(channel, [handler = std::move(handler)](const Msg& msg, const std::string& ch, int64_t) {
+      handler(msg, ch);
+    });
+  }
+
+  // handler(msg, channel, receive_utime): LCM's receive time, wall-clock microseconds on every
+  // provider (a played log's events are stamped as they are read). Logic that must replay
+  // deterministically uses the message's own utime instead.
+  template <typename Msg>
+  void subscribe_timed(const std::string& channel,
+                       std::function<void(const Msg&, const std::string& channel, int64_t receive_utime)> handler) {
     auto h = std::make_unique<Typed<Msg>>(std::move(handler), counters_);
     h->subscription = lcm_.subscribe(channel, &Typed<Msg>::on_raw, h.get());
     handlers_.push_back(std::move(h));
@@ -47,7 +58,8 @@ class Subscriptions {
   };
   template <typename Msg>
   struct Typed : Base {
-    Typed(std::function<void(const Msg&, const std::string&)> f, Counters& c) : fn(std::move(f)), counters(c) {}
+    using Handler = std::function<void(const Msg&, const std::string&, int64_t)>;
+    Typed(Handler f, Counters& c) : fn(std::move(f)), counters(c) {}
     void on_raw(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
       ++counters.messages_in;
       Msg msg;
@@ -58,13 +70,13 @@ class Subscriptions {
         return;
       }
       try {
-        fn(msg, channel);
+        fn(msg, channel, rbuf->recv_utime);
       } catch (const std::exception& e) {
         ++counters.errors;
         log::error() << "skipped a message on " << channel << ": " << e.what();
       }
     }
-    std::function<void(const Msg&, const std::string&)> fn;
+    Handler fn;
     Counters& counters;
   };
 

@@ -1,0 +1,85 @@
+#include "handlers.hpp"
+
+#include "nudge/bus/image.hpp"
+#include "nudge/bus/symmetry_convert.hpp"
+#include "nudge/contours_t.hpp"
+#include "nudge/log.hpp"
+#include "nudge/timing.hpp"
+
+namespace nudge::symmetry_service {
+
+namespace {
+
+// The contour of each of the first `count` lines, as a message (thesis sec. 4.2).
+contours_t contours_message(const symmetry::EdgeSet& edges, const std::vector<symmetry::Line>& lines, int count,
+                            const segmentation::Segmenter& segmenter, const image_t& image) {
+  contours_t msg;
+  msg.utime = image.utime;
+  msg.frame_id = image.frame_id;
+  msg.camera = image.camera;
+  auto to_points = [](const std::vector<cv::Point2d>& side) {
+    std::vector<std::vector<float>> out;
+    for (const auto& p : side) out.push_back({static_cast<float>(p.x), static_cast<float>(p.y)});
+    return out;
+  };
+  for (int i = 0; i < std::min<int>(count, static_cast<int>(lines.size())); ++i) {
+    const segmentation::Contour c = segmenter.segment(edges, lines[i]);
+    if (c.empty()) continue;
+    object_contour_t oc;
+    oc.line_index = i;
+    oc.score = static_cast<float>(c.score);
+    oc.left = to_points(c.left);
+    oc.right = to_points(c.right);
+    oc.num_left = static_cast<int32_t>(oc.left.size());
+    oc.num_right = static_cast<int32_t>(oc.right.size());
+    msg.contours.push_back(oc);
+  }
+  msg.num_contours = static_cast<int32_t>(msg.contours.size());
+  return msg;
+}
+
+// Mirror-tolerant voting needs the edges' gradient orientations.
+symmetry::EdgeParams edge_params_for(const Options& options) {
+  symmetry::EdgeParams edge = options.edge;
+  edge.gradients = options.params.mirror_tolerance_deg > 0;
+  return edge;
+}
+
+segmentation::SegmentParams segment_params_for(const Options& options) {
+  segmentation::SegmentParams params;
+  if (options.params.dmax > 0) params.max_width = options.params.dmax;  // thesis: MAXw is usually Dmax
+  return params;
+}
+
+}  // namespace
+
+Handlers::Handlers(bus::Service& service, const Options& options)
+    : service_(service),
+      options_(options),
+      detector_(options.params, edge_params_for(options)),
+      segmenter_(segment_params_for(options)) {
+  options_.edge = edge_params_for(options);
+  for (const auto& channel : options_.inputs) {
+    const std::string out = bus::channel::derived(channel, bus::channel::SYMMETRY);
+    const std::string contours_out = bus::channel::derived(channel, bus::channel::CONTOURS);
+    service_.subscriptions().subscribe<image_t>(
+        channel, [this, out, contours_out](const image_t& msg, const std::string&) { on_image(msg, out, contours_out); });
+    log::info() << channel << " -> " << out;
+  }
+}
+
+void Handlers::on_image(const image_t& msg, const std::string& out, const std::string& contours_out) {
+  const cv::Mat image = bus::to_mat(msg);  // throws ImageError naming the image: counted, skipped
+  Stopwatch watch;
+  const symmetry::EdgeSet edges = symmetry::detect_edges(image, options_.edge);
+  const double edges_ms = watch.elapsed_ms();
+  symmetry::Result result = detector_.detect(edges);
+  result.ms.edges_ms = edges_ms;
+  service_.publish(out, bus::to_message(result, msg.utime, msg.frame_id, msg.camera));
+  if (options_.contours > 0)
+    service_.publish(contours_out, contours_message(edges, result.lines, options_.contours, segmenter_, msg));
+  log::debug() << out << " frame " << msg.frame_id << ": " << result.lines.size() << " lines, " << result.num_edges
+                << " edges, " << result.ms.total_ms() << " ms";
+}
+
+}  // namespace nudge::symmetry_service

@@ -1,0 +1,40 @@
+#pragma once
+// The symmetry service's message handlers, apart from main() so that tests build them on an
+// in-process bus (docs/architecture.md, "Testing a service's handlers in one process").
+#include <string>
+#include <vector>
+
+#include "nudge/bus/channels.hpp"
+#include "nudge/bus/service.hpp"
+#include "nudge/image_t.hpp"
+#include "nudge/segmentation/segment.hpp"
+#include "nudge/symmetry/detector.hpp"
+
+namespace nudge::symmetry_service {
+
+struct Options {
+  symmetry::Params params;
+  symmetry::EdgeParams edge;
+  std::vector<std::string> inputs = {bus::channel::CAMERA_LEFT, bus::channel::CAMERA_RIGHT};
+  int contours = 0;  // also segment the contours of the top N lines; 0: off
+};
+
+// Subscribes the started `service` to every input channel: each image's symmetry lines go out on
+// its SYMMETRY_* channel, with Options::contours > 0 also the contours on CONTOURS_*. A bad image
+// is reported naming it, counted and skipped. Holds the detector: keep it while handling.
+class Handlers {
+ public:
+  Handlers(bus::Service& service, const Options& options);
+  Handlers(const Handlers&) = delete;
+  Handlers& operator=(const Handlers&) = delete;
+
+ private:
+  void on_image(const image_t& msg, const std::string& out, const std::string& contours_out);
+
+  bus::Service& service_;
+  Options options_;
+  symmetry::Detector detector_;
+  segmentation::Segmenter segmenter_;
+};
+
+}  // namespace nudge::symmetry_service
