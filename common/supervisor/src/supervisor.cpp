@@ -197,7 +197,25 @@ void Supervisor::verify(int64_t now) {
     end_attempt(Outcome::NoMotion, "the object moved only " + std::to_string(static_cast<int>(std::lround(moved * 1e3))) + " mm", now);
     return;
   }
-  request_still(State::SnapshotAfter, now);
+  // The after still is taken with the arm parked where it was for the before still (at home):
+  // the arm then makes no difference between the two.
+  nudge_seq_ = 0;
+  park(now, "object at rest at " + millimetres(*a.rest) + ": parking the arm before the after still");
+}
+
+void Supervisor::park(int64_t now, const std::string& why) {
+  home_seq_ = next_seq_++;
+  after_home_ = why;
+  enter(State::Home, now, why);
+  outputs_.push_back(HomeCommand{home_seq_});
+}
+
+void Supervisor::parked(int64_t now, const std::string& how) {
+  if (attempt_) {
+    request_still(State::SnapshotAfter, now, how);
+  } else {
+    survey(now, after_home_ + (how.empty() ? "" : "; " + how));
+  }
 }
 
 // The thesis' check: both trackers still on the object, their lines triangulated to an upright
@@ -280,12 +298,29 @@ void Supervisor::segment(int64_t now) {
   if (!a.before_line) a.before_line = predicted_before;
   if (!a.after_line) a.after_line = predicted_after;
   a.segmentation = segment_(a.before, a.after, *a.before_line, *a.after_line);
-  if (a.segmentation.mask.empty() || cv::countNonZero(a.segmentation.mask) == 0) {
+  keep_object_rows(a);
+  if (a.segmentation.mask.empty() || cv::countNonZero(a.segmentation.mask) < config_.min_mask_pixels) {
     end_attempt(Outcome::SegmentationFailed,
                 "segmentation empty" + (a.segmentation.error.empty() ? std::string() : ": " + a.segmentation.error), now);
     return;
   }
   end_attempt(Outcome::Segmented, "segmented", now);
+}
+
+// Only rows between the object's foot and the tallest object's top can be the object: motion
+// further up the line (an arm, a hand) is not kept.
+void Supervisor::keep_object_rows(Attempt& a) const {
+  cv::Mat& mask = a.segmentation.mask;
+  if (mask.empty() || !a.rest) return;
+  const auto foot = scene_.project_right(*a.rest, mask.size());
+  const auto top = scene_.project_right(*a.rest + Eigen::Vector3d(0, 0, config_.object_height_m), mask.size());
+  if (!foot || !top) return;
+  const int margin = mask.rows / 48;  // 20 px at 960 rows: the foot's shadow and rounding
+  const int first = std::clamp(static_cast<int>(std::min(foot->y, top->y)) - margin, 0, mask.rows);
+  const int last = std::clamp(static_cast<int>(std::max(foot->y, top->y)) + margin, 0, mask.rows);
+  mask.rowRange(0, first).setTo(0);
+  mask.rowRange(last, mask.rows).setTo(0);
+  if (!a.segmentation.cutout.empty()) a.segmentation.cutout.setTo(cv::Scalar::all(0), mask == 0);
 }
 
 void Supervisor::end_attempt(Outcome outcome, const std::string& reason, int64_t now) {
@@ -316,10 +351,7 @@ void Supervisor::end_attempt(Outcome outcome, const std::string& reason, int64_t
   }
   // The arm has moved: park it before looking again.
   nudge_seq_ = 0;
-  home_seq_ = next_seq_++;
-  after_home_ = why;
-  enter(State::Home, now, why + "; parking the arm");
-  outputs_.push_back(HomeCommand{home_seq_});
+  park(now, why + "; parking the arm");
 }
 
 int64_t Supervisor::awaited_arm_seq() const {
@@ -357,7 +389,7 @@ void Supervisor::on_time(int64_t now) {
       if (static_cast<double>(now - arm_done_time_) >= config_.settle_s * kMicro) verify(now);
       break;
     case State::Home:
-      if (timed_out(config_.nudge_timeout_s, now)) survey(now, after_home_ + "; the arm did not report parking in time");
+      if (timed_out(config_.nudge_timeout_s, now)) parked(now, "the arm did not report parking in time");
       break;
     default:
       break;
@@ -415,9 +447,8 @@ void Supervisor::on_arm_state(const ArmStatus& arm, int64_t now) {
   joints_ = arm.joints;
   if (state_ == State::Home && arm.command_seq == home_seq_ && arm.motion != ArmStatus::Motion::Moving &&
       arm.motion != ArmStatus::Motion::Idle) {
-    // Parked, or not (refused, stopped): the survey goes ahead either way, saying so.
-    const bool parked = arm.motion == ArmStatus::Motion::Done;
-    survey(now, after_home_ + (parked ? "" : "; the arm did not park (" + arm.last_error + ")"));
+    // Parked, or not (refused, stopped): the loop goes on either way, saying so.
+    parked(now, arm.motion == ArmStatus::Motion::Done ? "" : "the arm did not park (" + arm.last_error + ")");
     return;
   }
   if (state_ != State::Nudge || arm.command_seq != nudge_seq_) return;  // not about our nudge

@@ -53,6 +53,7 @@ struct Config {
   double upright_max_tilt_deg = 12;  // median tilt; thesis ch. 6 keeps candidates within 10 deg, a settled axis gets 2 deg for noise
   double min_displacement_m = 0.004; // a smaller slide gives no difference to segment
   double object_height_m = 0.25;     // the tallest expected object (lines drawn up to it)
+  int min_mask_pixels = 200;         // a smaller mask (in the still) is no object
   // Rows watched for motion: from the table to this height. The object's foot moves when it is
   // pushed; the arm's links, higher up, may pass beyond the line in the image, the pad never does.
   double motion_rows_height_m = 0.06;
@@ -192,6 +193,9 @@ class Supervisor {
   void verify(int64_t now);
   void segment(int64_t now);
   void end_attempt(Outcome outcome, const std::string& reason, int64_t now);
+  void park(int64_t now, const std::string& why);
+  void parked(int64_t now, const std::string& how);
+  void keep_object_rows(Attempt& attempt) const;
   void finish(State state, const std::string& reason, int64_t now);
   bool timed_out(double seconds, int64_t now) const;
   bool in_attempt() const;
