@@ -1,6 +1,7 @@
 // camera: publishes frames from image files, a video or a capture device on CAMERA_* channels.
 // Stereo: --left SRC --right SRC publish CAMERA_LEFT / CAMERA_RIGHT with one shared utime per pair.
-// Simulation: --source sim --scene FILE renders the world service's SIM_STATE (sim_backend.cpp).
+// Simulation: --source sim --scene FILE renders the world service's SIM_STATE (sim_backend.cpp,
+// built only with the simulator, NUDGE_CAMERA_SIM: a real robot's build needs no MuJoCo/OSMesa).
 #include <sstream>
 #include <thread>
 
@@ -21,14 +22,22 @@ struct Stream {
   std::string channel, camera_name;
 };
 
+#ifdef NUDGE_CAMERA_SIM
+constexpr const char* kSimUsage =
+    "Simulation: --source sim --scene FILE renders every SIM_STATE as a stereo pair.";
+#else
+constexpr const char* kSimUsage =
+    "Simulation (--source sim): not in this build, which has no simulator (MuJoCo/OSMesa).";
+#endif
+
 }  // namespace
 
 int main(int argc, char** argv) {
   return bus::guarded_main("camera", [&] {
     bus::Service service("camera",
                          "Publishes camera frames. Sources: images:GLOB, video:PATH, device:N.\n"
-                         "Mono: --source SRC [--channel CAMERA]. Stereo: --left SRC --right SRC.\n"
-                         "Simulation: --source sim --scene FILE renders every SIM_STATE as a stereo pair.");
+                         "Mono: --source SRC [--channel CAMERA]. Stereo: --left SRC --right SRC.\n" +
+                             std::string(kSimUsage));
     std::string source_spec, left_spec, right_spec, channel = bus::channel::CAMERA, format = "gray";
     double rate = 25.0;
     bool loop = false;
@@ -59,6 +68,10 @@ int main(int argc, char** argv) {
     if (count < 0) throw FlagError("--count must be >= 0");
     const int8_t pixel_format = bus::format_from_name(format);
     if (source_spec == "sim") {
+#ifndef NUDGE_CAMERA_SIM
+      throw FlagError("--source sim: this nudge-camera was built without the simulator (nudge_sim: MuJoCo and "
+                      "OSMesa); build with them to render SIM_STATE (docs/sim.md)");
+#else
       // Frames follow the simulated clock (one pair per SIM_STATE): --rate and --loop do not apply.
       if (!left_spec.empty() || !right_spec.empty()) throw FlagError("--source sim renders both cameras itself: no --left/--right");
       if (sim.scene_file.empty()) throw FlagError("--source sim needs --scene FILE");
@@ -68,6 +81,7 @@ int main(int argc, char** argv) {
       sim.jpeg_quality = jpeg_quality;
       sim.count = count;
       return camera_service::run_sim_camera(service, sim);
+#endif
     }
     if (!sim.scene_file.empty() || sim.snapshots) throw FlagError("--scene and --snapshots need --source sim");
 

@@ -3,14 +3,15 @@
 // drawn and published on CAMERA_LEFT / CAMERA_RIGHT with the state's (simulated) utime.
 #include "sim_backend.hpp"
 
-#include <opencv2/imgproc.hpp>
-
 #include <optional>
+#include <random>
+#include <vector>
 
 #include "nudge/bus/channels.hpp"
 #include "nudge/bus/image.hpp"
 #include "nudge/bus/pose_convert.hpp"
 #include "nudge/log.hpp"
+#include "nudge/sim/sensor.hpp"
 #include "nudge/sim/state_sync.hpp"
 #include "nudge/sim/world.hpp"
 #include "nudge/sim_state_t.hpp"
@@ -40,7 +41,7 @@ int run_sim_camera(bus::Service& service, const SimOptions& options) {
   if (blur) scene.render.noise_sigma = 0;  // noise goes on the blurred frame, not on every sub-render
   sim::World world(scene);
   log::info() << "rendering SIM_STATE of " << options.scene_file << " (" << scene.rig.width << "x"
-              << scene.rig.height << ", noise " << scene.render.noise_sigma << ")";
+              << scene.rig.height << ", noise " << noise_sigma << ")";
   service.start();
 
   int64_t frame_id = 0, snapshot_id = 0;
@@ -50,20 +51,16 @@ int run_sim_camera(bus::Service& service, const SimOptions& options) {
   // state (motion blur), with the sensor noise added once, seeded by scene seed and frame.
   auto render = [&](int camera, const sim::PoseSnapshot& poses) {
     if (!blur || !previous) return world.render(camera);
-    cv::Mat sum = cv::Mat::zeros(scene.rig.height, scene.rig.width, CV_32FC3);
+    std::vector<cv::Mat> renders;
     for (int k = 1; k <= options.motion_blur; ++k) {
       sim::apply_poses(world, sim::interpolate_poses(*previous, poses, static_cast<double>(k) / options.motion_blur));
-      cv::accumulate(world.render(camera), sum);
+      renders.push_back(world.render(camera));
     }
-    sum /= options.motion_blur;
-    if (noise_sigma > 0) {
-      cv::Mat noise(sum.size(), CV_32FC3);
-      cv::RNG rng(scene.seed * 1000003u + static_cast<uint64_t>(frame_id) * 2 + camera);
-      rng.fill(noise, cv::RNG::NORMAL, 0, noise_sigma);
-      sum += noise;
-    }
+    cv::Mat exposure = sim::average_frames(renders);
+    std::mt19937_64 rng(scene.seed * 1000003u + static_cast<uint64_t>(frame_id) * 2 + camera);
+    sim::add_sensor_noise(exposure, noise_sigma, rng);
     cv::Mat out;
-    sum.convertTo(out, CV_8UC3);
+    exposure.convertTo(out, CV_8UC3);
     return out;
   };
   service.subscriptions().subscribe<sim_state_t>(bus::channel::SIM_STATE, [&](const sim_state_t& state, const std::string&) {

@@ -6,11 +6,7 @@
 // (thesis fig. 6.3-6.4). Needs root for the namespace: skipped otherwise.
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
-#include <fcntl.h>
 #include <sched.h>
-#include <signal.h>
-#include <spawn.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <Eigen/Geometry>
@@ -30,7 +26,7 @@
 #include "nudge/bus/channels.hpp"
 #include "nudge/bus/pose_convert.hpp"
 #include "nudge/sim_state_t.hpp"
-#include "process.hpp"
+#include "nudge/test/process.hpp"
 
 namespace channel = nudge::bus::channel;
 
@@ -39,7 +35,7 @@ namespace {
 const std::string kBin = NUDGE_BIN_DIR;
 const std::string kUrl = "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=16777216";
 
-using nudge::testing::Process;
+using nudge::test::Process;
 
 struct Watch {
   std::optional<nudge::sim_state_t> sim;

@@ -25,9 +25,9 @@
 #include "nudge/sim_state_t.hpp"
 #include "nudge/supervisor/scene.hpp"
 #include "nudge/supervisor_state_t.hpp"
-#include "process.hpp"
+#include "nudge/test/process.hpp"
 
-using nudge::testing::Process;
+using nudge::test::Process;
 namespace channel = nudge::bus::channel;
 
 namespace {

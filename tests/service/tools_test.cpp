@@ -74,6 +74,22 @@ TEST(CameraService, BadSourcesAreRefused) {
   EXPECT_EQ(run(bin("nudge-camera") + " --left images:/a", &out), 2);
 }
 
+// nudge-camera has its simulator backend only in builds with nudge_sim (MuJoCo and OSMesa);
+// tests/CMakeLists.txt tells this test which build it is in.
+TEST(CameraService, SourceSimIsRefusedClearlyWhereTheBuildHasNoSimulator) {
+  std::string help, out;
+  EXPECT_EQ(run(bin("nudge-camera") + " --help", &help), 0);
+  const int exit_code = run(bin("nudge-camera") + " --source sim --lcm-in memq://", &out);
+  EXPECT_EQ(exit_code, 2) << out;
+#ifdef NUDGE_TEST_CAMERA_WITHOUT_SIM
+  EXPECT_NE(help.find("not in this build"), std::string::npos) << help;
+  EXPECT_NE(out.find("--source sim: this nudge-camera was built without the simulator"), std::string::npos) << out;
+#else
+  EXPECT_NE(help.find("--source sim --scene FILE renders every SIM_STATE"), std::string::npos) << help;
+  EXPECT_NE(out.find("--source sim needs --scene FILE"), std::string::npos) << out;
+#endif
+}
+
 TEST(DetectTool, FindsKnownAxesAndReportsUnreadableFiles) {
   const std::string dir = scratch_dir("detect_tool");
   struct Case {

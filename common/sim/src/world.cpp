@@ -3,6 +3,7 @@
 #include "nudge/sim/mjcf.hpp"
 #include "nudge/sim/objects.hpp"
 #include "nudge/sim/renderer.hpp"
+#include "nudge/sim/sensor.hpp"
 
 #include <mujoco/mujoco.h>
 #include <opencv2/imgproc.hpp>
@@ -609,18 +610,7 @@ cv::Mat World::draw(int camera_index, bool snapshot, bool labels) {
               labels ? cv::INTER_NEAREST : cv::INTER_LINEAR, cv::BORDER_CONSTANT);
     image = warped;
   }
-  if (!labels && scene_.render.noise_sigma > 0) {
-    cv::Mat noise(image.size(), CV_32FC3);
-    std::normal_distribution<float> normal(0.0f, static_cast<float>(scene_.render.noise_sigma));
-    for (int y = 0; y < noise.rows; ++y) {
-      float* p = noise.ptr<float>(y);
-      for (int x = 0; x < noise.cols * 3; ++x) p[x] = normal(s.noise_rng);
-    }
-    cv::Mat sum;
-    image.convertTo(sum, CV_32FC3);
-    sum += noise;
-    sum.convertTo(image, CV_8UC3);  // saturating
-  }
+  if (!labels) add_sensor_noise(image, scene_.render.noise_sigma, s.noise_rng);
   return image;
 }
 

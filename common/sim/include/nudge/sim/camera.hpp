@@ -65,9 +65,9 @@ struct Axis3d {
   Eigen::Vector3d top() const { return base + height * direction; }
 };
 
-// A symmetry line in the image in the project's convention (SPEC.md): (cos theta, sin theta) is
-// the line's normal about the image centre ((w-1)/2, (h-1)/2); theta = 0 is a vertical line;
-// theta in (-pi/2, pi/2]. `bottom`/`top` are the projections of the axis' ends.
+// A symmetry line in the image in the project's convention (docs/architecture.md, "Conventions"):
+// (cos theta, sin theta) is the line's normal about the image centre ((w-1)/2, (h-1)/2); theta = 0
+// is a vertical line; theta in (-pi/2, pi/2]. `bottom`/`top` are the projections of the axis' ends.
 struct ImageLine {
   bool valid = false;  // false when the axis projects to a point or lies behind the camera
   double r = 0;

@@ -1,7 +1,7 @@
 #pragma once
 // A symmetry line in an image, and how far apart two lines are.
 //
-// Conventions (SPEC.md): a line is (R, theta) about the image centre ((w-1)/2, (h-1)/2);
+// Conventions (the project's, docs/architecture.md): a line is (R, theta) about the image centre ((w-1)/2, (h-1)/2);
 // (cos theta, sin theta) is its normal, so theta = 0 is a vertical line; theta in (-90, 90] deg.
 // (R, theta) and (-R, theta + 180 deg) are the same line, which is why differences must wrap.
 #include <opencv2/core/types.hpp>

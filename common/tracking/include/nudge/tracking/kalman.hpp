@@ -23,9 +23,9 @@ struct KalmanParams {
   double measurement_var_r = 9.0;      // px^2 (thesis)
   double measurement_var_theta = 9.0;  // deg^2 (thesis)
   // Process noise diagonal, per frame, in state order [R, theta, R', theta', R'', theta''].
-  // The thesis' list is garbled; SPEC says start from (1, 10, 1, 10, 1, 10). With those values the
-  // predicted sigma is ~9 px / 9 deg, so the 9.21 gate spans ~+-30 px / +-30 deg and the filter
-  // hardly smooths (error ratio 0.93). These tuned values (docs/tracking.md) keep the gate at
+  // The thesis' list is garbled ("1, 0, 1, 10, 1, 10, 1"); its likely reading (1, 10, 1, 10, 1, 10)
+  // was the starting point. With those values the predicted sigma is ~9 px / 9 deg, so the 9.21
+  // gate spans ~+-30 px / +-30 deg and the filter hardly smooths (error ratio 0.93). These tuned values (docs/tracking.md) keep the gate at
   // ~+-15 px / deg, smooth noise to 0.75 of the raw error, and still gate a 10 px/frame object that
   // stops dead (normalised innovation <= 4).
   std::array<double, 6> process_noise = {1.0, 1.0, 0.5, 0.5, 0.05, 0.05};
