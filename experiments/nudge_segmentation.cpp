@@ -258,12 +258,13 @@ int main(int argc, char** argv) {
       effector += s.effector_pixels;
       if (!s.gallery.empty()) gallery.push_back(s.gallery);
     }
-    char row[512];
-    std::snprintf(row, sizeof row, "| %s | %d | %d | %s | %d | %d | %d | %d | %.0f | %s |\n", r.name.c_str(), r.objects_present,
-                  r.attempts, segmented.empty() ? "–" : segmented.c_str(),
-                  [&] { int e = 0; for (const auto& s : r.segmented) e += s.effector_pixels; return e; }(), r.no_motion,
-                  r.tipped, r.other_failures, r.wall_s, r.end_reason.c_str());
-    table << row;
+    int run_effector = 0;
+    for (const Segmented& seg : r.segmented) run_effector += seg.effector_pixels;
+    char wall[32];
+    std::snprintf(wall, sizeof wall, "%.0f", r.wall_s);
+    table << "| " << r.name << " | " << r.objects_present << " | " << r.attempts << " | "
+          << (segmented.empty() ? "–" : segmented) << " | " << run_effector << " | " << r.no_motion << " | " << r.tipped
+          << " | " << r.other_failures << " | " << wall << " | " << r.end_reason << " |\n";
   }
   const double ms = time_motion_segmentation(attempt_dirs);
   const double mean_iou = ious.empty() ? 0 : ex::mean(ious);
