@@ -121,15 +121,6 @@ std::vector<Eigen::Vector2d> find_corners(const cv::Mat& bgr, const std::string&
   return in_board_order(corners);
 }
 
-geo::Camera to_geometry(const sim::CameraModel& c) {
-  geo::Camera g;
-  g.width = c.width;
-  g.height = c.height;
-  g.K = c.K;
-  g.distortion = c.distortion;
-  return g;
-}
-
 std::string numbers(const Eigen::MatrixXd& m) {
   std::ostringstream s;
   s.precision(12);
@@ -189,10 +180,7 @@ int main(int argc, char** argv) {
       sim::World world(scene);
       const sim::CameraModel left_cam = stills ? world.snapshot_camera(0) : world.camera(0);
       const sim::CameraModel right_cam = stills ? world.snapshot_camera(1) : world.camera(1);
-      rig.left = to_geometry(left_cam);
-      rig.right = to_geometry(right_cam);
-      rig.R = world.rig().R_right_left();
-      rig.T = world.rig().t_right_left();
+      rig = sim::calibrated(left_cam, right_cam);
       truth_right = right_cam;
       const cv::Mat left = stills ? world.render_snapshot(0) : world.render(0);
       const cv::Mat right = stills ? world.render_snapshot(1) : world.render(1);

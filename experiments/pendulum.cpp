@@ -314,7 +314,7 @@ BackgroundResult run_background(const std::string& name, int frames) {
   double moving_typical = 0;  // slowly decaying maximum of the moving-block count
   cv::Mat hist, prev_grey;
   std::vector<FrameRecord> rec(frames);
-  const int w = world.camera(0).width, h = world.camera(0).height;
+  const int w = world.camera(0).lens.width, h = world.camera(0).lens.height;
   Stopwatch render_watch;
   double render_ms = 0, detect_ms = 0;
   for (int k = 0; k < frames; ++k) {

@@ -69,23 +69,6 @@ std::vector<ObjectCase> thesis_objects() {
 // thesis' checkerboard.
 const std::vector<Eigen::Vector2d> kLocations = {{0.20, 0.09}, {0.20, -0.09}, {0.31, 0.09}, {0.31, -0.09}};
 
-geo::StereoRig geometry_rig(const sim::World& world) {
-  geo::StereoRig rig;
-  auto convert = [](const sim::CameraModel& c) {
-    geo::Camera cam;
-    cam.width = c.width;
-    cam.height = c.height;
-    cam.K = c.K;
-    cam.distortion = c.distortion;
-    return cam;
-  };
-  rig.left = convert(world.camera(0));
-  rig.right = convert(world.camera(1));
-  rig.R = world.rig().R_right_left();
-  rig.T = world.rig().t_right_left();
-  return rig;
-}
-
 // The table plane z = 0 of the world, in the right camera's frame.
 geo::Plane table_in_right_camera(const sim::World& world) {
   const sim::CameraModel& right = world.camera(1);
@@ -133,7 +116,7 @@ Trial run_trial(const ObjectCase& object, int location, int repeats) {
   params.dmin = 25;
   params.dmax = 250;
   sym::Detector detector(params, sym::EdgeParams{1.0, 30, 90, false});
-  const geo::StereoRig rig = geometry_rig(world);
+  const geo::StereoRig rig = world.rig().calibrated();
   const geo::Plane table = table_in_right_camera(world);
   geo::AxisFilter filter;  // 15 deg from the table normal, within reach
   Trial t;

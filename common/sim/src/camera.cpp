@@ -13,70 +13,65 @@ using Eigen::Vector2d;
 using Eigen::Vector3d;
 
 bool CameraModel::distorted() const {
-  for (double d : distortion)
+  for (double d : lens.distortion)
     if (d != 0) return true;
   return false;
 }
 
-Vector2d CameraModel::distort(const Vector2d& n) const {
-  const double k1 = distortion[0], k2 = distortion[1], p1 = distortion[2], p2 = distortion[3],
-               k3 = distortion[4];
-  const double x = n.x(), y = n.y(), r2 = x * x + y * y;
-  const double radial = 1 + r2 * (k1 + r2 * (k2 + r2 * k3));
-  return Vector2d(x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x * x),
-                  y * radial + p1 * (r2 + 2 * y * y) + 2 * p2 * x * y);
-}
+Vector2d CameraModel::distort(const Vector2d& n) const { return lens.distort(n); }
 
 Vector2d CameraModel::undistort(const Vector2d& pixel) const {
-  const Vector2d d((pixel.x() - K(0, 2)) / K(0, 0), (pixel.y() - K(1, 2)) / K(1, 1));
-  if (!distorted()) return d;
-  // Fixed-point iteration n <- n + (d - distort(n)), as OpenCV's undistortPoints, then polished.
-  Vector2d n = d;
-  for (int i = 0; i < 50; ++i) {
-    const Vector2d step = d - distort(n);
-    n += step;
-    if (step.norm() < 1e-12) break;
-  }
-  return n;
+  const geometry::Outcome<Vector2d> n = lens.normalise(pixel);
+  if (!n) throw std::domain_error("camera '" + name + "': " + n.reason());
+  return *n;
 }
 
 Vector2d CameraModel::project(const Vector3d& world, double* depth) const {
   const Vector3d c = to_camera(world);
   if (depth) *depth = c.z();
-  const Vector2d n = distort(Vector2d(c.x() / c.z(), c.y() / c.z()));
-  return Vector2d(K(0, 0) * n.x() + K(0, 2), K(1, 1) * n.y() + K(1, 2));
+  return lens.project(c);
 }
 
 PinholeCanvas pinhole_canvas(const CameraModel& camera) {
-  PinholeCanvas canvas{camera.width, camera.height};
+  PinholeCanvas canvas{camera.lens.width, camera.lens.height};
   if (!camera.distorted()) return canvas;
   // The undistorted positions of the border pixels bound the pinhole image needed.
   double ex = 0, ey = 0;
   auto visit = [&](double u, double v) {
     const Vector2d n = camera.undistort(Vector2d(u, v));
-    ex = std::max(ex, std::fabs(camera.K(0, 0) * n.x()));
-    ey = std::max(ey, std::fabs(camera.K(1, 1) * n.y()));
+    ex = std::max(ex, std::fabs(camera.lens.K(0, 0) * n.x()));
+    ey = std::max(ey, std::fabs(camera.lens.K(1, 1) * n.y()));
   };
-  for (int u = 0; u < camera.width; ++u) {
+  for (int u = 0; u < camera.lens.width; ++u) {
     visit(u, 0);
-    visit(u, camera.height - 1);
+    visit(u, camera.lens.height - 1);
   }
-  for (int v = 0; v < camera.height; ++v) {
+  for (int v = 0; v < camera.lens.height; ++v) {
     visit(0, v);
-    visit(camera.width - 1, v);
+    visit(camera.lens.width - 1, v);
   }
   // Even sizes keep the centre at (size - 1) / 2; 2 px margin for interpolation.
-  canvas.width = std::max(camera.width, 2 * static_cast<int>(std::ceil(ex + 2)));
-  canvas.height = std::max(camera.height, 2 * static_cast<int>(std::ceil(ey + 2)));
+  canvas.width = std::max(camera.lens.width, 2 * static_cast<int>(std::ceil(ex + 2)));
+  canvas.height = std::max(camera.lens.height, 2 * static_cast<int>(std::ceil(ey + 2)));
   return canvas;
 }
 
 Matrix3d StereoRig::R_right_left() const {
-  return cameras[1].R * cameras[0].R.transpose();
+  return calibrated().R;
 }
 
 Vector3d StereoRig::t_right_left() const {
-  return cameras[1].t - R_right_left() * cameras[0].t;
+  return calibrated().T;
+}
+
+geometry::StereoRig calibrated(const CameraModel& left, const CameraModel& right) {
+  geometry::StereoRig rig;
+  rig.left = left.lens;
+  rig.right = right.lens;
+  // X_right = R_r (R_l^T (X_left - t_l)) + t_r.
+  rig.R = right.R * left.R.transpose();
+  rig.T = right.t - rig.R * left.t;
+  return rig;
 }
 
 StereoRig make_rig(const RigSpec& spec) {
@@ -106,11 +101,11 @@ StereoRig make_rig(const RigSpec& spec) {
     const Vector3d rgt = std::cos(half) * right + side * std::sin(half) * forward;
     CameraModel& cam = rig.cameras[i];
     cam.name = i == 0 ? "left" : "right";
-    cam.width = spec.width;
-    cam.height = spec.height;
     cam.fovy = spec.fovy;
-    cam.K = K;
-    cam.distortion = spec.distortion;
+    cam.lens.width = spec.width;
+    cam.lens.height = spec.height;
+    cam.lens.K = K;
+    cam.lens.distortion = spec.distortion;
     cam.R.row(0) = rgt.transpose();
     cam.R.row(1) = down.transpose();
     cam.R.row(2) = fwd.transpose();
@@ -123,12 +118,13 @@ StereoRig make_rig(const RigSpec& spec) {
 CameraModel scaled(const CameraModel& camera, int scale) {
   if (scale < 1) throw std::invalid_argument("scaled: scale must be >= 1");
   CameraModel out = camera;
-  out.width = camera.width * scale;
-  out.height = camera.height * scale;
-  out.K(0, 0) = camera.K(0, 0) * scale;
-  out.K(1, 1) = camera.K(1, 1) * scale;
-  out.K(0, 2) = 0.5 * (out.width - 1);
-  out.K(1, 2) = 0.5 * (out.height - 1);
+  geometry::Camera& lens = out.lens;
+  lens.width = camera.lens.width * scale;
+  lens.height = camera.lens.height * scale;
+  lens.K(0, 0) = camera.lens.K(0, 0) * scale;
+  lens.K(1, 1) = camera.lens.K(1, 1) * scale;
+  lens.K(0, 2) = 0.5 * (lens.width - 1);
+  lens.K(1, 2) = 0.5 * (lens.height - 1);
   return out;
 }
 
@@ -161,7 +157,7 @@ ImageLine project_axis(const CameraModel& camera, const Axis3d& axis) {
     line.top = b;
     return line;
   }
-  return line_through(a, b, camera.width, camera.height);
+  return line_through(a, b, camera.lens.width, camera.lens.height);
 }
 
 double signed_distance(const ImageLine& line, const Vector2d& pixel, int width, int height) {

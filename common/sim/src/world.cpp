@@ -580,19 +580,19 @@ cv::Mat World::draw(int camera_index, bool snapshot, bool labels) {
     if (warp->map_x.empty()) {
       const PinholeCanvas canvas = pinhole_canvas(cam);
       warp->size = cv::Size(canvas.width, canvas.height);
-      warp->map_x.create(cam.height, cam.width, CV_32F);
-      warp->map_y.create(cam.height, cam.width, CV_32F);
+      warp->map_x.create(cam.lens.height, cam.lens.width, CV_32F);
+      warp->map_y.create(cam.lens.height, cam.lens.width, CV_32F);
       const double cx = 0.5 * (canvas.width - 1), cy = 0.5 * (canvas.height - 1);
-      for (int v = 0; v < cam.height; ++v)
-        for (int u = 0; u < cam.width; ++u) {
+      for (int v = 0; v < cam.lens.height; ++v)
+        for (int u = 0; u < cam.lens.width; ++u) {
           const Eigen::Vector2d n = cam.undistort(Eigen::Vector2d(u, v));
-          warp->map_x.at<float>(v, u) = static_cast<float>(cam.K(0, 0) * n.x() + cx);
-          warp->map_y.at<float>(v, u) = static_cast<float>(cam.K(1, 1) * n.y() + cy);
+          warp->map_x.at<float>(v, u) = static_cast<float>(cam.lens.K(0, 0) * n.x() + cx);
+          warp->map_y.at<float>(v, u) = static_cast<float>(cam.lens.K(1, 1) * n.y() + cy);
         }
-      warp->fovy_deg = 2 * std::atan(0.5 * canvas.height / cam.K(1, 1)) * 180.0 / M_PI;
+      warp->fovy_deg = 2 * std::atan(0.5 * canvas.height / cam.lens.K(1, 1)) * 180.0 / M_PI;
     }
   }
-  const cv::Size size = warp ? warp->size : cv::Size(cam.width, cam.height);
+  const cv::Size size = warp ? warp->size : cv::Size(cam.lens.width, cam.lens.height);
   const mjtNum fovy = s.model->cam_fovy[id];
   if (warp) s.model->cam_fovy[id] = warp->fovy_deg;
   cv::Mat image;

@@ -21,9 +21,9 @@ TEST(SimCamera, VergedRigGeometry) {
   EXPECT_LT(l.to_camera(r.centre()).x(), 0.26);
   EXPECT_GT(l.to_camera(r.centre()).x(), 0.24);
   // Intrinsics: principal point at the image centre, f from the vertical field of view.
-  EXPECT_DOUBLE_EQ(l.K(0, 2), 319.5);
-  EXPECT_DOUBLE_EQ(l.K(1, 2), 239.5);
-  EXPECT_NEAR(l.K(1, 1), 240 / std::tan(22.5 * kDeg), 1e-9);
+  EXPECT_DOUBLE_EQ(l.lens.K(0, 2), 319.5);
+  EXPECT_DOUBLE_EQ(l.lens.K(1, 2), 239.5);
+  EXPECT_NEAR(l.lens.K(1, 1), 240 / std::tan(22.5 * kDeg), 1e-9);
   // The target is in front of both cameras, near the middle of the images.
   for (const CameraModel& c : rig.cameras) {
     double depth = 0;
@@ -79,8 +79,48 @@ TEST(SimCamera, DistortionRoundTrip) {
   EXPECT_GT(canvas.width, 640);
   EXPECT_GT(canvas.height, 480);
   CameraModel ideal = cam;
-  ideal.distortion = {};
+  ideal.lens.distortion = {};
   EXPECT_EQ(pinhole_canvas(ideal).width, 640);
+}
+
+// The geometry rig a sim rig calibrates to sees a world point where the sim cameras do: the left
+// lens projects the point in the left camera's frame, the right lens the point carried over by the
+// rig's extrinsics.
+void expect_calibrated_rig_matches(const RigSpec& spec) {
+  const StereoRig sim_rig = make_rig(spec);
+  const nudge::geometry::StereoRig rig = sim_rig.calibrated();
+  const CameraModel& l = sim_rig.cameras[0];
+  const CameraModel& r = sim_rig.cameras[1];
+  EXPECT_EQ(rig.left.width, l.lens.width);
+  EXPECT_EQ(rig.right.height, r.lens.height);
+  EXPECT_LT((rig.R - sim_rig.R_right_left()).norm(), 1e-12);
+  EXPECT_LT((rig.T - sim_rig.t_right_left()).norm(), 1e-12);
+  for (const Eigen::Vector3d& X : {Eigen::Vector3d(0.25, 0, 0.06), Eigen::Vector3d(0.1, 0.3, 0.0),
+                                  Eigen::Vector3d(0.4, -0.25, 0.2)}) {
+    const Eigen::Vector3d in_left = l.to_camera(X);
+    EXPECT_LT((rig.left_to_right(in_left) - r.to_camera(X)).norm(), 1e-12);
+    EXPECT_LT((rig.left.project(in_left) - l.project(X)).norm(), 1e-9);
+    EXPECT_LT((rig.right.project(rig.left_to_right(in_left)) - r.project(X)).norm(), 1e-9);
+  }
+}
+
+TEST(SimCamera, CalibratedRigProjectsLikeTheSimCameras) {
+  RigSpec spec;
+  expect_calibrated_rig_matches(spec);
+  spec.distortion = {-0.25, 0.1, 0.001, -0.002, 0.01};
+  expect_calibrated_rig_matches(spec);
+}
+
+TEST(SimCamera, UndistortNamesTheCameraWhereTheLensFoldsOver) {
+  RigSpec spec;
+  spec.distortion = {-0.5, 0, 0, 0, 0};
+  const CameraModel cam = make_rig(spec).cameras[0];
+  try {
+    cam.undistort(Eigen::Vector2d(-5000, -5000));
+    FAIL() << "expected std::domain_error";
+  } catch (const std::domain_error& e) {
+    EXPECT_NE(std::string(e.what()).find("camera 'left'"), std::string::npos) << e.what();
+  }
 }
 
 // With lens distortion the renderer warps a larger pinhole image: silhouettes still land where

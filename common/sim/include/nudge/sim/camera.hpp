@@ -2,9 +2,11 @@
 // Cameras of the simulated stereo rig and ground-truth projection of symmetry axes.
 //
 // Camera frame: OpenCV's (x right, y down, z forward). Pose is world -> camera:
-// X_cam = R * X_world + t. Intrinsics K = [f 0 cx; 0 f cy; 0 0 1] with pixel indices from 0 at
-// pixel centres, so the principal point is the image centre ((w-1)/2, (h-1)/2). Optional lens
+// X_cam = R * X_world + t. The intrinsics and lens are a geometry::Camera (one lens model shared
+// with the stereo geometry): K = [f 0 cx; 0 f cy; 0 0 1] with pixel indices from 0 at pixel
+// centres, so the principal point is the image centre ((w-1)/2, (h-1)/2), and optional lens
 // distortion in OpenCV's model (k1, k2, p1, p2, k3), zero by default.
+#include "nudge/geometry/stereo_rig.hpp"
 #include "nudge/sim/scene.hpp"
 
 #include <Eigen/Core>
@@ -16,12 +18,10 @@ namespace nudge::sim {
 
 struct CameraModel {
   std::string name;  // "left" / "right"
-  int width = 0, height = 0;
   double fovy = 0;   // radians
-  Eigen::Matrix3d K = Eigen::Matrix3d::Identity();
+  geometry::Camera lens{0, 0};  // image size, K and distortion; projection is delegated to it
   Eigen::Matrix3d R = Eigen::Matrix3d::Identity();  // world -> camera rotation
   Eigen::Vector3d t = Eigen::Vector3d::Zero();      // world -> camera translation
-  std::array<double, 5> distortion{{0, 0, 0, 0, 0}};  // k1 k2 p1 p2 k3
 
   bool distorted() const;
   Eigen::Vector3d centre() const { return -R.transpose() * t; }  // in the world frame
@@ -31,7 +31,8 @@ struct CameraModel {
   Eigen::Vector2d project(const Eigen::Vector3d& world, double* depth = nullptr) const;
   // Normalised image coordinates (x/z, y/z) -> distorted normalised coordinates.
   Eigen::Vector2d distort(const Eigen::Vector2d& normalised) const;
-  // Pixel -> undistorted normalised coordinates (iterative inverse of distort()).
+  // Pixel -> undistorted normalised coordinates (geometry::Camera::normalise). Throws
+  // std::domain_error naming the camera and the pixel where the lens model cannot be inverted.
   Eigen::Vector2d undistort(const Eigen::Vector2d& pixel) const;
 };
 
@@ -43,12 +44,18 @@ struct PinholeCanvas {
 };
 PinholeCanvas pinhole_canvas(const CameraModel& camera);
 
+// The calibrated rig of two sim cameras (e.g. World::snapshot_camera's, which a StereoRig does not
+// hold): their lenses, and R, T with X_right = R * X_left + T.
+geometry::StereoRig calibrated(const CameraModel& left, const CameraModel& right);
+
 // The two cameras of a verged stereo rig, index 0 = left, 1 = right.
 struct StereoRig {
   std::array<CameraModel, 2> cameras;
   // Pose of the right camera relative to the left: X_right = R * X_left + t.
   Eigen::Matrix3d R_right_left() const;
   Eigen::Vector3d t_right_left() const;
+  // The rig as the stereo geometry sees it: both lenses and the left -> right extrinsics.
+  geometry::StereoRig calibrated() const { return sim::calibrated(cameras[0], cameras[1]); }
 };
 
 StereoRig make_rig(const RigSpec& spec);
