@@ -28,6 +28,15 @@ robot::SafetyConfig ArmSetup::safety_config() const {
   return config;
 }
 
+robot::PlannerConfig ArmSetup::planner() const {
+  robot::PlannerConfig config;
+  config.model = model;
+  config.safety = safety_config();
+  config.base = robot::BaseFrame{base_height, base_yaw};
+  config.nudge = nudge;
+  return config;
+}
+
 robot::JointVector ArmSetup::home() const {
   const robot::IkResult home = robot::home_configuration(model, safety_config());
   return home.ok() ? home.q : robot::JointVector::Zero();
@@ -97,6 +106,17 @@ TargetChoice choose_pass(const std::vector<Candidate>& candidates, const std::ve
           robot::plan_nudge(arm.model, arm.safety_config(), arm.point_to_base(c.position), direction_base, arm.nudge, seed);
       if (!plan.ok()) {
         why_not += std::string(why_not.empty() ? "" : "; the other way: ") + "out of reach: " + plan.reason;
+        continue;
+      }
+      // The whole command as the arm service will plan it from where the arm is (the move to P0
+      // included): a target it would refuse is not chosen.
+      robot::Command command;
+      command.kind = robot::CommandKind::Nudge;
+      command.target_position = c.position;
+      command.direction = horizontal(direction).normalized();
+      const robot::MotionPlan arm_plan = robot::plan_command(arm.planner(), command, seed);
+      if (!arm_plan.ok()) {
+        why_not += std::string(why_not.empty() ? "" : "; the other way: ") + "the arm would refuse: " + arm_plan.reason;
         continue;
       }
       choice.found = true;

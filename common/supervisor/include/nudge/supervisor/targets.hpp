@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "nudge/robot/command_planner.hpp"
 #include "nudge/robot/motions.hpp"
 #include "nudge/robot/workspace.hpp"
 
@@ -24,6 +25,8 @@ struct ArmSetup {
 
   // The safety checks with the table where the base height puts it.
   robot::SafetyConfig safety_config() const;
+  // The arm service's planner configuration for this arm: a nudge it accepts is one it can plan.
+  robot::PlannerConfig planner() const;
   // Where the arm parks (the arm service's COMMAND_HOME pose): the planner's seed before any ARM_STATE.
   robot::JointVector home() const;
   Eigen::Vector3d point_to_base(const Eigen::Vector3d& world) const;
