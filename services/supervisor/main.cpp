@@ -454,8 +454,7 @@ int main(int argc, char** argv) {
     const robot::Workspace workspace = workspace_flags.resolve();
     robot::apply_workspace(workspace, &opt.arm.model);
     robot::apply_workspace(workspace, &opt.arm.safety);
-    opt.arm.base_height = workspace.shoulder_height;
-    opt.arm.base_yaw = workspace.base_yaw;
+    opt.arm.base = robot::BaseFrame::of(workspace);
     if (opt.calibration.empty()) throw FlagError("--calibration FILE is required");
     if (opt.clock != "sim" && opt.clock != "wall") throw FlagError("--clock must be sim or wall, not '" + opt.clock + "'");
     if (opt.run_id.empty()) opt.run_id = default_run_id();

@@ -26,6 +26,7 @@ MotionWatch::MotionWatch(const symmetry::Line& line, const cv::Point2d& push, in
       if (beyond >= params_.margin_px && beyond <= params_.margin_px + params_.band_px) region_.at<uint8_t>(by, bx) = 255;
     }
   }
+  region_ones_ = region_ / 255;
 }
 
 void MotionWatch::feed(const cv::Mat& frame) {
@@ -38,9 +39,8 @@ void MotionWatch::feed(const cv::Mat& frame) {
   ++frames_;
   if (!previous_.empty()) {
     const tracking::BlockMotion motion = tracking::detect_block_motion(previous_, grey, params_.blocks);
-    cv::Mat in_band;
-    cv::bitwise_and(motion.moving, region_ / 255, in_band);
-    const int count = cv::countNonZero(in_band);
+    cv::bitwise_and(motion.moving, region_ones_, in_band_);
+    const int count = cv::countNonZero(in_band_);
     max_blocks_ = std::max(max_blocks_, count);
     if (count >= params_.min_blocks) ++frames_with_motion_;
   }

@@ -11,12 +11,6 @@ namespace {
 
 constexpr double kMicro = 1e6;
 
-std::string millimetres(const Eigen::Vector3d& p) {
-  char text[64];
-  std::snprintf(text, sizeof text, "(%.0f, %.0f) mm", 1e3 * p.x(), 1e3 * p.y());
-  return text;
-}
-
 double median(std::vector<double> values) {
   std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
   return values[values.size() / 2];

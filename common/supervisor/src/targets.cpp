@@ -10,7 +10,10 @@ namespace nudge::supervisor {
 
 namespace {
 
-Eigen::Matrix3d yaw_rotation(double yaw) { return Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix(); }
+
+Eigen::Vector3d horizontal(const Eigen::Vector3d& v) { return Eigen::Vector3d(v.x(), v.y(), 0.0); }
+
+}  // namespace
 
 std::string millimetres(const Eigen::Vector3d& p) {
   char text[64];
@@ -18,13 +21,9 @@ std::string millimetres(const Eigen::Vector3d& p) {
   return text;
 }
 
-Eigen::Vector3d horizontal(const Eigen::Vector3d& v) { return Eigen::Vector3d(v.x(), v.y(), 0.0); }
-
-}  // namespace
-
 robot::SafetyConfig ArmSetup::safety_config() const {
   robot::SafetyConfig config = safety;
-  config.table_z = -base_height;
+  config.table_z = base.table_z();
   return config;
 }
 
@@ -32,7 +31,7 @@ robot::PlannerConfig ArmSetup::planner() const {
   robot::PlannerConfig config;
   config.model = model;
   config.safety = safety_config();
-  config.base = robot::BaseFrame{base_height, base_yaw};
+  config.base = base;
   config.nudge = nudge;
   return config;
 }
@@ -42,11 +41,6 @@ robot::JointVector ArmSetup::home() const {
   return home.ok() ? home.q : robot::JointVector::Zero();
 }
 
-Eigen::Vector3d ArmSetup::point_to_base(const Eigen::Vector3d& world) const {
-  return yaw_rotation(-base_yaw) * (world - Eigen::Vector3d(0, 0, base_height));
-}
-Eigen::Vector3d ArmSetup::direction_to_base(const Eigen::Vector3d& world) const { return yaw_rotation(-base_yaw) * world; }
-Eigen::Vector3d ArmSetup::direction_to_world(const Eigen::Vector3d& base) const { return yaw_rotation(base_yaw) * base; }
 
 PushConflict push_conflict(const Eigen::Vector3d& target, const Eigen::Vector3d& direction,
                            const Eigen::Vector3d& other, const ArmSetup& arm, const TargetParams& params) {

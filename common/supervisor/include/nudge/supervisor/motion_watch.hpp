@@ -36,7 +36,9 @@ class MotionWatch {
  private:
   MotionWatchParams params_;
   cv::Size size_;
-  cv::Mat region_;  // blocks whose centre lies in the watched band
+  cv::Mat region_;  // blocks whose centre lies in the watched band (0/255)
+  cv::Mat region_ones_;  // the same as 0/1, to AND with the 0/1 moving flags
+  cv::Mat in_band_;      // scratch: moving blocks in the band (kept between frames: no allocation)
   cv::Mat previous_;
   int frames_ = 0, frames_with_motion_ = 0, max_blocks_ = 0;
 };

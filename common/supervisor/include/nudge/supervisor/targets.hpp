@@ -15,13 +15,12 @@
 namespace nudge::supervisor {
 
 // Where the arm stands in the world frame (docs/robot.md, "Frames"): its base on the world z axis
-// `base_height` above the table top, turned `base_yaw` about z.
+// `base.height` above the table top, turned `base.yaw` about z (robot::BaseFrame).
 struct ArmSetup {
   robot::ArmModel model = robot::puma260();
   robot::SafetyConfig safety;
   robot::NudgeParams nudge;
-  double base_height = robot::Workspace{}.shoulder_height;  // the workspace file's, in the service
-  double base_yaw = 0.0;
+  robot::BaseFrame base;  // the workspace file's, in the service
 
   // The safety checks with the table where the base height puts it.
   robot::SafetyConfig safety_config() const;
@@ -29,9 +28,11 @@ struct ArmSetup {
   robot::PlannerConfig planner() const;
   // Where the arm parks (the arm service's COMMAND_HOME pose): the planner's seed before any ARM_STATE.
   robot::JointVector home() const;
-  Eigen::Vector3d point_to_base(const Eigen::Vector3d& world) const;
-  Eigen::Vector3d direction_to_base(const Eigen::Vector3d& world) const;
-  Eigen::Vector3d direction_to_world(const Eigen::Vector3d& base) const;
+  Eigen::Vector3d point_to_base(const Eigen::Vector3d& world) const { return base.point_to_base(world); }
+  Eigen::Vector3d direction_to_base(const Eigen::Vector3d& world) const { return base.direction_to_base(world); }
+  Eigen::Vector3d direction_to_world(const Eigen::Vector3d& in_base) const {
+    return base.world_from_base().linear() * in_base;
+  }
 };
 
 struct TargetParams {
@@ -71,6 +72,9 @@ struct TargetChoice {
   std::vector<Rejection> rejected;                        // every candidate passed over, and why
   std::string note;  // set when the push was accepted although it may touch another candidate
 };
+
+// "(x, y) mm" of a world point, for reasons.
+std::string millimetres(const Eigen::Vector3d& p);
 
 // Candidates nearest the right camera first; the first nudgeable one is chosen. `explored` are
 // places already nudged (where a candidate stood, where a nudged object came to rest); `empty` are
