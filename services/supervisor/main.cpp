@@ -245,15 +245,14 @@ class Shell {
     supervisor_.on_lines(left, lines, now_);
   }
 
-  // Decoding costs: frames are decoded only while the loop watches the nudge and the object settle.
-  bool watching() const { return supervisor_.state() == sv::State::Nudge || supervisor_.state() == sv::State::Track; }
+  // Decoding costs: a frame is decoded only when the loop would use it.
   void on_frame(const image_t& m) {
-    if (!watching()) return;
+    if (!supervisor_.wants_frame(false)) return;
     supervisor_.on_right_frame(bus::to_mat(m), m.utime);
     drain();
   }
   void on_left_frame(const image_t& m) {
-    if (!watching()) return;
+    if (!supervisor_.wants_frame(true)) return;
     supervisor_.on_left_frame(bus::to_mat(m), m.utime);
     drain();
   }

@@ -494,6 +494,12 @@ void Supervisor::on_right_frame(const cv::Mat& frame, int64_t utime) {
   feed_tracker(1, frame, utime);
 }
 
+bool Supervisor::wants_frame(bool left) const {
+  const int camera = left ? 0 : 1;
+  const bool tracking = trackers_[camera] && !track_done_[camera] && (state_ == State::Nudge || state_ == State::Track);
+  return tracking || (!left && state_ == State::Nudge);
+}
+
 void Supervisor::on_left_frame(const cv::Mat& frame, int64_t utime) { feed_tracker(0, frame, utime); }
 
 void Supervisor::on_right_still(const cv::Mat& still, int64_t utime, int64_t now) {

@@ -170,6 +170,9 @@ class Supervisor {
   // settling: motion beyond the line (right) and the trackers (both).
   void on_right_frame(const cv::Mat& frame, int64_t utime);
   void on_left_frame(const cv::Mat& frame, int64_t utime);
+  // Whether the next frame of that camera would be used (decoding one costs): the right camera's
+  // while nudging, and either while its tracker runs.
+  bool wants_frame(bool left) const;
   void on_right_still(const cv::Mat& still, int64_t utime, int64_t now);
   void on_axes(const std::vector<Axis>& axes, int64_t now);
   // One camera's symmetry lines (SYMMETRY_LEFT / SYMMETRY_RIGHT, 640x480) during a survey: they
