@@ -51,9 +51,12 @@ inline constexpr const char* HEARTBEAT = "HEARTBEAT";  // heartbeat_t
 inline constexpr const char* SUPERVISOR_STATE = "SUPERVISOR_STATE";  // supervisor_state_t
 inline constexpr const char* SEGMENTATION = "SEGMENTATION";          // segmentation_t
 
-// For the services still to come (issue 9): recognition.
-inline constexpr const char* RECOGNIZE_REQUEST = "RECOGNIZE_REQUEST";
-inline constexpr const char* RECOGNITION = "RECOGNITION";
+// Learning and recognition (the learner service).
+inline constexpr const char* LEARN_VIEW = "LEARN_VIEW";                // learn_view_t
+inline constexpr const char* LEARN_COMMIT = "LEARN_COMMIT";            // learn_commit_t
+inline constexpr const char* LEARNED = "LEARNED";                      // learn_result_t
+inline constexpr const char* RECOGNIZE_REQUEST = "RECOGNIZE_REQUEST";  // recognize_request_t
+inline constexpr const char* RECOGNITION = "RECOGNITION";              // recognition_t
 
 // The channel of kind `kind` (SYMMETRY, CONTOURS, TRACK) that results from a camera channel:
 // CAMERA_LEFT -> SYMMETRY_LEFT, CAMERA -> SYMMETRY; a channel not named CAMERA... keeps its
