@@ -5,6 +5,7 @@
 // docs/supervisor.md has the protocol (channels in and out, and why).
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -30,6 +31,11 @@
 #include "nudge/candidates_t.hpp"
 #include "nudge/heartbeat_t.hpp"
 #include "nudge/image_t.hpp"
+#include "nudge/learn_commit_t.hpp"
+#include "nudge/learn_result_t.hpp"
+#include "nudge/learn_view_t.hpp"
+#include "nudge/recognition_t.hpp"
+#include "nudge/recognize_request_t.hpp"
 #include "nudge/log.hpp"
 #include "nudge/robot/workspace_flags.hpp"
 #include "nudge/segmentation_t.hpp"
@@ -54,6 +60,8 @@ struct Options {
   // A gentle push: tall objects (bottles) tip when the pad meets them at the arm's usual speed.
   double nudge_speed_scale = 0.25;
   bool keep_running = false;
+  std::string learn = "auto";      // on, off, auto (while the learner's heartbeat is heard)
+  std::string learner = "learner"; // the learner service's heartbeat name
   sv::Config config;
   sv::ArmSetup arm;
 };
@@ -119,7 +127,8 @@ class RunLog {
 // Published by the supervisor alone.
 const std::set<std::string> kOwnChannels = {bus::channel::CANDIDATES_REQUEST, bus::channel::CAMERA_SNAPSHOT_REQUEST,
                                             bus::channel::ARM_COMMAND, bus::channel::SUPERVISOR_STATE,
-                                            bus::channel::SEGMENTATION};
+                                            bus::channel::SEGMENTATION, bus::channel::RECOGNIZE_REQUEST,
+                                            bus::channel::LEARN_VIEW, bus::channel::LEARN_COMMIT};
 
 class Shell {
  public:
@@ -148,6 +157,15 @@ class Shell {
     subs.subscribe<image_t>(bus::channel::CAMERA_RIGHT, [this](const image_t& m, const std::string&) { on_frame(m); });
     subs.subscribe<image_t>(bus::channel::CAMERA_LEFT, [this](const image_t& m, const std::string&) { on_left_frame(m); });
     subs.subscribe<image_t>(bus::channel::SNAPSHOT_RIGHT, [this](const image_t& m, const std::string&) { on_still(m); });
+    subs.subscribe<image_t>(bus::channel::SNAPSHOT_LEFT, [this](const image_t& m, const std::string&) { on_left_still(m); });
+    subs.subscribe<recognition_t>(bus::channel::RECOGNITION, [this](const recognition_t& m, const std::string&) {
+      supervisor_.on_recognition(m.seq, m.label, m.reason, now_);
+      drain();
+    });
+    subs.subscribe<learn_result_t>(bus::channel::LEARNED, [this](const learn_result_t& m, const std::string&) {
+      supervisor_.on_learned(m.seq, m.ok, m.object_name, m.reason, now_);
+      drain();
+    });
   }
 
   // Wall-clock duties: the task clock (--clock wall), the 1 Hz state, the heartbeat watchdog live.
@@ -223,6 +241,7 @@ class Shell {
     status.command_seq = m.command_seq;
     status.last_error = m.last_error;
     for (int i = 0; i < 6; ++i) status.joints[i] = m.joints[i];
+    status.gripper_opening = std::isfinite(m.gripper) ? m.gripper : -1.0;
     supervisor_.on_arm_state(status, now_);
     drain();
   }
@@ -261,6 +280,10 @@ class Shell {
     supervisor_.on_right_still(bus::to_mat(m), m.utime, now_);
     drain();
   }
+  void on_left_still(const image_t& m) {
+    supervisor_.on_left_still(bus::to_mat(m), m.utime, now_);
+    drain();
+  }
 
   // ---- time and health ----
   void advance(int64_t now) {
@@ -290,6 +313,10 @@ class Shell {
   }
 
   void check_services(int64_t reference) {
+    // The learner is not required: with --learn auto the loop learns while it is heard.
+    const auto learner = last_beat_.find(opt_.learner);
+    supervisor_.set_learner_alive(learner != last_beat_.end() &&
+                                  static_cast<double>(reference - learner->second) <= opt_.service_timeout_s * 1e6);
     if (!started_) return;
     const std::set<std::string> silent = silent_services(reference);
     if (silent == silent_) return;
@@ -310,10 +337,10 @@ class Shell {
     m.lines_per_image = r.lines;
     publish(bus::channel::CANDIDATES_REQUEST, m);
   }
-  void handle(const sv::SnapshotRequest&) {
+  void handle(const sv::SnapshotRequest& r) {
     snapshot_request_t m{};
     m.utime = now_;
-    m.cameras = snapshot_request_t::CAMERAS_RIGHT;
+    m.cameras = r.both ? snapshot_request_t::CAMERAS_BOTH : snapshot_request_t::CAMERAS_RIGHT;
     publish(bus::channel::CAMERA_SNAPSHOT_REQUEST, m);
   }
   // A command with the fields every command shares (an identity orientation: a valid pose_t).
@@ -338,6 +365,61 @@ class Shell {
   }
   void handle(const sv::HomeCommand& c) {
     publish(bus::channel::ARM_COMMAND, arm_command(c.seq, arm_command_t::COMMAND_HOME));  // the arm's usual speed
+  }
+  // Grasp and place: the tool's x axis along world x (an identity orientation), the fingers
+  // `height` above the table over the object's foot.
+  void handle(const sv::GraspCommand& c) {
+    arm_command_t m = arm_command(c.seq, arm_command_t::COMMAND_GRASP);
+    copy3(c.position, m.target.position);
+    m.height = c.height;
+    publish(bus::channel::ARM_COMMAND, m);
+  }
+  void handle(const sv::PlaceCommand& c) {
+    arm_command_t m = arm_command(c.seq, arm_command_t::COMMAND_PLACE);
+    copy3(c.position, m.target.position);
+    m.height = c.height;
+    publish(bus::channel::ARM_COMMAND, m);
+  }
+  void handle(const sv::RotateCommand& c) {
+    arm_command_t m = arm_command(c.seq, arm_command_t::COMMAND_ROTATE_WRIST);
+    m.angle = c.angle;
+    publish(bus::channel::ARM_COMMAND, m);
+  }
+  void handle(const sv::RecognizeRequest& r) {
+    recognize_request_t m{};
+    m.utime = now_;
+    m.seq = r.seq;
+    const int roi[4] = {r.roi.x, r.roi.y, r.roi.width, r.roi.height};
+    std::copy(roi, roi + 4, m.roi);
+    m.want_match_picture = false;
+    m.image = bus::to_message(r.image, image_t::FORMAT_PNG, now_, r.seq, "right");
+    publish(bus::channel::RECOGNIZE_REQUEST, m);
+  }
+  void handle(const sv::LearnView& v) {
+    const std::string file = sv::save_view(run_dir_, supervisor_.report().attempt, v);
+    learn_view_t m{};
+    m.utime = v.utime;
+    m.run_id = opt_.run_id;
+    m.object_key = v.object_key;
+    m.view_index = v.index;
+    m.wrist_angle = v.angle;
+    const int box[4] = {v.box.x, v.box.y, v.box.width, v.box.height};
+    std::copy(box, box + 4, m.box);
+    m.image = bus::to_message(v.image, image_t::FORMAT_PNG, v.utime, v.index, "right");
+    publish(bus::channel::LEARN_VIEW, m);
+    log::info() << "view " << v.index << " (" << v.angle * 180 / M_PI << " deg) sent and saved as " << file;
+  }
+  void handle(const sv::LearnCommit& c) {
+    learn_commit_t m{};
+    m.utime = now_;
+    m.seq = c.seq;
+    m.run_id = opt_.run_id;
+    m.object_key = c.object_key;
+    m.object_name = "";
+    m.num_views = c.views;
+    m.height = c.height;
+    m.radius = c.radius;
+    publish(bus::channel::LEARN_COMMIT, m);
   }
   void handle(const sv::StopCommand& c) {
     publish(bus::channel::ARM_COMMAND, arm_command(c.seq, arm_command_t::COMMAND_STOP));
@@ -434,6 +516,15 @@ void add_flags(Flags& f, Options& o) {
   f.add_double("nudge-timeout", &o.config.nudge_timeout_s, "for the arm to finish a nudge, s of the task clock");
   f.add_double("nudge-speed", &o.nudge_speed_scale, "nudges at this fraction of the arm's joint speed limits (0.01-1)");
   f.add_double("object-radius", &o.config.targets.object_radius, "largest expected object radius (push clearance), m");
+  f.add_string("learn", &o.learn,
+               "learning by interaction (thesis ch. 7: recognise before nudging; grasp, turn, learn, put back after a "
+               "segmentation): on, off, or auto (while the learner's heartbeat is heard)");
+  f.add_string("learner", &o.learner, "the learner service's heartbeat name (--learn auto)");
+  f.add_int("views", &o.config.views, "training views per learned object (thesis 12)");
+  f.add_double("view-step", &o.config.view_step_deg, "wrist turn between training views, deg (thesis 30)");
+  f.add_double("recognise-timeout", &o.config.recognise_timeout_s, "for a RECOGNITION answer, s of the task clock (then the nudge goes ahead)");
+  f.add_double("learn-timeout", &o.config.learn_timeout_s, "for a LEARNED answer, s of the task clock (then the object is put back)");
+  f.add_double("top-radius", &o.config.grasp.top_radius_m, "r of the grasp height's r*tan(theta) lowering, m (thesis: 36 mm at 30 deg)");
   f.add_int("first-seq", &o.first_seq, "first ARM_COMMAND seq (default: from the wall clock; set it to replay a run)");
 }
 
@@ -461,6 +552,12 @@ int main(int argc, char** argv) {
     if (opt.require.empty()) opt.require = std::string("camera,symmetry,triangulation,arm") + (opt.clock == "sim" ? ",world" : "");
     if (!(opt.service_timeout_s > 0)) throw FlagError("--service-timeout must be > 0");
     if (!(opt.nudge_speed_scale >= 0.01 && opt.nudge_speed_scale <= 1)) throw FlagError("--nudge-speed must lie in [0.01, 1]");
+    if (opt.learn == "on") opt.config.learn = sv::Config::Learn::On;
+    else if (opt.learn == "off") opt.config.learn = sv::Config::Learn::Off;
+    else if (opt.learn == "auto") opt.config.learn = sv::Config::Learn::Auto;
+    else throw FlagError("--learn must be on, off or auto, not '" + opt.learn + "'");
+    if (opt.config.views <= 0 || opt.config.views > 36) throw FlagError("--views must lie in [1, 36]");
+    if (!(opt.config.view_step_deg > 0 && opt.config.view_step_deg <= 90)) throw FlagError("--view-step must lie in (0, 90] deg");
     Shell shell(service, opt);  // loads the calibration: a bad file ends here, naming the field
     service.start();
     shell.subscribe();

@@ -510,3 +510,278 @@ TEST_F(SupervisorTest, MotionFarAboveTheObjectIsNotKeptInItsMask) {
   EXPECT_EQ(cv::countNonZero(mask(cv::Rect(600, 10, 80, 60))), 0) << "the high blob is gone";
   EXPECT_GT(cv::countNonZero(mask), 1000) << "the object stays";
 }
+
+// ---- learning by interaction (thesis ch. 7): recognise, grasp, turn, learn, put back ----
+
+TEST(Grasp, TheObjectTopIsTheLargestBlobsFirstPixelOnTheLine) {
+  cv::Mat mask = cv::Mat::zeros(200, 300, CV_8U);
+  cv::rectangle(mask, cv::Rect(120, 60, 60, 120), cv::Scalar(255), cv::FILLED);  // the object
+  cv::rectangle(mask, cv::Rect(140, 5, 20, 20), cv::Scalar(255), cv::FILLED);    // motion above it, smaller
+  nudge::symmetry::Line vertical;  // x = 150: R = 150 - 149.5, theta = 0
+  vertical.r = 0.5;
+  vertical.theta = 0;
+  const auto top = sv::object_top(mask, vertical);
+  ASSERT_TRUE(top);
+  EXPECT_NEAR(top->x, 150, 1e-9);
+  EXPECT_EQ(top->y, 60);  // not 5: the smaller blob is not the object
+  nudge::symmetry::Line beside = vertical;
+  beside.r = 100;  // x = 249.5 misses the object
+  EXPECT_FALSE(sv::object_top(mask, beside));
+  EXPECT_FALSE(sv::object_top(cv::Mat::zeros(200, 300, CV_8U), vertical));
+}
+
+TEST(Grasp, TheTriangulatedTopIsLoweredByRTanTheta) {
+  const sv::SceneGeometry scene = make_scene();
+  const Eigen::Vector3d foot(0.28, -0.05, 0), top(0.28, -0.05, 0.12);
+  const cv::Size still(1280, 960);
+  const auto left = scene.project_left(top, still), right = scene.project_right(top, still);
+  const sv::GraspTarget g = sv::grasp_target(scene, *left, *right, still, foot);
+  ASSERT_TRUE(g.ok()) << g.reason;
+  EXPECT_LT((g.top - top).norm(), 1e-6);
+  const Eigen::Vector3d camera = scene.right_camera_in_world();
+  const double theta = std::atan2(camera.z() - top.z(), (camera - top).head<2>().norm());
+  EXPECT_NEAR(g.overestimate_m, 0.06 * std::tan(theta), 1e-9);
+  EXPECT_NEAR(g.grasp_height_m, 0.12 - g.overestimate_m, 1e-6);
+  // A top that is the table itself cannot be grasped; the reason says so.
+  const sv::GraspTarget flat = sv::grasp_target(scene, *scene.project_left(foot, still), *scene.project_right(foot, still), still, foot);
+  EXPECT_FALSE(flat.ok());
+  EXPECT_NE(flat.reason.find("too low"), std::string::npos) << flat.reason;
+  // The box of a cylinder contains its axis' projection.
+  const cv::Rect box = sv::cylinder_box(scene, foot, 0.04, 0, 0.12, still);
+  EXPECT_TRUE(box.contains(cv::Point(*right)) || box.contains(cv::Point(right->x, right->y + 1)));
+  EXPECT_TRUE(box.contains(cv::Point(*scene.project_right(foot, still))));
+}
+
+namespace {
+
+sv::ArmStatus gripping(sv::ArmStatus::Motion motion, int64_t seq, double opening) {
+  sv::ArmStatus a = arm(motion, seq);
+  a.gripper_opening = opening;
+  return a;
+}
+
+class LearningTest : public SupervisorTest {
+ protected:
+  const Eigen::Vector3d object_{0.28, -0.05, 0};
+  Eigen::Vector3d rest_;
+
+  sv::Supervisor make_learning() {
+    sv::Config config;
+    config.learn = sv::Config::Learn::On;
+    return make(config);
+  }
+  void stills(sv::Supervisor& s, const std::vector<Eigen::Vector3d>& objects) {
+    now_ += kSecond / 5;
+    s.on_right_still(draw_scene(scene_, {1280, 960}, objects), now_, now_);
+    s.on_left_still(draw_scene(scene_, {1280, 960}, objects, true), now_, now_);
+  }
+  // Up to the recognition request (both stills asked for and given).
+  sv::RecognizeRequest to_recognition(sv::Supervisor& s) {
+    const auto out = start_with(s, {object_});
+    const auto asked = outputs_of<sv::SnapshotRequest>(out);
+    EXPECT_TRUE(asked.size() == 1 && asked[0].both);
+    stills(s, {object_});
+    EXPECT_EQ(s.state(), sv::State::Recognise) << s.report().reason;
+    return outputs_of<sv::RecognizeRequest>(s.take_outputs()).at(0);
+  }
+  // Not recognised: nudged, settled, parked, both after stills: the grasp command.
+  sv::GraspCommand to_grasp(sv::Supervisor& s) {
+    const sv::RecognizeRequest request = to_recognition(s);
+    s.on_recognition(request.seq, "", "no object matched 3 or more features", now_);
+    const auto nudge = outputs_of<sv::NudgeCommand>(s.take_outputs()).at(0);
+    rest_ = object_ + 0.03 * nudge.direction;
+    play_nudge(s, nudge.seq, object_, rest_);
+    settle_with_axes(s, {rest_});
+    park(s);
+    EXPECT_EQ(s.state(), sv::State::SnapshotAfter) << s.report().reason;
+    s.take_outputs();
+    stills(s, {rest_});
+    EXPECT_EQ(s.state(), sv::State::Grasp) << s.report().reason;
+    return outputs_of<sv::GraspCommand>(s.take_outputs()).at(0);
+  }
+  // The arm reports the command done, holding (opening 6 cm).
+  void done(sv::Supervisor& s, int64_t seq, double opening = 0.06) {
+    s.on_arm_state(gripping(sv::ArmStatus::Motion::Moving, seq, opening), now_ += kSecond / 2);
+    s.on_arm_state(gripping(sv::ArmStatus::Motion::Done, seq, opening), now_ += kSecond / 2);
+  }
+  std::shared_ptr<const sv::Attempt> ended(const std::vector<sv::Output>& out) {
+    const auto e = outputs_of<sv::AttemptEnded>(out);
+    EXPECT_EQ(e.size(), 1u);
+    return e.empty() ? nullptr : e[0].attempt;
+  }
+};
+
+}  // namespace
+
+TEST_F(LearningTest, GraspsTurnsTwelveTimesLearnsAndPutsTheObjectBack) {
+  sv::Supervisor s = make_learning();
+  const sv::GraspCommand grasp = to_grasp(s);
+  EXPECT_EQ(s.awaited_arm_seq(), grasp.seq);
+  // Above the axis' foot where the object came to rest, the fingers at its lowered top (12 cm
+  // box, lowered by r tan(theta) ~ 3 cm).
+  EXPECT_LT((grasp.position - rest_).head<2>().norm(), 0.006);
+  EXPECT_GT(grasp.height, 0.06);
+  EXPECT_LT(grasp.height, 0.12);
+  done(s, grasp.seq);
+  std::vector<sv::LearnView> views;
+  std::vector<sv::LearnCommit> commits;
+  for (int view = 0; view < 12; ++view) {
+    ASSERT_EQ(s.state(), sv::State::Rotate) << s.report().reason;
+    auto out = s.take_outputs();
+    ASSERT_EQ(outputs_of<sv::SnapshotRequest>(out).size(), 1u);
+    EXPECT_FALSE(outputs_of<sv::SnapshotRequest>(out)[0].both);
+    now_ += kSecond / 5;
+    s.on_right_still(draw_scene(scene_, {1280, 960}, {}), now_, now_);
+    out = s.take_outputs();
+    const auto taken = outputs_of<sv::LearnView>(out);
+    ASSERT_EQ(taken.size(), 1u);
+    views.push_back(taken[0]);
+    commits = outputs_of<sv::LearnCommit>(out);
+    if (view < 11) {
+      ASSERT_EQ(outputs_of<sv::RotateCommand>(out).size(), 1u) << view << ": " << s.report().reason;
+      const auto turn = outputs_of<sv::RotateCommand>(out).at(0);
+      EXPECT_NEAR(std::abs(turn.angle), M_PI / 6, 1e-12);
+      done(s, turn.seq);
+    }
+  }
+  ASSERT_EQ(s.state(), sv::State::Learn);
+  for (int i = 0; i < 12; ++i) {
+    EXPECT_EQ(views[i].index, i);
+    EXPECT_NEAR(std::abs(views[i].angle), i * M_PI / 6, 1e-9);
+    EXPECT_EQ(views[i].object_key, "attempt_01");
+    EXPECT_GT(views[i].box.area(), 0);
+  }
+  ASSERT_EQ(commits.size(), 1u);
+  const sv::LearnCommit commit = commits[0];
+  EXPECT_EQ(commit.views, 12);
+  EXPECT_GT(commit.height, 0.06);
+  EXPECT_EQ(commit.object_key, "attempt_01");
+  s.on_learned(commit.seq + 1, true, "other", "", now_);  // not ours
+  EXPECT_EQ(s.state(), sv::State::Learn);
+  s.on_learned(commit.seq, true, "object_1", "", now_ += kSecond);
+  ASSERT_EQ(s.state(), sv::State::Place);
+  const auto place = outputs_of<sv::PlaceCommand>(s.take_outputs()).at(0);
+  EXPECT_LT((place.position - object_).norm(), 1e-9) << "back where it stood before the nudge";
+  EXPECT_NEAR(place.height, grasp.height, 1e-12);
+  done(s, place.seq);
+  auto out = s.take_outputs();
+  const auto a = ended(out);
+  ASSERT_TRUE(a);
+  EXPECT_EQ(a->outcome, sv::Outcome::Segmented);
+  EXPECT_EQ(a->learning, "learned");
+  EXPECT_EQ(a->learned_name, "object_1");
+  EXPECT_EQ(a->views.size(), 12u);
+  ASSERT_TRUE(a->top[0] && a->top[1] && a->grasp);
+  EXPECT_EQ(outputs_of<sv::HomeCommand>(out).size(), 1u) << "the arm parks after putting it back";
+  EXPECT_EQ(s.summary().learned, 1);
+}
+
+TEST_F(LearningTest, AKnownObjectIsNotNudgedAndTheSummaryNamesIt) {
+  sv::Supervisor s = make_learning();
+  const sv::RecognizeRequest request = to_recognition(s);
+  const auto projected = scene_.project_right(object_ + Eigen::Vector3d(0, 0, 0.05), {1280, 960});
+  EXPECT_TRUE(request.roi.contains(cv::Point(*projected))) << "the candidate's region";
+  EXPECT_EQ(request.image.size(), cv::Size(1280, 960));
+  s.on_recognition(request.seq, "green bottle", "", now_ += kSecond);
+  auto out = s.take_outputs();
+  EXPECT_TRUE(outputs_of<sv::NudgeCommand>(out).empty());
+  EXPECT_TRUE(outputs_of<sv::HomeCommand>(out).empty()) << "the arm never moved";
+  const auto a = ended(out);
+  ASSERT_TRUE(a);
+  EXPECT_EQ(a->outcome, sv::Outcome::Known);
+  EXPECT_EQ(a->recognised, "green bottle");
+  EXPECT_EQ(s.state(), sv::State::FindCandidates);
+  answer_survey(s, {object_});  // the same candidate again: not asked twice
+  EXPECT_EQ(s.state(), sv::State::Done);
+  ASSERT_EQ(s.summary().known.size(), 1u);
+  EXPECT_EQ(s.summary().known[0], "green bottle");
+}
+
+TEST_F(LearningTest, ASilentLearnerDoesNotStopTheNudge) {
+  sv::Supervisor s = make_learning();
+  to_recognition(s);
+  s.on_time(now_ += 4 * kSecond);
+  EXPECT_EQ(s.state(), sv::State::Recognise);
+  s.on_time(now_ += 2 * kSecond);
+  ASSERT_EQ(s.state(), sv::State::Nudge) << s.report().reason;
+  EXPECT_EQ(outputs_of<sv::NudgeCommand>(s.take_outputs()).size(), 1u);
+}
+
+TEST_F(LearningTest, ALearnerSilentAfterTheViewsStillGetsTheObjectPutBack) {
+  sv::Config few;  // 2 views suffice here
+  few.learn = sv::Config::Learn::On;
+  few.views = 2;
+  sv::Supervisor s = make(few);
+  done(s, to_grasp(s).seq);
+  for (int view = 0; view < 2; ++view) {
+    now_ += kSecond / 5;
+    s.on_right_still(draw_scene(scene_, {1280, 960}, {}), now_, now_);
+    const auto turns = outputs_of<sv::RotateCommand>(s.take_outputs());
+    if (view == 0) done(s, turns.at(0).seq);
+  }
+  ASSERT_EQ(s.state(), sv::State::Learn);
+  s.on_time(now_ += 31 * kSecond);
+  ASSERT_EQ(s.state(), sv::State::Place) << s.report().reason;
+  done(s, outputs_of<sv::PlaceCommand>(s.take_outputs()).at(0).seq);
+  const auto a = ended(s.take_outputs());
+  ASSERT_TRUE(a);
+  EXPECT_EQ(a->learning, "learner silent");
+  EXPECT_NE(a->learning_reason.find("LEARNED"), std::string::npos) << a->learning_reason;
+  EXPECT_EQ(s.summary().learned, 0);
+}
+
+TEST_F(LearningTest, ARefusedGraspEndsTheLearningWithTheArmsReason) {
+  sv::Supervisor s = make_learning();
+  const sv::GraspCommand grasp = to_grasp(s);
+  s.on_arm_state(arm(sv::ArmStatus::Motion::Refused, grasp.seq, "grasp: wrist below the table"), now_ += kSecond);
+  auto out = s.take_outputs();
+  const auto a = ended(out);
+  ASSERT_TRUE(a);
+  EXPECT_EQ(a->outcome, sv::Outcome::Segmented) << "the segmentation stands";
+  EXPECT_EQ(a->learning, "not grasped");
+  EXPECT_NE(a->learning_reason.find("wrist below the table"), std::string::npos) << a->learning_reason;
+  EXPECT_TRUE(outputs_of<sv::HomeCommand>(out).empty()) << "nothing moved";
+  EXPECT_EQ(s.state(), sv::State::FindCandidates);
+}
+
+TEST_F(LearningTest, AGripperThatClosesFullyHoldsNothing) {
+  sv::Supervisor s = make_learning();
+  done(s, to_grasp(s).seq, 0.001);  // closed to 1 mm: missed
+  auto out = s.take_outputs();
+  auto a = ended(out);
+  ASSERT_TRUE(a);
+  EXPECT_EQ(a->learning, "dropped");
+  EXPECT_NE(a->learning_reason.find("after the grasp"), std::string::npos) << a->learning_reason;
+  EXPECT_EQ(outputs_of<sv::HomeCommand>(out).size(), 1u) << "the arm parks";
+  EXPECT_TRUE(outputs_of<sv::PlaceCommand>(out).empty()) << "nothing to put back";
+}
+
+TEST_F(LearningTest, AnObjectDroppedWhileTurningIsNoticedAndTheRunGoesOn) {
+  sv::Supervisor s = make_learning();
+  done(s, to_grasp(s).seq);
+  now_ += kSecond / 5;
+  s.on_right_still(draw_scene(scene_, {1280, 960}, {}), now_, now_);
+  const auto turn = outputs_of<sv::RotateCommand>(s.take_outputs()).at(0);
+  done(s, turn.seq, 0.0);  // slipped out during the turn
+  auto out = s.take_outputs();
+  auto a = ended(out);
+  ASSERT_TRUE(a);
+  EXPECT_EQ(a->learning, "dropped");
+  EXPECT_NE(a->learning_reason.find("after turn 1"), std::string::npos) << a->learning_reason;
+  EXPECT_TRUE(outputs_of<sv::LearnCommit>(out).empty());
+  park(s);
+  EXPECT_EQ(s.state(), sv::State::FindCandidates);
+  EXPECT_EQ(s.summary().learning.at("dropped"), 1);
+}
+
+TEST_F(LearningTest, AutoLearnsOnlyWhileTheLearnerIsHeard) {
+  sv::Config config;
+  config.learn = sv::Config::Learn::Auto;
+  sv::Supervisor s = make(config);
+  auto out = start_with(s, {object_});
+  EXPECT_FALSE(outputs_of<sv::SnapshotRequest>(out).at(0).both) << "no learner: segmentation only";
+  sv::Supervisor heard = make(config);
+  heard.set_learner_alive(true);
+  out = start_with(heard, {object_});
+  EXPECT_TRUE(outputs_of<sv::SnapshotRequest>(out).at(0).both);
+}

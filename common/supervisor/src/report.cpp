@@ -41,7 +41,60 @@ void write_point(JsonWriter& j, const std::string& key, const Eigen::Vector3d& p
   j.key(key).begin_array().value(p.x()).value(p.y()).value(p.z()).end_array();
 }
 
+void write_pixel(JsonWriter& j, const std::string& key, const std::optional<cv::Point2d>& p) {
+  j.key(key);
+  if (!p) {
+    j.raw("null");
+    return;
+  }
+  j.begin_array().value(p->x).value(p->y).end_array();
+}
+
+// Thesis ch. 7: recognition, the grasp, the views and the learner's answer.
+void write_learning(JsonWriter& j, const Attempt& a) {
+  j.key("learning").begin_object();
+  j.field("outcome", a.learning).field("reason", a.learning_reason).field("object_key", a.object_key());
+  j.field("recognised", a.recognised).field("recognition_reason", a.recognition_reason).field("learned_name", a.learned_name);
+  write_line(j, "line_before_left", a.before_line_left);
+  write_line(j, "line_after_left", a.after_line_left);
+  j.field("mask_pixels_left", a.segmentation_left.mask.empty() ? 0 : cv::countNonZero(a.segmentation_left.mask));
+  write_pixel(j, "top_left", a.top[0]);
+  write_pixel(j, "top_right", a.top[1]);
+  j.key("grasp");
+  if (a.grasp) {
+    j.begin_object().field("reason", a.grasp->reason);
+    write_point(j, "foot", a.grasp->foot);
+    write_point(j, "top", a.grasp->top);
+    j.field("overestimate_m", a.grasp->overestimate_m).field("grasp_height_m", a.grasp->grasp_height_m).end_object();
+  } else {
+    j.raw("null");
+  }
+  j.key("views").begin_array();
+  for (const LearnView& v : a.views)
+    j.begin_object().field("index", v.index).field("wrist_angle", v.angle).field("utime", static_cast<long long>(v.utime))
+        .key("box").begin_array().value(v.box.x).value(v.box.y).value(v.box.width).value(v.box.height).end_array().end_object();
+  j.end_array();
+  j.end_object();
+}
+
+std::filesystem::path attempt_folder(const std::string& directory, int number) {
+  char name[32];
+  std::snprintf(name, sizeof name, "attempt_%02d", number);
+  return std::filesystem::path(directory) / name;
+}
+
 }  // namespace
+
+std::string save_view(const std::string& directory, int attempt_number, const LearnView& view) {
+  const std::filesystem::path folder = attempt_folder(directory, attempt_number) / "views";
+  std::error_code error;
+  std::filesystem::create_directories(folder, error);
+  if (error) throw std::runtime_error(folder.string() + ": cannot create the folder (" + error.message() + ")");
+  char name[32];
+  std::snprintf(name, sizeof name, "view_%02d.png", view.index);
+  write_png((folder / name).string(), view.image);
+  return (folder / name).string();
+}
 
 cv::Mat draw_workspace(const Attempt& attempt, const ArmSetup& arm, const Eigen::Vector3d& right_camera) {
   cv::Mat picture(2 * kHalfSize, 2 * kHalfSize, CV_8UC3, cv::Scalar(90, 90, 90));
@@ -107,15 +160,14 @@ std::string attempt_json(const Attempt& a) {
   j.key("rejected").begin_array();
   for (const Rejection& r : a.rejected) j.begin_object().field("candidate_index", r.index).field("reason", r.reason).end_object();
   j.end_array();
+  if (a.learn || !a.learning.empty() || !a.recognised.empty()) write_learning(j, a);
   j.end_object();
   return j.str();
 }
 
 std::string save_attempt(const std::string& directory, const Attempt& attempt, const ArmSetup& arm,
                          const Eigen::Vector3d& right_camera) {
-  char name[32];
-  std::snprintf(name, sizeof name, "attempt_%02d", attempt.number);
-  const std::filesystem::path folder = std::filesystem::path(directory) / name;
+  const std::filesystem::path folder = attempt_folder(directory, attempt.number);
   std::error_code error;
   std::filesystem::create_directories(folder / "stages", error);
   if (error) throw std::runtime_error(folder.string() + ": cannot create the folder (" + error.message() + ")");
@@ -125,6 +177,10 @@ std::string save_attempt(const std::string& directory, const Attempt& attempt, c
   write_png((folder / "cutout.png").string(), attempt.segmentation.cutout);
   write_png((folder / "workspace.png").string(), draw_workspace(attempt, arm, right_camera));
   for (const auto& [stage, image] : attempt.segmentation.stages) write_png((folder / "stages" / (stage + ".png")).string(), image);
+  // Learning (additive): the left stills and segmentation; the views are saved as they are taken.
+  write_png((folder / "before_left.png").string(), attempt.before_left);
+  write_png((folder / "after_left.png").string(), attempt.after_left);
+  write_png((folder / "mask_left.png").string(), attempt.segmentation_left.mask);
   write_file_atomically((folder / "attempt.json").string(), attempt_json(attempt) + "\n");
   return folder.string();
 }
@@ -137,6 +193,13 @@ std::string summary_json(const std::string& run_id, int64_t first_command_seq, c
   j.key("outcomes").begin_object();
   for (const auto& [outcome, count] : s.outcomes) j.field(outcome, count);
   j.end_object();
+  j.field("learned", s.learned);
+  j.key("learning").begin_object();
+  for (const auto& [outcome, count] : s.learning) j.field(outcome, count);
+  j.end_object();
+  j.key("known").begin_array();
+  for (const std::string& name : s.known) j.value(name);
+  j.end_array();
   j.key("last_survey_rejections").begin_object();
   for (const auto& [reason, count] : s.rejections) j.field(reason, count);
   j.end_object();

@@ -5,11 +5,19 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "nudge/robot/command_planner.hpp"
+
 namespace nudge::supervisor {
 
 namespace {
 
 constexpr double kMicro = 1e6;
+
+std::string seconds_text(double seconds) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g s", seconds);
+  return text;
+}
 
 double median(std::vector<double> values) {
   std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
@@ -33,6 +41,11 @@ const char* to_string(State state) {
     case State::SnapshotAfter: return "SNAPSHOT_AFTER";
     case State::Choose: return "CHOOSE";
     case State::Home: return "HOME";
+    case State::Grasp: return "GRASP";
+    case State::Rotate: return "ROTATE";
+    case State::Learn: return "LEARN";
+    case State::Recognise: return "RECOGNISE";
+    case State::Place: return "PLACE";
   }
   return "?";
 }
@@ -48,6 +61,7 @@ const char* to_string(Outcome outcome) {
     case Outcome::Aborted: return "aborted";
     case Outcome::SegmentationFailed: return "segmentation failed";
     case Outcome::TrackerLost: return "tracker lost";
+    case Outcome::Known: return "already known";
   }
   return "?";
 }
@@ -57,6 +71,8 @@ Supervisor::Supervisor(Config config, SceneGeometry scene, ArmSetup arm, Segment
   if (!segment_) throw std::invalid_argument("supervisor: a segmentation function is required");
   if (config_.survey_frames <= 0 || config_.survey_lines <= 0 || config_.max_attempts <= 0)
     throw std::invalid_argument("supervisor: survey_frames, survey_lines and max_attempts must be positive");
+  if (config_.views <= 0 || !(config_.view_step_deg > 0))
+    throw std::invalid_argument("supervisor: views and view_step_deg must be positive");
   joints_ = arm_.home();
 }
 
@@ -133,6 +149,7 @@ void Supervisor::choose(int64_t now) {
   attempt_->candidates = candidates_;
   attempt_->rejected = choice.rejected;
   attempt_->started = now;
+  attempt_->learn = learning_enabled();
   report_.attempt = attempt_->number;
   report_.candidate_index = choice.target.index;
   report_.target = choice.target.position;
@@ -146,7 +163,7 @@ void Supervisor::request_still(State state, int64_t now, const std::string& note
                                                       : "still after the nudge";
   if (!note.empty()) reason += " (" + note + ")";
   enter(state, now, reason);
-  outputs_.push_back(SnapshotRequest{});
+  outputs_.push_back(SnapshotRequest{attempt_->learn});
 }
 
 void Supervisor::start_nudge(int64_t now) {
@@ -198,6 +215,7 @@ void Supervisor::verify(int64_t now) {
 }
 
 void Supervisor::park(int64_t now, const std::string& why) {
+  arm_away_ = false;
   home_seq_ = next_seq_++;
   after_home_ = why;
   enter(State::Home, now, why);
@@ -298,6 +316,10 @@ void Supervisor::segment(int64_t now) {
                 "segmentation empty" + (a.segmentation.error.empty() ? std::string() : ": " + a.segmentation.error), now);
     return;
   }
+  if (a.learn) {
+    plan_grasp(now);
+    return;
+  }
   end_attempt(Outcome::Segmented, "segmented", now);
 }
 
@@ -324,6 +346,7 @@ void Supervisor::end_attempt(Outcome outcome, const std::string& reason, int64_t
   a.ended = now;
   ++summary_.outcomes[to_string(outcome)];
   if (outcome == Outcome::Segmented) ++summary_.segmented;
+  if (outcome == Outcome::Known) summary_.known.push_back(a.recognised);
   // A place once nudged is not nudged again (unless the attempt never touched it).
   if (outcome != Outcome::Aborted && outcome != Outcome::SnapshotLost) {
     explored_.push_back(a.target.position);
@@ -339,7 +362,8 @@ void Supervisor::end_attempt(Outcome outcome, const std::string& reason, int64_t
   tracking_started_ = false;
   settled_axes_.clear();
   const std::string why = "attempt " + std::to_string(a.number) + " " + to_string(outcome) + ": " + reason;
-  if (nudge_seq_ == 0) {
+  learn_seq_ = 0;
+  if (nudge_seq_ == 0 && !arm_away_) {
     survey(now, why);
     return;
   }
@@ -351,6 +375,7 @@ void Supervisor::end_attempt(Outcome outcome, const std::string& reason, int64_t
 int64_t Supervisor::awaited_arm_seq() const {
   if (state_ == State::Nudge) return nudge_seq_;
   if (state_ == State::Home) return home_seq_;
+  if (state_ == State::Grasp || state_ == State::Place || (state_ == State::Rotate && learn_seq_ != 0)) return learn_seq_;
   return 0;
 }
 
@@ -371,7 +396,13 @@ void Supervisor::on_time(int64_t now) {
       break;
     case State::SnapshotBefore:
     case State::SnapshotAfter:
-      if (timed_out(config_.snapshot_timeout_s, now)) end_attempt(Outcome::SnapshotLost, std::string("the ") + (state_ == State::SnapshotBefore ? "before" : "after") + " still never came", now);
+      // Learning without the left still: the attempt goes on as a segmentation only.
+      if (timed_out(config_.snapshot_timeout_s, now) && attempt_->learn && !(state_ == State::SnapshotBefore ? attempt_->before : attempt_->after).empty()) {
+        attempt_->learn = false;
+        attempt_->learning = "not grasped";
+        attempt_->learning_reason = "the left still never came";
+        stills_arrived(now);
+      } else if (timed_out(config_.snapshot_timeout_s, now)) end_attempt(Outcome::SnapshotLost, std::string("the ") + (state_ == State::SnapshotBefore ? "before" : "after") + " still never came", now);
       break;
     case State::Nudge:
       if (timed_out(config_.nudge_timeout_s, now)) {
@@ -384,6 +415,29 @@ void Supervisor::on_time(int64_t now) {
       break;
     case State::Home:
       if (timed_out(config_.nudge_timeout_s, now)) parked(now, "the arm did not report parking in time");
+      break;
+    case State::Recognise:
+      if (timed_out(config_.recognise_timeout_s, now)) {
+        attempt_->recognition_reason = "learner silent: no RECOGNITION within " + seconds_text(config_.recognise_timeout_s);
+        start_nudge(now);
+      }
+      break;
+    case State::Learn:
+      if (timed_out(config_.learn_timeout_s, now))
+        place(now, "learner silent", "no LEARNED within " + seconds_text(config_.learn_timeout_s) + " (the views are in the attempt's folder)");
+      break;
+    case State::Rotate:
+      if (learn_seq_ == 0 && timed_out(config_.snapshot_timeout_s, now)) {
+        place(now, "snapshot lost", "view " + std::to_string(attempt_->views.size()) + "'s still never came");
+        break;
+      }
+      [[fallthrough]];
+    case State::Grasp:
+    case State::Place:
+      if (learn_seq_ != 0 && timed_out(config_.arm_timeout_s, now)) {
+        outputs_.push_back(StopCommand{next_seq_++, std::string(to_string(state_)) + " timed out"});
+        learning_ended("arm failed", std::string("the arm did not finish ") + to_string(state_) + " within " + seconds_text(config_.arm_timeout_s), now);
+      }
       break;
     default:
       break;
@@ -412,7 +466,7 @@ void Supervisor::on_services(const std::set<std::string>& silent, int64_t now) {
       tracking_started_ = false;
       settled_axes_.clear();
       Attempt& a = *attempt_;
-      const bool touched = paused_from_ != State::SnapshotBefore;
+      const bool touched = paused_from_ != State::SnapshotBefore && paused_from_ != State::Recognise;
       end_attempt(touched ? Outcome::Aborted : Outcome::SnapshotLost,
                   std::string("aborted: a service went silent during ") + to_string(paused_from_), now);
       (void)a;
@@ -443,6 +497,11 @@ void Supervisor::on_arm_state(const ArmStatus& arm, int64_t now) {
       arm.motion != ArmStatus::Motion::Idle) {
     // Parked, or not (refused, stopped): the loop goes on either way, saying so.
     parked(now, arm.motion == ArmStatus::Motion::Done ? "" : "the arm did not park (" + arm.last_error + ")");
+    return;
+  }
+  if ((state_ == State::Grasp || state_ == State::Rotate || state_ == State::Place) && learn_seq_ != 0 &&
+      arm.command_seq == learn_seq_) {
+    on_learning_arm_state(arm, now);
     return;
   }
   if (state_ != State::Nudge || arm.command_seq != nudge_seq_) return;  // not about our nudge
@@ -507,12 +566,13 @@ void Supervisor::on_right_still(const cv::Mat& still, int64_t utime, int64_t now
   if (still.size() != config_.still_size)
     throw std::invalid_argument("right still of " + std::to_string(still.cols) + "x" + std::to_string(still.rows) +
                                 ", expected " + std::to_string(config_.still_size.width) + "x" + std::to_string(config_.still_size.height));
-  if (state_ == State::SnapshotBefore) {
-    attempt_->before = still.clone();
-    start_nudge(now);
-  } else if (state_ == State::SnapshotAfter) {
-    attempt_->after = still.clone();
-    segment(now);
+  if (state_ == State::SnapshotBefore || state_ == State::SnapshotAfter) {
+    cv::Mat& kept = state_ == State::SnapshotBefore ? attempt_->before : attempt_->after;
+    if (!kept.empty()) return;  // a second answer to the same request
+    kept = still.clone();
+    if (stills_complete()) stills_arrived(now);
+  } else if (state_ == State::Rotate && learn_seq_ == 0) {
+    take_view(still, utime, now);
   }
 }
 

@@ -16,10 +16,15 @@ namespace nudge::supervisor {
 // from P1 to P2.
 cv::Mat draw_workspace(const Attempt& attempt, const ArmSetup& arm, const Eigen::Vector3d& right_camera);
 
-// Writes `directory`/attempt_NN/{before,after,mask,cutout,workspace}.png, stages/ and attempt.json.
+// Writes `directory`/attempt_NN/{before,after,mask,cutout,workspace}.png, stages/ and attempt.json;
+// when learning, also {before,after,mask}_left.png (views/ is written by save_view).
 // Returns the attempt's folder. Throws std::runtime_error naming a file that cannot be written.
 std::string save_attempt(const std::string& directory, const Attempt& attempt, const ArmSetup& arm,
                          const Eigen::Vector3d& right_camera);
+
+// A training view as `directory`/attempt_NN/views/view_II.png (written as it is taken: a learner
+// that never answers leaves the views on disk). Returns the file's path; throws naming it.
+std::string save_view(const std::string& directory, int attempt_number, const LearnView& view);
 
 // One attempt as a JSON object (outcome, reason, target, rest, motion, lines, mask pixels, times).
 std::string attempt_json(const Attempt& attempt);

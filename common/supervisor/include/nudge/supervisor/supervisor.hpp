@@ -7,6 +7,8 @@
 //
 //   WAIT_SERVICES -> FIND_CANDIDATES -> CHOOSE -> SNAPSHOT_BEFORE -> NUDGE -> TRACK (settle, verify)
 //        -> SNAPSHOT_AFTER -> SEGMENT -> FIND_CANDIDATES ...   until no nudgeable candidate is left: DONE
+//   With learning (thesis ch. 7): SNAPSHOT_BEFORE -> RECOGNISE (a known object is not nudged) -> NUDGE
+//   ... SEGMENT (both cameras) -> GRASP -> ROTATE (12 views, LEARN_VIEW each) -> LEARN -> PLACE -> HOME.
 //   Every failure (not nudgeable, arm refused, no motion, tipped, snapshot lost, timeout) ends the
 //   attempt with its reason and goes on to the next candidate; a silent service stops the arm and
 //   PAUSES until it is back, then the run resumes from a fresh survey.
@@ -22,6 +24,7 @@
 #include <variant>
 #include <vector>
 
+#include "nudge/supervisor/grasp.hpp"
 #include "nudge/supervisor/line_search.hpp"
 #include "nudge/supervisor/motion_watch.hpp"
 #include "nudge/supervisor/scene.hpp"
@@ -34,6 +37,7 @@ namespace nudge::supervisor {
 enum class State : int8_t {
   Idle = 0, FindCandidates = 1, Nudge = 2, Track = 3, Segment = 4, Done = 9, Failed = 10,
   WaitServices = 11, Paused = 12, SnapshotBefore = 13, SnapshotAfter = 14, Choose = 15, Home = 16,
+  Grasp = 5, Rotate = 6, Learn = 7, Recognise = 8, Place = 17,
 };
 const char* to_string(State state);
 
@@ -71,6 +75,20 @@ struct Config {
   bool track = false;
   tracking::TrackerParams tracker;
   LineSearchParams line_search;
+
+  // ---- learning by interaction (thesis ch. 7) ----
+  // Off: segmentation only (ch. 6). On: recognise before nudging, grasp, turn and learn every
+  // segmented object. Auto: as On while the learner's heartbeat is heard (set_learner_alive), as
+  // Off otherwise; decided per attempt when its candidate is chosen.
+  enum class Learn { Off, On, Auto };
+  Learn learn = Learn::Off;
+  GraspTargetParams grasp;
+  int views = 12;                    // training views per object (sec. 7.2.3)
+  double view_step_deg = 30;         // wrist turn between views (SIFT tolerates +-15 deg)
+  double held_min_opening_m = 0.004; // the gripper closed tighter than this holds nothing
+  double recognise_timeout_s = 5;    // for RECOGNITION; then the nudge goes ahead, the reason kept
+  double learn_timeout_s = 30;       // for LEARNED; then the object is put back, the reason kept
+  double arm_timeout_s = 60;         // for each grasp, wrist turn and place
 };
 
 // ---- inputs ----
@@ -80,6 +98,7 @@ struct ArmStatus {
   int64_t command_seq = 0;
   std::string last_error;
   robot::JointVector joints = robot::JointVector::Zero();
+  double gripper_opening = -1;  // m; negative: not reported (no held-object check)
 };
 struct Axis {
   Eigen::Vector3d foot;     // where it meets the table, world frame
@@ -98,7 +117,14 @@ using SegmentFunction = std::function<Segmentation(const cv::Mat& before, const 
 
 // ---- outputs ----
 struct CandidatesRequest { int frames = 25, lines = 3; };
-struct SnapshotRequest {};
+struct SnapshotRequest { bool both = false; };  // both cameras (learning: the left segmentation too)
+// Learning (thesis ch. 7). Grasp/Place: the tool point `height` above the table over `position`.
+struct GraspCommand { int64_t seq = 0; Eigen::Vector3d position; double height = 0; };
+struct PlaceCommand { int64_t seq = 0; Eigen::Vector3d position; double height = 0; };
+struct RotateCommand { int64_t seq = 0; double angle = 0; };  // radians, relative
+struct RecognizeRequest { int64_t seq = 0; cv::Rect roi; cv::Mat image; };
+struct LearnView { int index = 0; double angle = 0; cv::Rect box; cv::Mat image; int64_t utime = 0; std::string object_key; };
+struct LearnCommit { int64_t seq = 0; std::string object_key; int views = 0; double height = 0, radius = 0; };
 struct NudgeCommand { int64_t seq = 0; Eigen::Vector3d target, direction; };
 struct StopCommand { int64_t seq = 0; std::string reason; };
 // The arm parks at its home pose (COMMAND_HOME) after a nudge, before the next survey: at the end
@@ -114,7 +140,7 @@ struct StateReport {
   int segmented = 0, failed_attempts = 0, rejected = 0;
 };
 
-enum class Outcome { Segmented, NoMotion, Tipped, Refused, SnapshotLost, ArmFailed, Aborted, SegmentationFailed, TrackerLost };
+enum class Outcome { Segmented, NoMotion, Tipped, Refused, SnapshotLost, ArmFailed, Aborted, SegmentationFailed, TrackerLost, Known };
 const char* to_string(Outcome outcome);
 
 struct Attempt {
@@ -141,6 +167,21 @@ struct Attempt {
   cv::Mat before, after;                   // right stills
   std::optional<symmetry::Line> before_line, after_line;  // in the stills
   Segmentation segmentation;
+
+  // ---- learning (thesis ch. 7); `learn` false: none of it happened ----
+  bool learn = false;
+  cv::Mat before_left, after_left;                                   // left stills
+  std::optional<symmetry::Line> before_line_left, after_line_left;  // in them
+  Segmentation segmentation_left;
+  std::optional<cv::Point2d> top[2];       // [left, right]: the object's top in the stills
+  std::optional<GraspTarget> grasp;
+  std::string recognised;                  // the learner's label: a known object, not nudged
+  std::string recognition_reason;          // why none was recognised (or the learner was silent)
+  std::vector<LearnView> views;            // the training views taken
+  std::string learning;                    // "learned", "not grasped", "dropped", "learner silent", ...
+  std::string learning_reason;
+  std::string learned_name;                // the learner's name for it
+  std::string object_key() const;          // "attempt_NN"
 };
 struct AttemptEnded { std::shared_ptr<const Attempt> attempt; };
 
@@ -149,11 +190,15 @@ struct Summary {
   std::map<std::string, int> outcomes;      // outcome name -> count
   std::map<std::string, int> rejections;    // reason -> candidates passed over for it (last survey)
   std::string end_reason;
+  int learned = 0;
+  std::map<std::string, int> learning;      // learning outcome -> count
+  std::vector<std::string> known;           // objects recognised, not nudged again
 };
 struct Finished { Summary summary; };
 
 using Output = std::variant<CandidatesRequest, SnapshotRequest, NudgeCommand, StopCommand, HomeCommand, StateReport,
-                            AttemptEnded, Finished>;
+                            AttemptEnded, Finished, GraspCommand, PlaceCommand, RotateCommand, RecognizeRequest, LearnView,
+                            LearnCommit>;
 
 class Supervisor {
  public:
@@ -178,6 +223,11 @@ class Supervisor {
   // One camera's symmetry lines (SYMMETRY_LEFT / SYMMETRY_RIGHT, 640x480) during a survey: they
   // tell which candidates both cameras really see (Candidate::stereo_agreement).
   void on_lines(bool left, const std::vector<symmetry::Line>& lines, int64_t now);
+  // Learning: the left still (SNAPSHOT_LEFT), the learner's answers and whether it is alive.
+  void on_left_still(const cv::Mat& still, int64_t utime, int64_t now);
+  void on_recognition(int64_t seq, const std::string& label, const std::string& reason, int64_t now);
+  void on_learned(int64_t seq, bool ok, const std::string& name, const std::string& reason, int64_t now);
+  void set_learner_alive(bool alive) { learner_alive_ = alive; }
 
   std::vector<Output> take_outputs();
   State state() const { return state_; }
@@ -230,6 +280,23 @@ class Supervisor {
   void feed_tracker(int camera, const cv::Mat& frame, int64_t utime);
   bool verify_by_tracking(int64_t now);
   bool verify_by_axes(int64_t now);
+  // ---- learning ----
+  bool learning_enabled() const;
+  bool stills_complete() const;
+  void stills_arrived(int64_t now);
+  void recognise(int64_t now);
+  void plan_grasp(int64_t now);
+  void on_learning_arm_state(const ArmStatus& arm, int64_t now);
+  bool holding(const ArmStatus& arm, const std::string& when, int64_t now);
+  void take_view(const cv::Mat& still, int64_t utime, int64_t now);
+  void commit_views(int64_t now);
+  void place(int64_t now, const std::string& learning, const std::string& reason);
+  void learning_ended(const std::string& learning, const std::string& reason, int64_t now);
+  bool learner_alive_ = false;
+  bool arm_away_ = false;      // the arm left home for the grasp: park it at the attempt's end
+  int64_t learn_seq_ = 0;      // the awaited arm command, RECOGNITION or LEARNED
+  double wrist_step_ = 0;      // rad, signed: the direction the wrist has room to turn
+  std::string pending_learning_, pending_reason_;  // the learning outcome, once the object is put back
   StateReport report_;
   Summary summary_;
 };

@@ -1,0 +1,53 @@
+#pragma once
+// Where to grasp a nudged object (thesis sec. 7.2.2, fig. 7.3-7.4): the top of the object in each
+// camera's segmentation (the post-nudge symmetry line meets the top of the mask's largest
+// 8-connected blob), triangulated; the triangulated top lies on the rear rim of the object, too
+// high by d = r tan(theta) (r: the top's radius, theta: the camera's angle of view over the table),
+// so the fingers close that much lower. Also the box a held object occupies in the right still
+// (the learner's background pruning, sec. 7.3).
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include <optional>
+#include <string>
+
+#include "nudge/supervisor/scene.hpp"
+#include "nudge/symmetry/detector.hpp"
+
+namespace nudge::supervisor {
+
+struct GraspTargetParams {
+  // r in d = r tan(theta). The thesis' objects have tops of 30-90 mm radius and it lowers by the
+  // middle value (36 mm at 30 deg: +-18 mm tolerance, which its foam pads exceed).
+  double top_radius_m = 0.06;
+  double min_grasp_height_m = 0.03;  // the fingers never close lower (the table)
+  double max_object_height_m = 0.35; // a taller triangulated top is a mismatch, not an object
+};
+
+// The top of the object in a segmentation mask (CV_8U, non-zero = object): the first pixel of
+// the largest 8-connected blob met walking down `line` (the post-nudge symmetry line, in the mask's
+// coordinates) from the image's top. Nothing when the mask is empty or the line misses the blob.
+std::optional<cv::Point2d> object_top(const cv::Mat& mask, const symmetry::Line& line);
+
+struct GraspTarget {
+  std::string reason;                              // why there is none; empty when ok
+  Eigen::Vector3d foot = Eigen::Vector3d::Zero();  // where the axis meets the table, world
+  Eigen::Vector3d top = Eigen::Vector3d::Zero();   // the triangulated top, world
+  double overestimate_m = 0;                       // d = r tan(theta)
+  double grasp_height_m = 0;                       // tool point above the table at the grasp
+  bool ok() const { return reason.empty(); }
+};
+
+// The grasp from the object's top in both stills (pixels at `still_size`) and its foot on the
+// table (world, from the settled axes). Fails with a reason when the tops do not triangulate, the
+// top is below the minimum grasp height or above any object.
+GraspTarget grasp_target(const SceneGeometry& scene, const cv::Point2d& left_top, const cv::Point2d& right_top,
+                         cv::Size still_size, const Eigen::Vector3d& foot, const GraspTargetParams& params = {});
+
+// The box (clamped to the image) a vertical cylinder of `radius` spanning heights [bottom, top]
+// (world z) about the vertical through `centre` occupies in the right camera at `size`; empty
+// when it is behind the camera or outside the image.
+cv::Rect cylinder_box(const SceneGeometry& scene, const Eigen::Vector3d& centre, double radius, double bottom,
+                      double top, cv::Size size);
+
+}  // namespace nudge::supervisor

@@ -1,0 +1,103 @@
+#include "nudge/supervisor/grasp.hpp"
+
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "nudge/geometry/workspace.hpp"
+
+namespace nudge::supervisor {
+
+namespace {
+
+// The label of the largest 8-connected blob, 0 when there is none.
+int largest_blob(const cv::Mat& mask, cv::Mat& labels) {
+  cv::Mat stats, centroids;
+  const int count = cv::connectedComponentsWithStats(mask != 0, labels, stats, centroids, 8, CV_32S);
+  int best = 0, best_area = 0;
+  for (int label = 1; label < count; ++label) {
+    const int area = stats.at<int>(label, cv::CC_STAT_AREA);
+    if (area > best_area) best = label, best_area = area;
+  }
+  return best;
+}
+
+// The still's pixel at the calibration's resolution (the inverse of scene.cpp's scaling).
+Eigen::Vector2d to_calibration(const geometry::Camera& camera, const cv::Point2d& pixel, cv::Size size) {
+  const double sx = static_cast<double>(camera.width) / size.width;
+  const double sy = static_cast<double>(camera.height) / size.height;
+  return {sx * (pixel.x + 0.5) - 0.5, sy * (pixel.y + 0.5) - 0.5};
+}
+
+}  // namespace
+
+std::optional<cv::Point2d> object_top(const cv::Mat& mask, const symmetry::Line& line) {
+  if (mask.empty() || mask.type() != CV_8U) return std::nullopt;
+  cv::Mat labels;
+  const int blob = largest_blob(mask, labels);
+  if (blob == 0) return std::nullopt;
+  // Points of the line: (x - cx) cos(theta) + (y - cy) sin(theta) = R. A near-horizontal line
+  // cannot be a standing object's axis.
+  const double c = std::cos(line.theta), s = std::sin(line.theta);
+  if (std::abs(c) < 0.2) return std::nullopt;
+  const double cx = (mask.cols - 1) / 2.0, cy = (mask.rows - 1) / 2.0;
+  for (int y = 0; y < mask.rows; ++y) {
+    const double x = cx + (line.r - (y - cy) * s) / c;
+    const int column = static_cast<int>(std::lround(x));
+    if (column < 0 || column >= mask.cols) continue;
+    if (labels.at<int>(y, column) == blob) return cv::Point2d(x, y);
+  }
+  return std::nullopt;
+}
+
+GraspTarget grasp_target(const SceneGeometry& scene, const cv::Point2d& left_top, const cv::Point2d& right_top,
+                         cv::Size still_size, const Eigen::Vector3d& foot, const GraspTargetParams& params) {
+  GraspTarget target;
+  target.foot = Eigen::Vector3d(foot.x(), foot.y(), 0.0);
+  const geometry::StereoRig& rig = scene.rig();
+  const auto top = geometry::triangulate_point(rig, to_calibration(rig.left, left_top, still_size),
+                                               to_calibration(rig.right, right_top, still_size));
+  if (!top) {
+    target.reason = "the object's top does not triangulate: " + top.reason();
+    return target;
+  }
+  target.top = scene.right_to_world(*top);
+  const double height = target.top.z();
+  char text[128];
+  if (!(height <= params.max_object_height_m)) {
+    std::snprintf(text, sizeof text, "the object's top triangulates %.0f mm above the table: no object is that tall", height * 1e3);
+    target.reason = text;
+    return target;
+  }
+  // Theta: the right camera's angle of view over the table at the object (fig. 7.4).
+  const Eigen::Vector3d camera = scene.right_camera_in_world();
+  const double theta = std::atan2(camera.z() - height, (camera - target.top).head<2>().norm());
+  target.overestimate_m = params.top_radius_m * std::tan(std::max(0.0, theta));
+  target.grasp_height_m = height - target.overestimate_m;
+  if (target.grasp_height_m < params.min_grasp_height_m) {
+    std::snprintf(text, sizeof text, "the object's top (%.0f mm, %.0f mm lowered) is too low to grasp", height * 1e3,
+                  target.overestimate_m * 1e3);
+    target.reason = text;
+  }
+  return target;
+}
+
+cv::Rect cylinder_box(const SceneGeometry& scene, const Eigen::Vector3d& centre, double radius, double bottom,
+                      double top, cv::Size size) {
+  double x0 = 1e9, y0 = 1e9, x1 = -1e9, y1 = -1e9;
+  for (double z : {bottom, top})
+    for (int k = 0; k < 16; ++k) {  // the rims, every 22.5 deg: their image hull bounds the cylinder
+      const double a = k * M_PI / 8;
+      const auto pixel = scene.project_right({centre.x() + radius * std::cos(a), centre.y() + radius * std::sin(a), z}, size);
+      if (!pixel) return {};
+      x0 = std::min(x0, pixel->x), y0 = std::min(y0, pixel->y);
+      x1 = std::max(x1, pixel->x), y1 = std::max(y1, pixel->y);
+    }
+  const cv::Rect box(cv::Point(static_cast<int>(std::floor(x0)), static_cast<int>(std::floor(y0))),
+                     cv::Point(static_cast<int>(std::ceil(x1)) + 1, static_cast<int>(std::ceil(y1)) + 1));
+  return box & cv::Rect(cv::Point(0, 0), size);
+}
+
+}  // namespace nudge::supervisor

@@ -1,0 +1,208 @@
+// The supervisor's learning states (thesis ch. 7, sec. 7.2): recognition before the nudge, and
+// after a segmentation the grasp, the twelve turns in front of the right camera, the learner's
+// commit and the object put back where it stood before the nudge.
+#include <cmath>
+#include <cstdio>
+
+#include "nudge/robot/command_planner.hpp"
+#include "nudge/robot/kinematics.hpp"
+#include "nudge/supervisor/supervisor.hpp"
+
+namespace nudge::supervisor {
+
+namespace {
+
+std::string mm(double metres) { return std::to_string(static_cast<int>(std::lround(metres * 1e3))) + " mm"; }
+
+}  // namespace
+
+std::string Attempt::object_key() const {
+  char text[32];
+  std::snprintf(text, sizeof text, "attempt_%02d", number);
+  return text;
+}
+
+bool Supervisor::learning_enabled() const {
+  return config_.learn == Config::Learn::On || (config_.learn == Config::Learn::Auto && learner_alive_);
+}
+
+bool Supervisor::stills_complete() const {
+  const Attempt& a = *attempt_;
+  if (state_ == State::SnapshotBefore) return !a.before.empty() && (!a.learn || !a.before_left.empty());
+  return !a.after.empty() && (!a.learn || !a.after_left.empty());
+}
+
+void Supervisor::stills_arrived(int64_t now) {
+  if (state_ == State::SnapshotAfter) {
+    segment(now);
+  } else if (attempt_->learn) {
+    recognise(now);
+  } else {
+    start_nudge(now);
+  }
+}
+
+void Supervisor::on_left_still(const cv::Mat& still, int64_t utime, int64_t now) {
+  if (!attempt_ || !attempt_->learn || utime < request_time_) return;
+  if (state_ != State::SnapshotBefore && state_ != State::SnapshotAfter) return;
+  if (still.size() != config_.still_size)
+    throw std::invalid_argument("left still of " + std::to_string(still.cols) + "x" + std::to_string(still.rows) +
+                                ", expected " + std::to_string(config_.still_size.width) + "x" + std::to_string(config_.still_size.height));
+  cv::Mat& kept = state_ == State::SnapshotBefore ? attempt_->before_left : attempt_->after_left;
+  if (!kept.empty()) return;
+  kept = still.clone();
+  if (stills_complete()) stills_arrived(now);
+}
+
+// Sec. 7.3 before the nudge: a candidate the learner already knows is not learned twice.
+void Supervisor::recognise(int64_t now) {
+  const Attempt& a = *attempt_;
+  const cv::Rect roi = cylinder_box(scene_, a.target.position, config_.targets.object_radius, 0.0,
+                                    config_.object_height_m, config_.still_size);
+  learn_seq_ = next_seq_++;
+  enter(State::Recognise, now, "asking the learner whether candidate " + std::to_string(a.target.index) + " is known");
+  outputs_.push_back(RecognizeRequest{learn_seq_, roi, a.before});
+}
+
+void Supervisor::on_recognition(int64_t seq, const std::string& label, const std::string& reason, int64_t now) {
+  if (state_ != State::Recognise || seq != learn_seq_) return;
+  learn_seq_ = 0;
+  Attempt& a = *attempt_;
+  if (!label.empty()) {
+    a.recognised = label;
+    end_attempt(Outcome::Known, "recognised as '" + label + "': already learned, not nudged", now);
+    return;
+  }
+  a.recognition_reason = reason.empty() ? "not recognised" : reason;
+  start_nudge(now);
+}
+
+// Sec. 7.2.2: the top in both cameras' segmentations, triangulated and lowered by r tan(theta);
+// the grasp checked with the arm service's own planner before it is asked for.
+void Supervisor::plan_grasp(int64_t now) {
+  Attempt& a = *attempt_;
+  const auto predicted_before = scene_.left_axis_line(a.target.position, config_.object_height_m, config_.still_size);
+  const auto predicted_after = scene_.left_axis_line(*a.rest, config_.object_height_m, config_.still_size);
+  if (!predicted_before || !predicted_after) return learning_ended("not grasped", "the object is not in the left camera's view", now);
+  a.before_line_left = find_line_near(a.before_left, *predicted_before, config_.line_search);
+  a.after_line_left = find_line_near(a.after_left, *predicted_after, config_.line_search);
+  if (!a.before_line_left) a.before_line_left = predicted_before;
+  if (!a.after_line_left) a.after_line_left = predicted_after;
+  a.segmentation_left = segment_(a.before_left, a.after_left, *a.before_line_left, *a.after_line_left);
+  a.top[0] = object_top(a.segmentation_left.mask, *a.after_line_left);
+  a.top[1] = object_top(a.segmentation.mask, *a.after_line);
+  for (int camera = 0; camera < 2; ++camera)
+    if (!a.top[camera])
+      return learning_ended("not grasped", std::string("no object top in the ") + (camera == 0 ? "left" : "right") +
+                                               " segmentation" + (a.segmentation_left.error.empty() || camera == 1 ? "" : ": " + a.segmentation_left.error), now);
+  a.grasp = grasp_target(scene_, *a.top[0], *a.top[1], config_.still_size, *a.rest, config_.grasp);
+  if (!a.grasp->ok()) return learning_ended("not grasped", a.grasp->reason, now);
+  robot::Command grasp;
+  grasp.kind = robot::CommandKind::Grasp;
+  grasp.target_position = a.grasp->foot;
+  grasp.height = a.grasp->grasp_height_m;
+  const robot::MotionPlan plan = robot::plan_command(arm_.planner(), grasp, joints_);
+  if (!plan.ok()) return learning_ended("not grasped", "the arm cannot grasp it: " + plan.reason, now);
+  learn_seq_ = next_seq_++;
+  arm_away_ = true;
+  enter(State::Grasp, now, "grasping the object at " + millimetres(a.grasp->foot) + ", fingers " + mm(a.grasp->grasp_height_m) +
+                               " above the table (top " + mm(a.grasp->top.z()) + ", lowered " + mm(a.grasp->overestimate_m) + ")");
+  outputs_.push_back(GraspCommand{learn_seq_, a.grasp->foot, a.grasp->grasp_height_m});
+}
+
+// A gripper that closed (nearly) fully holds nothing: the object slipped or was never caught.
+// What a real robot knows (the fingers' opening), not the simulator's truth.
+bool Supervisor::holding(const ArmStatus& arm, const std::string& when, int64_t now) {
+  if (arm.gripper_opening < 0 || arm.gripper_opening >= config_.held_min_opening_m) return true;
+  learning_ended("dropped", "nothing held " + when + ": the gripper closed to " + mm(arm.gripper_opening), now);
+  return false;
+}
+
+void Supervisor::on_learning_arm_state(const ArmStatus& arm, int64_t now) {
+  using Motion = ArmStatus::Motion;
+  if (arm.motion == Motion::Moving || arm.motion == Motion::Idle) return;
+  learn_seq_ = 0;
+  const std::string what = state_ == State::Grasp ? "grasp" : state_ == State::Rotate ? "wrist turn" : "place";
+  if (arm.motion == Motion::Refused && state_ == State::Grasp) {
+    arm_away_ = false;  // nothing moved
+    return learning_ended("not grasped", "arm refused the grasp: " + arm.last_error, now);
+  }
+  if (state_ == State::Place) {
+    const std::string how = arm.motion == Motion::Done ? "" : "; the arm did not put it back (" + arm.last_error + ")";
+    return learning_ended(pending_learning_, pending_reason_ + how, now);
+  }
+  if (arm.motion == Motion::Stopped) return learning_ended("arm failed", "arm stopped during the " + what + ": " + arm.last_error, now);
+  if (arm.motion == Motion::Refused) {  // the wrist can turn no further: learn from the views so far
+    attempt_->learning_reason = "the arm refused the wrist turn after view " + std::to_string(attempt_->views.size()) + ": " + arm.last_error;
+    return commit_views(now);
+  }
+  if (!holding(arm, state_ == State::Grasp ? "after the grasp" : "after turn " + std::to_string(attempt_->views.size()), now)) return;
+  if (state_ == State::Grasp) {
+    // Turn towards the side joint 6 has room on for every step.
+    const double total = (config_.views - 1) * config_.view_step_deg * M_PI / 180;
+    const double step = config_.view_step_deg * M_PI / 180;
+    wrist_step_ = joints_[5] + total <= arm_.model.limits.upper[5] ? step : -step;
+  }
+  request_time_ = now;
+  enter(State::Rotate, now, "view " + std::to_string(attempt_->views.size() + 1) + " of " + std::to_string(config_.views));
+  outputs_.push_back(SnapshotRequest{false});
+}
+
+// One training view: the right still with the held object's box, to the learner and kept.
+void Supervisor::take_view(const cv::Mat& still, int64_t utime, int64_t now) {
+  Attempt& a = *attempt_;
+  LearnView view;
+  view.index = static_cast<int>(a.views.size());
+  view.angle = view.index * wrist_step_;
+  view.image = still.clone();
+  view.utime = utime;
+  view.object_key = a.object_key();
+  // The held object hangs below the fingers, which closed at its (lowered) top: it spans the grasp
+  // height below the tool point, and the lowering's uncertainty above it.
+  const Eigen::Vector3d tool = arm_.base.world_from_base() * robot::forward_kinematics(arm_.model, joints_).translation();
+  view.box = cylinder_box(scene_, tool, config_.targets.object_radius, tool.z() - a.grasp->grasp_height_m,
+                          tool.z() + a.grasp->overestimate_m, config_.still_size);
+  a.views.push_back(view);
+  outputs_.push_back(view);
+  if (static_cast<int>(a.views.size()) >= config_.views) return commit_views(now);
+  learn_seq_ = next_seq_++;
+  enter(State::Rotate, now, "turning the wrist " + std::to_string(static_cast<int>(std::lround(wrist_step_ * 180 / M_PI))) + " deg");
+  outputs_.push_back(RotateCommand{learn_seq_, wrist_step_});
+}
+
+void Supervisor::commit_views(int64_t now) {
+  Attempt& a = *attempt_;
+  if (a.views.empty()) return place(now, "not learned", "no view was taken");
+  learn_seq_ = next_seq_++;
+  enter(State::Learn, now, "learning from " + std::to_string(a.views.size()) + " views");
+  const double height = a.grasp->top.z() - a.grasp->overestimate_m;
+  outputs_.push_back(LearnCommit{learn_seq_, a.object_key(), static_cast<int>(a.views.size()), height, config_.grasp.top_radius_m});
+}
+
+void Supervisor::on_learned(int64_t seq, bool ok, const std::string& name, const std::string& reason, int64_t now) {
+  if (state_ != State::Learn || seq != learn_seq_) return;
+  learn_seq_ = 0;
+  if (ok) attempt_->learned_name = name;
+  place(now, ok ? "learned" : "learn failed", ok ? "learned as '" + name + "'" : reason);
+}
+
+// Sec. 7.2.3: the object goes back where it stood before the nudge (revisits stay possible).
+void Supervisor::place(int64_t now, const std::string& learning, const std::string& reason) {
+  Attempt& a = *attempt_;
+  pending_learning_ = learning;
+  pending_reason_ = a.learning_reason.empty() ? reason : a.learning_reason + "; " + reason;
+  learn_seq_ = next_seq_++;
+  enter(State::Place, now, "putting the object back at " + millimetres(a.target.position) + " (" + learning + ")");
+  outputs_.push_back(PlaceCommand{learn_seq_, a.target.position, a.grasp->grasp_height_m});
+}
+
+void Supervisor::learning_ended(const std::string& learning, const std::string& reason, int64_t now) {
+  Attempt& a = *attempt_;
+  a.learning = learning;
+  a.learning_reason = reason;
+  ++summary_.learning[learning];
+  if (learning == "learned") ++summary_.learned;
+  end_attempt(Outcome::Segmented, "segmented; " + learning + (reason.empty() ? "" : ": " + reason), now);
+}
+
+}  // namespace nudge::supervisor
