@@ -524,6 +524,9 @@ void add_flags(Flags& f, Options& o) {
   f.add_double("view-step", &o.config.view_step_deg, "wrist turn between training views, deg (thesis 30)");
   f.add_double("recognise-timeout", &o.config.recognise_timeout_s, "for a RECOGNITION answer, s of the task clock (then the nudge goes ahead)");
   f.add_double("learn-timeout", &o.config.learn_timeout_s, "for a LEARNED answer, s of the task clock (then the object is put back)");
+  f.add_double("held-min-opening", &o.config.held_min_opening_m,
+               "ARM_STATE.gripper below this after a grasp or turn: nothing held (dropped), m; 0: no check (the sim "
+               "backend reports the commanded opening, docs/supervisor.md)");
   f.add_double("top-radius", &o.config.grasp.top_radius_m, "r of the grasp height's r*tan(theta) lowering, m (thesis: 36 mm at 30 deg)");
   f.add_int("first-seq", &o.first_seq, "first ARM_COMMAND seq (default: from the wall clock; set it to replay a run)");
 }
@@ -556,6 +559,7 @@ int main(int argc, char** argv) {
     else if (opt.learn == "off") opt.config.learn = sv::Config::Learn::Off;
     else if (opt.learn == "auto") opt.config.learn = sv::Config::Learn::Auto;
     else throw FlagError("--learn must be on, off or auto, not '" + opt.learn + "'");
+    if (!(opt.config.held_min_opening_m >= 0 && opt.config.held_min_opening_m < 0.1)) throw FlagError("--held-min-opening must lie in [0, 0.1) m");
     if (opt.config.views <= 0 || opt.config.views > 36) throw FlagError("--views must lie in [1, 36]");
     if (!(opt.config.view_step_deg > 0 && opt.config.view_step_deg <= 90)) throw FlagError("--view-step must lie in (0, 90] deg");
     Shell shell(service, opt);  // loads the calibration: a bad file ends here, naming the field

@@ -1,7 +1,8 @@
 // world: the simulated lab (MuJoCo physics of the table, the objects and the arm's pusher pad).
 // Publishes SIM_STATE at --rate in simulated time, answers SIM_TRUTH_REQUEST with SIM_TRUTH
 // (state + both cameras' object masks), and puts the pusher (or, with --tool gripper, the
-// gripper, its opening from ARM_STATE.gripper) at the arm's tool point from ARM_STATE. All logic
+// gripper, its opening from ARM_STATE.gripper; --tool auto: the gripper from a COMMAND_GRASP on,
+// the pad from a COMMAND_NUDGE on) at the arm's tool point from ARM_STATE. All logic
 // runs on simulated time; see docs/sim.md, "The world service".
 #include <algorithm>
 #include <cmath>
@@ -10,6 +11,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "nudge/arm_command_t.hpp"
 #include "nudge/arm_state_t.hpp"
 #include "nudge/bus/arm_convert.hpp"
 #include "nudge/bus/channels.hpp"
@@ -126,6 +128,19 @@ class Simulation {
     service_.publish(bus::channel::SIM_TRUTH, truth);
   }
 
+  // --tool auto: the real robot's one hand carries the nudging pad and the gripper; the simulation
+  // can make only one of them solid (they share the tool point), so the arm's command picks it.
+  void use_gripper(bool gripper) {
+    if (gripper == gripper_) return;
+    gripper_ = gripper;
+    if (gripper_) {
+      world_.set_gripper_opening(arm_ ? arm_->gripper : sim::gripper_geometry().max_opening);
+    } else {
+      world_.set_pusher(world_.pusher_position(), pusher_yaw_);
+    }
+    log::info() << "tool: " << (gripper_ ? "gripper" : "pad");
+  }
+
   sim_state_t state_message() const {
     sim_state_t msg;
     msg.utime = utime();
@@ -176,8 +191,13 @@ class Simulation {
 // same way every run. Bad messages are reported naming the channel, counted and skipped.
 class Inputs {
  public:
-  Inputs(bus::Service& service, Simulation& sim, BusClock& clock, LogTimeline timeline)
+  Inputs(bus::Service& service, Simulation& sim, BusClock& clock, LogTimeline timeline, bool auto_tool)
       : sim_(sim), clock_(clock), timeline_(timeline) {
+    if (auto_tool)
+      service.subscriptions().subscribe<arm_command_t>(bus::channel::ARM_COMMAND, [this](const arm_command_t& msg, const std::string&) {
+        if (msg.command == arm_command_t::COMMAND_GRASP) sim_.use_gripper(true);
+        if (msg.command == arm_command_t::COMMAND_NUDGE) sim_.use_gripper(false);
+      });
     service.subscriptions().subscribe<arm_state_t>(bus::channel::ARM_STATE, [this](const arm_state_t& msg, const std::string&) {
       catch_up(msg.utime);
       sim_.on_arm_state(msg);  // throws on a bad pose: counted, skipped
@@ -237,7 +257,8 @@ int main(int argc, char** argv) {
     f.add_double("rate", &rate, "SIM_STATE messages per simulated second");
     f.add_double("duration", &duration, "stop after this many simulated seconds (0: run until stopped)");
     std::string tool = "pad";
-    f.add_string("tool", &tool, "the arm's tool: pad (pushes) or gripper (grasps; fingers follow ARM_STATE.gripper)");
+    f.add_string("tool", &tool, "the arm's tool: pad (pushes), gripper (grasps; fingers follow ARM_STATE.gripper) or auto "
+                                "(the pad, the gripper from a COMMAND_GRASP until the next COMMAND_NUDGE)");
     // Scenes with the arm: its tool and shoulder height are the workspace's, as nudge-arm's.
     const robot::WorkspaceFlags workspace_flags(f, {"tool-length"}, "scenes with the arm: ");
     double log_origin_s = -1;
@@ -249,7 +270,7 @@ int main(int argc, char** argv) {
     if (!(rate > 0 && std::isfinite(rate))) throw FlagError("--rate must be > 0");
     if (!(duration >= 0 && std::isfinite(duration))) throw FlagError("--duration must be >= 0");
     if (seed < -1) throw FlagError("--seed must be >= 0 (or -1 for the scene's)");
-    if (tool != "pad" && tool != "gripper") throw FlagError("--tool must be pad or gripper, not '" + tool + "'");
+    if (tool != "pad" && tool != "gripper" && tool != "auto") throw FlagError("--tool must be pad, gripper or auto, not '" + tool + "'");
     const robot::Workspace workspace = workspace_flags.resolve();
     if (!(log_origin_s >= 0 || log_origin_s == -1)) throw FlagError("--log-origin must be >= 0 (or -1)");
     const int64_t log_origin = log_origin_s >= 0 ? std::llround(log_origin_s * 1e6) : -1;
@@ -268,7 +289,8 @@ int main(int argc, char** argv) {
     const bool from_log = service.input_is_log();
     // Message time from a log, else the wall clock (paced, or as fast as possible).
     BusClock clock(from_log ? ClockSource::Log : ClockSource::Wall);
-    Inputs inputs(service, sim, clock, LogTimeline(log_origin >= 0 ? std::optional<int64_t>(log_origin) : std::nullopt));
+    Inputs inputs(service, sim, clock, LogTimeline(log_origin >= 0 ? std::optional<int64_t>(log_origin) : std::nullopt),
+                  tool == "auto");
     if (scene.arm.present)
       log::info() << "the PUMA 260 with its tool point " << workspace.tool_length << " m along the flange"
                   << (workspace_flags.file().empty() ? "" : " (" + workspace_flags.file() + ")");
