@@ -35,7 +35,10 @@ bool Supervisor::stills_complete() const {
 void Supervisor::stills_arrived(int64_t now) {
   if (state_ == State::SnapshotAfter) {
     segment(now);
-  } else if (attempt_->learn) {
+    return;
+  }
+  before_lines();
+  if (attempt_->learn) {
     recognise(now);
   } else {
     start_nudge(now);
@@ -52,6 +55,17 @@ void Supervisor::on_left_still(const cv::Mat& still, int64_t utime, int64_t now)
   if (!kept.empty()) return;
   kept = still.clone();
   if (stills_complete()) stills_arrived(now);
+}
+
+// The object's lines in the before stills, searched for before the nudge rather than after it:
+// the time between the nudge's end and the grasp is the thesis' measure (160 ms).
+void Supervisor::before_lines() {
+  Attempt& a = *attempt_;
+  if (const auto right = scene_.right_axis_line(a.target.position, config_.object_height_m, config_.still_size))
+    a.before_line = find_line_near(a.before, *right, config_.line_search);
+  if (!a.learn) return;
+  if (const auto left = scene_.left_axis_line(a.target.position, config_.object_height_m, config_.still_size))
+    a.before_line_left = find_line_near(a.before_left, *left, config_.line_search);
 }
 
 // Sec. 7.3 before the nudge: a candidate the learner already knows is not learned twice.
@@ -77,18 +91,25 @@ void Supervisor::on_recognition(int64_t seq, const std::string& label, const std
   start_nudge(now);
 }
 
+// The left stills' lines and motion segmentation (possibly on another thread: it touches only
+// the attempt's left fields and the left segmenter).
+void Supervisor::segment_left(Attempt& a) const {
+  const auto predicted_before = scene_.left_axis_line(a.target.position, config_.object_height_m, config_.still_size);
+  const auto predicted_after = scene_.left_axis_line(*a.rest, config_.object_height_m, config_.still_size);
+  if (!predicted_before || !predicted_after) return;
+  if (!a.before_line_left) a.before_line_left = find_line_near(a.before_left, *predicted_before, config_.line_search);
+  a.after_line_left = find_line_near(a.after_left, *predicted_after, config_.line_search);
+  if (!a.before_line_left) a.before_line_left = predicted_before;
+  if (!a.after_line_left) a.after_line_left = predicted_after;
+  const SegmentFunction& segment = segment_left_ ? segment_left_ : segment_;
+  a.segmentation_left = segment(a.before_left, a.after_left, *a.before_line_left, *a.after_line_left);
+}
+
 // Sec. 7.2.2: the top in both cameras' segmentations, triangulated and lowered by r tan(theta);
 // the grasp checked with the arm service's own planner before it is asked for.
 void Supervisor::plan_grasp(int64_t now) {
   Attempt& a = *attempt_;
-  const auto predicted_before = scene_.left_axis_line(a.target.position, config_.object_height_m, config_.still_size);
-  const auto predicted_after = scene_.left_axis_line(*a.rest, config_.object_height_m, config_.still_size);
-  if (!predicted_before || !predicted_after) return learning_ended("not grasped", "the object is not in the left camera's view", now);
-  a.before_line_left = find_line_near(a.before_left, *predicted_before, config_.line_search);
-  a.after_line_left = find_line_near(a.after_left, *predicted_after, config_.line_search);
-  if (!a.before_line_left) a.before_line_left = predicted_before;
-  if (!a.after_line_left) a.after_line_left = predicted_after;
-  a.segmentation_left = segment_(a.before_left, a.after_left, *a.before_line_left, *a.after_line_left);
+  if (!a.after_line_left) return learning_ended("not grasped", "the object is not in the left camera's view", now);
   a.top[0] = object_top(a.segmentation_left.mask, *a.after_line_left);
   a.top[1] = object_top(a.segmentation.mask, *a.after_line);
   for (int camera = 0; camera < 2; ++camera)

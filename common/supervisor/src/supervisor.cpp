@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <future>
 #include <stdexcept>
 
 #include "nudge/robot/command_planner.hpp"
@@ -304,13 +305,19 @@ void Supervisor::segment(int64_t now) {
     end_attempt(Outcome::SegmentationFailed, "the object left the right camera's view", now);
     return;
   }
+  // Learning: the left camera's segmentation (for the object's top) alongside the right one's, on
+  // the second core when the shell gave it its own segmenter (the grasp is planned sooner).
+  std::future<void> left;
+  if (a.learn) left = std::async(segment_left_ ? std::launch::async : std::launch::deferred, [this, &a] { segment_left(a); });
   // The object's own lines in the stills; the calibration's prediction where none is detected.
-  a.before_line = find_line_near(a.before, *predicted_before, config_.line_search);
+  // (The before still's line was searched for while the arm nudged: see before_lines.)
+  if (!a.before_line) a.before_line = find_line_near(a.before, *predicted_before, config_.line_search);
   a.after_line = find_line_near(a.after, *predicted_after, config_.line_search);
   if (!a.before_line) a.before_line = predicted_before;
   if (!a.after_line) a.after_line = predicted_after;
   a.segmentation = segment_(a.before, a.after, *a.before_line, *a.after_line);
   keep_object_rows(a);
+  if (left.valid()) left.get();  // joined before the attempt can end
   if (a.segmentation.mask.empty() || cv::countNonZero(a.segmentation.mask) < config_.min_mask_pixels) {
     end_attempt(Outcome::SegmentationFailed,
                 "segmentation empty" + (a.segmentation.error.empty() ? std::string() : ": " + a.segmentation.error), now);

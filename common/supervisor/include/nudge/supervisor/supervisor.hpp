@@ -228,6 +228,9 @@ class Supervisor {
   void on_recognition(int64_t seq, const std::string& label, const std::string& reason, int64_t now);
   void on_learned(int64_t seq, bool ok, const std::string& name, const std::string& reason, int64_t now);
   void set_learner_alive(bool alive) { learner_alive_ = alive; }
+  // A second segmenter for the left stills (learning): the two cameras' segmentations then run on
+  // two threads. Without it the left one runs after the right one, with the same function.
+  void set_left_segmentation(SegmentFunction segment) { segment_left_ = std::move(segment); }
 
   std::vector<Output> take_outputs();
   State state() const { return state_; }
@@ -284,6 +287,9 @@ class Supervisor {
   bool learning_enabled() const;
   bool stills_complete() const;
   void stills_arrived(int64_t now);
+  void before_lines();
+  void segment_left(Attempt& attempt) const;
+  SegmentFunction segment_left_;
   void recognise(int64_t now);
   void plan_grasp(int64_t now);
   void on_learning_arm_state(const ArmStatus& arm, int64_t now);
