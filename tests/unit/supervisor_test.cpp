@@ -6,8 +6,14 @@
 #include <Eigen/Geometry>
 #include <opencv2/imgproc.hpp>
 
-#include <algorithm>
+#include <unistd.h>
 
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
+#include "nudge/supervisor/report.hpp"
 #include "nudge/supervisor/supervisor.hpp"
 
 namespace sv = nudge::supervisor;
@@ -784,4 +790,33 @@ TEST_F(LearningTest, AutoLearnsOnlyWhileTheLearnerIsHeard) {
   heard.set_learner_alive(true);
   out = start_with(heard, {object_});
   EXPECT_TRUE(outputs_of<sv::SnapshotRequest>(out).at(0).both);
+}
+
+TEST_F(LearningTest, TheViewsTheLeftStillsAndTheLearningAreSavedBesideTheAttempt) {
+  sv::Supervisor s = make_learning();
+  done(s, to_grasp(s).seq);
+  now_ += kSecond / 5;
+  s.on_right_still(draw_scene(scene_, {1280, 960}, {}), now_, now_);
+  auto out = s.take_outputs();
+  const auto view = outputs_of<sv::LearnView>(out).at(0);
+  done(s, outputs_of<sv::RotateCommand>(out).at(0).seq);
+  const std::string dir = testing::TempDir() + "/supervisor_views_" + std::to_string(::getpid());
+  std::filesystem::remove_all(dir);
+  const std::string file = sv::save_view(dir, 1, view);
+  EXPECT_EQ(file, dir + "/attempt_01/views/view_00.png");
+  EXPECT_TRUE(std::filesystem::exists(file));
+  s.on_time(now_ += 11 * kSecond);  // the next still never comes: the object is put back
+  ASSERT_EQ(s.state(), sv::State::Place) << s.report().reason;
+  done(s, outputs_of<sv::PlaceCommand>(s.take_outputs()).at(0).seq);
+  const auto a = ended(s.take_outputs());
+  ASSERT_TRUE(a);
+  EXPECT_EQ(a->learning, "snapshot lost");
+  const std::string folder = sv::save_attempt(dir, *a, sv::ArmSetup{}, scene_.right_camera_in_world());
+  for (const char* name : {"before.png", "after.png", "mask.png", "before_left.png", "after_left.png", "mask_left.png", "attempt.json"})
+    EXPECT_TRUE(std::filesystem::exists(folder + "/" + name)) << name;
+  std::ifstream in(folder + "/attempt.json");
+  const std::string json((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(json.find("\"learning\":{\"outcome\":\"snapshot lost\""), std::string::npos) << json.substr(0, 400);
+  EXPECT_NE(json.find("\"grasp_height_m\""), std::string::npos);
+  std::filesystem::remove_all(dir);
 }
