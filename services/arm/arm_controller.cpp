@@ -288,6 +288,7 @@ arm_state_t ArmController::state() const {
   s.utime = clock_;
   s.joints = joints.position;
   s.gripper_opening = joints.gripper_opening;
+  s.gripper_measured = measured_gripper_;
   s.tool_in_world = config_.planner.base.to_world(robot::forward_kinematics(config_.planner.model, joints.position));
   s.motion = motion_;
   s.command_seq = command_seq_;

@@ -71,6 +71,10 @@ class ArmController {
   // When the watchdog will fire if no heartbeat arrives (none while not armed).
   std::optional<int64_t> supervisor_deadline() const;
 
+  // The fingers' opening as a sensor measured it (the sim backend: the MuJoCo world's fingers,
+  // from SIM_STATE); negative: unknown. Reported in ARM_STATE.gripper_measured.
+  void set_measured_gripper(double opening) { measured_gripper_ = opening < 0 ? -1.0 : opening; }
+
   arm_state_t state() const;
   int64_t clock() const { return clock_; }
   bool busy() const { return !steps_.empty(); }
@@ -103,6 +107,7 @@ class ArmController {
   int64_t command_seq_ = -1;
   std::string last_error_;
   int64_t malformed_commands_ = 0;
+  double measured_gripper_ = -1;
 
   bool supervisor_seen_ = false;
   int64_t supervisor_last_ = 0;

@@ -81,7 +81,7 @@ int main(int argc, char** argv) {
     f.add_string("clock", &clock_name, "auto (log for file:// inputs, else wall), wall, sim (SIM_STATE utime) or log (utime of commands and heartbeats)");
     f.add_string("command-channel", &command_channel, "arm_command_t input");
     f.add_string("state-channel", &state_channel, "arm_state_t output");
-    f.add_string("sim-channel", &sim_channel, "sim_state_t input for --clock sim");
+    f.add_string("sim-channel", &sim_channel, "sim_state_t input for --clock sim and the sim backend's measured finger opening");
     f.add_double("rate", &rate, "ARM_STATE messages per second of the clock");
     f.add_double("max-catch-up", &max_catch_up, "after a clock jump publish at most this many seconds of states (wall, sim)");
     const robot::WorkspaceFlags workspace_flags(
@@ -163,9 +163,13 @@ int main(int argc, char** argv) {
       }
       after_event();
     });
-    if (clock.source() == ClockSource::Sim) {
-      service.subscriptions().subscribe<sim_state_t>(sim_channel, [&](const sim_state_t& sim, const std::string&) {
-        follow(sim.utime, Stamp::Simulated);
+    // The sim backend's finger sensor is the MuJoCo world: its SIM_STATE says how far the fingers
+    // really closed (on an object, or on nothing), which a drop check needs.
+    const bool measure_in_world = backend_name == "sim";
+    if (clock.source() == ClockSource::Sim || measure_in_world) {
+      service.subscriptions().subscribe<sim_state_t>(sim_channel, [&, measure_in_world](const sim_state_t& sim, const std::string&) {
+        if (measure_in_world && std::isfinite(sim.gripper)) controller->set_measured_gripper(sim.gripper);
+        if (clock.source() == ClockSource::Sim) follow(sim.utime, Stamp::Simulated);
       });
     }
     if (const std::optional<int64_t> now = clock.on_timer()) controller->advance_to(*now, publish);

@@ -242,7 +242,9 @@ class Shell {
     status.command_seq = m.command_seq;
     status.last_error = m.last_error;
     for (int i = 0; i < 6; ++i) status.joints[i] = m.joints[i];
-    status.gripper_opening = std::isfinite(m.gripper) ? m.gripper : -1.0;
+    // The measured opening (what the fingers closed on), not the commanded one: a gripper that
+    // closed on nothing measures ~0. No sensor (-1): no held-object check.
+    status.gripper_opening = std::isfinite(m.gripper_measured) ? m.gripper_measured : -1.0;
     supervisor_.on_arm_state(status, now_);
     drain();
   }
@@ -526,8 +528,8 @@ void add_flags(Flags& f, Options& o) {
   f.add_double("recognise-timeout", &o.config.recognise_timeout_s, "for a RECOGNITION answer, s of the task clock (then the nudge goes ahead)");
   f.add_double("learn-timeout", &o.config.learn_timeout_s, "for a LEARNED answer, s of the task clock (then the object is put back)");
   f.add_double("held-min-opening", &o.config.held_min_opening_m,
-               "ARM_STATE.gripper below this after a grasp or turn: nothing held (dropped), m; 0: no check (the sim "
-               "backend reports the commanded opening, docs/supervisor.md)");
+               "ARM_STATE.gripper_measured below this after a grasp or turn: nothing held (dropped), m; 0: no check "
+               "(no check either when the arm reports no measurement, -1)");
   f.add_double("top-radius", &o.config.grasp.top_radius_m, "r of the grasp height's r*tan(theta) lowering, m (thesis: 36 mm at 30 deg)");
   f.add_int("first-seq", &o.first_seq, "first ARM_COMMAND seq (default: from the wall clock; set it to replay a run)");
 }

@@ -148,7 +148,8 @@ class Simulation {
     // With an arm in the scene, its joints as simulated; else the latest ARM_STATE's.
     const std::array<double, 6> simulated = world_.arm_joints();
     for (int i = 0; i < 6; ++i) msg.joints[i] = world_.has_arm() ? simulated[i] : arm_ ? arm_->joints[i] : 0.0;
-    msg.gripper = arm_ ? arm_->gripper : 0.0;
+    // What a gripper's finger sensor would read: the simulated fingers stop on what they hold.
+    msg.gripper = gripper_ ? world_.gripper_opening() : -1.0;
     msg.num_objects = world_.num_objects();
     for (int i = 0; i < world_.num_objects(); ++i) {
       const sim::ObjectState st = world_.object(i);

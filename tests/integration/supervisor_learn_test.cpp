@@ -149,11 +149,10 @@ TEST(SupervisorLearn, GraspsTurnsTwelveViewsAndPutsTheCupBack) {
   Process world({kBin + "/nudge-world", "--lcm-url", kUrl, "--scene", scene, "--realtime-factor", "1", "--rate", "10",
                  "--tool", "auto"},
                 dir + "/world.log");
-  // One attempt; the simulated arm reports the commanded finger opening (0 when closed on the cup):
-  // no held-object check here (docs/supervisor.md).
+  // One attempt, with the held-object check on: the sim arm reports the world's measured finger
+  // opening, which stops on the cup.
   Process supervisor({kBin + "/nudge-supervisor", "--lcm-url", kUrl, "--calibration", kCalibration, "--out", dir,
-                      "--run-id", "learn", "--first-seq", "1000", "--learn", "on", "--max-attempts", "1",
-                      "--held-min-opening", "0"},
+                      "--run-id", "learn", "--first-seq", "1000", "--learn", "on", "--max-attempts", "1"},
                      dir + "/supervisor.log");
   ASSERT_TRUE(symmetry.started() && camera.started() && triangulation.started() && arm.started() && world.started() &&
               supervisor.started());
@@ -188,8 +187,7 @@ TEST(SupervisorLearn, GraspsTurnsTwelveViewsAndPutsTheCupBack) {
   const std::string log = dir + "/learn/learn.lcmlog";
   Process replay({kBin + "/nudge-supervisor", "--lcm-in", "file://" + log + "?speed=0", "--lcm-out",
                   "file://" + dir + "/replay_out.lcmlog?mode=w", "--calibration", kCalibration, "--out", dir,
-                  "--run-id", "replay", "--first-seq", "1000", "--learn", "on", "--max-attempts", "1",
-                  "--held-min-opening", "0"},
+                  "--run-id", "replay", "--first-seq", "1000", "--learn", "on", "--max-attempts", "1"},
                  dir + "/replay.log");
   ASSERT_EQ(replay.wait_exit(60), 0) << read_file(dir + "/replay.log");
   const std::vector<std::string> live = decisions(log), replayed = decisions(dir + "/replay_out.lcmlog");

@@ -455,6 +455,7 @@ TEST(ArmService, ClockSimFollowsTheSimulatedTimeOfSimState) {
   auto sim_state = [](int64_t utime) {
     nudge::sim_state_t s{};
     s.utime = utime;
+    s.gripper = utime < 3 * kSecond ? -1.0 : 0.05;  // the world's fingers: the pad first, then 5 cm open
     return s;
   };
   {
@@ -479,6 +480,13 @@ TEST(ArmService, ClockSimFollowsTheSimulatedTimeOfSimState) {
   int64_t after_five_seconds = 0;
   for (const auto& s : output.states) after_five_seconds += s.utime > 5 * kSecond;
   EXPECT_EQ(after_five_seconds, 101);
+  // The fake driver has no finger sensor; the sim backend's sensor is the world:
+  // ARM_STATE.gripper_measured follows SIM_STATE's fingers.
+  for (const auto& s : output.states) ASSERT_DOUBLE_EQ(s.gripper_measured, -1.0);
+  const Output simulated = run_service(in, out, " --clock sim --backend sim");
+  ASSERT_FALSE(simulated.states.empty());
+  EXPECT_DOUBLE_EQ(simulated.states.front().gripper_measured, -1.0);
+  EXPECT_DOUBLE_EQ(simulated.states.back().gripper_measured, 0.05);
 }
 
 TEST(ArmService, BadFlagsAreRefusedWithAUsageError) {

@@ -17,6 +17,7 @@ bus::ArmState moving_arm() {
   s.tool_in_world.linear() = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
   s.tool_in_world.translation() = Eigen::Vector3d(0.25, 0.05, 0.12);
   s.motion = arm_state_t::MOTION_MOVING;
+  s.gripper_measured = 0.028;
   s.command_seq = 17;
   s.last_error = "none yet";
   return s;
@@ -43,6 +44,7 @@ TEST(ArmConvert, ArmStateRoundTrips) {
   EXPECT_EQ(back.utime, s.utime);
   EXPECT_EQ(back.joints, s.joints);
   EXPECT_DOUBLE_EQ(back.gripper_opening, 0.03);
+  EXPECT_DOUBLE_EQ(back.gripper_measured, 0.028);
   EXPECT_LT((back.tool_in_world.matrix() - s.tool_in_world.matrix()).norm(), 1e-12);
   EXPECT_EQ(back.motion + 0, arm_state_t::MOTION_MOVING + 0);
   EXPECT_EQ(back.command_seq, 17);
@@ -57,6 +59,11 @@ TEST(ArmConvert, BadNumbersAreErrorsNamingTheField) {
   arm_state_t gripper = good;
   gripper.gripper = INFINITY;
   EXPECT_NE(error_of(gripper).find("gripper"), std::string::npos);
+  arm_state_t measured = good;
+  measured.gripper_measured = std::nan("");
+  EXPECT_NE(error_of(measured).find("gripper_measured"), std::string::npos);
+  measured.gripper_measured = -7;  // any negative: no sensor
+  EXPECT_DOUBLE_EQ(bus::from_message(measured).gripper_measured, -1.0);
   arm_state_t pose = good;
   pose.end_effector.orientation[0] = 0;
   pose.end_effector.orientation[1] = 0;

@@ -12,6 +12,7 @@ arm_state_t to_message(const ArmState& s) {
   m.utime = s.utime;
   for (int j = 0; j < robot::kNumJoints; ++j) m.joints[j] = s.joints[j];
   m.gripper = s.gripper_opening;
+  m.gripper_measured = s.gripper_measured;
   m.end_effector = to_message(s.tool_in_world);
   m.motion = s.motion;
   m.command_seq = s.command_seq;
@@ -24,10 +25,12 @@ ArmState from_message(const arm_state_t& m) {
   if (!from_message(m.end_effector, &s.tool_in_world))
     throw std::invalid_argument("end_effector: position must be finite and orientation a unit quaternion");
   if (!std::isfinite(m.gripper)) throw std::invalid_argument("gripper: not finite");
+  if (!std::isfinite(m.gripper_measured)) throw std::invalid_argument("gripper_measured: not finite");
   for (int j = 0; j < robot::kNumJoints; ++j) s.joints[j] = m.joints[j];
   if (!s.joints.allFinite()) throw std::invalid_argument("joints: not finite");
   s.utime = m.utime;
   s.gripper_opening = m.gripper;
+  s.gripper_measured = m.gripper_measured < 0 ? -1.0 : m.gripper_measured;
   s.motion = m.motion;
   s.command_seq = m.command_seq;
   s.last_error = m.last_error;

@@ -14,7 +14,8 @@ namespace nudge::bus {
 struct ArmState {
   int64_t utime = 0;
   robot::JointVector joints = robot::JointVector::Zero();  // radians
-  double gripper_opening = 0;                               // metres
+  double gripper_opening = 0;                               // metres, as commanded
+  double gripper_measured = -1;                             // metres, as measured; -1: no sensor
   Eigen::Isometry3d tool_in_world = Eigen::Isometry3d::Identity();  // the tool point, WORLD frame
   int8_t motion = arm_state_t::MOTION_IDLE;                 // arm_state_t::MOTION_*
   int64_t command_seq = -1;                                 // last command accepted
