@@ -4,6 +4,7 @@
 
 #include "nudge/sim/mesh_file.hpp"
 #include "nudge/sim/textures.hpp"
+#include "nudge/sim/truth_images.hpp"
 
 #include <cstdlib>
 #include <filesystem>
@@ -273,4 +274,37 @@ TEST(SimMeshes, BadInputNamesTheFileAndTheField) {
   scene.objects[0].appearance.kind = Appearance::Kind::Image;
   scene.objects[0].appearance.file = dir + "/not_an_image.png";
   expect(scene_error(scene), {"objects[0].file", "not a picture"});
+}
+
+TEST(SimMeshes, SurfaceCoordinatesSurviveAPngRoundTrip) {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  cv::Mat points(2, 2, CV_32FC3, cv::Scalar(nan, nan, nan));
+  points.at<cv::Vec3f>(0, 1) = cv::Vec3f(0.0123f, -0.0345f, 0.199f);
+  points.at<cv::Vec3f>(1, 0) = cv::Vec3f(-0.5f, 0.5f, 0.0f);
+  const std::string path = temp_dir("surface") + "/surface.png";
+  ASSERT_TRUE(cv::imwrite(path, encode_surface(points)));
+  const cv::Mat back = decode_surface(cv::imread(path, cv::IMREAD_UNCHANGED));
+  ASSERT_EQ(back.type(), CV_32FC3);
+  EXPECT_TRUE(std::isnan(back.at<cv::Vec3f>(0, 0)[0]));
+  EXPECT_TRUE(std::isnan(back.at<cv::Vec3f>(1, 1)[2]));
+  for (const cv::Point at : {cv::Point(1, 0), cv::Point(0, 1)})
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(back.at<cv::Vec3f>(at)[k], points.at<cv::Vec3f>(at)[k], 1e-5);
+  EXPECT_THROW(decode_surface(cv::Mat(2, 2, CV_8UC3)), std::invalid_argument);
+}
+
+// The learning experiment's seven training scenes: one labelled bottle each, in the workspace.
+TEST(SimLabels, TrainingScenesOfTheLearningExperimentLoad) {
+  const std::string dir = std::string(NUDGE_SOURCE_DIR) + "/experiments/scenes/learning";
+  int scenes = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    if (entry.path().extension() != ".yaml") continue;
+    SCOPED_TRACE(entry.path().string());
+    const Scene scene = load_scene(entry.path().string());
+    ++scenes;
+    ASSERT_EQ(scene.objects.size(), 1u);
+    EXPECT_EQ(scene.objects[0].kind, "bottle");
+    EXPECT_TRUE(scene.objects[0].label.present());
+    EXPECT_TRUE(scene.arm.present);
+  }
+  EXPECT_EQ(scenes, 7);
 }
