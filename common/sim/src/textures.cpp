@@ -46,8 +46,15 @@ uint64_t fnv1a(const std::vector<unsigned char>& bytes) {
 
 std::string texture_cache_dir() {
   if (const std::string dir = env("NUDGE_TEXTURE_CACHE"); !dir.empty()) return dir;
-  if (const std::string xdg = env("XDG_CACHE_HOME"); !xdg.empty()) return xdg + "/nudge/textures";
-  if (const std::string home = env("HOME"); !home.empty()) return home + "/.cache/nudge/textures";
+  // The first of the usual places that exists or can be made (a CI user may have no writable home).
+  std::vector<std::string> candidates;
+  if (const std::string xdg = env("XDG_CACHE_HOME"); !xdg.empty()) candidates.push_back(xdg + "/nudge/textures");
+  if (const std::string home = env("HOME"); !home.empty()) candidates.push_back(home + "/.cache/nudge/textures");
+  for (const std::string& dir : candidates) {
+    std::error_code ec;
+    std::filesystem::create_directories(dir, ec);
+    if (!ec && ::access(dir.c_str(), W_OK) == 0) return dir;
+  }
   return "/tmp/nudge-textures-" + std::to_string(::getuid());
 }
 

@@ -308,3 +308,55 @@ TEST(SimLabels, TrainingScenesOfTheLearningExperimentLoad) {
   }
   EXPECT_EQ(scenes, 7);
 }
+
+// The shipped carton (an OBJ, Y up, millimetres) with a four-colour picture: each visible pixel
+// shows the colour of the quadrant of the picture its surface point maps to, so the file's
+// texture coordinates are used the right way up and the right way round.
+TEST(SimMeshes, ObjTextureIsMappedTheRightWayRound) {
+  const std::string dir = temp_dir("carton");
+  cv::Mat picture(64, 64, CV_8UC3);
+  picture(cv::Rect(0, 0, 32, 32)).setTo(cv::Scalar(0, 0, 255));     // top left: red
+  picture(cv::Rect(32, 0, 32, 32)).setTo(cv::Scalar(0, 255, 0));    // top right: green
+  picture(cv::Rect(0, 32, 32, 32)).setTo(cv::Scalar(255, 0, 0));    // bottom left: blue
+  picture(cv::Rect(32, 32, 32, 32)).setTo(cv::Scalar(0, 255, 255));  // bottom right: yellow
+  cv::imwrite(dir + "/quadrants.png", picture);
+  Scene scene = default_scene();
+  ObjectSpec carton;
+  carton.kind = "mesh";
+  carton.position = Eigen::Vector2d(0.25, 0.0);
+  carton.yaw = 200 * kDeg;  // faces u in [0.25, 0.75] towards the cameras
+  carton.mesh.file = std::string(NUDGE_SOURCE_DIR) + "/experiments/scenes/learning/meshes/carton.obj";
+  carton.mesh.texture = dir + "/quadrants.png";
+  carton.mesh.scale = 0.001;
+  carton.mesh.rotation = Eigen::Vector3d(M_PI / 2, 0, 0);
+  scene.objects.push_back(carton);
+  World world(scene);
+  EXPECT_NEAR(world.object(0).height, 0.19, 1e-6);
+  cv::Mat mask;
+  const cv::Mat surface = world.render_surface(1, &mask);
+  const cv::Mat image = world.render(1);
+  int sides = 0, right = 0;
+  for (int y = 0; y < mask.rows; ++y)
+    for (int x = 0; x < mask.cols; ++x) {
+      if (mask.at<uchar>(y, x) != 1) continue;
+      const cv::Vec3f p = surface.at<cv::Vec3f>(y, x);
+      if (p[2] > 0.188 || std::fabs(p[2] - 0.095) < 0.01) continue;  // the top; the picture's middle row
+      // u runs once round: from the corner (-35, 35) mm via (-35, -35), (35, -35), (35, 35).
+      double u;
+      if (std::fabs(p[0] + 0.035) < 0.002) u = 0.25 * (0.035 - p[1]) / 0.07;
+      else if (std::fabs(p[1] + 0.035) < 0.002) u = 0.25 + 0.25 * (p[0] + 0.035) / 0.07;
+      else if (std::fabs(p[0] - 0.035) < 0.002) u = 0.5 + 0.25 * (p[1] + 0.035) / 0.07;
+      else if (std::fabs(p[1] - 0.035) < 0.002) u = 0.75 + 0.25 * (0.035 - p[0]) / 0.07;
+      else continue;
+      if (std::fabs(u - 0.5) < 0.02 || u < 0.02 || u > 0.98) continue;  // the picture's middle column, seam
+      ++sides;
+      const bool top = p[2] > 0.095, left = u < 0.5;
+      const cv::Vec3b c = image.at<cv::Vec3b>(y, x);
+      const int b = c[0], g = c[1], r = c[2];
+      const bool ok = top ? (left ? r > g + 40 && r > b + 40 : g > r + 40 && g > b + 40)
+                          : (left ? b > r + 40 && b > g + 40 : r > b + 40 && g > b + 40);
+      if (ok) ++right;
+    }
+  EXPECT_GT(sides, 1500);
+  EXPECT_GT(right, 0.95 * sides);
+}

@@ -1,8 +1,8 @@
 #pragma once
 // Pictures for MuJoCo textures. MuJoCo 2.2 reads PNG only: a picture in another format OpenCV
 // reads (JPEG, BMP, TIFF, ...) is converted once into a cache directory, never beside the user's
-// file: $NUDGE_TEXTURE_CACHE, else $XDG_CACHE_HOME/nudge/textures, else ~/.cache/nudge/textures,
-// else /tmp/nudge-textures-<uid>.
+// file: $NUDGE_TEXTURE_CACHE, else the first writable of $XDG_CACHE_HOME/nudge/textures and
+// ~/.cache/nudge/textures, else /tmp/nudge-textures-<uid>.
 #include <stdexcept>
 #include <string>
 
