@@ -247,6 +247,11 @@ TEST(SimMeshes, BadInputNamesTheFileAndTheField) {
   expect(error("{ kind: marker, position: [0.25, 0], label: " + dir + "/not_an_image.png }"), {"objects[0].label"});
   expect(error("{ kind: bottle, position: [0.25, 0], label: { file: " + dir + "/box.obj, top: 0.5 } }"),
          {"objects[0].label.file", "not a picture"});
+  cv::imwrite(dir + "/label.png", cv::Mat(8, 8, CV_8UC3, cv::Scalar(0, 0, 255)));
+  expect(error("{ kind: can, position: [0.25, 0], label: { file: " + dir + "/label.png, top: 0.5 } }"),
+         {"objects[0].label", "within the object's height"});
+  expect(error("{ kind: can, position: [0.25, 0], label: { file: " + dir + "/label.png, size: 2 } }"),
+         {"objects[0].label.size: unknown field"});
   // An unknown kind; a mesh object without a file, with a missing file, with files that do not load.
   expect(error("{ kind: teapot, position: [0.25, 0] }"), {"objects[0].kind", "teapot", "mesh"});
   expect(error("{ kind: mesh, position: [0.25, 0] }"), {"objects[0].mesh.file", "needs a mesh file"});
