@@ -193,8 +193,6 @@ ObjectModel checked_model(const ObjectSpec& o, const std::string& src, const std
     if (o.mesh.file.empty()) fail(src, join(ctx, "mesh.file"), "kind mesh needs a mesh file (.obj or .stl)");
     std::ifstream in(o.mesh.file, std::ios::binary);
     if (!in) fail(src, join(ctx, "mesh.file"), "cannot read '" + o.mesh.file + "'");
-    if (o.mesh.file.find_first_of("\"<>&") != std::string::npos)
-      fail(src, join(ctx, "mesh.file"), "'" + o.mesh.file + "': the characters \" < > & are not allowed");
     if (!(o.mesh.scale > 0 && o.mesh.scale <= 100)) fail(src, join(ctx, "mesh.scale"), "must be in (0, 100]");
     if (!o.mesh.rotation.allFinite()) fail(src, join(ctx, "mesh.rotation_deg"), "must be finite");
     if (!o.mesh.texture.empty()) check_picture(o.mesh.texture, src, join(ctx, "mesh.texture"));
