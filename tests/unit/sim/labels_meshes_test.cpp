@@ -14,13 +14,19 @@ using namespace nudge::sim::test;
 
 namespace {
 
-// A fresh empty directory for one test's files.
-std::string temp_dir(const std::string& name) {
-  const std::string dir = "/tmp/nudge_sim_test_" + std::to_string(::getpid()) + "_" + name;
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir;
-}
+// A fresh empty directory for one test's files, removed with it.
+struct TempDir {
+  explicit TempDir(const std::string& name)
+      : path("/tmp/nudge_sim_test_" + std::to_string(::getpid()) + "_" + name) {
+    std::filesystem::remove_all(path);
+    std::filesystem::create_directories(path);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path, ec);
+  }
+  const std::string path;
+};
 
 // A picture whose left half is red and right half blue, as a JPEG (MuJoCo reads PNG only).
 std::string red_blue_jpeg(const std::string& dir) {
@@ -99,7 +105,9 @@ TEST(SimLabels, SleeveWrapsTheBandJustOutsideTheBody) {
 // A JPEG label is converted into the texture cache (not beside the picture), drawn round the
 // bottle the right way round, and counted in the bottle's mask.
 TEST(SimLabels, JpegLabelIsDrawnAndMasked) {
-  const std::string dir = temp_dir("label"), cache = temp_dir("cache");
+  const TempDir label_dir("label"), cache_dir("cache");
+  const std::string& dir = label_dir.path;
+  const std::string& cache = cache_dir.path;
   ::setenv("NUDGE_TEXTURE_CACHE", cache.c_str(), 1);
   Scene scene = one_object("bottle", 0.28, 0.0);
   scene.objects[0].appearance.colour = Eigen::Vector3d(0.2, 0.8, 0.2);
@@ -139,7 +147,8 @@ TEST(SimLabels, JpegLabelIsDrawnAndMasked) {
 }
 
 TEST(SimMeshes, ObjAndStlFilesLoad) {
-  const std::string dir = temp_dir("mesh");
+  const TempDir temp("mesh");
+  const std::string& dir = temp.path;
   const Mesh obj = read_mesh_file(box_obj(dir));
   EXPECT_EQ(obj.faces.size(), 12u);
   EXPECT_EQ(obj.texcoords.size(), obj.vertices.size());
@@ -166,7 +175,8 @@ TEST(SimMeshes, ObjAndStlFilesLoad) {
 
 // A textured mesh object stands on the table at its pose, its mask and surface coordinates right.
 TEST(SimMeshes, MeshObjectInASceneWithItsTextureAndTruth) {
-  const std::string dir = temp_dir("mesh_scene");
+  const TempDir temp("mesh_scene");
+  const std::string& dir = temp.path;
   cv::imwrite(dir + "/texture.png", cv::Mat(32, 32, CV_8UC3, cv::Scalar(40, 40, 200)));
   box_obj(dir);
   const std::string path = dir + "/scene.yaml";
@@ -223,7 +233,8 @@ TEST(SimMeshes, SurfaceCoordinatesLieOnTheBottle) {
 }
 
 TEST(SimMeshes, BadInputNamesTheFileAndTheField) {
-  const std::string dir = temp_dir("bad");
+  const TempDir temp("bad");
+  const std::string& dir = temp.path;
   box_obj(dir);
   std::ofstream(dir + "/not_an_image.png") << "this is text, not a picture\n";
   std::ofstream(dir + "/bad_index.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n";
@@ -286,7 +297,8 @@ TEST(SimMeshes, SurfaceCoordinatesSurviveAPngRoundTrip) {
   cv::Mat points(2, 2, CV_32FC3, cv::Scalar(nan, nan, nan));
   points.at<cv::Vec3f>(0, 1) = cv::Vec3f(0.0123f, -0.0345f, 0.199f);
   points.at<cv::Vec3f>(1, 0) = cv::Vec3f(-0.5f, 0.5f, 0.0f);
-  const std::string path = temp_dir("surface") + "/surface.png";
+  const TempDir temp("surface");
+  const std::string path = temp.path + "/surface.png";
   ASSERT_TRUE(cv::imwrite(path, encode_surface(points)));
   const cv::Mat back = decode_surface(cv::imread(path, cv::IMREAD_UNCHANGED));
   ASSERT_EQ(back.type(), CV_32FC3);
@@ -318,7 +330,8 @@ TEST(SimLabels, TrainingScenesOfTheLearningExperimentLoad) {
 // shows the colour of the quadrant of the picture its surface point maps to, so the file's
 // texture coordinates are used the right way up and the right way round.
 TEST(SimMeshes, ObjTextureIsMappedTheRightWayRound) {
-  const std::string dir = temp_dir("carton");
+  const TempDir temp("carton");
+  const std::string& dir = temp.path;
   cv::Mat picture(64, 64, CV_8UC3);
   picture(cv::Rect(0, 0, 32, 32)).setTo(cv::Scalar(0, 0, 255));     // top left: red
   picture(cv::Rect(32, 0, 32, 32)).setTo(cv::Scalar(0, 255, 0));    // top right: green
