@@ -2,6 +2,7 @@
 
 #include "nudge/sim/camera.hpp"
 #include "nudge/sim/objects.hpp"
+#include "nudge/sim/textures.hpp"
 
 #include "nudge/robot/puma260.hpp"
 #include "nudge/robot/safety.hpp"
@@ -41,8 +42,27 @@ std::string vec(const Eigen::Vector3d& v) {
 }
 
 
-// A texture + material pair for an appearance. Returns the material name.
-std::string add_material(Xml& assets, const std::string& name, const Appearance& a, bool mesh) {
+// The PNG MuJoCo loads for a picture the scene names in `field`.
+std::string texture_file(const std::string& file, const std::string& source, const std::string& field) {
+  try {
+    return png_texture(file);
+  } catch (const TextureError& e) {
+    throw SceneError(source + ": " + field + ": " + e.what());
+  }
+}
+
+// A picture texture + material pair (labels, a mesh's own texture: its texture coordinates as they are).
+void add_picture_material(Xml& assets, const std::string& name, const std::string& png, double specular,
+                          double shininess, double opacity) {
+  assets << "    <texture name=\"" << name << "_tex\" type=\"2d\" file=\"" << png << "\"/>\n"
+         << "    <material name=\"" << name << "\" texture=\"" << name << "_tex\" rgba=\"1 1 1 " << opacity
+         << "\" specular=\"" << specular << "\" shininess=\"" << shininess << "\"/>\n";
+}
+
+// A texture + material pair for an appearance. Returns the material name. `field`: where the
+// scene sets it (for errors).
+std::string add_material(Xml& assets, const std::string& name, const Appearance& a, bool mesh,
+                         const std::string& source, const std::string& field) {
   const std::string tex = name + "_tex";
   bool textured = false;
   if (a.kind == Appearance::Kind::Checker) {
@@ -51,8 +71,8 @@ std::string add_material(Xml& assets, const std::string& name, const Appearance&
            << "\" width=\"256\" height=\"256\"/>\n";
     textured = true;
   } else if (a.kind == Appearance::Kind::Image) {
-    assets << "    <texture name=\"" << tex << "\" type=\"2d\" file=\"" << a.file
-           << "\"/>\n";
+    assets << "    <texture name=\"" << tex << "\" type=\"2d\" file=\""
+           << texture_file(a.file, source, field + ".file") << "\"/>\n";
     textured = true;
   }
   assets << "    <material name=\"" << name << "\"";
@@ -231,18 +251,32 @@ std::string build_mjcf(const Scene& scene) {
                      " pinhole image)");
 
   Xml assets, bodies;
-  add_material(assets, "table_mat", scene.table, false);
-  add_material(assets, "backdrop_mat", scene.background, false);
+  add_material(assets, "table_mat", scene.table, false, scene.source, "table");
+  add_material(assets, "backdrop_mat", scene.background, false, scene.source, "background");
 
   for (size_t i = 0; i < scene.objects.size(); ++i) {
     const ObjectSpec& spec = scene.objects[i];
-    const ObjectModel model = make_object(spec.kind);
+    const ObjectModel model = model_of(spec);
     const std::string id = "obj" + std::to_string(i);
-    add_material(assets, id + "_mat", spec.appearance, true);
+    const std::string field = "objects[" + std::to_string(i) + "]";
+    // A mesh's own texture follows the file's texture coordinates once; other pictures repeat.
+    double repeat = spec.appearance.repeat;
+    if (spec.kind == "mesh" && !spec.mesh.texture.empty()) {
+      add_picture_material(assets, id + "_mat", texture_file(spec.mesh.texture, scene.source, field + ".mesh.texture"),
+                           spec.appearance.specular, spec.appearance.shininess, spec.appearance.opacity);
+      repeat = 1.0;
+    } else {
+      add_material(assets, id + "_mat", spec.appearance, true, scene.source, field);
+    }
     std::vector<const Mesh*> parts;
     for (size_t k = 0; k < model.parts.size(); ++k) {
-      add_mesh(assets, id + "_part" + std::to_string(k), model.parts[k], spec.appearance.repeat);
+      add_mesh(assets, id + "_part" + std::to_string(k), model.parts[k], repeat);
       parts.push_back(&model.parts[k]);
+    }
+    if (!model.label.faces.empty()) {
+      add_picture_material(assets, id + "_label_mat", texture_file(spec.label.file, scene.source, field + ".label.file"),
+                           spec.label.specular, spec.label.shininess, 1.0);
+      add_mesh(assets, id + "_label", model.label, 1.0);
     }
     const double mass = spec.mass > 0 ? spec.mass : model.default_mass;
     const double friction = spec.friction > 0 ? spec.friction : model.default_friction;
@@ -264,6 +298,9 @@ std::string build_mjcf(const Scene& scene) {
              << "_part" << k << "\" material=\"" << id << "_mat\" contype=\"3\" conaffinity=\"7\""
              << " condim=\"3\" friction=\"" << friction << " 0.005 0.0001\"/>\n";
     }
+    if (!model.label.faces.empty())  // drawn only: no contacts, no mass (the body's inertial is explicit)
+      bodies << "      <geom name=\"" << id << "_label\" type=\"mesh\" mesh=\"" << id << "_label\" material=\""
+             << id << "_label_mat\" contype=\"0\" conaffinity=\"0\"/>\n";
     bodies << "    </body>\n";
   }
 

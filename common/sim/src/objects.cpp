@@ -130,6 +130,12 @@ ObjectModel from_profile(const std::string& kind, const std::vector<Vector2d>& p
 
 double ObjectModel::radius_at(double z) const {
   double r = 0;
+  if (profile.empty()) {  // a mesh object
+    for (const Mesh& part : parts)
+      for (const auto& v : part.vertices)
+        if (std::fabs(v.z() - z) <= 0.002) r = std::max(r, static_cast<double>(v.head<2>().norm()));
+    return r;
+  }
   for (size_t i = 0; i + 1 < profile.size(); ++i) {
     const Vector2d& a = profile[i];
     const Vector2d& b = profile[i + 1];
@@ -291,6 +297,103 @@ ObjectModel make_object(const std::string& kind, int segments) {
   std::string known;
   for (const auto& k : object_kinds()) known += (known.empty() ? "" : ", ") + k;
   throw std::invalid_argument("unknown object kind '" + kind + "' (known: " + known + ")");
+}
+
+std::pair<double, double> default_label_band(const std::string& kind) {
+  if (kind == "bottle") return {0.030, 0.120};
+  if (kind == "can") return {0.015, 0.105};
+  if (kind == "cup") return {0.025, 0.080};
+  if (kind == "mug") return {0.015, 0.085};
+  throw std::invalid_argument("a " + kind + " has no place for a label");
+}
+
+Mesh label_sleeve(const ObjectModel& model, double bottom, double top, int segments) {
+  if (!(bottom >= 0 && top > bottom + 1e-3 && top <= model.height))
+    throw std::invalid_argument("label band [" + std::to_string(bottom) + ", " + std::to_string(top) +
+                                "] m must lie within the object's height [0, " + std::to_string(model.height) + "]");
+  if (segments < 3) throw std::invalid_argument("label_sleeve: segments must be >= 3");
+  constexpr double kGap = 1e-4, kThickness = 3e-4;
+  const int rows = std::max(2, static_cast<int>(std::ceil((top - bottom) / 0.002)) + 1);
+  Mesh mesh;
+  // Two skins (outer = 0, inner = 1), each (rows) x (segments + 1) vertices; the seam is duplicated
+  // for the texture.
+  const int ring = segments + 1, skin = rows * ring;
+  for (int s = 0; s < 2; ++s) {
+    for (int i = 0; i < rows; ++i) {
+      const double z = top - (top - bottom) * i / (rows - 1);  // from the top down: v = 0 at the top
+      const double r = model.radius_at(z) + kGap + (s == 0 ? kThickness : 0.0);
+      for (int j = 0; j <= segments; ++j) {
+        const double phi = 2 * M_PI * j / segments;
+        mesh.vertices.emplace_back(static_cast<float>(r * std::cos(phi)), static_cast<float>(r * std::sin(phi)),
+                                   static_cast<float>(z));
+        mesh.texcoords.emplace_back(static_cast<float>(j) / segments, static_cast<float>(i) / (rows - 1));
+      }
+    }
+  }
+  auto at = [&](int s, int i, int j) { return s * skin + i * ring + j; };
+  for (int i = 0; i + 1 < rows; ++i)
+    for (int j = 0; j < segments; ++j) {
+      // Row i is above row i + 1. Outer skin faces out, inner skin faces in.
+      const int a = at(0, i + 1, j), b = at(0, i + 1, j + 1), c = at(0, i, j), d = at(0, i, j + 1);
+      mesh.faces.emplace_back(a, b, d);
+      mesh.faces.emplace_back(a, d, c);
+      const int e = at(1, i + 1, j), f = at(1, i + 1, j + 1), g = at(1, i, j), h = at(1, i, j + 1);
+      mesh.faces.emplace_back(e, h, f);
+      mesh.faces.emplace_back(e, g, h);
+    }
+  // Rims joining the skins: facing up at the top (row 0), down at the bottom (row rows - 1).
+  for (int j = 0; j < segments; ++j) {
+    const int o0 = at(0, 0, j), o1 = at(0, 0, j + 1), i0 = at(1, 0, j), i1 = at(1, 0, j + 1);
+    mesh.faces.emplace_back(o0, o1, i1);
+    mesh.faces.emplace_back(o0, i1, i0);
+    const int p0 = at(0, rows - 1, j), p1 = at(0, rows - 1, j + 1), k0 = at(1, rows - 1, j), k1 = at(1, rows - 1, j + 1);
+    mesh.faces.emplace_back(p0, k1, p1);
+    mesh.faces.emplace_back(p0, k0, k1);
+  }
+  return mesh;
+}
+
+ObjectModel mesh_object(const Mesh& file_mesh, double scale, const Eigen::Vector3d& rotation) {
+  if (!(scale > 0) || !std::isfinite(scale)) throw std::invalid_argument("mesh scale must be positive");
+  if (file_mesh.vertices.empty() || file_mesh.faces.empty()) throw std::invalid_argument("the mesh is empty");
+  const Eigen::Matrix3d turn = (Eigen::AngleAxisd(rotation.z(), Vector3d::UnitZ()) *
+                                Eigen::AngleAxisd(rotation.y(), Vector3d::UnitY()) *
+                                Eigen::AngleAxisd(rotation.x(), Vector3d::UnitX()))
+                                   .toRotationMatrix();
+  Mesh mesh = file_mesh;
+  Eigen::AlignedBox3d box;
+  for (auto& v : mesh.vertices) {
+    v = (turn * (scale * v.cast<double>())).cast<float>();
+    box.extend(v.cast<double>());
+  }
+  const Vector3d shift(-box.center().x(), -box.center().y(), -box.min().z());
+  for (auto& v : mesh.vertices) v += shift.cast<float>();
+  const Vector3d size = box.sizes();
+  if (size.minCoeff() < 1e-4)
+    throw std::invalid_argument("the scaled mesh is flat (bounding box " + std::to_string(size.x()) + " x " +
+                                std::to_string(size.y()) + " x " + std::to_string(size.z()) + " m)");
+  ObjectModel model;
+  model.kind = "mesh";
+  model.height = size.z();
+  for (const auto& v : mesh.vertices) {
+    const double r = v.head<2>().cast<double>().norm();
+    model.max_radius = std::max(model.max_radius, r);
+    if (v.z() <= 0.002f) model.base_radius = std::max(model.base_radius, r);
+  }
+  if (mesh.texcoords.size() == mesh.vertices.size()) {
+    for (auto& t : mesh.texcoords) t.y() = 1.0f - t.y();
+  } else {  // a cylindrical projection, as revolve()'s: u = angle / 2pi, v = height / circumference
+    mesh.texcoords.clear();
+    const double circumference = 2 * M_PI * std::max(model.max_radius, 1e-6);
+    for (const auto& v : mesh.vertices)
+      mesh.texcoords.emplace_back(static_cast<float>(std::atan2(v.y(), v.x()) / (2 * M_PI) + 0.5),
+                                  static_cast<float>(v.z() / circumference));
+  }
+  orient_outwards(mesh);
+  model.parts.push_back(std::move(mesh));
+  model.default_mass = 0.1;
+  model.default_friction = 0.5;
+  return model;
 }
 
 }  // namespace nudge::sim

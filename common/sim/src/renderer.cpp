@@ -28,7 +28,7 @@ struct Renderer::Impl {
 
   // Renders camera `camera_id` into `rgb` (bottom row first, as OpenGL reads).
   void draw(mjData* data, int camera_id, int width, int height, const RenderSpec* spec,
-            bool segment, int hidden_group) {
+            bool segment, int hidden_group, std::vector<float>* depth = nullptr) {
     if (camera_id < 0 || camera_id >= model->ncam)
       throw SimError("Renderer: no camera " + std::to_string(camera_id));
     make_current();
@@ -50,7 +50,8 @@ struct Renderer::Impl {
     const mjrRect viewport = {0, 0, width, height};
     mjr_render(viewport, &scene, &gl);
     rgb.resize(static_cast<size_t>(width) * height * 3);
-    mjr_readPixels(rgb.data(), nullptr, viewport, &gl);
+    if (depth) depth->resize(static_cast<size_t>(width) * height);
+    mjr_readPixels(rgb.data(), depth ? depth->data() : nullptr, viewport, &gl);
   }
 };
 
@@ -134,10 +135,24 @@ cv::Mat Renderer::colour(mjData_* data, int camera_id, const RenderSpec& spec, i
 }
 
 cv::Mat Renderer::labels(mjData_* data, int camera_id, const std::vector<unsigned char>& geom_label,
-                         int hidden_group, cv::Size size) {
+                         int hidden_group, cv::Size size, cv::Mat* depth) {
   size = checked(size);
   const int width = size.width, height = size.height;
-  impl_->draw(data, camera_id, width, height, nullptr, true, hidden_group);
+  std::vector<float> buffer;
+  impl_->draw(data, camera_id, width, height, nullptr, true, hidden_group, depth ? &buffer : nullptr);
+  if (depth) {
+    // OpenGL's depth buffer holds d in [0, 1] of MuJoCo's perspective projection; the distance
+    // along the optical axis is near / (1 - d (1 - near / far)).
+    const double extent = impl_->model->stat.extent;
+    const double near = impl_->model->vis.map.znear * extent, far = impl_->model->vis.map.zfar * extent;
+    depth->create(height, width, CV_32F);
+    for (int y = 0; y < height; ++y) {
+      const float* src = buffer.data() + static_cast<size_t>(height - 1 - y) * width;
+      float* dst = depth->ptr<float>(y);
+      for (int x = 0; x < width; ++x)
+        dst[x] = static_cast<float>(near / (1.0 - src[x] * (1.0 - near / far)));
+    }
+  }
   // With mjRND_IDCOLOR each pixel holds the drawn geom's segid + 1 (little-endian RGB).
   const mjvScene& scene = impl_->scene;
   std::vector<unsigned char> segid_label;

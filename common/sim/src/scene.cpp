@@ -3,7 +3,9 @@
 #include "nudge/robot/puma260.hpp"
 #include "nudge/robot/safety.hpp"
 
+#include "nudge/sim/mesh_file.hpp"
 #include "nudge/sim/objects.hpp"
+#include "nudge/sim/textures.hpp"
 
 #include <opencv2/core.hpp>
 
@@ -159,6 +161,8 @@ void read_appearance(MapReader& r, Appearance& a, const std::string& source, con
   a.opacity = r.number("opacity", a.opacity);
 }
 
+void check_picture(const std::string& file, const std::string& source, const std::string& field);
+
 void check_appearance(const Appearance& a, const std::string& source, const std::string& ctx) {
   for (int i = 0; i < 3; ++i) {
     if (!(a.colour[i] >= 0 && a.colour[i] <= 1)) fail(source, join(ctx, "colour"), "components must be in [0, 1]");
@@ -173,12 +177,80 @@ void check_appearance(const Appearance& a, const std::string& source, const std:
     if (a.file.empty()) fail(source, join(ctx, "file"), "type image needs a PNG file");
     if (a.file.find_first_of("\"<>&") != std::string::npos)
       fail(source, join(ctx, "file"), "'" + a.file + "': the characters \" < > & are not allowed");
-    const auto dot = a.file.find_last_of('.');
-    if (dot == std::string::npos || a.file.substr(dot) != ".png")
-      fail(source, join(ctx, "file"), "'" + a.file + "' must be a .png file");
-    std::ifstream in(a.file, std::ios::binary);
-    if (!in) fail(source, join(ctx, "file"), "cannot read '" + a.file + "'");
+    check_picture(a.file, source, join(ctx, "file"));
   }
+}
+
+void check_picture(const std::string& file, const std::string& source, const std::string& field) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) fail(source, field, "cannot read '" + file + "'");
+  if (!is_image_file(file)) fail(source, field, "'" + file + "' is not a picture (PNG or JPEG)");
+}
+
+// Checks a label or a mesh and builds the object's model, or fails naming the field.
+ObjectModel checked_model(const ObjectSpec& o, const std::string& src, const std::string& ctx) {
+  if (o.kind == "mesh") {
+    if (o.mesh.file.empty()) fail(src, join(ctx, "mesh.file"), "kind mesh needs a mesh file (.obj or .stl)");
+    std::ifstream in(o.mesh.file, std::ios::binary);
+    if (!in) fail(src, join(ctx, "mesh.file"), "cannot read '" + o.mesh.file + "'");
+    if (!(o.mesh.scale > 0 && o.mesh.scale <= 100)) fail(src, join(ctx, "mesh.scale"), "must be in (0, 100]");
+    if (!o.mesh.rotation.allFinite()) fail(src, join(ctx, "mesh.rotation_deg"), "must be finite");
+    if (!o.mesh.texture.empty()) check_picture(o.mesh.texture, src, join(ctx, "mesh.texture"));
+  } else {
+    if (!o.mesh.file.empty() || !o.mesh.texture.empty())
+      fail(src, join(ctx, "mesh"), "only objects of kind mesh take a mesh (this one is a " + o.kind + ")");
+  }
+  if (o.label.present()) {
+    if (o.kind == "mesh" || o.kind == "marker")
+      fail(src, join(ctx, "label"), "a " + o.kind + " takes no label (bottles, cans, cups and mugs do)");
+    check_picture(o.label.file, src, join(ctx, "label.file"));
+    if (!(o.label.specular >= 0 && o.label.specular <= 1)) fail(src, join(ctx, "label.specular"), "must be in [0, 1]");
+    if (!(o.label.shininess >= 0 && o.label.shininess <= 1)) fail(src, join(ctx, "label.shininess"), "must be in [0, 1]");
+  }
+  try {
+    return model_of(o, 8);
+  } catch (const MeshFileError& e) {
+    fail(src, join(ctx, "mesh.file"), std::string("the mesh does not load: ") + e.what());
+  } catch (const std::invalid_argument& e) {
+    fail(src, join(ctx, o.label.present() ? "label" : "mesh"), e.what());
+  }
+}
+
+// `label: picture.jpg`, or `label: { file: picture.jpg, bottom: 0.03, top: 0.12, specular: .., shininess: .. }`.
+void read_label(MapReader& r, LabelSpec& label, const std::string& source, const std::string& dir) {
+  if (!r.has("label")) return;
+  const cv::FileNode node = r.node("label");
+  const std::string ctx = join(r.ctx(), "label");
+  if (node.isString()) {
+    label.file = resolve(static_cast<std::string>(node), dir);
+    if (label.file.empty()) fail(source, ctx, "names no picture");
+    return;
+  }
+  MapReader l(node, source, ctx);
+  if (!l.has("file")) fail(source, join(ctx, "file"), "missing (a PNG or JPEG picture)");
+  label.file = resolve(l.string("file", ""), dir);
+  if (label.file.empty()) fail(source, join(ctx, "file"), "names no picture");
+  label.bottom = l.number("bottom", label.bottom);
+  label.top = l.number("top", label.top);
+  label.specular = l.number("specular", label.specular);
+  label.shininess = l.number("shininess", label.shininess);
+  l.finish();
+}
+
+// `mesh: { file: duck.obj, texture: duck.png, scale: 0.01, rotation_deg: [90, 0, 0] }`.
+void read_mesh(MapReader& r, MeshSpec& mesh, const std::string& source, const std::string& dir) {
+  if (!r.has("mesh")) return;
+  const std::string ctx = join(r.ctx(), "mesh");
+  MapReader m(r.node("mesh"), source, ctx);
+  if (!m.has("file")) fail(source, join(ctx, "file"), "missing (an .obj or .stl file)");
+  mesh.file = resolve(m.string("file", ""), dir);
+  mesh.texture = resolve(m.string("texture", ""), dir);
+  mesh.scale = m.number("scale", mesh.scale);
+  if (m.has("rotation_deg")) {
+    const auto v = m.numbers("rotation_deg", 3, 3);
+    mesh.rotation = Eigen::Vector3d(v[0], v[1], v[2]) * kDeg;
+  }
+  m.finish();
 }
 
 bool valid_name(const std::string& name) {
@@ -189,6 +261,19 @@ bool valid_name(const std::string& name) {
 }
 
 }  // namespace
+
+ObjectModel model_of(const ObjectSpec& spec, int segments) {
+  ObjectModel model = spec.kind == "mesh"
+                          ? mesh_object(read_mesh_file(spec.mesh.file), spec.mesh.scale, spec.mesh.rotation)
+                          : make_object(spec.kind, segments);
+  if (spec.label.present()) {
+    auto band = default_label_band(spec.kind);
+    if (spec.label.bottom >= 0) band.first = spec.label.bottom;
+    if (spec.label.top >= 0) band.second = spec.label.top;
+    model.label = label_sleeve(model, band.first, band.second, segments);
+  }
+  return model;
+}
 
 Scene default_scene() {
   Scene scene;
@@ -296,7 +381,7 @@ Scene load_scene(const std::string& path) {
       const std::string ctx = "objects[" + std::to_string(i) + "]";
       MapReader r(objects[static_cast<int>(i)], path, ctx);
       ObjectSpec obj;
-      if (!r.has("kind")) fail(path, join(ctx, "kind"), "missing (one of cup, mug, bottle, can, marker)");
+      if (!r.has("kind")) fail(path, join(ctx, "kind"), "missing (one of cup, mug, bottle, can, marker, mesh)");
       obj.kind = r.string("kind", "");
       obj.name = r.string("name", "");
       if (!r.has("position")) fail(path, join(ctx, "position"), "missing ([x, y] in metres)");
@@ -306,6 +391,8 @@ Scene load_scene(const std::string& path) {
       obj.mass = r.number("mass", 0.0);
       obj.friction = r.number("friction", 0.0);
       obj.fill = r.number("fill", 0.0);
+      read_label(r, obj.label, path, dir);
+      read_mesh(r, obj.mesh, path, dir);
       read_appearance(r, obj.appearance, path, dir);
       r.finish();
       scene.objects.push_back(obj);
@@ -322,13 +409,14 @@ void validate(const Scene& scene) {
   check_appearance(scene.background, src, "background");
   if (scene.objects.size() > 254) fail(src, "objects", "at most 254 objects (mask labels are 8-bit)");
   std::set<std::string> names;
+  std::vector<double> footprint;  // object index -> widest radius
   for (size_t i = 0; i < scene.objects.size(); ++i) {
     const ObjectSpec& o = scene.objects[i];
     const std::string ctx = "objects[" + std::to_string(i) + "]";
-    if (!is_object_kind(o.kind)) {
+    if (!is_object_kind(o.kind) && o.kind != "mesh") {
       std::string known;
       for (const auto& k : object_kinds()) known += (known.empty() ? "" : ", ") + k;
-      fail(src, join(ctx, "kind"), "unknown kind '" + o.kind + "' (known: " + known + ")");
+      fail(src, join(ctx, "kind"), "unknown kind '" + o.kind + "' (known: " + known + ", mesh)");
     }
     if (!o.name.empty()) {
       if (!valid_name(o.name)) fail(src, join(ctx, "name"), "'" + o.name + "': use letters, digits, _ and -");
@@ -347,6 +435,7 @@ void validate(const Scene& scene) {
     if (!(o.friction >= 0 && o.friction < 5)) fail(src, join(ctx, "friction"), "must be in [0, 5) (0 = default)");
     if (!(o.fill >= 0 && o.fill <= 1)) fail(src, join(ctx, "fill"), "must be in [0, 1]");
     check_appearance(o.appearance, src, ctx);
+    footprint.push_back(checked_model(o, src, ctx).max_radius);
   }
   // Objects must not start inside each other (footprints: widest radius; a mug's handle may
   // still touch a neighbour).
@@ -354,8 +443,7 @@ void validate(const Scene& scene) {
     for (size_t j = 0; j < i; ++j) {
       const ObjectSpec& a = scene.objects[i];
       const ObjectSpec& b = scene.objects[j];
-      const double gap = (a.position - b.position).norm() - make_object(a.kind, 8).max_radius -
-                         make_object(b.kind, 8).max_radius;
+      const double gap = (a.position - b.position).norm() - footprint[i] - footprint[j];
       if (gap < 0)
         fail(src, "objects[" + std::to_string(i) + "].position",
              "overlaps objects[" + std::to_string(j) + "] by " +
@@ -383,7 +471,7 @@ void validate(const Scene& scene) {
   if (arm.present) {
     for (size_t i = 0; i < scene.objects.size(); ++i) {
       const ObjectSpec& o = scene.objects[i];
-      if (o.position.norm() < robot::SafetyConfig{}.pedestal_radius + make_object(o.kind, 8).max_radius)
+      if (o.position.norm() < robot::SafetyConfig{}.pedestal_radius + footprint[i])
         fail(src, "objects[" + std::to_string(i) + "].position", "overlaps the arm's pedestal at the origin");
     }
   }

@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <random>
 
 namespace nudge::sim {
@@ -160,7 +161,7 @@ World::World(const Scene& input) : impl_(std::make_unique<Impl>()), scene_(input
     s.body.push_back(b);
     s.qpos_adr.push_back(s.model->jnt_qposadr[j]);
     s.qvel_adr.push_back(s.model->jnt_dofadr[j]);
-    s.height.push_back(make_object(scene_.objects[i].kind, 8).height);
+    s.height.push_back(model_of(scene_.objects[i], 8).height);
     for (int g = 0; g < s.model->ngeom; ++g)
       if (s.model->geom_bodyid[g] == b) s.geom_label[g] = static_cast<unsigned char>(i + 1);
   }
@@ -561,7 +562,48 @@ CameraModel World::snapshot_camera(int camera_index) const {
   return scaled(camera(camera_index), scene_.render.snapshot_scale);
 }
 
-cv::Mat World::draw(int camera_index, bool snapshot, bool labels) {
+cv::Mat World::render_surface(int camera_index, cv::Mat* mask) {
+  cv::Mat surface;
+  cv::Mat labels = draw(camera_index, false, true, &surface);
+  if (mask) *mask = labels;
+  return surface;
+}
+
+cv::Mat World::render_snapshot_surface(int camera_index, cv::Mat* mask) {
+  cv::Mat surface;
+  cv::Mat labels = draw(camera_index, true, true, &surface);
+  if (mask) *mask = labels;
+  return surface;
+}
+
+// Back-projects each labelled pixel of an ideal pinhole image (focal length and principal point of
+// `cam`'s K, centred in the image drawn) to the world, then into its object's frame.
+cv::Mat World::surface_points(const cv::Mat& labels, const cv::Mat& depth, const CameraModel& cam) const {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  cv::Mat points(labels.size(), CV_32FC3, cv::Scalar(nan, nan, nan));
+  const double fx = cam.lens.K(0, 0), fy = cam.lens.K(1, 1);
+  const double cx = 0.5 * (labels.cols - 1), cy = 0.5 * (labels.rows - 1);
+  std::vector<Eigen::Isometry3d> world_to_object(num_objects());
+  for (int i = 0; i < num_objects(); ++i) {
+    const ObjectState o = object(i);
+    world_to_object[i] = (Eigen::Translation3d(o.position) * o.orientation).inverse();
+  }
+  const Eigen::Matrix3d Rt = cam.R.transpose();
+  for (int v = 0; v < labels.rows; ++v) {
+    const unsigned char* label = labels.ptr<unsigned char>(v);
+    const float* z = depth.ptr<float>(v);
+    cv::Vec3f* out = points.ptr<cv::Vec3f>(v);
+    for (int u = 0; u < labels.cols; ++u) {
+      if (label[u] == 0 || label[u] > num_objects()) continue;
+      const Eigen::Vector3d in_camera(z[u] * (u - cx) / fx, z[u] * (v - cy) / fy, z[u]);
+      const Eigen::Vector3d p = world_to_object[label[u] - 1] * (Rt * (in_camera - cam.t));
+      out[u] = cv::Vec3f(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()));
+    }
+  }
+  return points;
+}
+
+cv::Mat World::draw(int camera_index, bool snapshot, bool labels, cv::Mat* surface) {
   if (camera_index < 0 || camera_index > 1)
     throw std::out_of_range("World::render: camera must be 0 (left) or 1 (right)");
   Impl& s = *impl_;
@@ -597,8 +639,10 @@ cv::Mat World::draw(int camera_index, bool snapshot, bool labels) {
   if (warp) s.model->cam_fovy[id] = warp->fovy_deg;
   cv::Mat image;
   try {
-    image = labels ? s.renderer->labels(s.data, id, s.geom_label, hidden, size)
+    cv::Mat depth;
+    image = labels ? s.renderer->labels(s.data, id, s.geom_label, hidden, size, surface ? &depth : nullptr)
                    : s.renderer->colour(s.data, id, scene_.render, hidden, size);
+    if (surface) *surface = surface_points(image, depth, cam);
   } catch (...) {
     s.model->cam_fovy[id] = fovy;
     throw;
@@ -609,6 +653,13 @@ cv::Mat World::draw(int camera_index, bool snapshot, bool labels) {
     cv::remap(image, warped, warp->map_x, warp->map_y,
               labels ? cv::INTER_NEAREST : cv::INTER_LINEAR, cv::BORDER_CONSTANT);
     image = warped;
+    if (surface) {
+      const double nan = std::numeric_limits<double>::quiet_NaN();
+      cv::Mat points;
+      cv::remap(*surface, points, warp->map_x, warp->map_y, cv::INTER_NEAREST, cv::BORDER_CONSTANT,
+                cv::Scalar(nan, nan, nan));
+      *surface = points;
+    }
   }
   if (!labels) add_sensor_noise(image, scene_.render.noise_sigma, s.noise_rng);
   return image;

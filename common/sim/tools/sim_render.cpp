@@ -3,6 +3,7 @@
 //   nudge-sim-render common/sim/scenes/three_objects.yaml --out /tmp/sim --steps 0
 #include "nudge/flags.hpp"
 #include "nudge/log.hpp"
+#include "nudge/sim/truth_images.hpp"
 #include "nudge/sim/world.hpp"
 #include "nudge/timing.hpp"
 
@@ -17,7 +18,7 @@ int main(int argc, char** argv) {
   std::string out = ".";
   double seconds = 0;
   int repeat = 5;
-  bool masks = false, axes = false, mjcf = false;
+  bool masks = false, axes = false, mjcf = false, surface = false;
   nudge::Flags flags("nudge-sim-render", "Render a scene's stereo pair to PNG files.");
   flags.set_positional("SCENE", "scene file (YAML)");
   flags.add_string("out", &out, "output directory (must exist)");
@@ -26,6 +27,8 @@ int main(int argc, char** argv) {
   flags.add_bool("masks", &masks, "also write the segmentation masks (object index + 1, scaled)");
   flags.add_bool("axes", &axes, "also write images with the ground-truth symmetry axes drawn");
   flags.add_bool("mjcf", &mjcf, "also write the generated MuJoCo model as world.xml");
+  flags.add_bool("surface", &surface,
+                 "also write each pixel's object-surface coordinates (16-bit PNG, nudge/sim/truth_images.hpp)");
   try {
     if (!flags.parse(argc, argv)) return 0;
     if (flags.positional().size() != 1) throw nudge::FlagError("expected one SCENE file");
@@ -63,6 +66,8 @@ int main(int argc, char** argv) {
         first.mask[c].convertTo(scaled, CV_8U, 255.0 / std::max(1, world.num_objects()));
         cv::imwrite(out + "/" + names[c] + "_mask.png", scaled);
       }
+      if (surface)
+        cv::imwrite(out + "/" + names[c] + "_surface.png", nudge::sim::encode_surface(world.render_surface(c)));
       if (axes) {
         cv::Mat drawn = first.colour[c].clone();
         for (int i = 0; i < world.num_objects(); ++i) {

@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace nudge::sim {
@@ -50,8 +51,13 @@ struct ObjectModel {
   // The space a liquid can fill, as a cylinder: radius, bottom and height (fill = 1).
   double liquid_radius = 0, liquid_bottom = 0, liquid_height = 0;
 
+  // Drawn only (no collision, no mass): a label wrapped round the body; empty without one.
+  Mesh label;
+
   // Outer radius of the body of revolution at height z (largest r where the profile crosses z;
   // handle excluded); 0 outside [0, height]. Where a pad at that height first touches the object.
+  // A mesh object (no profile): the largest horizontal distance of its vertices from the z axis
+  // within 2 mm of z.
   double radius_at(double z) const;
 };
 
@@ -62,6 +68,27 @@ bool is_object_kind(const std::string& kind);
 // Builds the model of a kind; throws std::invalid_argument for an unknown kind.
 // `segments`: number of facets around the axis.
 ObjectModel make_object(const std::string& kind, int segments = 48);
+
+// The band of the side a label covers by default: the straight wall of a bottle or a can, most
+// of a cup's or mug's side. (bottom, top) heights in metres; throws std::invalid_argument for a
+// kind without one (marker).
+std::pair<double, double> default_label_band(const std::string& kind);
+
+// A label wrapped once round a body of revolution over the heights [bottom, top]: a thin closed
+// sleeve (0.3 mm thick) standing 0.1 mm off the surface, following the profile. Texture
+// coordinates: u = angle / 2pi (the picture's width once round, its left edge at the object's +x
+// axis, running counter-clockwise seen from above, i.e. left to right seen from outside), v = 0 at
+// the top of the band and 1 at its bottom (the picture's top row up). Throws std::invalid_argument
+// when the band is empty or leaves [0, height].
+Mesh label_sleeve(const ObjectModel& model, double bottom, double top, int segments);
+
+// An object made of a mesh file's triangles (read_mesh_file(), mesh_file.hpp): scaled, turned by
+// the x-y-z Euler angles `rotation` (rad, about fixed axes, x first), then moved so that its lowest
+// point is on the table (z = 0) and its bounding box is centred on the z axis. Faces are turned
+// outwards. Texture coordinates: the file's (v flipped: OBJ's v = 0 is the picture's bottom row),
+// or, when it has none, a cylindrical projection about z like the library's objects'.
+// kind "mesh", default mass 0.1 kg. Throws std::invalid_argument for a bad scale or a flat result.
+ObjectModel mesh_object(const Mesh& file_mesh, double scale, const Eigen::Vector3d& rotation);
 
 // Turns a profile about the z axis. `profile` goes from a point on the axis (r = 0) along the
 // object's surface to another point on the axis (e.g. bottom centre, out, up the wall, in, top

@@ -31,8 +31,9 @@ class Renderer {
   cv::Mat colour(mjData_* data, int camera_id, const RenderSpec& spec, int hidden_group = -1,
                  cv::Size size = cv::Size());
   // Segmentation: each pixel gets geom_label[id of the model geom seen there] (0 for none).
+  // `depth` (if not null): CV_32F, each pixel's distance along the optical axis, metres.
   cv::Mat labels(mjData_* data, int camera_id, const std::vector<unsigned char>& geom_label,
-                 int hidden_group = -1, cv::Size size = cv::Size());
+                 int hidden_group = -1, cv::Size size = cv::Size(), cv::Mat* depth = nullptr);
 
  private:
   cv::Size checked(cv::Size size) const;

@@ -9,6 +9,7 @@
 #include <Eigen/Core>
 
 #include "nudge/robot/workspace.hpp"
+#include "nudge/sim/objects.hpp"
 
 #include <array>
 #include <cmath>
@@ -35,7 +36,7 @@ struct Appearance {
   Kind kind = Kind::Plain;
   Eigen::Vector3d colour{0.8, 0.8, 0.8};   // RGB in [0, 1]
   Eigen::Vector3d colour2{0.3, 0.3, 0.3};  // second colour of a checker
-  std::string file;                        // PNG for Kind::Image (absolute, or relative to the scene file)
+  std::string file;                        // PNG or JPEG for Kind::Image (absolute, or relative to the scene file)
   double repeat = 4.0;                     // texture repetitions across the surface
   double specular = 0.3;
   double shininess = 0.3;
@@ -43,15 +44,35 @@ struct Appearance {
   double opacity = 1.0;                    // 1 = opaque; less: transparent (glass, clear plastic)
 };
 
+// A picture wrapped once round a body of revolution (bottle, can, cup, mug) over a band of its
+// side, like a drink bottle's label. Drawn only: it changes neither collisions nor mass.
+struct LabelSpec {
+  std::string file;      // PNG or JPEG (anything OpenCV reads); empty = no label
+  double bottom = -1.0;  // m above the base; < 0: the kind's default band (default_label_band())
+  double top = -1.0;
+  double specular = 0.3, shininess = 0.3;
+  bool present() const { return !file.empty(); }
+};
+
+// An object of kind "mesh": the triangles of a user's OBJ or STL file.
+struct MeshSpec {
+  std::string file;                                 // .obj or .stl (absolute, or relative to the scene file)
+  std::string texture;                              // optional picture mapped by the OBJ's texture coordinates
+  double scale = 1.0;                               // file units to metres (e.g. 0.001 for millimetres)
+  Eigen::Vector3d rotation = Eigen::Vector3d::Zero();  // x-y-z Euler angles, rad (e.g. a Y-up file: x = 90 deg)
+};
+
 struct ObjectSpec {
   std::string name;                // unique; defaults to "<kind><index>"
-  std::string kind;                // a kind of the object library: cup, mug, bottle, can, marker
+  std::string kind;                // a kind of the object library: cup, mug, bottle, can, marker; or mesh
   Eigen::Vector2d position{0.25, 0.0};  // of the base centre on the table, world x y
   double yaw = 0.0;                // about the world z axis (turns a mug's handle)
   Appearance appearance;
   double mass = 0.0;               // kg; 0 = the library's default for the kind
   double friction = 0.0;           // sliding friction; 0 = the library's default
   double fill = 0.0;               // fraction of the liquid space filled with water (rigid: no sloshing)
+  LabelSpec label;                 // bodies of revolution only
+  MeshSpec mesh;                   // kind "mesh" only
 };
 
 // A verged stereo pair (thesis ch. 4.3). The rig's centre looks at `target` from `distance`,
@@ -117,6 +138,12 @@ struct Scene {
   PhysicsSpec physics;
   ArmSpec arm;
 };
+
+// The model of a scene object: the object library's kind (make_object()), or a mesh file's
+// triangles (kind "mesh"), with its label's sleeve if it has one. Throws std::invalid_argument or
+// MeshFileError (mesh_file.hpp) with the reason; validate() turns those into SceneErrors naming
+// the field.
+ObjectModel model_of(const ObjectSpec& spec, int segments = 48);
 
 // Defaults for the table and backdrop: light wood-coloured table, plain off-white wall.
 Scene default_scene();

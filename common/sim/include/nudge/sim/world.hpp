@@ -155,10 +155,18 @@ class World {
   cv::Mat render_snapshot(int camera);
   cv::Mat render_snapshot_mask(int camera);
   CameraModel snapshot_camera(int camera) const;
+  // Which surface point of which object each pixel shows (ground truth for feature matches: two
+  // pixels show the same point of an object when their coordinates agree). CV_32FC3: the point in
+  // that object's own frame (metres; origin at its base centre, z up its axis), NaN where no
+  // object is seen. From a label pass's depth buffer, so exact to about a pixel's footprint.
+  // `mask` (if not null) gets the render_mask() of the same pass.
+  cv::Mat render_surface(int camera, cv::Mat* mask = nullptr);
+  cv::Mat render_snapshot_surface(int camera, cv::Mat* mask = nullptr);
   bool pusher_visible = true;       // draw the pusher pad / gripper (colour images and masks)
 
  private:
-  cv::Mat draw(int camera, bool snapshot, bool labels);
+  cv::Mat draw(int camera, bool snapshot, bool labels, cv::Mat* surface = nullptr);
+  cv::Mat surface_points(const cv::Mat& labels, const cv::Mat& depth, const CameraModel& cam) const;
   void use_gripper(bool gripper);
   struct Impl;
   std::unique_ptr<Impl> impl_;
