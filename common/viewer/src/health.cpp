@@ -7,13 +7,14 @@ void HealthTable::observe(const Heartbeat& heartbeat) {
   Entry& entry = services_[name];
   // A restarted process (new pid) or a log played again (time going back) starts its rates afresh.
   const bool continues = !entry.last.service.empty() && entry.last.pid == heartbeat.pid &&
+                         entry.last.log_time == heartbeat.log_time &&
                          heartbeat.seen_utime > entry.last.seen_utime;
   entry.has_previous = continues;
   if (continues) entry.previous = entry.last;
   entry.last = heartbeat;
 }
 
-std::vector<HealthRow> HealthTable::rows(int64_t now_utime) const {
+std::vector<HealthRow> HealthTable::rows(const HealthClock& now) const {
   std::vector<HealthRow> rows;
   for (const auto& [name, entry] : services_) {
     HealthRow row;
@@ -22,6 +23,7 @@ std::vector<HealthRow> HealthTable::rows(int64_t now_utime) const {
     row.state = entry.last.state;
     row.errors = entry.last.errors;
     row.status = entry.last.status;
+    const int64_t now_utime = entry.last.log_time ? now.log_utime : now.wall_utime;
     row.last_seen_s = (now_utime - entry.last.seen_utime) * 1e-6;
     row.alive = row.last_seen_s <= dead_after_s_;
     if (entry.has_previous) {

@@ -115,7 +115,12 @@ void ViewModel::observe_state(const StateEntry& state) {
 
 void ViewModel::observe_heartbeat(Heartbeat heartbeat, int64_t sender_utime, int64_t receive_utime) {
   std::lock_guard<std::mutex> lock(mutex_);
-  heartbeat.seen_utime = replaying() ? sender_utime : receive_utime;
+  // A heartbeat stamped within the replayed log's span came from the log; any other (the viewer's
+  // own, a live service's) is judged live.
+  constexpr int64_t kMargin = 10'000'000;
+  heartbeat.log_time = replaying() && sender_utime >= replay_.start_utime - kMargin &&
+                       sender_utime <= replay_.end_utime + kMargin;
+  heartbeat.seen_utime = heartbeat.log_time ? sender_utime : receive_utime;
   health_.observe(heartbeat);
 }
 
@@ -133,7 +138,6 @@ bool ViewModel::mask_png(size_t index, std::vector<uint8_t>* png) const {
 
 void ViewModel::set_replay(const ReplayStatus& status) {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (!replaying()) health_.clear();  // rows seen live were stamped on another clock
   replay_ = status;
 }
 
@@ -201,10 +205,9 @@ json ViewModel::to_json(int64_t now_wall) const {
   }
   out["segmentations"] = segmentations;
 
-  // Live, health is judged on the wall clock; on a log, at the replay's position in log time.
-  const int64_t health_now = replaying() ? replay_.position_utime : now_wall;
+  // Live, health is judged on the wall clock; a log's heartbeats at the replay's position.
   json health = json::array();
-  for (const HealthRow& row : health_.rows(health_now))
+  for (const HealthRow& row : health_.rows({now_wall, replay_.position_utime}))
     health.push_back({{"name", row.name},
                       {"pid", row.pid},
                       {"state", row.state},

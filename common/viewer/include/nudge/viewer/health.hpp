@@ -10,7 +10,8 @@
 
 namespace nudge::viewer {
 
-// One heartbeat, as received. seen_utime is on the clock the caller also passes to rows().
+// One heartbeat, as received. seen_utime is on the wall clock, or on the log's clock for a
+// heartbeat played from a log (log_time): rows() judges each against the matching "now".
 struct Heartbeat {
   std::string service, instance;
   int pid = 0;
@@ -18,6 +19,12 @@ struct Heartbeat {
   int64_t messages_in = 0, messages_out = 0, errors = 0;
   std::string status;
   int64_t seen_utime = 0;
+  bool log_time = false;
+};
+
+// "Now" on both clocks: the wall clock, and the replayed log's position (0 when none).
+struct HealthClock {
+  int64_t wall_utime = 0, log_utime = 0;
 };
 
 struct HealthRow {
@@ -37,8 +44,7 @@ class HealthTable {
   explicit HealthTable(double dead_after_s = 2.5) : dead_after_s_(dead_after_s) {}
   void observe(const Heartbeat& heartbeat);
   // One row per service ever seen, in name order.
-  std::vector<HealthRow> rows(int64_t now_utime) const;
-  void clear() { services_.clear(); }
+  std::vector<HealthRow> rows(const HealthClock& now) const;
 
  private:
   struct Entry {

@@ -23,7 +23,6 @@ class StateTimeline {
   // Returns whether the entry was a transition (appended).
   bool observe(const StateEntry& entry);
   const std::deque<StateEntry>& entries() const { return entries_; }
-  void clear() { entries_.clear(); }
 
  private:
   size_t max_entries_;
