@@ -13,6 +13,7 @@ NUDGE_PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libmujoco-dev libosmesa6-dev
   iproute2 util-linux procps opencv-doc
+  libcpp-httplib-dev nlohmann-json3-dev chromium
 )
 
 nudge_log() { printf '\033[1m[nudge]\033[0m %s\n' "$*" >&2; }
@@ -84,6 +85,11 @@ nudge_run_loop() {
   "$bin/nudge-triangulation" --lcm-url "$url" --calibration "$calibration" --workspace "$workspace" \
     2>"$logs/triangulation.log" & pids+=($!)
   "$bin/nudge-arm" --lcm-url "$url" --backend sim --clock sim --workspace "$workspace" 2>"$logs/arm.log" & pids+=($!)
+  # NUDGE_VIEWER=PORT: the operator's page on http://127.0.0.1:PORT/ (docs/operator.md; reachable
+  # from this host's browser with NUDGE_HOST_NETWORK=1).
+  if [ -n "${NUDGE_VIEWER:-}" ]; then
+    "$bin/nudge-viewer" --lcm-url "$url" --port "$NUDGE_VIEWER" 2>"$logs/viewer.log" & pids+=($!)
+  fi
   # Every subscriber listens before the world's first state (the camera builds its scene first).
   for _ in $(seq 300); do
     [ "$(grep -l "started:" "$logs"/{symmetry,camera,triangulation,arm}.log 2>/dev/null | wc -l)" -eq 4 ] && break
