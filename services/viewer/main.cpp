@@ -9,6 +9,7 @@
 //       GET /api/state        everything but images, as JSON (viewer::ViewModel::to_json)
 //       GET /api/frame/NAME?after=SEQ[&wait=MS]   the camera's next JPEG (waits up to 1 s; 204 if none)
 //       GET /api/mask/I       the I-th segmentation mask (PNG)
+// It also shows the processes nudge-launch runs (PROCESS_STATUS).
 //       POST /api/replay?command=play|pause|step|speed[&speed=X]
 #include <httplib.h>
 
@@ -26,6 +27,7 @@
 #include "nudge/heartbeat_t.hpp"
 #include "nudge/image_t.hpp"
 #include "nudge/log.hpp"
+#include "nudge/process_status_t.hpp"
 #include "nudge/replay_command_t.hpp"
 #include "nudge/replay_status_t.hpp"
 #include "nudge/segmentation_t.hpp"
@@ -78,6 +80,17 @@ std::string heartbeat_state_name(int8_t state) {
     case heartbeat_t::STATE_RUNNING: return "running";
     case heartbeat_t::STATE_DEGRADED: return "degraded";
     case heartbeat_t::STATE_STOPPING: return "stopping";
+  }
+  return "state " + std::to_string(state);
+}
+
+std::string process_state_name(int8_t state) {
+  switch (state) {
+    case process_info_t::STATE_RUNNING: return "running";
+    case process_info_t::STATE_BACKOFF: return "restarting";
+    case process_info_t::STATE_EXITED: return "exited";
+    case process_info_t::STATE_STOPPING: return "stopping";
+    case process_info_t::STATE_STOPPED: return "stopped";
   }
   return "state " + std::to_string(state);
 }
@@ -231,6 +244,22 @@ void subscribe_health(bus::Service& service, viewer::ViewModel& model) {
     status.total_events = msg.total_events;
     status.received_wall_utime = wall_utime();
     model.set_replay(status);
+  });
+  subs.subscribe<process_status_t>(channel::PROCESS_STATUS, [&model](const process_status_t& msg, const std::string&) {
+    std::vector<viewer::ProcessRow> rows;
+    for (const process_info_t& p : msg.processes) {
+      viewer::ProcessRow row;
+      row.name = p.name;
+      row.state = process_state_name(p.state);
+      row.log = p.log;
+      row.pid = p.pid;
+      row.restarts = p.restarts;
+      row.last_exit_code = p.last_exit_code;
+      row.uptime_s = p.uptime_s;
+      row.restart_in_s = p.restart_in_s;
+      rows.push_back(row);
+    }
+    model.set_processes(std::move(rows));
   });
 }
 

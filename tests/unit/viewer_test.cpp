@@ -198,6 +198,11 @@ TEST(ViewModel, JsonCarriesOverlaysTableTimelineMasksAndHealth) {
   seg.png = {1, 2, 3};
   model.add_segmentation(seg);
   model.observe_heartbeat(beat("camera", 0, 0), 123, 10 * kSecond);
+  ProcessRow process;
+  process.name = "symmetry";
+  process.state = "restarting";
+  process.restarts = 2;
+  model.set_processes({process});
   const auto j = model.to_json(11 * kSecond);
   EXPECT_EQ(j["mode"], "live");
   EXPECT_EQ(j["cameras"]["right"]["lines"].size(), 2u);
@@ -213,6 +218,8 @@ TEST(ViewModel, JsonCarriesOverlaysTableTimelineMasksAndHealth) {
   EXPECT_FALSE(model.mask_png(1, &png));
   EXPECT_DOUBLE_EQ(j["health"][0]["last_seen_s"].get<double>(), 1.0) << "live: judged by the arrival time";
   EXPECT_TRUE(j["replay"].is_null());
+  EXPECT_EQ(j["processes"][0]["state"], "restarting");
+  EXPECT_EQ(j["processes"][0]["restarts"], 2);
 }
 
 TEST(ViewModel, OnAReplayTheLogsHeartbeatsGoByLogTimeAndLiveOnesByArrival) {

@@ -141,6 +141,11 @@ void ViewModel::set_replay(const ReplayStatus& status) {
   replay_ = status;
 }
 
+void ViewModel::set_processes(std::vector<ProcessRow> processes) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  processes_ = std::move(processes);
+}
+
 json ViewModel::to_json(int64_t now_wall) const {
   std::lock_guard<std::mutex> lock(mutex_);
   json out;
@@ -219,6 +224,18 @@ json ViewModel::to_json(int64_t now_wall) const {
                       {"alive", row.alive},
                       {"status", row.status}});
   out["health"] = health;
+
+  json processes = json::array();
+  for (const ProcessRow& p : processes_)
+    processes.push_back({{"name", p.name},
+                         {"state", p.state},
+                         {"pid", p.pid},
+                         {"restarts", p.restarts},
+                         {"last_exit_code", p.last_exit_code},
+                         {"uptime_s", p.uptime_s},
+                         {"restart_in_s", p.restart_in_s},
+                         {"log", p.log}});
+  out["processes"] = processes;
 
   if (replaying()) {
     out["replay"] = {{"log", replay_.log},

@@ -62,6 +62,9 @@ inline constexpr const char* RECOGNITION = "RECOGNITION";              // recogn
 inline constexpr const char* REPLAY_COMMAND = "REPLAY_COMMAND";  // replay_command_t
 inline constexpr const char* REPLAY_STATUS = "REPLAY_STATUS";    // replay_status_t
 
+// The set of processes nudge-launch runs.
+inline constexpr const char* PROCESS_STATUS = "PROCESS_STATUS";  // process_status_t
+
 // The channel of kind `kind` (SYMMETRY, CONTOURS, TRACK) that results from a camera channel:
 // CAMERA_LEFT -> SYMMETRY_LEFT, CAMERA -> SYMMETRY; a channel not named CAMERA... keeps its
 // name behind the kind, so that two inputs never share an output: LEFT_EYE -> SYMMETRY_LEFT_EYE.

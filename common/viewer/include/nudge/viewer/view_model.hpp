@@ -64,6 +64,13 @@ struct ReplayStatus {
   int64_t received_wall_utime = 0;
 };
 
+// One process of the set nudge-launch runs (PROCESS_STATUS).
+struct ProcessRow {
+  std::string name, state, log;
+  int pid = 0, restarts = 0, last_exit_code = -1;
+  double uptime_s = 0, restart_in_s = 0;
+};
+
 struct JpegFrame {
   int64_t seq = 0, utime = 0;
   int width = 0, height = 0;
@@ -93,6 +100,7 @@ class ViewModel {
   void add_segmentation(Segmentation segmentation);
   bool mask_png(size_t index, std::vector<uint8_t>* png) const;
   void set_replay(const ReplayStatus& status);
+  void set_processes(std::vector<ProcessRow> processes);
 
   // Everything the page draws, as of wall time `now_wall`.
   nlohmann::json to_json(int64_t now_wall) const;
@@ -123,6 +131,7 @@ class ViewModel {
   HealthTable health_;
   std::vector<Segmentation> segmentations_;
   ReplayStatus replay_;
+  std::vector<ProcessRow> processes_;
 };
 
 }  // namespace nudge::viewer
