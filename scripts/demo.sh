@@ -5,7 +5,7 @@
 # (candidates), the arm service, and the supervisor, which surveys, nudges each object, watches it
 # move, cuts it out of the stills and goes on until nothing is left, printing every state change.
 # It leaves in out/runs/<run>/ the run's LCM log, summary.json and per attempt the stills, the mask,
-# the cut-out, the fig. 6.6 picture and the fig. 6.7 stages.
+# the cut-out, the fig. 6.6 picture and the fig. 6.7 stages, and report.html (nudge-report).
 #   scripts/demo.sh                       # the loop (NUDGE_DEMO_SCENE, default arm_three_objects.yaml)
 #   scripts/demo.sh perception            # perception only: world -> camera -> symmetry -> monitor
 #   scripts/demo.sh 'images:/data/left/*.png' 'images:/data/right/*.png'   # recorded stereo data
@@ -102,6 +102,7 @@ if [ $# -eq 0 ]; then
   if [ -f "$dir/summary.json" ]; then
     nudge_log "run $run: $(grep -o '"segmented":[0-9]*' "$dir/summary.json" | head -1 | cut -d: -f2) objects segmented in $(grep -o '"attempts":[0-9]*' "$dir/summary.json" | head -1 | cut -d: -f2) nudges"
     nudge_log "files: $dir/ (LCM log $run.lcmlog, summary.json, attempt_NN/ with before/after stills, mask, cutout, workspace.png, stages/)"
+    "$NUDGE_BUILD_DIR/bin/nudge-report" "$dir" >/dev/null && nudge_log "report: $dir/report.html (opens in a browser, docs/operator.md)"
     nudge_log "replay the decisions: build/bin/nudge-supervisor --lcm-in 'file://$dir/$run.lcmlog?speed=0' --lcm-out 'file:///tmp/replay.lcmlog?mode=w' --calibration config/calibration_sim.yaml --first-seq $(grep -o '"first_command_seq":[0-9]*' "$dir/summary.json" | cut -d: -f2)"
   fi
   exit $status

@@ -13,6 +13,7 @@ NUDGE_PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libmujoco-dev libosmesa6-dev
   iproute2 util-linux procps opencv-doc
+  libcpp-httplib-dev nlohmann-json3-dev chromium
 )
 
 nudge_log() { printf '\033[1m[nudge]\033[0m %s\n' "$*" >&2; }
@@ -77,13 +78,26 @@ nudge_run_loop() {
   local logs="$out/$run/services"
   mkdir -p "$logs"
   local pids=()
-  "$bin/nudge-symmetry" --lcm-url "$url" --lines 5 --theta-min -25 --theta-max 25 --once-per-row \
-    --mirror-tolerance 15 2>"$logs/symmetry.log" & pids+=($!)
-  "$bin/nudge-camera" --lcm-url "$url" --source sim --scene "$scene" --snapshots --snapshot-format png \
-    2>"$logs/camera.log" & pids+=($!)
-  "$bin/nudge-triangulation" --lcm-url "$url" --calibration "$calibration" --workspace "$workspace" \
-    2>"$logs/triangulation.log" & pids+=($!)
-  "$bin/nudge-arm" --lcm-url "$url" --backend sim --clock sim --workspace "$workspace" 2>"$logs/arm.log" & pids+=($!)
+  # The services run under nudge-launch (docs/operator.md): a log each in $logs, restarted with
+  # back-off if one crashes, all stopped together (SIGINT, then SIGKILL), their status on
+  # PROCESS_STATUS. NUDGE_VIEWER=PORT adds the operator's page on http://127.0.0.1:PORT/ (reachable
+  # from this host's browser with NUDGE_HOST_NETWORK=1).
+  local viewer=
+  [ -n "${NUDGE_VIEWER:-}" ] && viewer=",
+    {\"name\": \"viewer\", \"command\": [\"$bin/nudge-viewer\", \"--port\", \"$NUDGE_VIEWER\"]}"
+  cat >"$logs/launch.json" <<EOF
+{"lcm_url": "$url", "log_dir": "$logs", "backoff": {"initial_s": 1, "max_s": 10},
+ "processes": [
+    {"name": "symmetry", "command": ["$bin/nudge-symmetry", "--lines", "5", "--theta-min", "-25", "--theta-max", "25",
+                                     "--once-per-row", "--mirror-tolerance", "15"]},
+    {"name": "camera", "command": ["$bin/nudge-camera", "--source", "sim", "--scene", "$scene", "--snapshots",
+                                   "--snapshot-format", "png"]},
+    {"name": "triangulation", "command": ["$bin/nudge-triangulation", "--calibration", "$calibration",
+                                          "--workspace", "$workspace"]},
+    {"name": "arm", "command": ["$bin/nudge-arm", "--backend", "sim", "--clock", "sim", "--workspace", "$workspace"]}$viewer
+ ]}
+EOF
+  "$bin/nudge-launch" "$logs/launch.json" 2>"$logs/launch.log" & pids+=($!)
   # Every subscriber listens before the world's first state (the camera builds its scene first).
   for _ in $(seq 300); do
     [ "$(grep -l "started:" "$logs"/{symmetry,camera,triangulation,arm}.log 2>/dev/null | wc -l)" -eq 4 ] && break

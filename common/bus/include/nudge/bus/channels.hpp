@@ -58,6 +58,13 @@ inline constexpr const char* LEARNED = "LEARNED";                      // learn_
 inline constexpr const char* RECOGNIZE_REQUEST = "RECOGNIZE_REQUEST";  // recognize_request_t
 inline constexpr const char* RECOGNITION = "RECOGNITION";              // recognition_t
 
+// A replayed log under the operator's control (nudge-replay; nudge-viewer sends the commands).
+inline constexpr const char* REPLAY_COMMAND = "REPLAY_COMMAND";  // replay_command_t
+inline constexpr const char* REPLAY_STATUS = "REPLAY_STATUS";    // replay_status_t
+
+// The set of processes nudge-launch runs.
+inline constexpr const char* PROCESS_STATUS = "PROCESS_STATUS";  // process_status_t
+
 // The channel of kind `kind` (SYMMETRY, CONTOURS, TRACK) that results from a camera channel:
 // CAMERA_LEFT -> SYMMETRY_LEFT, CAMERA -> SYMMETRY; a channel not named CAMERA... keeps its
 // name behind the kind, so that two inputs never share an output: LEFT_EYE -> SYMMETRY_LEFT_EYE.

@@ -1,0 +1,20 @@
+#pragma once
+// A run's report (out/runs/<run>/report.html): one HTML file that opens in a browser with no
+// server (images by relative path). It shows the run's figures from summary.json (attempts,
+// outcomes, times per attempt), the timeline of the supervisor's states, and per attempt its
+// stills, mask and cut-out, the fig. 6.6 picture, the fig. 6.7 stages, the tracking plot (θ of
+// each tracker over time, from attempt.json's track_trace) and any other pictures the attempt's
+// folder holds (learned views, recognition matches). nudge-report is its shell.
+#include <string>
+#include <vector>
+
+#include "nudge/viewer/timeline.hpp"
+
+namespace nudge::viewer {
+
+// Reads RUN_DIR (summary.json, attempt_NN/) and renders the report; `states` are the supervisor's
+// transitions (from the run's log). Throws std::runtime_error naming the file when summary.json
+// is missing or not JSON.
+std::string render_run_report(const std::string& run_dir, const std::vector<StateEntry>& states);
+
+}  // namespace nudge::viewer
