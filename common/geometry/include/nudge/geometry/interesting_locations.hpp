@@ -69,10 +69,10 @@ struct LocationParams {
   // a left and a right line are one object's only if the heights their support segments cover
   // on the triangulated axis agree (overlap / union >= min_height_overlap) and start on the table
   // (the lower end within max_foot_height_m of it); each line then pairs at most once per frame,
-  // the most consistent pairing first.
+  // the most consistent pairing first. Values chosen on the busy-table family (docs/clutter.md).
   bool stereo_check = false;
-  double min_height_overlap = 0.5;
-  double max_foot_height_m = 0.05;
+  double min_height_overlap = 0.3;
+  double max_foot_height_m = 0.08;
 };
 
 // Throws std::invalid_argument naming the offending parameter.

@@ -17,13 +17,14 @@
 
 namespace nudge::symmetry {
 
+// Defaults: chosen on the development family of busy tables (docs/clutter.md).
 struct VerifyParams {
-  int keep = 5;                  // lines returned, best score first
-  double band_gap_px = 12;       // pairs further apart along the line start a new band
-  double colour_tolerance = 40;  // L1 BGR difference (0-765) below which mirrored samples agree
+  int keep = 8;                  // lines returned, best score first
+  double band_gap_px = 8;        // pairs further apart along the line start a new band
+  double colour_tolerance = 90;  // L1 BGR difference (0-765) below which mirrored samples agree
   double min_appearance = 0.0;   // drop lines whose appearance agreement is below this (0-1)
   // score = votes x band share ^ band_weight x appearance ^ appearance_weight
-  double band_weight = 1;
+  double band_weight = 0.5;
   double appearance_weight = 1;
   // A line this close to a better one (both in R and in theta) is the same peak again: dropped.
   double suppress_px = 4, suppress_deg = 3;
