@@ -32,6 +32,8 @@ int main(int argc, char** argv) {
     f.add_double("mirror-tolerance", &params.mirror_tolerance_deg,
                  "pairs vote only if their edge orientations mirror about the axis within DEG (0: off)");
     f.add_int("threads", &params.threads, "threads across angles");
+    f.add_int("suppress-r", &params.suppress_r, "non-maximum suppression half-size in R, px");
+    f.add_int("suppress-theta", &params.suppress_theta, "non-maximum suppression half-size in theta, degrees");
     int verify = 0;
     f.add_int("verify", &verify, "busy tables: verify the --lines peaks (local support, mirrored colour) and publish the best N; 0: off");
     f.add_double("appearance-tolerance", &options.verify_params.colour_tolerance,
