@@ -41,7 +41,7 @@ contours_t contours_message(const symmetry::EdgeSet& edges, const std::vector<sy
 // Mirror-tolerant voting needs the edges' gradient orientations.
 symmetry::EdgeParams edge_params_for(const Options& options) {
   symmetry::EdgeParams edge = options.edge;
-  edge.gradients = options.params.mirror_tolerance_deg > 0;
+  edge.gradients = options.params.mirror_tolerance_deg > 0 || edge.gradients;
   return edge;
 }
 
@@ -75,6 +75,11 @@ void Handlers::on_image(const image_t& msg, const std::string& out, const std::s
   const double edges_ms = watch.elapsed_ms();
   symmetry::Result result = detector_.detect(edges);
   result.ms.edges_ms = edges_ms;
+  if (options_.verify) {  // part of finding the peaks
+    Stopwatch verify_watch;
+    result.lines = symmetry::verify_lines(detector_, edges, image, result.lines, options_.verify_params);
+    result.ms.peaks_ms += verify_watch.elapsed_ms();
+  }
   service_.publish(out, bus::to_message(result, msg.utime, msg.frame_id, msg.camera));
   if (options_.contours > 0)
     service_.publish(contours_out, contours_message(edges, result.lines, options_.contours, segmenter_, msg));

@@ -9,6 +9,7 @@
 #include "nudge/image_t.hpp"
 #include "nudge/segmentation/segment.hpp"
 #include "nudge/symmetry/detector.hpp"
+#include "nudge/symmetry/verify.hpp"
 
 namespace nudge::symmetry_service {
 
@@ -17,6 +18,10 @@ struct Options {
   symmetry::EdgeParams edge;
   std::vector<std::string> inputs = {bus::channel::CAMERA_LEFT, bus::channel::CAMERA_RIGHT};
   int contours = 0;  // also segment the contours of the top N lines; 0: off
+  // Busy tables (issue 14, docs/clutter.md): verify the params.num_lines peaks (local support,
+  // mirrored colour) and publish the best verify.keep of them; off unless `verify` is set.
+  bool verify = false;
+  symmetry::VerifyParams verify_params;
 };
 
 // Subscribes the started `service` to every input channel: each image's symmetry lines go out on

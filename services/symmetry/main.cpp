@@ -32,13 +32,24 @@ int main(int argc, char** argv) {
     f.add_double("mirror-tolerance", &params.mirror_tolerance_deg,
                  "pairs vote only if their edge orientations mirror about the axis within DEG (0: off)");
     f.add_int("threads", &params.threads, "threads across angles");
+    f.add_int("suppress-r", &params.suppress_r, "non-maximum suppression half-size in R, px");
+    f.add_int("suppress-theta", &params.suppress_theta, "non-maximum suppression half-size in theta, degrees");
+    int verify = 0;
+    f.add_int("verify", &verify, "busy tables: verify the --lines peaks (local support, mirrored colour) and publish the best N; 0: off");
+    f.add_double("appearance-tolerance", &options.verify_params.colour_tolerance,
+                 "with --verify: L1 BGR difference under which mirrored colour samples agree");
+    f.add_bool("colour-edges", &edge.colour, "Canny on the colour image (the channel that changes most)");
     f.add_int("contours", &options.contours, "also segment the contours of the top N lines (CONTOURS_*); 0: off");
     if (!service.parse(argc, argv)) return 0;
+    if (verify < 0) throw FlagError("--verify must be >= 0");
+    options.verify = verify > 0;
+    options.verify_params.keep = verify;
     edge.canny_low = canny[0];
     edge.canny_high = canny[1];
     try {
       symmetry::validate(params);
       symmetry::validate(edge);
+      symmetry::validate(options.verify_params);
     } catch (const std::invalid_argument& e) {
       throw FlagError(e.what());
     }

@@ -192,6 +192,13 @@ void add_flags(Flags& f, Options& o) {
   f.add_double("candidate-tilt", &o.locations.max_tilt_deg, "CANDIDATES: max angle from the table normal, degrees");
   f.add_double("cluster-radius", &o.locations.qt.radius, "CANDIDATES: QT cluster radius, m");
   f.add_double("cluster-min-fraction", &o.locations.qt.min_fraction, "CANDIDATES: smallest cluster, fraction of all");
+  f.add_bool("stereo-check", &o.locations.stereo_check,
+             "CANDIDATES: pair a left and a right line only if their support segments cover the same heights "
+             "on the axis, from the table up; each line once per frame (busy tables, docs/clutter.md)");
+  f.add_double("min-height-overlap", &o.locations.min_height_overlap,
+               "CANDIDATES with --stereo-check: least overlap / union of the two lines' heights");
+  f.add_double("max-foot-height", &o.locations.max_foot_height_m,
+               "CANDIDATES with --stereo-check: lowest support end at most this far from the table, m");
 }
 
 void check(const Options& o) {

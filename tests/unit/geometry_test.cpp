@@ -11,6 +11,7 @@
 #include <random>
 #include <sstream>
 
+#include "nudge/geometry/interesting_locations.hpp"
 #include "nudge/geometry/plane.hpp"
 #include "nudge/geometry/qt_cluster.hpp"
 #include "nudge/geometry/stereo_rig.hpp"
@@ -526,4 +527,69 @@ TEST(GeometryRig, MissingOrBadFieldNamesFieldAndFile) {
   bad.R(0, 0) = 2;
   EXPECT_THROW(save_rig(bad, path), std::invalid_argument);
   std::filesystem::remove(path);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Stereo consistency of CANDIDATES (issue 14)
+
+TEST(GeometryStereoCheck, SupportHeightsSpanTheObject) {
+  const StereoRig rig = verged_rig(Lens::None);
+  const Table table;
+  const Plane plane = table_plane_in_right(rig, table);
+  const StereoAxis a = observe_axis(rig, table, -0.05, 0.6, 0.12);
+  const auto axis = triangulate_axis(rig, a.left, a.right);
+  ASSERT_TRUE(axis.ok()) << axis.reason();
+  const auto hit = check_axis(*axis, plane);
+  ASSERT_TRUE(hit.ok()) << hit.reason();
+  for (Side side : {Side::Left, Side::Right}) {
+    const auto h = support_heights(rig, side, side == Side::Left ? a.left : a.right, *axis, *hit, plane);
+    ASSERT_TRUE(h.ok()) << h.reason();
+    EXPECT_NEAR(h->low, 0.0, 0.005);
+    EXPECT_NEAR(h->high, 0.12, 0.005);
+  }
+}
+
+TEST(GeometryStereoCheck, KeepsEachObjectsOwnPairingAndDropsFloatingSupport) {
+  const StereoRig rig = verged_rig(Lens::None);
+  const Table table;
+  const Plane plane = table_plane_in_right(rig, table);
+  const StereoAxis a = observe_axis(rig, table, -0.06, 0.6, 0.10), b = observe_axis(rig, table, 0.05, 0.62, 0.22);
+  // The right image lists the objects the other way round: pairing by rank would mix them.
+  const std::vector<sym::Line> left = {a.left, b.left}, right = {b.right, a.right};
+  const PairingResult all = triangulate_pairings(rig, left, right, &plane);
+  LocationParams params;
+  params.stereo_check = true;
+  const std::vector<PairedAxis> kept = consistent_pairings(rig, left, right, all, plane, params);
+  ASSERT_EQ(kept.size(), 2u);
+  for (const PairedAxis& p : kept) {
+    EXPECT_EQ(p.left_index, 1 - p.right_index);  // a with a, b with b
+    const Eigen::Vector3d truth = p.left_index == 0 ? a.base : b.base;
+    EXPECT_LT((p.hit->point - truth).norm(), 0.01);
+  }
+  // Support that starts high above the table (a line through something standing on the objects,
+  // or between the tops of two of them) is no object standing on the table.
+  std::vector<sym::Line> high_left = left, high_right = right;
+  for (sym::Line* l : {&high_left[1], &high_right[0]}) l->seg1 = l->seg1 + 0.6 * (l->seg2 - l->seg1);
+  const std::vector<PairedAxis> only_a = consistent_pairings(
+      rig, high_left, high_right, triangulate_pairings(rig, high_left, high_right, &plane), plane, params);
+  ASSERT_EQ(only_a.size(), 1u);
+  EXPECT_EQ(only_a[0].left_index, 0);
+}
+
+TEST(GeometryStereoCheck, LocationFinderUsesItOnlyWhenAsked) {
+  const StereoRig rig = verged_rig(Lens::None);
+  const Table table;
+  const Plane plane = table_plane_in_right(rig, table);
+  const StereoAxis a = observe_axis(rig, table, -0.06, 0.6, 0.10), b = observe_axis(rig, table, 0.05, 0.62, 0.22);
+  LocationParams params;
+  params.frames = 1;
+  params.lines_per_image = 2;
+  LocationFinder thesis(rig, plane, std::nullopt, params);
+  const int every = thesis.add_frame({a.left, b.left}, {b.right, a.right});
+  params.stereo_check = true;
+  LocationFinder checked(rig, plane, std::nullopt, params);
+  EXPECT_EQ(checked.add_frame({a.left, b.left}, {b.right, a.right}), 2);
+  EXPECT_GE(every, 2);
+  params.min_height_overlap = 1.5;
+  EXPECT_THROW(LocationFinder(rig, plane, std::nullopt, params), std::invalid_argument);
 }

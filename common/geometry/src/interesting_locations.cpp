@@ -1,6 +1,8 @@
 #include "nudge/geometry/interesting_locations.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 
 namespace nudge::geometry {
@@ -92,6 +94,77 @@ void validate(const LocationParams& p) {
     throw std::invalid_argument("location parameters need 0 <= ring_inner_m < ring_outer_m");
   if (!(p.qt.radius > 0) || !(p.qt.min_fraction >= 0 && p.qt.min_fraction <= 1))
     throw std::invalid_argument("location QT parameters need radius > 0 and min_fraction in [0, 1]");
+  if (!(p.min_height_overlap >= 0 && p.min_height_overlap <= 1))
+    throw std::invalid_argument("location parameter min_height_overlap must be in [0, 1]");
+  if (!(p.max_foot_height_m > 0)) throw std::invalid_argument("location parameter max_foot_height_m must be > 0");
+}
+
+namespace {
+
+// Parameter along the axis (unit direction `u` through `p0`) of the point nearest the ray o + t d.
+std::optional<double> nearest_on_axis(const Eigen::Vector3d& p0, const Eigen::Vector3d& u, const Eigen::Vector3d& o,
+                                      const Eigen::Vector3d& d) {
+  const Eigen::Vector3d w = p0 - o;
+  const double b = u.dot(d), c = d.dot(d), dd = u.dot(w), e = d.dot(w);
+  const double denominator = c - b * b;  // |u| = 1
+  if (denominator < 1e-12 * c) return std::nullopt;  // the ray runs along the axis
+  return (b * e - c * dd) / denominator;
+}
+
+}  // namespace
+
+Outcome<HeightRange> support_heights(const StereoRig& rig, Side side, const symmetry::Line& line, const Segment3& axis,
+                                     const TableHit& hit, const Plane& table) {
+  const Camera& camera = side == Side::Left ? rig.left : rig.right;
+  Eigen::Vector3d up = axis.direction();
+  if (up.dot(table.normal) < 0) up = -up;
+  double h[2];
+  const cv::Point2d ends[2] = {line.seg1, line.seg2};
+  for (int i = 0; i < 2; ++i) {
+    const auto n = camera.normalise(Eigen::Vector2d(ends[i].x, ends[i].y));
+    if (!n) return Outcome<HeightRange>::failure("support end " + std::to_string(i + 1) + ": " + n.reason());
+    Eigen::Vector3d origin = Eigen::Vector3d::Zero(), direction(n->x(), n->y(), 1.0);
+    if (side == Side::Left) {
+      origin = rig.left_centre();
+      direction = rig.R * direction;
+    }
+    const auto t = nearest_on_axis(hit.point, up, origin, direction);
+    if (!t) return Outcome<HeightRange>::failure("a support ray runs along the axis");
+    h[i] = *t;
+  }
+  return Outcome<HeightRange>::success({std::min(h[0], h[1]), std::max(h[0], h[1])});
+}
+
+std::vector<PairedAxis> consistent_pairings(const StereoRig& rig, const std::vector<symmetry::Line>& left,
+                                            const std::vector<symmetry::Line>& right, const PairingResult& result,
+                                            const Plane& table, const LocationParams& params) {
+  struct Scored {
+    double overlap;
+    size_t index;
+  };
+  std::vector<Scored> scored;
+  for (size_t i = 0; i < result.axes.size(); ++i) {
+    const PairedAxis& a = result.axes[i];
+    if (!a.hit) continue;
+    const auto l = support_heights(rig, Side::Left, left[a.left_index], a.axis, *a.hit, table);
+    const auto r = support_heights(rig, Side::Right, right[a.right_index], a.axis, *a.hit, table);
+    if (!l || !r) continue;
+    const double overlap = std::min(l->high, r->high) - std::max(l->low, r->low);
+    const double span = std::max(l->high, r->high) - std::min(l->low, r->low);
+    const double share = span > 0 ? std::max(0.0, overlap) / span : 0.0;
+    const bool on_table = std::fabs(std::min(l->low, r->low)) <= params.max_foot_height_m;
+    if (share >= params.min_height_overlap && on_table) scored.push_back({share, i});
+  }
+  std::stable_sort(scored.begin(), scored.end(), [](const Scored& a, const Scored& b) { return a.overlap > b.overlap; });
+  std::vector<bool> left_used(left.size(), false), right_used(right.size(), false);
+  std::vector<PairedAxis> out;
+  for (const Scored& s : scored) {
+    const PairedAxis& a = result.axes[s.index];
+    if (left_used[a.left_index] || right_used[a.right_index]) continue;
+    left_used[a.left_index] = right_used[a.right_index] = true;
+    out.push_back(a);
+  }
+  return out;
 }
 
 LocationFinder::LocationFinder(const StereoRig& rig, const Plane& table, const std::optional<Eigen::Vector3d>& arm_base,
@@ -109,9 +182,11 @@ LocationFinder::LocationFinder(const StereoRig& rig, const Plane& table, const s
 int LocationFinder::add_frame(const std::vector<symmetry::Line>& left, const std::vector<symmetry::Line>& right) {
   const PairingResult result =
       triangulate_pairings(rig_, left, right, &table_, filter_, triangulation_, params_.lines_per_image);
-  for (const PairedAxis& axis : result.axes) points_.push_back(axis.hit->point);
+  const std::vector<PairedAxis> axes =
+      params_.stereo_check ? consistent_pairings(rig_, left, right, result, table_, params_) : result.axes;
+  for (const PairedAxis& axis : axes) points_.push_back(axis.hit->point);
   ++frames_;
-  return static_cast<int>(result.axes.size());
+  return static_cast<int>(axes.size());
 }
 
 std::vector<Location> LocationFinder::locations() const {

@@ -11,6 +11,7 @@
 
 #include "nudge/geometry/plane.hpp"
 #include "nudge/geometry/qt_cluster.hpp"
+#include "nudge/geometry/stereo_pairing.hpp"
 #include "nudge/geometry/stereo_rig.hpp"
 #include "nudge/geometry/triangulation.hpp"
 #include "nudge/robot/workspace.hpp"
@@ -64,10 +65,32 @@ struct LocationParams {
   // The arm's workspace ring (thesis: 150-350 mm), robot::Workspace's unless a service sets it.
   double ring_inner_m = robot::Workspace{}.ring_inner, ring_outer_m = robot::Workspace{}.ring_outer;
   QtParams qt;               // radius 10 mm, clusters of at least 1/9 of all intersects
+  // Stereo consistency (issue 14), off by default (the thesis pairs every line with every line):
+  // a left and a right line are one object's only if the heights their support segments cover
+  // on the triangulated axis agree (overlap / union >= min_height_overlap) and start on the table
+  // (the lower end within max_foot_height_m of it); each line then pairs at most once per frame,
+  // the most consistent pairing first. Values chosen on the busy-table family (docs/clutter.md).
+  bool stereo_check = false;
+  double min_height_overlap = 0.3;
+  double max_foot_height_m = 0.08;
 };
 
 // Throws std::invalid_argument naming the offending parameter.
 void validate(const LocationParams& params);
+
+// The heights above the table (along the axis, from its table hit) that a line's support segment
+// (Line::seg1..seg2) covers: where the camera rays through its ends pass closest to the axis.
+struct HeightRange {
+  double low = 0, high = 0;
+};
+Outcome<HeightRange> support_heights(const StereoRig& rig, Side side, const symmetry::Line& line,
+                                     const Segment3& axis, const TableHit& hit, const Plane& table);
+
+// The pairings of `result` (triangulate_pairings with a table) that pass the stereo check of
+// `params`, each line used once, most consistent first.
+std::vector<PairedAxis> consistent_pairings(const StereoRig& rig, const std::vector<symmetry::Line>& left,
+                                            const std::vector<symmetry::Line>& right, const PairingResult& result,
+                                            const Plane& table, const LocationParams& params);
 
 struct Location {
   Eigen::Vector3d position;  // cluster centroid on the table, right camera frame

@@ -1,0 +1,484 @@
+// nudge-exp-clutter (issue 14): symmetry lines and CANDIDATES on busy tables.
+//
+// For every scene of the clutter family (common/sim/scenes/clutter/, nudge-clutter-scenes) it
+// renders `--frames` noisy stereo pairs, detects each camera's lines as the symmetry service does
+// in the supervisor's loop, and feeds the pairs to the triangulation service's LocationFinder as
+// a survey does. Against the simulator's truth it counts, per camera, the objects whose projected
+// axis is among the lines (within 3 px at the axis' middle and 2 deg), the phantom lines (further
+// than 8 px or 5 deg from every object's axis: between objects, or in texture), and after
+// clustering the candidates within 25 mm of an object's axis, the objects without one, and the
+// phantom candidates. Two pipelines are measured in one run: the one before issue 14 and today's.
+//   nudge-exp-clutter [--set eval|dev] [--frames 25] [--no-write]
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <sstream>
+
+#include "nudge/flags.hpp"
+#include "nudge/geometry/interesting_locations.hpp"
+#include "nudge/sim/world.hpp"
+#include "nudge/symmetry/detector.hpp"
+#include "nudge/symmetry/verify.hpp"
+#include "report.hpp"
+
+namespace fs = std::filesystem;
+namespace geo = nudge::geometry;
+namespace sim = nudge::sim;
+namespace sym = nudge::symmetry;
+using namespace nudge::experiments;
+
+namespace {
+
+constexpr double kLineDistancePx = 3, kLineAngleDeg = 2;        // "among the lines" (issue 14)
+constexpr double kPhantomDistancePx = 8, kPhantomAngleDeg = 5;  // further from every axis: a phantom
+constexpr double kCandidateRadiusM = 0.025;                     // a candidate this close is the object
+constexpr int kMinVisiblePixels = 150;                          // fewer: the object is hidden
+
+// What turns images into lines and lines into candidates.
+struct Pipeline {
+  std::string name;
+  sym::Params params;
+  sym::EdgeParams edge;
+  sym::VerifyParams verify;
+  bool verify_lines = false;
+  geo::LocationParams locations;
+};
+
+// The symmetry service as scripts/lib.sh and the supervisor's loop test run it, and the
+// triangulation service's defaults with the supervisor's survey request (25 frames, 3 lines).
+Pipeline before_issue14() {
+  Pipeline p;
+  p.name = "before";
+  p.params.num_lines = 5;
+  p.params.theta_min_deg = -25;
+  p.params.theta_max_deg = 25;
+  p.params.once_per_row = true;
+  p.params.mirror_tolerance_deg = 15;
+  p.edge.blur_sigma = 1.0;
+  p.locations.frames = 25;
+  p.locations.lines_per_image = 3;
+  return p;
+}
+
+// Issue 14's pipeline (docs/clutter.md): every value below was chosen on the development family.
+struct AfterOptions {
+  double dmin = 8, dmax = 90, blur = 2.0, canny_low = 30, canny_high = 90;
+  int candidates = 20, suppress = 4, keep = 8;
+  bool verify = true;
+  double appearance_weight = 1, band_weight = 0.5, min_appearance = 0, colour_tolerance = 90, band_gap = 8, verify_suppress = 4;
+  int candidate_lines = 8;
+  bool stereo_check = true, colour_edges = true;
+  double min_overlap = 0.3, max_foot = 0.08;
+  double min_fraction = 0.03;
+};
+
+Pipeline after_issue14(const AfterOptions& o) {
+  Pipeline p = before_issue14();
+  p.name = "after";
+  p.params.dmin = o.dmin;
+  p.params.dmax = o.dmax;
+  p.params.num_lines = o.candidates;
+  p.params.suppress_r = o.suppress;
+  p.params.suppress_theta = o.suppress;
+  p.edge.blur_sigma = o.blur;
+  p.edge.canny_low = o.canny_low;
+  p.edge.canny_high = o.canny_high;
+  p.edge.colour = o.colour_edges;
+  p.verify_lines = o.verify;
+  p.verify.keep = o.keep;
+  p.verify.appearance_weight = o.appearance_weight;
+  p.verify.band_weight = o.band_weight;
+  p.verify.min_appearance = o.min_appearance;
+  p.verify.colour_tolerance = o.colour_tolerance;
+  p.verify.band_gap_px = o.band_gap;
+  p.verify.suppress_px = o.verify_suppress;
+  p.locations.lines_per_image = o.candidate_lines;
+  p.locations.stereo_check = o.stereo_check;
+  p.locations.min_height_overlap = o.min_overlap;
+  p.locations.max_foot_height_m = o.max_foot;
+  p.locations.qt.min_fraction = o.min_fraction;
+  return p;
+}
+
+struct CameraCount {
+  int visible = 0, found = 0, lines = 0, phantoms = 0, images = 0;
+};
+
+struct SceneResult {
+  std::string name;
+  int objects = 0;
+  std::array<CameraCount, 2> cameras;
+  int candidates = 0, object_candidates = 0, duplicate_candidates = 0, objects_without = 0, phantom_candidates = 0;
+  cv::Mat picture;
+};
+
+double angle_diff_deg(double a, double b) {
+  double d = std::fmod(std::fabs(a - b), M_PI);
+  if (d > M_PI / 2) d = M_PI - d;
+  return d * 180 / M_PI;
+}
+
+// Distance from the middle of the true axis' image to the line, and the angle between them.
+std::pair<double, double> line_error(const sym::Line& line, const sim::ImageLine& truth, int width, int height) {
+  const Eigen::Vector2d middle = 0.5 * (truth.bottom + truth.top);
+  const double cx = 0.5 * (width - 1), cy = 0.5 * (height - 1);
+  const double distance = std::fabs((middle.x() - cx) * std::cos(line.theta) + (middle.y() - cy) * std::sin(line.theta) - line.r);
+  return {distance, angle_diff_deg(line.theta, truth.theta)};
+}
+
+geo::Plane table_in_right_camera(const sim::World& world) {
+  const sim::CameraModel& right = world.camera(1);
+  geo::Plane p;
+  p.normal = right.R * Eigen::Vector3d::UnitZ();
+  p.offset = -p.normal.dot(right.t);
+  if (p.offset < 0) {
+    p.normal = -p.normal;
+    p.offset = -p.offset;
+  }
+  return p;
+}
+
+std::vector<sym::Line> detect(sym::Detector& detector, const Pipeline& pipeline, const cv::Mat& image) {
+  if (!pipeline.verify_lines) return detector.detect(image).lines;
+  sym::EdgeParams edge = pipeline.edge;
+  edge.gradients = true;  // as Detector::detect with the mirror rule on
+  const sym::EdgeSet edges = sym::detect_edges(image, edge);
+  const sym::Result result = detector.detect(edges);
+  return sym::verify_lines(detector, edges, image, result.lines, pipeline.verify);
+}
+
+void draw_frame(const cv::Mat& image, const std::vector<sym::Line>& lines, const std::vector<sim::ImageLine>& truth,
+                const std::vector<Eigen::Vector2d>& candidates, const std::vector<bool>& candidate_is_object,
+                cv::Mat* out) {
+  cv::Mat canvas = image.clone();
+  for (const auto& t : truth)
+    if (t.valid) cv::line(canvas, cv::Point2d(t.bottom.x(), t.bottom.y()), cv::Point2d(t.top.x(), t.top.y()), {0, 255, 0}, 1);
+  for (const auto& l : lines) cv::line(canvas, l.seg1, l.seg2, {0, 0, 255}, 2);
+  for (size_t i = 0; i < candidates.size(); ++i) {
+    const cv::Point c(cvRound(candidates[i].x()), cvRound(candidates[i].y()));
+    const cv::Scalar colour = candidate_is_object[i] ? cv::Scalar(255, 255, 0) : cv::Scalar(255, 0, 255);
+    cv::drawMarker(canvas, c, colour, cv::MARKER_TILTED_CROSS, 18, 3);
+  }
+  *out = canvas;
+}
+
+SceneResult run_scene(const std::string& file, const Pipeline& pipeline, int frames, bool picture) {
+  SceneResult result;
+  result.name = fs::path(file).stem().string();
+  sim::World world(sim::load_scene(file));
+  result.objects = world.num_objects();
+  const geo::StereoRig rig = world.rig().calibrated();
+  const geo::Plane table = table_in_right_camera(world);
+  const sim::CameraModel& right = world.camera(1);
+  geo::LocationParams locations = pipeline.locations;
+  locations.frames = frames;
+  geo::LocationFinder finder(rig, table, Eigen::Vector3d(right.t), locations);
+  sym::Detector detector(pipeline.params, pipeline.edge);
+
+  std::array<std::vector<sim::ImageLine>, 2> truth;
+  std::array<std::vector<bool>, 2> visible;
+  std::vector<sym::Line> first_left;
+  cv::Mat first_image;
+  for (int f = 0; f < frames; ++f) {
+    const sim::StereoImages images = world.render_stereo(f == 0);
+    std::array<std::vector<sym::Line>, 2> lines;
+    for (int c = 0; c < 2; ++c) {
+      if (f == 0) {
+        for (int i = 0; i < world.num_objects(); ++i) {
+          truth[c].push_back(world.axis_in_image(i, c));
+          visible[c].push_back(cv::countNonZero(images.mask[c] == i + 1) >= kMinVisiblePixels && truth[c].back().valid);
+        }
+      }
+      const cv::Mat& image = images.colour[c];
+      lines[c] = detect(detector, pipeline, image);
+      CameraCount& count = result.cameras[c];
+      ++count.images;
+      count.lines += static_cast<int>(lines[c].size());
+      for (int i = 0; i < world.num_objects(); ++i) {
+        if (!visible[c][i]) continue;
+        ++count.visible;
+        for (const auto& l : lines[c]) {
+          const auto [d, a] = line_error(l, truth[c][i], image.cols, image.rows);
+          if (d <= kLineDistancePx && a <= kLineAngleDeg) {
+            ++count.found;
+            break;
+          }
+        }
+      }
+      for (const auto& l : lines[c]) {
+        bool near_object = false;
+        for (int i = 0; i < world.num_objects() && !near_object; ++i) {
+          if (!truth[c][i].valid) continue;
+          const auto [d, a] = line_error(l, truth[c][i], image.cols, image.rows);
+          near_object = d <= kPhantomDistancePx && a <= kPhantomAngleDeg;
+        }
+        count.phantoms += !near_object;
+      }
+    }
+    if (f == 0) {
+      first_left = lines[0];
+      first_image = images.colour[0];
+    }
+    finder.add_frame(lines[0], lines[1]);
+  }
+
+  // Candidates against the objects' axes, on the table (world frame).
+  std::vector<bool> has_candidate(world.num_objects(), false);
+  std::vector<Eigen::Vector2d> drawn;
+  std::vector<bool> drawn_is_object;
+  for (const geo::Location& location : finder.locations()) {
+    const Eigen::Vector3d p = right.R.transpose() * (location.position - right.t);
+    ++result.candidates;
+    int nearest = -1;
+    double best = kCandidateRadiusM;
+    for (int i = 0; i < world.num_objects(); ++i) {
+      const double d = (p.head<2>() - world.object(i).position.head<2>()).norm();
+      if (d <= best) {
+        best = d;
+        nearest = i;
+      }
+    }
+    if (nearest < 0) ++result.phantom_candidates;
+    else if (has_candidate[nearest]) ++result.duplicate_candidates;
+    else {
+      has_candidate[nearest] = true;
+      ++result.object_candidates;
+    }
+    drawn.push_back(world.camera(0).project(p));
+    drawn_is_object.push_back(nearest >= 0);
+  }
+  for (bool has : has_candidate) result.objects_without += !has;
+  if (picture) draw_frame(first_image, first_left, truth[0], drawn, drawn_is_object, &result.picture);
+  return result;
+}
+
+struct Summary {
+  int scenes = 0, objects = 0;
+  std::array<double, 2> in_lines{};  // per camera
+  double phantom_lines_per_frame = 0, candidates_share = 0, phantom_candidates_per_scene = 0;
+  double lines_per_frame = 0;
+};
+
+Summary summarise(const std::vector<SceneResult>& results) {
+  Summary s;
+  std::array<int, 2> visible{}, found{};
+  int phantoms = 0, lines = 0, images = 0, with_candidate = 0, phantom_candidates = 0;
+  for (const auto& r : results) {
+    ++s.scenes;
+    s.objects += r.objects;
+    for (int c = 0; c < 2; ++c) {
+      visible[c] += r.cameras[c].visible;
+      found[c] += r.cameras[c].found;
+      phantoms += r.cameras[c].phantoms;
+      lines += r.cameras[c].lines;
+      images += r.cameras[c].images;
+    }
+    with_candidate += r.object_candidates;
+    phantom_candidates += r.phantom_candidates;
+  }
+  for (int c = 0; c < 2; ++c) s.in_lines[c] = visible[c] ? static_cast<double>(found[c]) / visible[c] : 0;
+  s.phantom_lines_per_frame = images ? static_cast<double>(phantoms) / images : 0;
+  s.lines_per_frame = images ? static_cast<double>(lines) / images : 0;
+  s.candidates_share = s.objects ? static_cast<double>(with_candidate) / s.objects : 0;
+  s.phantom_candidates_per_scene = s.scenes ? static_cast<double>(phantom_candidates) / s.scenes : 0;
+  return s;
+}
+
+std::string fixed(double v, int digits = 3) {
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(digits) << v;
+  return s.str();
+}
+
+std::string summary_json(const Summary& s) {
+  std::ostringstream j;
+  j << "{\"scenes\": " << s.scenes << ", \"objects\": " << s.objects << ", \"objects_in_lines_share\": {\"left\": "
+    << fixed(s.in_lines[0]) << ", \"right\": " << fixed(s.in_lines[1]) << ", \"mean\": "
+    << fixed(0.5 * (s.in_lines[0] + s.in_lines[1])) << "}, \"lines_per_frame\": " << fixed(s.lines_per_frame, 2)
+    << ", \"phantom_lines_per_frame\": " << fixed(s.phantom_lines_per_frame, 2)
+    << ", \"objects_as_candidates_share\": " << fixed(s.candidates_share)
+    << ", \"phantom_candidates_per_scene\": " << fixed(s.phantom_candidates_per_scene, 2) << "}";
+  return j.str();
+}
+
+std::vector<std::string> scene_files(const std::string& dir, const std::string& prefix) {
+  std::vector<std::string> files;
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind(prefix + "_", 0) == 0 && entry.path().extension() == ".yaml") files.push_back(entry.path().string());
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+// mirror_vote_ms and mirror_speedup from the voting experiment, when it has been run.
+std::string mirror_voting_fields() {
+  std::ifstream in(results_dir() + "/mirror_voting.json");
+  if (!in) return "\"mirror_vote_ms\": null, \"mirror_speedup\": null";
+  std::stringstream text;
+  text << in.rdbuf();
+  const std::string s = text.str();
+  auto field = [&](const std::string& key) -> std::string {
+    const size_t at = s.find("\"" + key + "\"");
+    if (at == std::string::npos) return "null";
+    size_t start = s.find(':', at) + 1;
+    while (start < s.size() && std::isspace(static_cast<unsigned char>(s[start]))) ++start;
+    int depth = 0;
+    size_t end = start;
+    for (; end < s.size(); ++end) {
+      const char ch = s[end];
+      if (ch == '{' || ch == '[') ++depth;
+      if (ch == '}' || ch == ']') {
+        if (depth == 0) break;
+        --depth;
+      }
+      if (ch == ',' && depth == 0) break;
+    }
+    return s.substr(start, end - start);
+  };
+  return "\"mirror_vote_ms\": " + field("mirror_vote_ms") + ", \"mirror_speedup\": " + field("mirror_speedup");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string set = "eval", scenes_dir = std::string(NUDGE_SOURCE_DIR) + "/common/sim/scenes/clutter";
+  int frames = 25;
+  bool no_write = false, skip_before = false;
+  std::string pictures;
+  AfterOptions after_options;
+  std::vector<double> canny;
+  nudge::Flags flags("nudge-exp-clutter", "Symmetry lines and candidates on busy tables (issue 14).");
+  flags.add_string("set", &set, "scene family: eval (the report) or dev (for tuning)");
+  flags.add_string("scenes", &scenes_dir, "directory of the clutter scenes");
+  flags.add_int("frames", &frames, "stereo pairs per scene (a survey's)");
+  flags.add_bool("no-write", &no_write, "print only; write no result files");
+  flags.add_string("pictures", &pictures, "also write each scene's picture (after) to this directory");
+  flags.add_bool("skip-before", &skip_before, "measure only the issue-14 pipeline (with --no-write, for tuning)");
+  AfterOptions& a = after_options;
+  double verify_flag = 1, colour_flag = 1, stereo_flag = 1;
+  flags.add_double("dmin", &a.dmin, "after: minimum pairing distance, px");
+  flags.add_double("dmax", &a.dmax, "after: maximum pairing distance, px");
+  flags.add_double("blur", &a.blur, "after: Gaussian blur before Canny");
+  flags.add_doubles("canny", &canny, 2, "after: Canny thresholds LOW HIGH");
+  flags.add_int("candidates", &a.candidates, "after: peaks taken from the accumulator");
+  flags.add_int("suppress", &a.suppress, "after: non-maximum suppression half-size, px and deg");
+  flags.add_double("verify", &verify_flag, "after: 1 = verify the peaks (local support, appearance) and keep the best, 0 = off");
+  flags.add_int("keep", &a.keep, "after: lines kept per image after verification");
+  flags.add_double("appearance-weight", &a.appearance_weight, "after: exponent of the appearance agreement");
+  flags.add_double("band-weight", &a.band_weight, "after: exponent of the largest band's share of the pairs");
+  flags.add_double("min-appearance", &a.min_appearance, "after: drop lines below this appearance agreement");
+  flags.add_double("colour-tolerance", &a.colour_tolerance, "after: L1 BGR tolerance of mirrored samples");
+  flags.add_double("band-gap", &a.band_gap, "after: gap that splits bands along a line, px");
+  flags.add_double("verify-suppress", &a.verify_suppress, "after: verified lines closer than this (px, and 3 deg) to a better one are dropped");
+  flags.add_double("colour-edges", &colour_flag, "after: 1 = Canny on the colour image, 0 = on grey");
+  flags.add_double("stereo-check", &stereo_flag, "after: 1 = pair lines only when their support heights agree, 0 = off");
+  flags.add_double("min-overlap", &a.min_overlap, "after: stereo check, least overlap / union of the heights");
+  flags.add_double("max-foot", &a.max_foot, "after: stereo check, lowest support end at most this far from the table, m");
+  flags.add_int("candidate-lines", &a.candidate_lines, "after: lines per image paired for CANDIDATES");
+  flags.add_double("min-fraction", &a.min_fraction, "after: smallest QT cluster, share of all intersects");
+  try {
+    if (!flags.parse(argc, argv)) return 0;
+    if (set != "eval" && set != "dev") throw nudge::FlagError("--set must be eval or dev");
+    if (frames < 1) throw nudge::FlagError("--frames must be >= 1");
+    if (skip_before && !no_write) throw nudge::FlagError("--skip-before needs --no-write");
+    a.verify = verify_flag != 0;
+    a.colour_edges = colour_flag != 0;
+    a.stereo_check = stereo_flag != 0;
+    if (!canny.empty()) {
+      a.canny_low = canny[0];
+      a.canny_high = canny[1];
+    }
+  } catch (const nudge::FlagError& e) {
+    std::cerr << e.what() << "\n" << flags.help();
+    return 2;
+  }
+  const std::vector<std::string> files = scene_files(scenes_dir, set);
+  if (files.empty()) {
+    std::cerr << "nudge-exp-clutter: no " << set << "_*.yaml scenes in " << scenes_dir << "\n";
+    return 1;
+  }
+  std::vector<Pipeline> pipelines = {before_issue14(), after_issue14(after_options)};
+  if (skip_before) pipelines.erase(pipelines.begin());
+  std::map<std::string, std::vector<SceneResult>> results;
+  for (const Pipeline& pipeline : pipelines) {
+    for (const std::string& file : files) {
+      results[pipeline.name].push_back(run_scene(file, pipeline, frames, pipeline.name == "after"));
+      const SceneResult& r = results[pipeline.name].back();
+      if (!pictures.empty() && !r.picture.empty()) cv::imwrite(pictures + "/" + r.name + ".png", r.picture);
+      std::cerr << pipeline.name << " " << r.name << ": " << r.objects << " objects; in lines L " << r.cameras[0].found
+                << "/" << r.cameras[0].visible << " R " << r.cameras[1].found << "/" << r.cameras[1].visible
+                << "; phantom lines " << r.cameras[0].phantoms + r.cameras[1].phantoms << "/"
+                << r.cameras[0].lines + r.cameras[1].lines << "; candidates " << r.candidates << ": objects "
+                << r.object_candidates << ", duplicates " << r.duplicate_candidates << ", phantoms "
+                << r.phantom_candidates << ", objects without " << r.objects_without << "\n";
+    }
+    std::cerr << pipeline.name << ": " << summary_json(summarise(results[pipeline.name])) << "\n";
+  }
+  if (no_write) return 0;
+  // The report, written once per run on the evaluation family only.
+  if (set != "eval") {
+    std::cerr << "(dev set: nothing written)\n";
+    return 0;
+  }
+  const Summary before = summarise(results["before"]), after = summarise(results["after"]);
+  std::ostringstream json;
+  json << "{\n  \"machine\": \"" << machine_description() << "\",\n  \"date\": \"" << today() << "\",\n  \"frames_per_scene\": "
+       << frames << ",\n  \"scenes\": " << after.scenes << ",\n  \"objects\": " << after.objects
+       << ",\n  \"objects_in_lines_share\": {\"left\": " << fixed(after.in_lines[0]) << ", \"right\": " << fixed(after.in_lines[1])
+       << ", \"mean\": " << fixed(0.5 * (after.in_lines[0] + after.in_lines[1])) << "},\n  \"phantom_lines_per_frame\": "
+       << fixed(after.phantom_lines_per_frame, 2) << ",\n  \"objects_as_candidates_share\": " << fixed(after.candidates_share)
+       << ",\n  \"phantom_candidates_per_scene\": " << fixed(after.phantom_candidates_per_scene, 2) << ",\n  "
+       << mirror_voting_fields() << ",\n  \"before\": " << summary_json(before) << ",\n  \"after\": " << summary_json(after)
+       << ",\n  \"per_scene\": [\n";
+  const auto& rs = results["after"];
+  for (size_t i = 0; i < rs.size(); ++i) {
+    const SceneResult& r = rs[i];
+    json << "    {\"scene\": \"" << r.name << "\", \"objects\": " << r.objects << ", \"in_lines\": [" << r.cameras[0].found << ", "
+         << r.cameras[1].found << "], \"visible\": [" << r.cameras[0].visible << ", " << r.cameras[1].visible
+         << "], \"phantom_lines\": " << r.cameras[0].phantoms + r.cameras[1].phantoms << ", \"candidates\": " << r.candidates
+         << ", \"object_candidates\": " << r.object_candidates << ", \"objects_without\": " << r.objects_without
+         << ", \"phantom_candidates\": " << r.phantom_candidates << "}" << (i + 1 < rs.size() ? "," : "") << "\n";
+  }
+  json << "  ]\n}\n";
+  write_result("clutter.json", json.str());
+
+  std::ostringstream md;
+  md << "# Busy tables: symmetry lines and candidates (issue 14)\n\n"
+     << "`nudge-exp-clutter`, " << today() << ". " << machine_description() << ". The evaluation family "
+     << "(`common/sim/scenes/clutter/eval_*.yaml`, seeds fixed before any result: docs/clutter.md), " << frames
+     << " noisy stereo pairs per scene (a survey's). Objects \"in the lines\": the true axis within " << kLineDistancePx
+     << " px (at its middle) and " << kLineAngleDeg << " deg of one of the camera's lines, over the objects with at least "
+     << kMinVisiblePixels << " visible pixels; phantom lines: further than " << kPhantomDistancePx << " px or "
+     << kPhantomAngleDeg << " deg from every axis; a candidate is an object within " << kCandidateRadiusM * 1000
+     << " mm of its axis.\n\n"
+     << "| pipeline | scenes | objects | in left lines | in right lines | lines / image | phantom lines / image | objects as candidates | phantom candidates / scene |\n"
+     << "|---|---|---|---|---|---|---|---|---|\n";
+  for (const auto& [label, s] : {std::pair<std::string, Summary>{"before issue 14", before}, {"after", after}})
+    md << "| " << label << " | " << s.scenes << " | " << s.objects << " | " << fixed(100 * s.in_lines[0], 1) << " % | "
+       << fixed(100 * s.in_lines[1], 1) << " % | " << fixed(s.lines_per_frame, 1) << " | " << fixed(s.phantom_lines_per_frame, 2)
+       << " | " << fixed(100 * s.candidates_share, 1) << " % | " << fixed(s.phantom_candidates_per_scene, 2) << " |\n";
+  md << "\nTargets (issue 14): >= 90 % of objects in each camera's lines, >= 95 % of objects a candidate, <= 1 phantom "
+        "candidate per scene.\n\n## Per scene (after)\n\n"
+     << "| scene | objects | in left / right lines (object-frames) | phantom lines | candidates | objects | objects without | phantoms |\n"
+     << "|---|---|---|---|---|---|---|---|\n";
+  for (const SceneResult& r : rs)
+    md << "| " << r.name << " | " << r.objects << " | " << r.cameras[0].found << "/" << r.cameras[0].visible << ", "
+       << r.cameras[1].found << "/" << r.cameras[1].visible << " | " << r.cameras[0].phantoms + r.cameras[1].phantoms << " | "
+       << r.candidates << " | " << r.object_candidates << " | " << r.objects_without << " | " << r.phantom_candidates << " |\n";
+  md << "\nOne left frame per scene (half size): true axes green, the frame's lines red (their support segments), "
+        "candidates projected from the table: cyan = an object, magenta = a phantom.\n\n";
+  for (const SceneResult& r : rs) {
+    cv::Mat half;
+    cv::resize(r.picture, half, cv::Size(), 0.5, 0.5, cv::INTER_AREA);
+    write_png("clutter_" + r.name + ".png", half);
+    md << "![" << r.name << "](clutter_" << r.name << ".png)\n";
+  }
+  write_result("clutter.md", md.str());
+  return 0;
+}

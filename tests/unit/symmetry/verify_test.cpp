@@ -1,0 +1,110 @@
+// Line verification on busy images (issue 14): an object's line keeps its rank, a line between
+// two objects over a textured background loses it.
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include "nudge/symmetry/detector.hpp"
+#include "nudge/symmetry/verify.hpp"
+
+namespace sym = nudge::symmetry;
+
+namespace {
+
+constexpr int kWidth = 320, kHeight = 240;
+
+// A pale yellow object (x 50..89, axis 69.5: on an R bin) on a horizontal grey ramp, and a blue and a
+// green object (x 170..200 and 230..270), taller than the yellow one, whose facing sides pair up into
+// a phantom at x = 215; in the gap between them a dark stripe of table texture.
+cv::Mat busy_image() {
+  cv::Mat image(kHeight, kWidth, CV_8UC3);
+  for (int x = 0; x < kWidth; ++x) image.col(x).setTo(cv::Scalar::all(20 + (x * 200) / kWidth));
+  cv::rectangle(image, cv::Rect(50, 60, 40, 140), cv::Scalar(200, 230, 255), cv::FILLED);
+  cv::rectangle(image, cv::Rect(170, 15, 31, 210), cv::Scalar(200, 60, 30), cv::FILLED);
+  cv::rectangle(image, cv::Rect(230, 15, 41, 210), cv::Scalar(40, 190, 40), cv::FILLED);
+  cv::rectangle(image, cv::Rect(202, 15, 9, 210), cv::Scalar(20, 20, 20), cv::FILLED);
+  return image;
+}
+
+double x_of(const sym::Line& line) { return line.r / std::cos(line.theta) + 0.5 * (kWidth - 1); }
+
+const sym::Line* line_at(const std::vector<sym::Line>& lines, double x) {
+  for (const auto& l : lines)
+    if (std::fabs(l.theta) < 0.02 && std::fabs(x_of(l) - x) < 1.5) return &l;
+  return nullptr;
+}
+
+struct Detection {
+  sym::Detector detector;
+  sym::EdgeSet edges;
+  std::vector<sym::Line> lines;
+};
+
+Detection detect(const cv::Mat& image) {
+  sym::Params params;
+  params.dmin = 10;
+  params.dmax = 120;
+  params.num_lines = 20;
+  params.theta_min_deg = -25;  // upright objects, as the supervisor's loop runs the service
+  params.theta_max_deg = 25;
+  params.suppress_r = 3;
+  params.suppress_theta = 3;
+  Detection d{sym::Detector(params), {}, {}};
+  d.edges = sym::detect_edges(image, {});
+  d.lines = d.detector.detect(d.edges).lines;
+  return d;
+}
+
+}  // namespace
+
+TEST(SymmetryVerify, ObjectAgreesWithItselfThePhantomDoesNot) {
+  const cv::Mat image = busy_image();
+  const Detection d = detect(image);
+  const sym::Line* object = line_at(d.lines, 69.5);
+  const sym::Line* phantom = line_at(d.lines, 215);
+  ASSERT_NE(object, nullptr);
+  ASSERT_NE(phantom, nullptr);
+  EXPECT_GT(phantom->votes, object->votes);  // what the accumulator alone would rank first
+  const sym::LineEvidence on_object = sym::line_evidence(d.detector, d.edges, image, *object);
+  const sym::LineEvidence on_phantom = sym::line_evidence(d.detector, d.edges, image, *phantom);
+  EXPECT_GT(on_object.appearance, 0.9);
+  EXPECT_LT(on_phantom.appearance, 0.5);
+  EXPECT_GT(on_object.band_share, 0.9);
+  EXPECT_GT(on_object.pairs, 100);
+}
+
+TEST(SymmetryVerify, RanksTheObjectAboveThePhantomAndTrimsItsSupport) {
+  const cv::Mat image = busy_image();
+  const Detection d = detect(image);
+  sym::VerifyParams params;
+  params.keep = 20;
+  std::vector<sym::LineEvidence> evidence;
+  const std::vector<sym::Line> verified = sym::verify_lines(d.detector, d.edges, image, d.lines, params, &evidence);
+  ASSERT_EQ(evidence.size(), verified.size());
+  int object_rank = -1, phantom_rank = -1;
+  for (size_t i = 0; i < verified.size(); ++i) {
+    if (std::fabs(verified[i].theta) < 0.02 && std::fabs(x_of(verified[i]) - 69.5) < 1.5 && object_rank < 0) object_rank = i;
+    if (std::fabs(verified[i].theta) < 0.02 && std::fabs(x_of(verified[i]) - 215) < 1.5 && phantom_rank < 0) phantom_rank = i;
+  }
+  ASSERT_GE(object_rank, 0);
+  if (phantom_rank >= 0) EXPECT_LT(object_rank, phantom_rank);
+  // The object's support is its own height (rows 60..199), not the whole image column.
+  const sym::Line& object = verified[object_rank];
+  EXPECT_NEAR(std::min(object.seg1.y, object.seg2.y), 60, 6);
+  EXPECT_NEAR(std::max(object.seg1.y, object.seg2.y), 199, 6);
+  params.keep = 2;
+  EXPECT_EQ(sym::verify_lines(d.detector, d.edges, image, d.lines, params).size(), 2u);
+}
+
+TEST(SymmetryVerify, RefusesBadInput) {
+  const cv::Mat image = busy_image();
+  const Detection d = detect(image);
+  sym::VerifyParams bad;
+  bad.colour_tolerance = -1;
+  EXPECT_THROW(sym::verify_lines(d.detector, d.edges, image, d.lines, bad), std::invalid_argument);
+  bad = {};
+  bad.band_gap_px = 0;
+  EXPECT_THROW(sym::validate(bad), std::invalid_argument);
+  const cv::Mat smaller = image(cv::Rect(0, 0, 100, 100)).clone();
+  EXPECT_THROW(sym::verify_lines(d.detector, d.edges, smaller, d.lines), std::invalid_argument);
+}
