@@ -332,6 +332,83 @@ TEST(SymmetryVote, MirrorWindowsKeepExactlyThePairsWithinTheTolerance) {
   expect_mirror_variants_equal_plain(edges, p);
 }
 
+TEST(SymmetryVote, MirrorPolarityKeepsOnlyPairsOfTheSameContrast) {
+  // Pixels mirror-symmetric about the vertical line x = 100 (R = 0, theta = 0). Gradient
+  // directions of a mirrored pair with the same contrast on both sides: a and 180 deg - a.
+  EdgeSet edges;
+  edges.width = edges.height = 201;
+  std::mt19937 rng(6);
+  for (int y = 20; y < 180; y += 2) {
+    const int dx = std::uniform_int_distribution<int>(15, 80)(rng);
+    edges.points.emplace_back(100 - dx, y);
+    edges.points.emplace_back(100 + dx, y);
+  }
+  auto axis_votes = [&](double left_deg, double right_deg, bool polarity) {
+    edges.orientation.clear();
+    edges.direction.clear();
+    for (size_t i = 0; i < edges.points.size(); ++i) {
+      const double angle = (i % 2 == 0 ? left_deg : right_deg) * kDeg;
+      edges.orientation.push_back(orientation_units(angle));
+      edges.direction.push_back(direction_units(angle));
+    }
+    Params p = synthetic_params();
+    p.mirror_tolerance_deg = 10;
+    p.mirror_polarity = polarity;
+    Detector d(p);
+    const Accumulator& acc = d.vote(edges);
+    expect_same_accumulator(acc, reference_vote(edges, p));
+    return acc.votes[0].at<int32_t>(89 /* theta 0 */, acc.r_max /* R 0 */);
+  };
+  const int all = axis_votes(30, 150, false);
+  ASSERT_GE(all, 80);
+  EXPECT_EQ(axis_votes(30, 150, true), all);   // same contrast: mirrored directions
+  EXPECT_EQ(axis_votes(0, 180, true), all);    // a vertical outline, dark outside on both sides
+  EXPECT_EQ(axis_votes(30, 142, true), all);   // 8 deg off: inside the tolerance
+  EXPECT_EQ(axis_votes(30, 330, false), all);  // opposite contrast: the orientation rule keeps it...
+  EXPECT_EQ(axis_votes(30, 330, true), 0);     // ...the polarity rule drops it
+  EXPECT_EQ(axis_votes(0, 0, true), 0);        // a step edge seen twice, both gradients pointing right
+}
+
+TEST(SymmetryVote, MirrorPolarityFastEqualsPlain) {
+  EdgeParams e{1.0, 30, 90, false};
+  e.gradients = true;
+  const EdgeSet edges = detect_edges(syn::indoor_scene(41, 240, 180, 4), e);
+  ASSERT_EQ(edges.direction.size(), edges.points.size());
+  for (size_t i = 0; i < edges.points.size(); ++i)  // the direction modulo 180 deg is the orientation
+    ASSERT_LE(std::abs(static_cast<int16_t>(static_cast<uint16_t>(2 * edges.direction[i] - edges.orientation[i]))), 2);
+  Params p;
+  p.dmin = 5;
+  p.dmax = 200;
+  p.mirror_tolerance_deg = 15;
+  p.mirror_polarity = true;
+  expect_mirror_variants_equal_plain(edges, p);
+  Params wrap = p;  // axes near +-90 deg
+  wrap.theta_min_deg = 75;
+  wrap.theta_max_deg = -75;
+  expect_mirror_variants_equal_plain(edges, wrap);
+}
+
+TEST(SymmetryBadInput, MirrorPolarityNeedsTheRuleAndDirections) {
+  Params p;
+  p.mirror_polarity = true;
+  try {
+    validate(p);
+    ADD_FAILURE() << "polarity without the mirror rule accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("mirror_polarity"), std::string::npos) << e.what();
+  }
+  p.mirror_tolerance_deg = 15;
+  EdgeSet edges = edges_from_mask(cv::Mat::ones(20, 20, CV_8U));
+  edges.orientation.assign(edges.points.size(), 0);  // orientations, but no directions
+  Detector d(p);
+  try {
+    d.vote(edges);
+    ADD_FAILURE() << "polarity without directions accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("direction"), std::string::npos) << e.what();
+  }
+}
+
 TEST(SymmetryVote, ThreadsGiveTheSameAccumulator) {
   const cv::Mat scene = syn::indoor_scene(7);
   const EdgeSet edges = detect_edges(scene, EdgeParams{1.0, 30, 90, false});

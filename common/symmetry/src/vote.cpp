@@ -337,9 +337,7 @@ const Accumulator& Detector::vote(const EdgeSet& edges) {
     m.setTo(0);
   }
   const size_t n = edges.points.size();
-  if (params_.mirror_tolerance_deg > 0 && edges.orientation.size() != n)
-    throw std::invalid_argument("symmetry parameter mirror_tolerance needs the edge pixels' orientations "
-                                "(EdgeParams::gradients)");
+  detail::require_mirror_angles(edges, params_);
   prepare_pixels(edges, choose_kernels(detail::make_layout(edges.width, edges.height, params_), params_).windowed);
   const std::vector<int> thetas = theta_bins_in_range(params_.theta_min_deg, params_.theta_max_deg);
   const int num_threads = std::max(1, std::min<int>(params_.threads, static_cast<int>(thetas.size())));
@@ -364,13 +362,14 @@ const Accumulator& Detector::vote(const EdgeSet& edges) {
 void Detector::prepare_pixels(const EdgeSet& edges, bool group_by_orientation) {
   const size_t n = edges.points.size();
   const bool mirror = params_.mirror_tolerance_deg > 0;
+  const std::vector<int16_t>& angles = detail::mirror_angles(edges, params_);  // orientations or directions
   u2_.resize(n);
   v2_.resize(n);
   angle_.assign(mirror ? n : 0, 0);
   std::vector<uint32_t> order(n);
   for (size_t i = 0; i < n; ++i) order[i] = static_cast<uint32_t>(i);
   if (group_by_orientation) {
-    auto bucket = [&](size_t i) { return static_cast<uint16_t>(edges.orientation[i]) >> kAngleBucketShift; };
+    auto bucket = [&](size_t i) { return static_cast<uint16_t>(angles[i]) >> kAngleBucketShift; };
     size_t next[kAngleBuckets + 1] = {};
     for (size_t i = 0; i < n; ++i) ++next[bucket(i) + 1];
     for (int b = 0; b < kAngleBuckets; ++b) next[b + 1] += next[b];
@@ -380,7 +379,7 @@ void Detector::prepare_pixels(const EdgeSet& edges, bool group_by_orientation) {
     const cv::Point p = edges.points[order[k]];
     u2_[k] = 2 * p.x - (edges.width - 1);
     v2_[k] = 2 * p.y - (edges.height - 1);
-    if (mirror) angle_[k] = edges.orientation[order[k]];
+    if (mirror) angle_[k] = angles[order[k]];
   }
 }
 
@@ -493,7 +492,7 @@ void Detector::vote_thetas(const EdgeSet& edges, const std::vector<int>& thetas,
     else if (narrow) scatter(s.sorted16.data(), std::false_type{});
     else if (mirror) scatter(s.sorted.data(), std::true_type{});
     else scatter(s.sorted.data(), std::false_type{});
-    const detail::MirrorRule mirror_rule = detail::mirror_rule(k, params_.mirror_tolerance_deg);
+    const detail::MirrorRule mirror_rule = detail::mirror_rule(k, params_.mirror_tolerance_deg, params_.mirror_polarity);
 
     // A grouped row taken twice over (see row_pair_bins_windowed).
     auto doubled = [](const auto* row, int count, auto& buffer) {
@@ -568,8 +567,8 @@ void Detector::vote_thetas(const EdgeSet& edges, const std::vector<int>& thetas,
 
 Accumulator reference_vote(const EdgeSet& edges, const Params& params) {
   validate(params);
-  if (params.mirror_tolerance_deg > 0 && edges.orientation.size() != edges.points.size())
-    throw std::invalid_argument("symmetry parameter mirror_tolerance needs the edge pixels' orientations");
+  detail::require_mirror_angles(edges, params);
+  const std::vector<int16_t>& angles = detail::mirror_angles(edges, params);
   const Layout layout = detail::make_layout(edges.width, edges.height, params);
   Accumulator acc;
   acc.r_max = layout.r_max;
@@ -586,10 +585,10 @@ Accumulator reference_vote(const EdgeSet& edges, const Params& params) {
     for (size_t i = 0; i < edges.points.size(); ++i) {
       const cv::Point p = edges.points[i];
       const int32_t u2 = 2 * p.x - (edges.width - 1), v2 = 2 * p.y - (edges.height - 1);
-      const int16_t orientation = edges.orientation.empty() ? int16_t{0} : edges.orientation[i];
+      const int16_t orientation = angles.empty() ? int16_t{0} : angles[i];
       rows[detail::rotated_row(u2, v2, t) + layout.row_max].push_back({detail::rotated_xq(u2, v2, t), orientation});
     }
-    const detail::MirrorRule mirror = detail::mirror_rule(k, params.mirror_tolerance_deg);
+    const detail::MirrorRule mirror = detail::mirror_rule(k, params.mirror_tolerance_deg, params.mirror_polarity);
     for (size_t sk = 0; sk < acc.votes.size(); ++sk) {
       const double tan_phi = sk == 0 ? 0.0 : std::tan(params.skew_deg[sk - 1] * M_PI / 180.0);
       int32_t* out = acc.votes[sk].ptr<int32_t>(k);

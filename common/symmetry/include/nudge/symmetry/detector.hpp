@@ -48,6 +48,12 @@ struct Params {
   // EdgeSet::orientation (EdgeParams::gradients); not with skew. 0 = off (Algorithm 1 as published
   // uses edge locations only).
   double mirror_tolerance_deg = 0;
+  // With the mirror rule: also the gradients' polarity must mirror (their directions modulo 360
+  // deg, a + b = 2 theta + 180 deg: the same contrast on both sides of the axis, as an object on a
+  // plain background shows). Needs EdgeSet::direction. Off by default: the thesis' rule is on
+  // orientation only, and an object before a background brighter on one side than the other
+  // shows opposite contrasts on its two sides.
+  bool mirror_polarity = false;
   // With the mirror rule: keep each row of Rot grouped by orientation and check each pixel only
   // against the partners whose orientations can mirror its own about the current angle (the other
   // pairs cannot vote). Applies to the 32-bit pair loops (no AVX-512, vector_kernels = false, or
@@ -73,10 +79,15 @@ struct EdgeSet {
   // Optional, one per point: the gradient's orientation modulo 180 deg (polarity-free) in units of
   // 180/65536 deg, so that int16 arithmetic wraps exactly as angles modulo 180 deg do.
   std::vector<int16_t> orientation;
+  // Optional, one per point, filled with orientation: the gradient's direction modulo 360 deg (the
+  // polarity kept) in units of 360/65536 deg (Params::mirror_polarity).
+  std::vector<int16_t> direction;
 };
 
 // An angle (radians) as EdgeSet::orientation units, modulo 180 deg.
 int16_t orientation_units(double radians);
+// An angle (radians) as EdgeSet::direction units, modulo 360 deg.
+int16_t direction_units(double radians);
 
 struct Timing {
   double edges_ms = 0, vote_ms = 0, peaks_ms = 0;
@@ -160,7 +171,7 @@ class Detector {
   // For windowed pair checks (Params::mirror_sorted_rows) grouped by orientation bucket: a stable
   // counting sort into rows then keeps every row grouped.
   std::vector<int32_t> u2_, v2_;
-  std::vector<int16_t> angle_;  // the pixels' orientations, in the order of u2_ and v2_
+  std::vector<int16_t> angle_;  // the pixels' mirror-rule angles (detail::mirror_angles), in the order of u2_ and v2_
 };
 
 // Plain, obviously-correct Algorithm 1 (every pair of every row checked against Dmin/Dmax).
