@@ -430,7 +430,7 @@ void Detector::vote_thetas(const EdgeSet& edges, const std::vector<int>& thetas,
     int32_t* counts = s.fill.data();  // kLanes x num_rows, lane-major
     int16_t* angle_out_sorted = s.angle16.data();
     std::fill(s.fill.begin(), s.fill.end(), 0);
-    const size_t quarter = (n + kLanes - 1) / kLanes;  // sorted rows: lane l counts pixels [l quarter, (l + 1) quarter)
+    const size_t quarter = (n + kLanes - 1) / kLanes;  // grouped rows: lane l counts pixels [l quarter, (l + 1) quarter)
     const size_t last_quarter = n - std::min(n, (kLanes - 1) * quarter);
     if (sorted_rows) {
       size_t i = 0;
@@ -485,8 +485,8 @@ void Detector::vote_thetas(const EdgeSet& edges, const std::vector<int>& thetas,
       for (; j < n; ++j) place(j, counts[row[j]]);
     };
     if (sorted_rows) {
-      // Stable: lane l takes the l-th quarter of the (orientation-sorted) pixels, and its slots in
-      // every row come after those of lanes < l, so each row stays sorted by orientation.
+      // Stable: lane l takes the l-th quarter of the (orientation-grouped) pixels, and its slots in
+      // every row come after those of lanes < l, so each row stays grouped by orientation bucket.
       stable_scatter(s.sorted.data());
     } else if (narrow && mirror) scatter(s.sorted16.data(), std::true_type{});
     else if (narrow) scatter(s.sorted16.data(), std::false_type{});
