@@ -87,10 +87,11 @@ std::string format_number(double v) {
   return s.str();
 }
 
-sym::PhotoOptions options_with_mirror(double tolerance_deg) {
+sym::PhotoOptions options_with_mirror(double tolerance_deg, bool polarity = false) {
   sym::PhotoOptions options;
   options.params.num_lines = 1;
   options.params.mirror_tolerance_deg = tolerance_deg;
+  options.params.mirror_polarity = polarity;
   return options;
 }
 
@@ -110,7 +111,7 @@ int main(int argc, char** argv) {
     Method fast{"fast", "fast symmetry (defaults: mirror rule " + format_number(default_tolerance) + "°)", {}, {}, {}};
     Method plain{"fast_locations_only", "fast symmetry, locations only (Algorithm 1)", {}, {}, {}};
     Method le{"loy_eklundh", "Loy & Eklundh", {}, {}, {}};
-    std::vector<int> sweep_hits(sweep.size(), 0);
+    std::vector<int> sweep_hits(sweep.size(), 0), polarity_hits(sweep.size(), 0);  // polarity: Params::mirror_polarity
     std::vector<std::string> files;
     for (const auto& row : rows) {
       const cv::Mat image = cv::imread(row.path, cv::IMREAD_COLOR);
@@ -130,6 +131,8 @@ int main(int argc, char** argv) {
       for (size_t t = 0; t < sweep.size(); ++t) {
         const auto lines = sym::detect_photo(image, options_with_mirror(sweep[t])).in_image.lines;
         sweep_hits[t] += !lines.empty() && sym::competition_match(lines[0], row.a, row.b);
+        const auto polar = sym::detect_photo(image, options_with_mirror(sweep[t], true)).in_image.lines;
+        polarity_hits[t] += !polar.empty() && sym::competition_match(polar[0], row.a, row.b);
       }
       std::cout << files.back() << ": fast " << (fast.hits.back() ? "hit" : "miss") << ", locations only "
                 << (plain.hits.back() ? "hit" : "miss") << ", Loy-Eklundh " << (le.hits.back() ? "hit" : "miss") << "\n";
@@ -148,7 +151,8 @@ int main(int argc, char** argv) {
     j.field("mirror_tolerance_deg", default_tolerance);
     j.key("mirror_tolerance_sweep").begin_array();
     for (size_t t = 0; t < sweep.size(); ++t)
-      j.begin_object().field("tolerance_deg", sweep[t]).field("top_line_hits", sweep_hits[t]).end_object();
+      j.begin_object().field("tolerance_deg", sweep[t]).field("top_line_hits", sweep_hits[t])
+          .field("top_line_hits_with_polarity", polarity_hits[t]).end_object();
     j.end_array();
     j.field("time_ratio_le_over_fast", median(le.ms) / median(fast.ms));
     j.end_object();
@@ -172,8 +176,11 @@ int main(int argc, char** argv) {
        << "| top line correct | " << fast.hit_count() << " / " << images << " | " << plain.hit_count() << " / "
        << images << " | " << le.hit_count() << " / " << images << " |\n"
        << "| median ms per image | " << median(fast.ms) << " | " << median(plain.ms) << " | " << median(le.ms) << " |\n"
-       << "\nThe mirror rule's tolerance (top lines correct, of " << images << "):\n\n| tolerance | hits |\n|---|---|\n";
-    for (size_t t = 0; t < sweep.size(); ++t) md << "| " << sweep[t] << "° | " << sweep_hits[t] << " |\n";
+       << "\nThe mirror rule's tolerance (top lines correct, of " << images << "), on orientations (the default) "
+          "and with the gradients' polarity as well (`mirror_polarity`, `nudge-detect --mirror-polarity`):\n\n"
+          "| tolerance | hits | hits with polarity |\n|---|---|---|\n";
+    for (size_t t = 0; t < sweep.size(); ++t)
+      md << "| " << sweep[t] << "° | " << sweep_hits[t] << " | " << polarity_hits[t] << " |\n";
     write_result(name + ".md", md.str());
   } catch (const std::exception& e) {
     std::cerr << "nudge-exp-photos: " << e.what() << "\n";

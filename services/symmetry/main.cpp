@@ -31,6 +31,8 @@ int main(int argc, char** argv) {
     f.add_int("max-row-pixels", &params.max_row_pixels, "skip rows of Rot with more pixels (0: off)");
     f.add_double("mirror-tolerance", &params.mirror_tolerance_deg,
                  "pairs vote only if their edge orientations mirror about the axis within DEG (0: off)");
+    f.add_bool("mirror-polarity", &params.mirror_polarity,
+               "with --mirror-tolerance: the gradients' polarity must mirror too (same contrast on both sides)");
     f.add_int("threads", &params.threads, "threads across angles");
     f.add_int("suppress-r", &params.suppress_r, "non-maximum suppression half-size in R, px");
     f.add_int("suppress-theta", &params.suppress_theta, "non-maximum suppression half-size in theta, degrees");

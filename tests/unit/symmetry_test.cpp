@@ -174,6 +174,241 @@ TEST(SymmetryVote, CornerCuttingBaselineCastsOnlySomeOfTheVotes) {
   EXPECT_THROW(voter.vote(edges, p), std::invalid_argument);
 }
 
+namespace {
+
+// Every pair-loop variant of the mirror rule: windowed checks on rows grouped by orientation
+// (mirror_sorted_rows) or whole rows, portable or AVX-512 loops (vector_kernels), one thread or two.
+void expect_mirror_variants_equal_plain(const EdgeSet& edges, const Params& base, bool need_votes = true) {
+  const Accumulator plain = reference_vote(edges, base);
+  for (bool sorted : {true, false}) {
+    for (bool vector : {true, false}) {
+      for (int threads : {1, 2}) {
+        if (threads == 2 && !(sorted && !vector)) continue;  // two threads: on the windowed loops only
+        Params p = base;
+        p.mirror_sorted_rows = sorted;
+        p.vector_kernels = vector;
+        p.threads = threads;
+        SCOPED_TRACE("sorted rows " + std::to_string(sorted) + ", vector kernels " + std::to_string(vector) +
+                     ", threads " + std::to_string(threads));
+        Detector d(p);
+        if (need_votes) {
+          expect_same_accumulator(d.vote(edges), plain);
+        } else {
+          const Accumulator& fast = d.vote(edges);
+          ASSERT_EQ(fast.votes.size(), plain.votes.size());
+          EXPECT_EQ(cv::countNonZero(fast.votes[0] != plain.votes[0]), 0);
+        }
+      }
+    }
+  }
+}
+
+// Edge pixels at random places with orientations drawn by `angle_of(rng)` (orientation units).
+template <typename AngleOf>
+EdgeSet random_edges(int width, int height, int count, uint32_t seed, AngleOf angle_of) {
+  EdgeSet edges;
+  edges.width = width;
+  edges.height = height;
+  std::mt19937 rng(seed);
+  std::uniform_int_distribution<int> x(0, width - 1), y(0, height - 1);
+  for (int i = 0; i < count; ++i) {
+    edges.points.emplace_back(x(rng), y(rng));
+    edges.orientation.push_back(angle_of(rng));
+  }
+  return edges;
+}
+
+}  // namespace
+
+TEST(SymmetryVote, MirrorWindowsEqualPlainOnScenes) {
+  // Dense scenes (long rows), a narrow image (16-bit loops) and one too wide for them, tolerances
+  // from a fraction of an orientation bucket to everything, with once-per-row and row limits.
+  struct Case {
+    int width, height;
+    double tolerance;
+    bool once = false;
+    int max_row = 0;
+  };
+  const std::vector<Case> cases = {{240, 180, 15}, {160, 120, 0.5}, {160, 120, 90}, {160, 120, 7, true},
+                                   {160, 120, 20, false, 30}, {5600, 24, 15}};  // 5600 wide: too wide for 16-bit lanes
+  for (size_t i = 0; i < cases.size(); ++i) {
+    const Case& c = cases[i];
+    EdgeParams e{1.0, 30, 90, false};
+    e.gradients = true;
+    const EdgeSet edges = detect_edges(syn::indoor_scene(static_cast<uint32_t>(300 + i), c.width, c.height, 4), e);
+    Params p;
+    p.dmin = 5;
+    p.dmax = 200;
+    p.mirror_tolerance_deg = c.tolerance;
+    p.once_per_row = c.once;
+    p.max_row_pixels = c.max_row;
+    SCOPED_TRACE("case " + std::to_string(i));
+    expect_mirror_variants_equal_plain(edges, p);
+  }
+}
+
+TEST(SymmetryVote, MirrorWindowsEqualPlainOnEdgeCases) {
+  Params p = synthetic_params();
+  p.dmin = 2;
+  p.mirror_tolerance_deg = 10;
+  const int16_t near_zero = orientation_units(0.3 * kDeg);  // windows that wrap past 0 / 180 deg
+  {
+    SCOPED_TRACE("orientations within a few degrees of 0 / 180 deg");
+    const EdgeSet edges = random_edges(120, 90, 3000, 11, [&](std::mt19937& rng) {
+      return static_cast<int16_t>(near_zero + std::uniform_int_distribution<int>(-2000, 2000)(rng));
+    });
+    expect_mirror_variants_equal_plain(edges, p);
+    Params near_wrap = p;  // and axes near +-90 deg, where 2 theta wraps too
+    near_wrap.theta_min_deg = 80;
+    near_wrap.theta_max_deg = -80;
+    expect_mirror_variants_equal_plain(edges, near_wrap);
+  }
+  {
+    SCOPED_TRACE("vertical and horizontal edges only (0 and 90 deg: int16 -32768)");
+    const EdgeSet edges = random_edges(120, 90, 3000, 12, [](std::mt19937& rng) {
+      return static_cast<int16_t>(std::uniform_int_distribution<int>(0, 1)(rng) ? 0 : -32768);
+    });
+    expect_mirror_variants_equal_plain(edges, p);
+  }
+  {
+    SCOPED_TRACE("every orientation, one edge pixel per image row (rows of Rot near theta = 0 hold one)");
+    EdgeSet edges;
+    edges.width = 200;
+    edges.height = 150;
+    std::mt19937 rng(13);
+    for (int y = 0; y < edges.height; ++y) {
+      edges.points.emplace_back(std::uniform_int_distribution<int>(0, edges.width - 1)(rng), y);
+      edges.orientation.push_back(static_cast<int16_t>(std::uniform_int_distribution<int>(-32768, 32767)(rng)));
+    }
+    expect_mirror_variants_equal_plain(edges, p);
+  }
+  {
+    SCOPED_TRACE("a sparse frame (most rows of Rot empty) and a single pixel");
+    const EdgeSet sparse = random_edges(400, 300, 40, 14, [](std::mt19937& rng) {
+      return static_cast<int16_t>(std::uniform_int_distribution<int>(-32768, 32767)(rng));
+    });
+    expect_mirror_variants_equal_plain(sparse, p, /*need_votes=*/false);
+    const EdgeSet one = random_edges(400, 300, 1, 15, [](std::mt19937&) { return int16_t{123}; });
+    expect_mirror_variants_equal_plain(one, p, /*need_votes=*/false);
+  }
+  {
+    SCOPED_TRACE("no edge pixels");
+    EdgeSet none;
+    none.width = 64;
+    none.height = 48;
+    Detector d(p);
+    EXPECT_EQ(cv::countNonZero(d.vote(none).votes[0]), 0);
+  }
+}
+
+TEST(SymmetryVote, MirrorWindowsKeepExactlyThePairsWithinTheTolerance) {
+  // One row of Rot at theta = 0 (image row y = 10) holding pixels of every orientation: the
+  // windowed checks must keep a pair exactly when |a + b| <= tolerance (mod 180 deg), on both
+  // sides of the bucket edges and of the 0 / 180 deg wrap.
+  EdgeSet edges;
+  edges.width = 400;
+  edges.height = 21;
+  const int count = 180;
+  for (int i = 0; i < count; ++i) {
+    edges.points.emplace_back(2 * i + 10, 10);
+    edges.orientation.push_back(orientation_units((i * 7 % count) * kDeg + 0.01 * kDeg));
+  }
+  Params p = synthetic_params();
+  p.dmin = 0.5;
+  p.theta_min_deg = p.theta_max_deg = 0;
+  p.mirror_tolerance_deg = 4;
+  long expected = 0;
+  for (int i = 0; i < count; ++i)
+    for (int j = i + 1; j < count; ++j) {
+      const int error = std::abs(static_cast<int16_t>(static_cast<uint16_t>(edges.orientation[i] + edges.orientation[j])));
+      expected += error <= static_cast<int>(std::round(4 * 65536.0 / 180.0));
+    }
+  ASSERT_GT(expected, count);  // each pixel has partners: the count is a real check
+  for (bool vector : {true, false}) {
+    p.vector_kernels = vector;
+    Detector d(p);
+    EXPECT_EQ(cv::sum(d.vote(edges).votes[0])[0], static_cast<double>(expected)) << "vector kernels " << vector;
+  }
+  expect_mirror_variants_equal_plain(edges, p);
+}
+
+TEST(SymmetryVote, MirrorPolarityKeepsOnlyPairsOfTheSameContrast) {
+  // Pixels mirror-symmetric about the vertical line x = 100 (R = 0, theta = 0). Gradient
+  // directions of a mirrored pair with the same contrast on both sides: a and 180 deg - a.
+  EdgeSet edges;
+  edges.width = edges.height = 201;
+  std::mt19937 rng(6);
+  for (int y = 20; y < 180; y += 2) {
+    const int dx = std::uniform_int_distribution<int>(15, 80)(rng);
+    edges.points.emplace_back(100 - dx, y);
+    edges.points.emplace_back(100 + dx, y);
+  }
+  auto axis_votes = [&](double left_deg, double right_deg, bool polarity) {
+    edges.orientation.clear();
+    edges.direction.clear();
+    for (size_t i = 0; i < edges.points.size(); ++i) {
+      const double angle = (i % 2 == 0 ? left_deg : right_deg) * kDeg;
+      edges.orientation.push_back(orientation_units(angle));
+      edges.direction.push_back(direction_units(angle));
+    }
+    Params p = synthetic_params();
+    p.mirror_tolerance_deg = 10;
+    p.mirror_polarity = polarity;
+    Detector d(p);
+    const Accumulator& acc = d.vote(edges);
+    expect_same_accumulator(acc, reference_vote(edges, p));
+    return acc.votes[0].at<int32_t>(89 /* theta 0 */, acc.r_max /* R 0 */);
+  };
+  const int all = axis_votes(30, 150, false);
+  ASSERT_GE(all, 80);
+  EXPECT_EQ(axis_votes(30, 150, true), all);   // same contrast: mirrored directions
+  EXPECT_EQ(axis_votes(0, 180, true), all);    // a vertical outline, dark outside on both sides
+  EXPECT_EQ(axis_votes(30, 142, true), all);   // 8 deg off: inside the tolerance
+  EXPECT_EQ(axis_votes(30, 330, false), all);  // opposite contrast: the orientation rule keeps it...
+  EXPECT_EQ(axis_votes(30, 330, true), 0);     // ...the polarity rule drops it
+  EXPECT_EQ(axis_votes(0, 0, true), 0);        // a step edge seen twice, both gradients pointing right
+}
+
+TEST(SymmetryVote, MirrorPolarityFastEqualsPlain) {
+  EdgeParams e{1.0, 30, 90, false};
+  e.gradients = true;
+  const EdgeSet edges = detect_edges(syn::indoor_scene(41, 240, 180, 4), e);
+  ASSERT_EQ(edges.direction.size(), edges.points.size());
+  for (size_t i = 0; i < edges.points.size(); ++i)  // the direction modulo 180 deg is the orientation
+    ASSERT_LE(std::abs(static_cast<int16_t>(static_cast<uint16_t>(2 * edges.direction[i] - edges.orientation[i]))), 2);
+  Params p;
+  p.dmin = 5;
+  p.dmax = 200;
+  p.mirror_tolerance_deg = 15;
+  p.mirror_polarity = true;
+  expect_mirror_variants_equal_plain(edges, p);
+  Params wrap = p;  // axes near +-90 deg
+  wrap.theta_min_deg = 75;
+  wrap.theta_max_deg = -75;
+  expect_mirror_variants_equal_plain(edges, wrap);
+}
+
+TEST(SymmetryBadInput, MirrorPolarityNeedsTheRuleAndDirections) {
+  Params p;
+  p.mirror_polarity = true;
+  try {
+    validate(p);
+    ADD_FAILURE() << "polarity without the mirror rule accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("mirror_polarity"), std::string::npos) << e.what();
+  }
+  p.mirror_tolerance_deg = 15;
+  EdgeSet edges = edges_from_mask(cv::Mat::ones(20, 20, CV_8U));
+  edges.orientation.assign(edges.points.size(), 0);  // orientations, but no directions
+  Detector d(p);
+  try {
+    d.vote(edges);
+    ADD_FAILURE() << "polarity without directions accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("direction"), std::string::npos) << e.what();
+  }
+}
+
 TEST(SymmetryVote, ThreadsGiveTheSameAccumulator) {
   const cv::Mat scene = syn::indoor_scene(7);
   const EdgeSet edges = detect_edges(scene, EdgeParams{1.0, 30, 90, false});

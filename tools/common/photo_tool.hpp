@@ -30,6 +30,8 @@ inline void add_photo_flags(Flags& flags, symmetry::PhotoOptions* o) {
   flags.add_int("max-row-pixels", &o->params.max_row_pixels, "skip rows of Rot with more pixels (0: off)");
   flags.add_double("mirror-tolerance", &o->params.mirror_tolerance_deg,
                    "pairs vote only if their edge orientations mirror about the axis within DEG (0: off)");
+  flags.add_bool("mirror-polarity", &o->params.mirror_polarity,
+                 "with --mirror-tolerance: the gradients' polarity must mirror too (same contrast on both sides)");
   flags.add_int("max-side", &o->max_side, "detect on a copy scaled to this long side, px (0: full size)");
 }
 

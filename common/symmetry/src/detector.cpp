@@ -39,6 +39,8 @@ void validate(const Params& p) {
   }
   require(std::isfinite(p.mirror_tolerance_deg) && p.mirror_tolerance_deg >= 0 && p.mirror_tolerance_deg <= 90,
           "symmetry parameter mirror_tolerance must be in [0, 90] degrees");
+  require(!p.mirror_polarity || p.mirror_tolerance_deg > 0,
+          "symmetry parameter mirror_polarity needs the mirror rule (mirror_tolerance > 0)");
   require(p.mirror_tolerance_deg == 0 || p.skew_deg.empty(),
           "symmetry parameters: mirror_tolerance does not combine with skew angles");
 }
@@ -49,6 +51,8 @@ int16_t orientation_units(double radians) {
   const int64_t wrapped = std::llround(units - 65536.0 * std::floor(units / 65536.0)) & 0xFFFF;
   return static_cast<int16_t>(static_cast<uint16_t>(wrapped));
 }
+
+int16_t direction_units(double radians) { return orientation_units(0.5 * radians); }
 
 void validate(const EdgeParams& p) {
   require(std::isfinite(p.blur_sigma) && p.blur_sigma >= 0 && p.blur_sigma <= 50,
@@ -93,6 +97,7 @@ namespace {
 void add_orientations(const cv::Mat& dx, const cv::Mat& dy, EdgeSet* edges) {
   const int channels = dx.channels();
   edges->orientation.resize(edges->points.size());
+  edges->direction.resize(edges->points.size());
   for (size_t i = 0; i < edges->points.size(); ++i) {
     const cv::Point p = edges->points[i];
     const int16_t* gx = dx.ptr<int16_t>(p.y) + p.x * channels;
@@ -100,7 +105,9 @@ void add_orientations(const cv::Mat& dx, const cv::Mat& dy, EdgeSet* edges) {
     int best = 0;
     for (int c = 1; c < channels; ++c)
       if (std::abs(gx[c]) + std::abs(gy[c]) > std::abs(gx[best]) + std::abs(gy[best])) best = c;
-    edges->orientation[i] = orientation_units(std::atan2(static_cast<double>(gy[best]), static_cast<double>(gx[best])));
+    const double angle = std::atan2(static_cast<double>(gy[best]), static_cast<double>(gx[best]));
+    edges->orientation[i] = orientation_units(angle);
+    edges->direction[i] = direction_units(angle);
   }
 }
 
@@ -183,6 +190,7 @@ EdgeSet detect_edges(const cv::Mat& image, const EdgeParams& params, cv::Mat* ed
   if (params.gradients) {
     if (big_enough) add_orientations(dx, dy, &set);
     else set.orientation.assign(set.points.size(), 0);
+    if (!big_enough) set.direction.assign(set.points.size(), 0);
   }
   return set;
 }

@@ -10,6 +10,8 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <stdexcept>
+#include <vector>
 
 #include "nudge/symmetry/detector.hpp"
 
@@ -47,12 +49,28 @@ struct MirrorRule {
   int16_t tolerance = 0;  // orientation units
 };
 
-inline MirrorRule mirror_rule(int bin, double tolerance_deg) {
+// With polarity the angles are EdgeSet::direction (modulo 360 deg): a + b = 2 theta + 180 deg.
+inline MirrorRule mirror_rule(int bin, double tolerance_deg, bool polarity = false) {
   MirrorRule m;
   m.on = tolerance_deg > 0;
-  m.target = orientation_units(2.0 * theta_of_bin_deg(bin) * M_PI / 180.0);
-  m.tolerance = static_cast<int16_t>(std::min(32767.0, std::round(tolerance_deg * 65536.0 / 180.0)));
+  const double two_theta = 2.0 * theta_of_bin_deg(bin) * M_PI / 180.0;
+  m.target = polarity ? direction_units(two_theta + M_PI) : orientation_units(two_theta);
+  const double units_per_deg = 65536.0 / (polarity ? 360.0 : 180.0);
+  m.tolerance = static_cast<int16_t>(std::min(32767.0, std::round(tolerance_deg * units_per_deg)));
   return m;
+}
+
+// The per-pixel angles the mirror rule compares: orientations, or directions with polarity.
+inline const std::vector<int16_t>& mirror_angles(const EdgeSet& edges, const Params& p) {
+  return p.mirror_polarity ? edges.direction : edges.orientation;
+}
+inline void require_mirror_angles(const EdgeSet& edges, const Params& p) {
+  if (p.mirror_tolerance_deg > 0 && mirror_angles(edges, p).size() != edges.points.size())
+    throw std::invalid_argument(p.mirror_polarity
+                                    ? "symmetry parameter mirror_polarity needs the edge pixels' gradient directions "
+                                      "(EdgeSet::direction, EdgeParams::gradients)"
+                                    : "symmetry parameter mirror_tolerance needs the edge pixels' orientations "
+                                      "(EdgeParams::gradients)");
 }
 
 inline int16_t mirror_error(int16_t a, int16_t b, int16_t target) {

@@ -21,8 +21,9 @@ void for_each_voting_pair(const EdgeSet& edges, const Params& params, const Line
   struct Item {
     int32_t xq, index;
   };
-  const detail::MirrorRule mirror = detail::mirror_rule(line.theta_bin, params.mirror_tolerance_deg);
-  const bool have_orientation = edges.orientation.size() == edges.points.size();
+  const detail::MirrorRule mirror = detail::mirror_rule(line.theta_bin, params.mirror_tolerance_deg, params.mirror_polarity);
+  const std::vector<int16_t>& angles = detail::mirror_angles(edges, params);
+  const bool have_orientation = angles.size() == edges.points.size();
   // Group by row of Rot with one counting sort, then sort each (short) row by xq.
   const int num_rows = 2 * layout.row_max + 1;
   std::vector<int32_t> row_of(edges.points.size()), starts(num_rows + 1, 0);
@@ -56,8 +57,7 @@ void for_each_voting_pair(const EdgeSet& edges, const Params& params, const Line
       if (want_lo > want_hi) continue;
       auto b = std::lower_bound(a + 1, end, want_lo, [](const Item& it, int32_t v) { return it.xq < v; });
       for (; b != end && b->xq <= want_hi; ++b) {
-        if (mirror.on && (!have_orientation || !detail::mirror_consistent(edges.orientation[a->index],
-                                                                          edges.orientation[b->index], mirror)))
+        if (mirror.on && (!have_orientation || !detail::mirror_consistent(angles[a->index], angles[b->index], mirror)))
           continue;
         visit(edges.points[a->index], edges.points[b->index]);
       }

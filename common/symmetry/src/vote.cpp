@@ -13,6 +13,13 @@
 //  * The buffer, filled by many rows, is histogrammed into four interleaved copies of the
 //    accumulator row, so that consecutive increments of one bin do not wait on each other; the
 //    copies are summed once per theta.
+//  * With the mirror rule (Params::mirror_tolerance_deg) most pairs of a row are examined only to be
+//    rejected: a pixel of orientation a can only pair with orientations within the tolerance of
+//    2 theta - a. For the 32-bit loops, pixels are grouped by orientation bucket once per frame and
+//    a stable counting sort keeps every row of Rot grouped, so the possible partners of a pixel
+//    are one run of the row taken twice over, found through a table of where each bucket starts;
+//    only those are checked (Params::mirror_sorted_rows). The 16-bit AVX-512 loops check up to 32
+//    partners a step, and there whole rows measured faster than windows.
 // The accumulator is bit-identical to reference_vote() (tests compare them).
 #include <algorithm>
 #include <cstring>
@@ -56,6 +63,20 @@ inline int row_pair_bins_mirror(const int32_t* x, const int16_t* a, int n, const
       out[count] = (xi + x[j] + rule.offset) >> 2;
       count += (static_cast<uint32_t>(d - rule.dmin2) <= rule.span) &
                (std::abs(static_cast<int>(detail::mirror_error(a[i], a[j], mirror.target))) <= mirror.tolerance);
+    }
+  }
+  return count;
+}
+
+// The portable loop of row_pair_bins (Params::vector_kernels = false, or no AVX-512).
+inline int row_pair_bins_scalar(const int32_t* x, int n, const PairRule& rule, int32_t* out) {
+  int count = 0;
+  for (int i = 0; i + 1 < n; ++i) {
+    const int32_t xi = x[i];
+    for (int j = i + 1; j < n; ++j) {  // branch-free: always store, advance only when valid
+      const int32_t d = std::abs(x[j] - xi);
+      out[count] = (xi + x[j] + rule.offset) >> 2;
+      count += static_cast<uint32_t>(d - rule.dmin2) <= rule.span;
     }
   }
   return count;
@@ -105,14 +126,7 @@ inline int row_pair_bins(const int32_t* x, int n, const PairRule& rule, int32_t*
     }
   }
 #else
-  for (int i = 0; i + 1 < n; ++i) {
-    const int32_t xi = x[i];
-    for (int j = i + 1; j < n; ++j) {  // branch-free: always store, advance only when valid
-      const int32_t d = std::abs(x[j] - xi);
-      out[count] = (xi + x[j] + rule.offset) >> 2;
-      count += static_cast<uint32_t>(d - rule.dmin2) <= rule.span;
-    }
-  }
+  count = row_pair_bins_scalar(x, n, rule, out);
 #endif
   return count;
 }
@@ -194,6 +208,67 @@ inline int row_pair_bins16(const int16_t*, const int16_t*, int, const PairRule&,
 }
 #endif
 
+// Rows grouped by orientation bucket (Params::mirror_sorted_rows). A pixel of orientation a can only pair
+// with orientations in the window [S, S + 2 tol], S = 2 theta - tol - a (modulo 180 deg). The row is
+// taken twice over (the second copy's orientations counting as raised by 180 deg), so that every
+// window, even one that wraps past 180 deg, is one run [lo, hi) of the doubled row; index k of the
+// doubled row is pixel k mod n. The runs come from a table of where each orientation bucket (the
+// orientation's top bits) starts: a superset of the possible partners, since the exact distance
+// and mirror tests still decide every pair.
+constexpr int kAngleBucketBits = 6;
+constexpr int kAngleBuckets = 1 << kAngleBucketBits;
+constexpr int kAngleBucketShift = 16 - kAngleBucketBits;
+// Shorter rows are checked whole: the table of bucket starts would cost more than it saves.
+constexpr int kWindowedRowPixels = 8;
+
+// starts[b], b = 0..2 kAngleBuckets: the first index of bucket b in the doubled row a[0..n),
+// whose pixels are grouped by ascending bucket. Found from the back (no read-modify-write chain).
+inline void bucket_starts(const int16_t* a, int n, int32_t* starts) {
+  for (int b = 0; b <= kAngleBuckets; ++b) starts[b] = -1;
+  for (int k = n - 1; k >= 0; --k) starts[static_cast<uint16_t>(a[k]) >> kAngleBucketShift] = k;
+  starts[kAngleBuckets] = n;
+  for (int b = kAngleBuckets - 1; b >= 0; --b)
+    if (starts[b] < 0) starts[b] = starts[b + 1];  // an empty bucket starts where the next one does
+  for (int b = 0; b < kAngleBuckets; ++b) starts[kAngleBuckets + b] = n + starts[b];
+  starts[2 * kAngleBuckets] = 2 * n;
+}
+
+// The run [lo, hi) of the doubled row that holds every possible later partner of pixel i, of
+// orientation a: at most n long, so that no pixel appears twice, and starting after i (pixels
+// k in [n, n + i] inside it are i's earlier ones again, skipped by the caller).
+struct Window {
+  int lo, hi;
+};
+inline Window mirror_window(int i, int16_t a, const detail::MirrorRule& mirror, const int32_t* starts, int n) {
+  const int window_start = static_cast<uint16_t>(mirror.target - mirror.tolerance - a);
+  const int lo = starts[window_start >> kAngleBucketShift];
+  const int hi = starts[((window_start + 2 * mirror.tolerance) >> kAngleBucketShift) + 1];
+  return {std::max(lo, i + 1), std::min(hi, lo + n)};
+}
+
+// The windowed pair check of the 32-bit loops: the same tests as row_pair_bins_mirror, on the
+// partners in each pixel's window only. x and a are the doubled row (2n entries); index k is
+// pixel k mod n, a later partner of i (each pair once) for k in (i, n) or (n + i, 2n).
+inline int row_pair_bins_windowed(const int32_t* x, const int16_t* a, int n, const PairRule& rule,
+                                  const detail::MirrorRule& mirror, const int32_t* starts, int32_t* out) {
+  int count = 0;
+  for (int i = 0; i + 1 < n; ++i) {
+    const Window w = mirror_window(i, a[i], mirror, starts, n);
+    const int32_t xi = x[i];
+    auto check = [&](int k0, int k1) {
+      for (int k = k0; k < k1; ++k) {  // branch-free: always store, advance only when valid
+        const int32_t d = std::abs(x[k] - xi);
+        out[count] = (xi + x[k] + rule.offset) >> 2;
+        count += (static_cast<uint32_t>(d - rule.dmin2) <= rule.span) &
+                 (std::abs(static_cast<int>(detail::mirror_error(a[i], a[k], mirror.target))) <= mirror.tolerance);
+      }
+    };
+    check(w.lo, std::min(w.hi, n));
+    check(std::max(w.lo, n + i + 1), w.hi);
+  }
+  return count;
+}
+
 // Skew offsets are whole quarter-pixels of the pair sum: R_skew = x'_mid - y' tan(phi).
 inline int32_t skew_shift(int row, double tan_phi) {
   return static_cast<int32_t>(std::lround(-4.0 * row * tan_phi));
@@ -204,6 +279,24 @@ int skew_margin(const std::vector<double>& skew_deg) {
   double m = 0;
   for (double s : skew_deg) m = std::max(m, std::fabs(std::tan(s * M_PI / 180.0)));
   return static_cast<int>(std::ceil(m));
+}
+
+// Which pair loops a frame uses. 16-bit AVX-512 lanes (narrow) when coordinates, sums plus offsets
+// and histogram indices all fit in int16; otherwise the 32-bit loops, where with the mirror rule
+// rows grouped by orientation let each pixel check only its possible partners (windowed). The
+// 16-bit loops check a whole row of up to 32 pixels in one step: there windows measured slower
+// (docs/results/mirror_voting.md), so narrow rows are checked whole.
+struct KernelChoice {
+  int32_t offset;  // added to pair sums so that histogram indices are >= 0 for any skew
+  bool narrow;
+  bool windowed;
+};
+KernelChoice choose_kernels(const Layout& layout, const Params& p) {
+  KernelChoice c;
+  c.offset = 4 * (layout.r_max + 2) * (1 + skew_margin(p.skew_deg));
+  c.narrow = kHaveNarrowPath && p.vector_kernels && 4 * layout.r_max + 2 * c.offset + 16 < 32767;
+  c.windowed = !c.narrow && p.mirror_tolerance_deg > 0 && p.mirror_sorted_rows;
+  return c;
 }
 
 }  // namespace
@@ -244,15 +337,8 @@ const Accumulator& Detector::vote(const EdgeSet& edges) {
     m.setTo(0);
   }
   const size_t n = edges.points.size();
-  if (params_.mirror_tolerance_deg > 0 && edges.orientation.size() != n)
-    throw std::invalid_argument("symmetry parameter mirror_tolerance needs the edge pixels' orientations "
-                                "(EdgeParams::gradients)");
-  u2_.resize(n);
-  v2_.resize(n);
-  for (size_t i = 0; i < n; ++i) {
-    u2_[i] = 2 * edges.points[i].x - (edges.width - 1);
-    v2_[i] = 2 * edges.points[i].y - (edges.height - 1);
-  }
+  detail::require_mirror_angles(edges, params_);
+  prepare_pixels(edges, choose_kernels(detail::make_layout(edges.width, edges.height, params_), params_).windowed);
   const std::vector<int> thetas = theta_bins_in_range(params_.theta_min_deg, params_.theta_max_deg);
   const int num_threads = std::max(1, std::min<int>(params_.threads, static_cast<int>(thetas.size())));
   scratch_.resize(num_threads);
@@ -269,6 +355,34 @@ const Accumulator& Detector::vote(const EdgeSet& edges) {
   return acc_;
 }
 
+// Edge pixels in doubled coordinates about the image centre, with their orientations: in the
+// EdgeSet's order, or grouped by orientation bucket for windowed pair checks (a stable counting
+// sort: within a bucket the pixels keep their order, so that pixels placed one after the other
+// into rows of Rot land near each other).
+void Detector::prepare_pixels(const EdgeSet& edges, bool group_by_orientation) {
+  const size_t n = edges.points.size();
+  const bool mirror = params_.mirror_tolerance_deg > 0;
+  const std::vector<int16_t>& angles = detail::mirror_angles(edges, params_);  // orientations or directions
+  u2_.resize(n);
+  v2_.resize(n);
+  angle_.assign(mirror ? n : 0, 0);
+  std::vector<uint32_t> order(n);
+  for (size_t i = 0; i < n; ++i) order[i] = static_cast<uint32_t>(i);
+  if (group_by_orientation) {
+    auto bucket = [&](size_t i) { return static_cast<uint16_t>(angles[i]) >> kAngleBucketShift; };
+    size_t next[kAngleBuckets + 1] = {};
+    for (size_t i = 0; i < n; ++i) ++next[bucket(i) + 1];
+    for (int b = 0; b < kAngleBuckets; ++b) next[b + 1] += next[b];
+    for (size_t i = 0; i < n; ++i) order[next[bucket(i)]++] = static_cast<uint32_t>(i);
+  }
+  for (size_t k = 0; k < n; ++k) {
+    const cv::Point p = edges.points[order[k]];
+    u2_[k] = 2 * p.x - (edges.width - 1);
+    v2_[k] = 2 * p.y - (edges.height - 1);
+    if (mirror) angle_[k] = angles[order[k]];
+  }
+}
+
 void Detector::vote_thetas(const EdgeSet& edges, const std::vector<int>& thetas, size_t first, size_t step,
                            Scratch& s) {
   const Layout layout = detail::make_layout(edges.width, edges.height, params_);
@@ -276,7 +390,8 @@ void Detector::vote_thetas(const EdgeSet& edges, const std::vector<int>& thetas,
   const int num_rows = 2 * layout.row_max + 1;
   const int num_layers = static_cast<int>(acc_.votes.size());
   // Histogram index = (xq_a + xq_b + shift + offset + 2) >> 2; offset keeps it >= 0 for any skew.
-  const int32_t offset = 4 * (layout.r_max + 2) * (1 + skew_margin(params_.skew_deg));
+  const KernelChoice kernels = choose_kernels(layout, params_);
+  const int32_t offset = kernels.offset;
   const int index_of_bin0 = offset / 4 - layout.r_max;  // histogram index of R bin 0
   const size_t hist_size = static_cast<size_t>(2 * (offset / 4) + 8);
   constexpr int kCopies = 4;
@@ -290,11 +405,12 @@ void Detector::vote_thetas(const EdgeSet& edges, const std::vector<int>& thetas,
   std::vector<double> tan_skew;
   for (double d : params_.skew_deg) tan_skew.push_back(std::tan(d * M_PI / 180.0));
   const PairRule base_rule{layout.dmin2, static_cast<uint32_t>(layout.dmax2 - layout.dmin2), offset + 2};
-  // 16-bit lanes when coordinates, sums plus offsets and histogram indices all fit in int16.
-  const bool narrow = kHaveNarrowPath && 4 * layout.r_max + 2 * offset + 16 < 32767;
+  const bool narrow = kernels.narrow;
   if (narrow) s.sorted16.resize(n);
   const bool mirror = params_.mirror_tolerance_deg > 0;
+  const bool sorted_rows = kernels.windowed;  // rows of Rot keep the pixels' orientation grouping
   if (mirror) s.angle16.resize(n);
+  s.bucket_start.resize(2 * kAngleBuckets + 1);
 
   for (size_t ti = first; ti < thetas.size(); ti += step) {
     const int k = thetas[ti];
@@ -312,11 +428,23 @@ void Detector::vote_thetas(const EdgeSet& edges, const std::vector<int>& thetas,
     }
     constexpr int kLanes = 4;
     int32_t* counts = s.fill.data();  // kLanes x num_rows, lane-major
+    int16_t* angle_out_sorted = s.angle16.data();
     std::fill(s.fill.begin(), s.fill.end(), 0);
-    size_t i = 0;
-    for (; i + kLanes <= n; i += kLanes)
-      for (int l = 0; l < kLanes; ++l) ++counts[l * num_rows + row[i + l]];
-    for (; i < n; ++i) ++counts[row[i]];
+    const size_t quarter = (n + kLanes - 1) / kLanes;  // grouped rows: lane l counts pixels [l quarter, (l + 1) quarter)
+    const size_t last_quarter = n - std::min(n, (kLanes - 1) * quarter);
+    if (sorted_rows) {
+      size_t i = 0;
+      for (; i < last_quarter; ++i)
+        for (int l = 0; l < kLanes; ++l) ++counts[l * num_rows + row[l * quarter + i]];
+      for (; i < quarter; ++i)
+        for (int l = 0; l + 1 < kLanes; ++l)
+          if (l * quarter + i < n) ++counts[l * num_rows + row[l * quarter + i]];
+    } else {
+      size_t i = 0;
+      for (; i + kLanes <= n; i += kLanes)
+        for (int l = 0; l < kLanes; ++l) ++counts[l * num_rows + row[i + l]];
+      for (; i < n; ++i) ++counts[row[i]];
+    }
     int32_t running = 0;
     for (int r = 0; r < num_rows; ++r) {
       s.starts[r] = running;
@@ -327,8 +455,22 @@ void Detector::vote_thetas(const EdgeSet& edges, const std::vector<int>& thetas,
       }
     }
     s.starts[num_rows] = running;
+    auto stable_scatter = [&](auto* out) {
+      using Value = std::remove_pointer_t<decltype(out)>;
+      auto place = [&](size_t src, int32_t& slot) {
+        const int32_t dst = slot++;
+        out[dst] = static_cast<Value>(xq[src]);
+        angle_out_sorted[dst] = angle_[src];
+      };
+      size_t j = 0;
+      for (; j < last_quarter; ++j)
+        for (int l = 0; l < kLanes; ++l) place(l * quarter + j, counts[l * num_rows + row[l * quarter + j]]);
+      for (; j < quarter; ++j)
+        for (int l = 0; l + 1 < kLanes; ++l)
+          if (l * quarter + j < n) place(l * quarter + j, counts[l * num_rows + row[l * quarter + j]]);
+    };
     // With the mirror rule each pixel's orientation goes to the same place as its xq.
-    const int16_t* orientation = edges.orientation.data();
+    const int16_t* orientation = angle_.data();
     int16_t* angle_out = s.angle16.data();
     auto scatter = [&](auto* out, auto with_angles) {
       using Value = std::remove_pointer_t<decltype(out)>;
@@ -342,12 +484,27 @@ void Detector::vote_thetas(const EdgeSet& edges, const std::vector<int>& thetas,
         for (int l = 0; l < kLanes; ++l) place(j + l, counts[l * num_rows + row[j + l]]);
       for (; j < n; ++j) place(j, counts[row[j]]);
     };
-    if (narrow && mirror) scatter(s.sorted16.data(), std::true_type{});
+    if (sorted_rows) {
+      // Stable: lane l takes the l-th quarter of the (orientation-grouped) pixels, and its slots in
+      // every row come after those of lanes < l, so each row stays grouped by orientation bucket.
+      stable_scatter(s.sorted.data());
+    } else if (narrow && mirror) scatter(s.sorted16.data(), std::true_type{});
     else if (narrow) scatter(s.sorted16.data(), std::false_type{});
     else if (mirror) scatter(s.sorted.data(), std::true_type{});
     else scatter(s.sorted.data(), std::false_type{});
-    const detail::MirrorRule mirror_rule = detail::mirror_rule(k, params_.mirror_tolerance_deg);
+    const detail::MirrorRule mirror_rule = detail::mirror_rule(k, params_.mirror_tolerance_deg, params_.mirror_polarity);
 
+    // A grouped row taken twice over (see row_pair_bins_windowed).
+    auto doubled = [](const auto* row, int count, auto& buffer) {
+      buffer.resize(2 * static_cast<size_t>(count));
+      std::copy(row, row + count, buffer.begin());
+      std::copy(row, row + count, buffer.begin() + count);
+      return buffer.data();
+    };
+    auto starts_of = [&](const int16_t* angles, int count) {
+      bucket_starts(angles, count, s.bucket_start.data());
+      return s.bucket_start.data();
+    };
     for (int layer = 0; layer < num_layers; ++layer) {
       const double tan_phi = layer == 0 ? 0.0 : tan_skew[layer - 1];
       size_t pending = 0;  // bins waiting in s.pairs / s.pairs16
@@ -377,8 +534,15 @@ void Detector::vote_thetas(const EdgeSet& edges, const std::vector<int>& thetas,
           }
           const int32_t* x32 = s.sorted.data() + s.starts[r];
           int32_t* out32 = s.pairs.data() + pending;
-          pending += mirror ? row_pair_bins_mirror(x32, s.angle16.data() + s.starts[r], count, rule, mirror_rule, out32)
-                            : row_pair_bins(x32, count, rule, out32);
+          const int16_t* a16 = s.angle16.data() + s.starts[r];
+          if (sorted_rows && count > kWindowedRowPixels)
+            pending += row_pair_bins_windowed(doubled(x32, count, s.doubled_x), doubled(a16, count, s.doubled_angle),
+                                              count, rule, mirror_rule, starts_of(a16, count), out32);
+          else if (mirror)
+            pending += row_pair_bins_mirror(x32, a16, count, rule, mirror_rule, out32);
+          else
+            pending += params_.vector_kernels ? row_pair_bins(x32, count, rule, out32)
+                                              : row_pair_bins_scalar(x32, count, rule, out32);
         }
         if (params_.once_per_row) {  // the rule needs each row's bins on their own
           if (narrow) add_votes_once(s.pairs16.data(), static_cast<int>(pending), (k * num_layers + layer) * num_rows + r, s);
@@ -403,8 +567,8 @@ void Detector::vote_thetas(const EdgeSet& edges, const std::vector<int>& thetas,
 
 Accumulator reference_vote(const EdgeSet& edges, const Params& params) {
   validate(params);
-  if (params.mirror_tolerance_deg > 0 && edges.orientation.size() != edges.points.size())
-    throw std::invalid_argument("symmetry parameter mirror_tolerance needs the edge pixels' orientations");
+  detail::require_mirror_angles(edges, params);
+  const std::vector<int16_t>& angles = detail::mirror_angles(edges, params);
   const Layout layout = detail::make_layout(edges.width, edges.height, params);
   Accumulator acc;
   acc.r_max = layout.r_max;
@@ -421,10 +585,10 @@ Accumulator reference_vote(const EdgeSet& edges, const Params& params) {
     for (size_t i = 0; i < edges.points.size(); ++i) {
       const cv::Point p = edges.points[i];
       const int32_t u2 = 2 * p.x - (edges.width - 1), v2 = 2 * p.y - (edges.height - 1);
-      const int16_t orientation = edges.orientation.empty() ? int16_t{0} : edges.orientation[i];
+      const int16_t orientation = angles.empty() ? int16_t{0} : angles[i];
       rows[detail::rotated_row(u2, v2, t) + layout.row_max].push_back({detail::rotated_xq(u2, v2, t), orientation});
     }
-    const detail::MirrorRule mirror = detail::mirror_rule(k, params.mirror_tolerance_deg);
+    const detail::MirrorRule mirror = detail::mirror_rule(k, params.mirror_tolerance_deg, params.mirror_polarity);
     for (size_t sk = 0; sk < acc.votes.size(); ++sk) {
       const double tan_phi = sk == 0 ? 0.0 : std::tan(params.skew_deg[sk - 1] * M_PI / 180.0);
       int32_t* out = acc.votes[sk].ptr<int32_t>(k);

@@ -48,6 +48,22 @@ struct Params {
   // EdgeSet::orientation (EdgeParams::gradients); not with skew. 0 = off (Algorithm 1 as published
   // uses edge locations only).
   double mirror_tolerance_deg = 0;
+  // With the mirror rule: also the gradients' polarity must mirror (their directions modulo 360
+  // deg, a + b = 2 theta + 180 deg: the same contrast on both sides of the axis, as an object on a
+  // plain background shows). Needs EdgeSet::direction. Off by default: the thesis' rule is on
+  // orientation only, and an object before a background brighter on one side than the other
+  // shows opposite contrasts on its two sides.
+  bool mirror_polarity = false;
+  // With the mirror rule: keep each row of Rot grouped by orientation and check each pixel only
+  // against the partners whose orientations can mirror its own about the current angle (the other
+  // pairs cannot vote). Applies to the 32-bit pair loops (no AVX-512, vector_kernels = false, or
+  // images too large for 16-bit lanes); the 16-bit AVX-512 loops check whole rows, which measured
+  // faster (docs/results/mirror_voting.md). The accumulator is the same either way; false checks
+  // every pair of every row.
+  bool mirror_sorted_rows = true;
+  // false: the portable scalar pair loops even where AVX-512 is available (what builds without it
+  // run; for tests and measurements). Same accumulator.
+  bool vector_kernels = true;
   int threads = 1;             // threads across theta; results are identical for any count
 };
 
@@ -63,10 +79,15 @@ struct EdgeSet {
   // Optional, one per point: the gradient's orientation modulo 180 deg (polarity-free) in units of
   // 180/65536 deg, so that int16 arithmetic wraps exactly as angles modulo 180 deg do.
   std::vector<int16_t> orientation;
+  // Optional, one per point, filled with orientation: the gradient's direction modulo 360 deg (the
+  // polarity kept) in units of 360/65536 deg (Params::mirror_polarity).
+  std::vector<int16_t> direction;
 };
 
 // An angle (radians) as EdgeSet::orientation units, modulo 180 deg.
 int16_t orientation_units(double radians);
+// An angle (radians) as EdgeSet::direction units, modulo 360 deg.
+int16_t direction_units(double radians);
 
 struct Timing {
   double edges_ms = 0, vote_ms = 0, peaks_ms = 0;
@@ -128,6 +149,10 @@ class Detector {
   struct Scratch {  // per-thread working memory, kept between frames to avoid allocation
     std::vector<int32_t> xq, row, sorted, starts, fill, pairs, hist, stamp;
     std::vector<int16_t> sorted16, pairs16, angle16;  // angle16: orientations in row order
+    // Windowed pair checks with the mirror rule: one row taken twice over, and where its
+    // orientation buckets start.
+    std::vector<int16_t> doubled_angle;
+    std::vector<int32_t> doubled_x, bucket_start;
   };
   template <typename Bin>
   void add_votes(const Bin* bins, int votes, size_t hist_size, Scratch& s) const;
@@ -136,13 +161,17 @@ class Detector {
   void vote_thetas(const EdgeSet& edges, const std::vector<int>& thetas, size_t first, size_t step,
                    Scratch& scratch);
   void add_support(const EdgeSet& edges, Line* line) const;
+  void prepare_pixels(const EdgeSet& edges, bool group_by_orientation);
 
   Params params_;
   EdgeParams edge_params_;
   Accumulator acc_;
   std::vector<Scratch> scratch_;
   // Edge pixels in doubled coordinates about the image centre (see quantise.hpp).
+  // For windowed pair checks (Params::mirror_sorted_rows) grouped by orientation bucket: a stable
+  // counting sort into rows then keeps every row grouped.
   std::vector<int32_t> u2_, v2_;
+  std::vector<int16_t> angle_;  // the pixels' mirror-rule angles (detail::mirror_angles), in the order of u2_ and v2_
 };
 
 // Plain, obviously-correct Algorithm 1 (every pair of every row checked against Dmin/Dmax).

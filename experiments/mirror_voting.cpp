@@ -1,0 +1,244 @@
+// Voting with the mirror rule on dense real frames (issue 14, "Faster by not visiting pairs that
+// cannot vote"): today's exact voting with the rule on (every pair of a row checked) against the
+// windowed voting (rows grouped by orientation, each pixel checks only the partners whose
+// orientations can mirror its own), for the AVX-512 pair loops this build uses and for the portable
+// loops that builds without AVX-512 run; the thesis author's shortcut loop (corner_cutting.hpp, a
+// baseline casting only some of the votes, rule off) beside them. Every timed variant's
+// accumulator is checked against the plain Algorithm 1 loop with the same rule first.
+//   nudge-exp-mirror-voting [--repeats 5] [--tolerance 15] [--images DIR]
+// Frames: opencv-doc's building.jpg, home.jpg, box_in_scene.png, fruits.jpg (plain or .gz) resized
+// to 640x480; Canny sigma 1, 30/90 with gradient orientations; Dmin 25, Dmax 250, full 180 deg.
+// Times are the thread's CPU time (the host is shared), medians of --repeats runs, the variants
+// interleaved within each repeat. Writes docs/results/mirror_voting.{json,md}.
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <sstream>
+
+#include "nudge/flags.hpp"
+#include "nudge/json.hpp"
+#include "nudge/symmetry/corner_cutting.hpp"
+#include "nudge/symmetry/detector.hpp"
+#include "report.hpp"
+
+using namespace nudge;
+using namespace nudge::experiments;
+namespace sym = nudge::symmetry;
+
+namespace {
+
+const std::vector<std::string> kFrames = {"building.jpg", "home.jpg", "box_in_scene.png", "fruits.jpg"};
+
+// An image file, or its gzip-compressed copy (NAME.gz, as some Debian packages ship them).
+cv::Mat read_frame(const std::string& dir, const std::string& name) {
+  const std::string path = dir + "/" + name;
+  if (std::filesystem::exists(path)) return cv::imread(path, cv::IMREAD_COLOR);
+  if (!std::filesystem::exists(path + ".gz")) return {};
+  std::vector<uchar> bytes;
+  FILE* pipe = popen(("gzip -dc '" + path + ".gz'").c_str(), "r");
+  if (!pipe) return {};
+  uchar buffer[65536];
+  for (size_t got; (got = fread(buffer, 1, sizeof buffer, pipe)) > 0;) bytes.insert(bytes.end(), buffer, buffer + got);
+  pclose(pipe);
+  return bytes.empty() ? cv::Mat() : cv::imdecode(bytes, cv::IMREAD_COLOR);
+}
+
+double thread_cpu_ms() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return t.tv_sec * 1e3 + t.tv_nsec * 1e-6;
+}
+
+sym::Params voting_params(double tolerance, bool windowed, bool vector_kernels) {
+  sym::Params p;
+  p.dmin = 25;
+  p.dmax = 250;
+  p.mirror_tolerance_deg = tolerance;
+  p.mirror_sorted_rows = windowed;
+  p.vector_kernels = vector_kernels;
+  return p;
+}
+
+struct Variant {
+  std::string key;  // JSON key
+  sym::Params params;
+  std::vector<double> ms;
+};
+
+struct FrameResult {
+  std::string name;
+  int edges = 0;
+  std::map<std::string, double> ms;  // variant key -> median ms
+  double author_loop_ms = 0, exact_rule_off_ms = 0, author_votes_fraction = 0;
+};
+
+FrameResult measure(const std::string& name, const cv::Mat& image, double tolerance, int repeats) {
+  cv::Mat frame;
+  cv::resize(image, frame, {640, 480}, 0, 0, cv::INTER_AREA);
+  sym::EdgeParams edge_params{1.0, 30, 90, false};
+  edge_params.gradients = true;
+  const sym::EdgeSet edges = sym::detect_edges(frame, edge_params);
+  FrameResult out;
+  out.name = name;
+  out.edges = static_cast<int>(edges.points.size());
+  std::vector<Variant> variants = {{"before", voting_params(tolerance, false, true), {}},
+                                   {"after", voting_params(tolerance, true, true), {}},
+                                   {"portable_before", voting_params(tolerance, false, false), {}},
+                                   {"portable_after", voting_params(tolerance, true, false), {}}};
+  // Same accumulator as the plain loop with the same rule, for every variant, before timing.
+  const sym::Accumulator plain = sym::reference_vote(edges, variants[0].params);
+  std::vector<sym::Detector> detectors;
+  for (const Variant& v : variants) detectors.emplace_back(v.params);
+  for (size_t i = 0; i < variants.size(); ++i)
+    if (cv::countNonZero(detectors[i].vote(edges).votes[0] != plain.votes[0]) != 0)
+      throw std::runtime_error(name + ": the " + variants[i].key + " accumulator differs from the plain loop's");
+  const sym::Params rule_off = voting_params(0, false, true);
+  sym::Detector exact_rule_off(rule_off);
+  sym::CornerCuttingVoter author;
+  std::vector<double> author_ms, exact_ms;
+  for (int r = 0; r < repeats; ++r) {
+    for (size_t i = 0; i < variants.size(); ++i) {
+      const double t0 = thread_cpu_ms();
+      detectors[i].vote(edges);
+      variants[i].ms.push_back(thread_cpu_ms() - t0);
+    }
+    double t0 = thread_cpu_ms();
+    author.vote(edges, rule_off);
+    author_ms.push_back(thread_cpu_ms() - t0);
+    t0 = thread_cpu_ms();
+    exact_rule_off.vote(edges);
+    exact_ms.push_back(thread_cpu_ms() - t0);
+  }
+  for (const Variant& v : variants) out.ms[v.key] = median(v.ms);
+  out.author_loop_ms = median(author_ms);
+  out.exact_rule_off_ms = median(exact_ms);
+  out.author_votes_fraction = cv::sum(author.vote(edges, rule_off).votes[0])[0] /
+                              std::max(1.0, cv::sum(exact_rule_off.vote(edges).votes[0])[0]);
+  return out;
+}
+
+std::string fixed(double v, int digits = 1) {
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(digits) << v;
+  return s.str();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) try {
+  int repeats = 5;
+  double tolerance = 15;
+  std::string images = "/usr/share/doc/opencv-doc/examples/data";
+  Flags flags("nudge-exp-mirror-voting", "Mirror-rule voting on dense 640x480 frames: before/after, author's loop.");
+  flags.add_int("repeats", &repeats, "timed runs per frame and variant (median)");
+  flags.add_double("tolerance", &tolerance, "mirror-rule tolerance, degrees");
+  flags.add_string("images", &images, "directory with building.jpg, home.jpg, box_in_scene.png, fruits.jpg (or .gz)");
+  if (!flags.parse(argc, argv)) return 0;
+  if (repeats < 1) throw std::invalid_argument("--repeats must be >= 1");
+  if (!(tolerance > 0 && tolerance <= 90)) throw std::invalid_argument("--tolerance must be in (0, 90] degrees");
+
+  std::vector<FrameResult> rows;
+  for (const std::string& name : kFrames) {
+    const cv::Mat image = read_frame(images, name);
+    if (image.empty()) throw std::runtime_error("cannot read " + images + "/" + name + " (or .gz): install opencv-doc");
+    rows.push_back(measure(name, image, tolerance, repeats));
+    const FrameResult& r = rows.back();
+    std::cout << name << ": " << r.edges << " edges, before " << r.ms.at("before") << " ms, after " << r.ms.at("after")
+              << " ms, portable before " << r.ms.at("portable_before") << " ms, portable after "
+              << r.ms.at("portable_after") << " ms, author's loop " << r.author_loop_ms << " ms" << std::endl;
+  }
+
+  auto mean_of = [&](auto value) {
+    std::vector<double> v;
+    for (const FrameResult& r : rows) v.push_back(value(r));
+    return mean(v);
+  };
+  const double before = mean_of([](const FrameResult& r) { return r.ms.at("before"); });
+  const double after = mean_of([](const FrameResult& r) { return r.ms.at("after"); });
+  const double portable_before = mean_of([](const FrameResult& r) { return r.ms.at("portable_before"); });
+  const double portable_after = mean_of([](const FrameResult& r) { return r.ms.at("portable_after"); });
+  const double author = mean_of([](const FrameResult& r) { return r.author_loop_ms; });
+  bool faster_than_author_everywhere = true;
+  for (const FrameResult& r : rows) faster_than_author_everywhere &= r.ms.at("after") < r.author_loop_ms;
+
+  JsonWriter j;
+  j.begin_object();
+  j.field("cpu_model", machine_description()).field("date", today()).field("repeats", repeats);
+  j.field("mirror_tolerance_deg", tolerance).field("frame_size", "640x480").field("dmin", 25).field("dmax", 250);
+  j.field("timing", "thread CPU time, median of repeats, variants interleaved, one thread");
+  auto per_frame = [&](const std::string& key, auto value, double mean_value) {
+    j.key(key).begin_object();
+    for (const FrameResult& r : rows) j.field(r.name, value(r));
+    j.field("mean", mean_value);
+    j.end_object();
+  };
+  j.key("mirror_vote_ms").begin_object();
+  per_frame("before", [](const FrameResult& r) { return r.ms.at("before"); }, before);
+  per_frame("after", [](const FrameResult& r) { return r.ms.at("after"); }, after);
+  j.end_object();
+  j.field("mirror_speedup", before / after);
+  j.key("mirror_vote_ms_portable").begin_object();
+  per_frame("before", [](const FrameResult& r) { return r.ms.at("portable_before"); }, portable_before);
+  per_frame("after", [](const FrameResult& r) { return r.ms.at("portable_after"); }, portable_after);
+  j.end_object();
+  j.field("mirror_speedup_portable", portable_before / portable_after);
+  per_frame("author_loop_ms", [](const FrameResult& r) { return r.author_loop_ms; }, author);
+  per_frame("author_loop_votes_fraction", [](const FrameResult& r) { return r.author_votes_fraction; },
+            mean_of([](const FrameResult& r) { return r.author_votes_fraction; }));
+  per_frame("exact_rule_off_ms", [](const FrameResult& r) { return r.exact_rule_off_ms; },
+            mean_of([](const FrameResult& r) { return r.exact_rule_off_ms; }));
+  j.key("edges").begin_object();
+  for (const FrameResult& r : rows) j.field(r.name, r.edges);
+  j.end_object();
+  j.key("targets").begin_object();
+  j.field("speedup_at_least_4x", before / after >= 4).field("faster_than_author_loop_on_every_frame",
+                                                             faster_than_author_everywhere);
+  j.end_object();
+  j.end_object();
+  write_result("mirror_voting.json", j.str() + "\n");
+
+  std::ostringstream md;
+  md << "# Voting with the mirror rule on dense frames\n\n"
+     << "Issue 14, \"Faster by not visiting pairs that cannot vote\". `nudge-exp-mirror-voting`: opencv-doc's "
+        "`building.jpg`, `home.jpg`, `box_in_scene.png`, `fruits.jpg` at 640×480, Canny σ = 1, 30/90 with "
+        "gradient orientations, Dmin 25, Dmax 250, full 180°, mirror tolerance "
+     << tolerance << "°. One thread; thread CPU time (the host is shared), median of " << repeats
+     << " runs, the variants interleaved in each run. Every variant's accumulator equals the plain Algorithm 1 "
+        "loop's with the same rule (checked before timing).\n\n"
+     << "Machine: " << machine_description() << ", " << today() << ".\n\n"
+     << "- **before**: today's exact voting with the rule on (`mirror_sorted_rows = false`): every pair of a row "
+        "checked.\n"
+     << "- **after**: the default (`mirror_sorted_rows = true`). With this build's AVX-512 16-bit pair loops the "
+        "rows are still checked whole (windows measured slower there, see below), so before and after run the "
+        "same loops.\n"
+     << "- **portable**: the same with `vector_kernels = false` — the scalar loops that builds without AVX-512 "
+        "run; here `after` groups each row by orientation and checks each pixel only against the partners whose "
+        "orientations can mirror its own.\n"
+     << "- **author's loop**: the thesis author's shortcuts (`corner_cutting.hpp`, a baseline: rule off, casts "
+        "only some of the votes).\n\n"
+     << "| frame | edges | before ms | after ms | portable before ms | portable after ms | portable speed-up | "
+        "author's loop ms (votes cast) | exact, rule off ms |\n|---|---|---|---|---|---|---|---|---|\n";
+  for (const FrameResult& r : rows)
+    md << "| " << r.name << " | " << r.edges << " | " << fixed(r.ms.at("before")) << " | " << fixed(r.ms.at("after"))
+       << " | " << fixed(r.ms.at("portable_before")) << " | " << fixed(r.ms.at("portable_after")) << " | "
+       << fixed(r.ms.at("portable_before") / r.ms.at("portable_after"), 2) << "× | " << fixed(r.author_loop_ms) << " ("
+       << fixed(100 * r.author_votes_fraction, 0) << " %) | " << fixed(r.exact_rule_off_ms) << " |\n";
+  md << "| **mean** | | " << fixed(before) << " | " << fixed(after) << " | " << fixed(portable_before) << " | "
+     << fixed(portable_after) << " | " << fixed(portable_before / portable_after, 2) << "× | " << fixed(author)
+     << " | |\n\n"
+     << "`mirror_speedup` (before ÷ after, means): " << fixed(before / after, 2) << "×; portable loops: "
+     << fixed(portable_before / portable_after, 2) << "×. The issue's targets — ≥ 4× and faster than the author's "
+        "loop on every frame — are "
+     << (before / after >= 4 && faster_than_author_everywhere ? "met" : "**not met**") << " on this machine.\n";
+  write_result("mirror_voting.md", md.str());
+  return 0;
+} catch (const std::exception& e) {
+  std::cerr << "nudge-exp-mirror-voting: " << e.what() << "\n";
+  return 1;
+}
