@@ -1,0 +1,32 @@
+#pragma once
+// SIFT features of one image (thesis sec. 7.3.2), optionally only those inside a box.
+#include <opencv2/core.hpp>
+
+#include <vector>
+
+namespace nudge::learning {
+
+// Keypoints and their SIFT descriptors (CV_32F, one 128-wide row per keypoint).
+struct Features {
+  std::vector<cv::KeyPoint> keypoints;
+  cv::Mat descriptors;
+
+  int size() const { return static_cast<int>(keypoints.size()); }
+  bool empty() const { return keypoints.empty(); }
+};
+
+// SIFT on the grey image (BGR or grey, 8-bit). Throws std::invalid_argument for an empty or
+// non-8-bit image.
+Features detect_features(const cv::Mat& image);
+
+// The box grown by `margin` times its width and height on every side (the thesis' "generous" box,
+// allowing for the tilt and shift of an imperfect grasp), clipped to the image.
+cv::Rect generous_box(const cv::Rect& box, double margin, cv::Size image_size);
+
+// The features whose keypoint lies inside `box`; an empty box keeps everything.
+Features features_inside(const Features& features, const cv::Rect& box);
+
+// The features whose index `keep` marks.
+Features select_features(const Features& features, const std::vector<bool>& keep);
+
+}  // namespace nudge::learning

@@ -1,0 +1,69 @@
+#pragma once
+// An object model learned from the views of an object the arm turns in front of the camera
+// (thesis sec. 7.3): per view, the SIFT features left after background pruning.
+#include <opencv2/core.hpp>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "nudge/learning/features.hpp"
+
+namespace nudge::learning {
+
+// One training image as it arrives: the camera's still, where the object is (empty: unknown) and
+// how far the wrist had turned.
+struct TrainingImage {
+  cv::Mat image;
+  cv::Rect box;
+  double wrist_angle = 0;  // radians, relative to the first view
+};
+
+struct ModelView {
+  Features features;      // kept after pruning
+  cv::Rect box;
+  double wrist_angle = 0;
+  cv::Mat image;          // the training image; may be empty (a model loaded without its pictures)
+};
+
+// When and how an object was learned, and its size (stored with it in the database).
+struct ObjectInfo {
+  std::string name;
+  std::string run_id, object_key;  // the run that learned it
+  int64_t learned_utime = 0;
+  double height = 0, radius = 0;   // metres; 0: unknown
+};
+
+struct ObjectModel {
+  ObjectInfo info;
+  std::vector<ModelView> views;
+
+  int descriptor_count() const;
+};
+
+struct LearnParams {
+  double box_margin = 0.25;   // of the box's size, each side
+  double ratio = 0.6;         // Lowe's ratio between views (thesis: N = 0.6)
+  int background_matches = 3; // a descriptor matching this many other views' descriptors is background
+};
+
+struct LearnStats {
+  int detected = 0;            // SIFT keypoints in every view
+  int outside_box = 0;         // pruned by the generous box
+  int background = 0;          // pruned by the matches-across-views rule
+  int kept = 0;
+};
+
+// For every view's descriptors: true when it is background by the thesis' rule (sec. 7.3.3). An
+// object descriptor stays visible for one turn step either way, so it matches at most the previous
+// and the next view; one that matches (Lowe's ratio test) descriptors of `background_matches` or
+// more other views belongs to the static scene behind the object.
+std::vector<std::vector<bool>> background_descriptors(const std::vector<Features>& views, double ratio,
+                                                      int background_matches);
+
+// Detects, prunes (box, then across views) and keeps the images. Throws std::invalid_argument
+// naming the view when an image is empty or not 8-bit, and when no views are given.
+ObjectModel learn_object(const ObjectInfo& info, const std::vector<TrainingImage>& images,
+                         const LearnParams& params = {}, LearnStats* stats = nullptr);
+
+}  // namespace nudge::learning

@@ -1,0 +1,82 @@
+#pragma once
+// Recognition against learned object models (thesis sec. 7.3.4): Lowe's ratio test against each
+// object's training views in turn, a geometric check per training view so that a match is a match,
+// and the thesis' rule that the best object needs three or more matches.
+#include <opencv2/core.hpp>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "nudge/learning/model.hpp"
+
+namespace nudge::learning {
+
+// How descriptors are matched: exhaustively, or approximately by FLANN's randomised k-d trees.
+// bench/learning_bench.cpp measures both against database size (docs/benchmarks.md).
+enum class MatcherKind { BruteForce, Flann };
+MatcherKind matcher_from_name(const std::string& name);  // "bf" | "flann"; throws std::invalid_argument
+std::string matcher_name(MatcherKind kind);
+
+struct RecognizeParams {
+  double ratio = 0.6;           // d1 < ratio * d2 (thesis: N = 0.6)
+  int min_matches = 3;          // the best object needs this many verified matches (thesis: 3)
+  bool geometric_check = true;  // RANSAC similarity or homography per training view
+  int min_support = 2;          // matches agreeing with a mapping beyond those that fixed it
+  double ransac_px = 6.0;       // reprojection error an inlier may have, pixels
+  MatcherKind matcher = MatcherKind::Flann;
+};
+
+// How one object scored against the query.
+struct ObjectScore {
+  std::string name;
+  int ratio_matches = 0;            // passed the ratio test, summed over the views
+  int verified_matches = 0;         // geometric inliers in the best view (its ratio matches when unchecked)
+  int best_view = -1;
+  std::vector<cv::DMatch> matches;  // verified: queryIdx into the query, trainIdx into best_view's features
+};
+
+struct Recognition {
+  int best = -1;                    // index into scores; -1: nothing recognised
+  std::string reason;               // why nothing was recognised
+  std::vector<ObjectScore> scores;  // one per object, in the recognizer's order
+  Features query;                   // the query image's features (in full-image coordinates)
+  double elapsed_ms = 0;
+
+  bool recognised() const { return best >= 0; }
+  const ObjectScore* best_score() const { return best >= 0 ? &scores[best] : nullptr; }
+};
+
+class Recognizer {
+ public:
+  explicit Recognizer(const RecognizeParams& params = {});
+  ~Recognizer();
+  Recognizer(Recognizer&&) noexcept;
+  Recognizer& operator=(Recognizer&&) noexcept;
+
+  // Adds a model, or replaces the one of the same name; builds its matcher index now.
+  void add(std::shared_ptr<const ObjectModel> model);
+  bool remove(const std::string& name);
+  int size() const;
+  const ObjectModel& model(int index) const;
+  const ObjectModel* find(const std::string& name) const;
+  const RecognizeParams& params() const { return params_; }
+
+  // Which object `image` shows, looking inside `roi` only (empty: the whole image). Throws
+  // std::invalid_argument for an empty or non-8-bit image.
+  Recognition recognize(const cv::Mat& image, const cv::Rect& roi = {}) const;
+  // The same on features already detected.
+  Recognition recognize(const Features& query) const;
+
+ private:
+  struct Entry;
+  RecognizeParams params_;
+  std::vector<std::unique_ptr<Entry>> entries_;
+};
+
+// Thesis fig. 7.10: the query image above the best training view, the verified matches as red
+// lines, the label in green. `training_image` is that view's picture (BGR or grey).
+cv::Mat draw_match_picture(const cv::Mat& query_image, const cv::Mat& training_image, const Features& training,
+                           const Recognition& result);
+
+}  // namespace nudge::learning

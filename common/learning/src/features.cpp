@@ -1,0 +1,52 @@
+#include "nudge/learning/features.hpp"
+
+#include <opencv2/features2d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <stdexcept>
+
+namespace nudge::learning {
+
+Features detect_features(const cv::Mat& image) {
+  if (image.empty()) throw std::invalid_argument("SIFT: empty image");
+  if (image.depth() != CV_8U) throw std::invalid_argument("SIFT: image is not 8-bit");
+  cv::Mat grey;
+  if (image.channels() == 3) cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
+  else if (image.channels() == 4) cv::cvtColor(image, grey, cv::COLOR_BGRA2GRAY);
+  else grey = image;
+  // One detector per thread: cv::SIFT keeps scratch state.
+  thread_local cv::Ptr<cv::SIFT> sift = cv::SIFT::create();
+  Features features;
+  sift->detectAndCompute(grey, cv::noArray(), features.keypoints, features.descriptors);
+  if (features.descriptors.empty()) features.descriptors.create(0, 128, CV_32F);
+  return features;
+}
+
+cv::Rect generous_box(const cv::Rect& box, double margin, cv::Size image_size) {
+  const int dx = static_cast<int>(box.width * margin), dy = static_cast<int>(box.height * margin);
+  const cv::Rect grown(box.x - dx, box.y - dy, box.width + 2 * dx, box.height + 2 * dy);
+  return grown & cv::Rect(cv::Point(0, 0), image_size);
+}
+
+Features select_features(const Features& features, const std::vector<bool>& keep) {
+  Features out;
+  out.descriptors.create(0, features.descriptors.empty() ? 128 : features.descriptors.cols, CV_32F);
+  for (int i = 0; i < features.size(); ++i) {
+    if (!keep[i]) continue;
+    out.keypoints.push_back(features.keypoints[i]);
+    out.descriptors.push_back(features.descriptors.row(i));
+  }
+  return out;
+}
+
+Features features_inside(const Features& features, const cv::Rect& box) {
+  if (box.empty()) return features;
+  std::vector<bool> keep(features.size());
+  for (int i = 0; i < features.size(); ++i) {
+    const cv::Point2f& p = features.keypoints[i].pt;
+    keep[i] = p.x >= box.x && p.y >= box.y && p.x < box.x + box.width && p.y < box.y + box.height;
+  }
+  return select_features(features, keep);
+}
+
+}  // namespace nudge::learning

@@ -1,0 +1,72 @@
+#include "nudge/learning/model.hpp"
+
+#include <opencv2/features2d.hpp>
+
+#include <stdexcept>
+
+#include "ratio_match.hpp"
+
+namespace nudge::learning {
+
+int ObjectModel::descriptor_count() const {
+  int n = 0;
+  for (const auto& view : views) n += view.features.size();
+  return n;
+}
+
+std::vector<std::vector<bool>> background_descriptors(const std::vector<Features>& views, double ratio,
+                                                      int background_matches) {
+  std::vector<std::vector<int>> matched_views(views.size());
+  for (size_t i = 0; i < views.size(); ++i) matched_views[i].assign(views[i].size(), 0);
+  for (size_t j = 0; j < views.size(); ++j) {
+    cv::BFMatcher matcher(cv::NORM_L2);
+    matcher.add(views[j].descriptors);
+    for (size_t i = 0; i < views.size(); ++i) {
+      if (i == j) continue;
+      for (const cv::DMatch& m : detail::ratio_matches(matcher, views[i].descriptors, views[j].size(), ratio))
+        ++matched_views[i][m.queryIdx];
+    }
+  }
+  std::vector<std::vector<bool>> background(views.size());
+  for (size_t i = 0; i < views.size(); ++i) {
+    background[i].resize(views[i].size());
+    for (int k = 0; k < views[i].size(); ++k) background[i][k] = matched_views[i][k] >= background_matches;
+  }
+  return background;
+}
+
+ObjectModel learn_object(const ObjectInfo& info, const std::vector<TrainingImage>& images, const LearnParams& params,
+                         LearnStats* stats) {
+  if (images.empty()) throw std::invalid_argument("object " + info.name + ": no training views");
+  LearnStats counts;
+  std::vector<Features> boxed;
+  for (size_t v = 0; v < images.size(); ++v) {
+    const TrainingImage& t = images[v];
+    if (t.image.empty() || t.image.depth() != CV_8U)
+      throw std::invalid_argument("object " + info.name + ": view " + std::to_string(v) + " is empty or not 8-bit");
+    const Features all = detect_features(t.image);
+    const cv::Rect box = t.box.empty() ? cv::Rect() : generous_box(t.box, params.box_margin, t.image.size());
+    boxed.push_back(features_inside(all, box));
+    counts.detected += all.size();
+    counts.outside_box += all.size() - boxed.back().size();
+  }
+  const auto background = background_descriptors(boxed, params.ratio, params.background_matches);
+  ObjectModel model;
+  model.info = info;
+  for (size_t v = 0; v < images.size(); ++v) {
+    std::vector<bool> keep(background[v].size());
+    for (size_t k = 0; k < keep.size(); ++k) keep[k] = !background[v][k];
+    ModelView view;
+    view.features = select_features(boxed[v], keep);
+    view.box = images[v].box;
+    view.wrist_angle = images[v].wrist_angle;
+    view.image = images[v].image;
+    counts.background += boxed[v].size() - view.features.size();
+    counts.kept += view.features.size();
+    model.views.push_back(std::move(view));
+  }
+  if (stats) *stats = counts;
+  return model;
+}
+
+}  // namespace nudge::learning

@@ -1,0 +1,197 @@
+#include "nudge/learning/recognizer.hpp"
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/features2d.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+#include <stdexcept>
+
+#include "nudge/timing.hpp"
+#include "ratio_match.hpp"
+
+namespace nudge::learning {
+
+MatcherKind matcher_from_name(const std::string& name) {
+  if (name == "bf") return MatcherKind::BruteForce;
+  if (name == "flann") return MatcherKind::Flann;
+  throw std::invalid_argument("unknown matcher '" + name + "' (bf or flann)");
+}
+
+std::string matcher_name(MatcherKind kind) { return kind == MatcherKind::BruteForce ? "bf" : "flann"; }
+
+// One object's descriptor sets, one matcher per training view. The ratio test runs per view, not
+// over the object's whole set as the thesis did: neighbouring views show the same surface point,
+// whose second neighbour would then often be itself one turn step on, failing a true match.
+struct Recognizer::Entry {
+  std::shared_ptr<const ObjectModel> model;
+  std::vector<cv::Ptr<cv::DescriptorMatcher>> view_matchers;  // null for a view of < 2 descriptors
+};
+
+namespace {
+
+cv::Ptr<cv::DescriptorMatcher> make_matcher(MatcherKind kind) {
+  if (kind == MatcherKind::BruteForce) return cv::makePtr<cv::BFMatcher>(cv::NORM_L2);
+  // Randomised k-d trees: 4 trees, 32 leaves checked (Lowe's and OpenCV's usual setting for SIFT).
+  return cv::makePtr<cv::FlannBasedMatcher>(cv::makePtr<cv::flann::KDTreeIndexParams>(4),
+                                           cv::makePtr<cv::flann::SearchParams>(32));
+}
+
+// One match per training point and per query point. SIFT gives a point several keypoints when it
+// has several dominant orientations; their matches are one piece of evidence, not several, and
+// would otherwise agree with each other in any geometric check.
+std::vector<cv::DMatch> one_per_point(std::vector<cv::DMatch> matches, const Features& query, const Features& view) {
+  std::sort(matches.begin(), matches.end(), [](const cv::DMatch& a, const cv::DMatch& b) { return a.distance < b.distance; });
+  auto key = [](const cv::Point2f& p) { return std::make_pair(std::lround(p.x * 2), std::lround(p.y * 2)); };
+  std::set<std::pair<long, long>> used_query, used_train;
+  std::vector<cv::DMatch> out;
+  for (const auto& m : matches) {
+    const auto q = key(query.keypoints[m.queryIdx].pt), t = key(view.keypoints[m.trainIdx].pt);
+    if (used_query.count(q) || used_train.count(t)) continue;
+    used_query.insert(q);
+    used_train.insert(t);
+    out.push_back(m);
+  }
+  return out;
+}
+
+// A homography is tried only with this many matches: fewer fit it too easily.
+constexpr int kHomographyMinMatches = 10;
+
+std::vector<cv::DMatch> inliers_of(const std::vector<cv::DMatch>& matches, const std::vector<uchar>& mask) {
+  std::vector<cv::DMatch> out;
+  for (size_t i = 0; i < matches.size(); ++i)
+    if (mask[i]) out.push_back(matches[i]);
+  return out;
+}
+
+// The largest set of matches one mapping of the training view onto the query explains: a
+// similarity (rotation, scale, shift: 2 matches fix it) or, with enough matches, a homography (4
+// fix it). The matches that fixed the mapping agree with it by construction, so a set counts only
+// when `min_support` more matches agree; otherwise none are verified.
+std::vector<cv::DMatch> geometric_inliers(const std::vector<cv::DMatch>& matches, const Features& query,
+                                          const Features& view, double ransac_px, int min_support) {
+  if (matches.size() < 3) return {};
+  std::vector<cv::Point2f> from, to;
+  for (const auto& m : matches) {
+    from.push_back(view.keypoints[m.trainIdx].pt);
+    to.push_back(query.keypoints[m.queryIdx].pt);
+  }
+  std::vector<cv::DMatch> best;
+  std::vector<uchar> mask;
+  if (!cv::estimateAffinePartial2D(from, to, mask, cv::RANSAC, ransac_px, 2000, 0.995).empty()) {
+    auto inliers = inliers_of(matches, mask);
+    if (static_cast<int>(inliers.size()) >= 2 + min_support) best = std::move(inliers);
+  }
+  if (static_cast<int>(matches.size()) >= kHomographyMinMatches) {
+    const cv::Mat h = cv::findHomography(from, to, cv::RANSAC, ransac_px, mask, 2000, 0.995);
+    // A mirrored or collapsed mapping is not a view of a surface.
+    if (!h.empty() && cv::determinant(h(cv::Rect(0, 0, 2, 2))) > 1e-4) {
+      auto inliers = inliers_of(matches, mask);
+      if (static_cast<int>(inliers.size()) >= 4 + min_support && inliers.size() > best.size()) best = std::move(inliers);
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+Recognizer::Recognizer(const RecognizeParams& params) : params_(params) {}
+Recognizer::~Recognizer() = default;
+Recognizer::Recognizer(Recognizer&&) noexcept = default;
+Recognizer& Recognizer::operator=(Recognizer&&) noexcept = default;
+
+void Recognizer::add(std::shared_ptr<const ObjectModel> model) {
+  auto entry = std::make_unique<Entry>();
+  for (const ModelView& view : model->views) {
+    cv::Ptr<cv::DescriptorMatcher> matcher;
+    if (view.features.size() >= 2) {
+      matcher = make_matcher(params_.matcher);
+      matcher->add(view.features.descriptors);
+      matcher->train();  // builds FLANN's trees now, not on the first query
+    }
+    entry->view_matchers.push_back(matcher);
+  }
+  entry->model = std::move(model);
+  for (auto& e : entries_) {
+    if (e->model->info.name == entry->model->info.name) {
+      e = std::move(entry);
+      return;
+    }
+  }
+  entries_.push_back(std::move(entry));
+}
+
+bool Recognizer::remove(const std::string& name) {
+  for (auto it = entries_.begin(); it != entries_.end(); ++it) {
+    if ((*it)->model->info.name == name) {
+      entries_.erase(it);
+      return true;
+    }
+  }
+  return false;
+}
+
+int Recognizer::size() const { return static_cast<int>(entries_.size()); }
+const ObjectModel& Recognizer::model(int index) const { return *entries_.at(index)->model; }
+
+const ObjectModel* Recognizer::find(const std::string& name) const {
+  for (const auto& e : entries_)
+    if (e->model->info.name == name) return e->model.get();
+  return nullptr;
+}
+
+Recognition Recognizer::recognize(const cv::Mat& image, const cv::Rect& roi) const {
+  Stopwatch watch;
+  if (image.empty()) throw std::invalid_argument("recognize: empty image");
+  const cv::Rect area = roi.empty() ? cv::Rect(cv::Point(0, 0), image.size()) : roi & cv::Rect(cv::Point(0, 0), image.size());
+  if (area.empty()) throw std::invalid_argument("recognize: the region lies outside the image");
+  Features query = detect_features(image(area));
+  for (auto& k : query.keypoints) k.pt += cv::Point2f(static_cast<float>(area.x), static_cast<float>(area.y));
+  Recognition result = recognize(query);
+  result.elapsed_ms = watch.elapsed_ms();
+  return result;
+}
+
+Recognition Recognizer::recognize(const Features& query) const {
+  Stopwatch watch;
+  Recognition result;
+  result.query = query;
+  for (const auto& entry : entries_) {
+    ObjectScore score;
+    score.name = entry->model->info.name;
+    for (size_t view = 0; view < entry->view_matchers.size(); ++view) {
+      if (!entry->view_matchers[view]) continue;
+      const Features& features = entry->model->views[view].features;
+      const std::vector<cv::DMatch> matches = one_per_point(
+          detail::ratio_matches(*entry->view_matchers[view], query.descriptors, features.size(), params_.ratio), query,
+          features);
+      score.ratio_matches += static_cast<int>(matches.size());
+      const std::vector<cv::DMatch> kept =
+          params_.geometric_check ? geometric_inliers(matches, query, features, params_.ransac_px, params_.min_support) : matches;
+      if (static_cast<int>(kept.size()) > score.verified_matches) {
+        score.verified_matches = static_cast<int>(kept.size());
+        score.best_view = static_cast<int>(view);
+        score.matches = kept;
+      }
+    }
+    result.scores.push_back(std::move(score));
+  }
+  int best = -1;
+  for (int i = 0; i < static_cast<int>(result.scores.size()); ++i)
+    if (best < 0 || result.scores[i].verified_matches > result.scores[best].verified_matches) best = i;
+  if (entries_.empty()) {
+    result.reason = "empty database";
+  } else if (query.empty()) {
+    result.reason = "no SIFT features in the image";
+  } else if (result.scores[best].verified_matches < params_.min_matches) {
+    result.reason = "no object matched " + std::to_string(params_.min_matches) + " or more features";
+  } else {
+    result.best = best;
+  }
+  result.elapsed_ms = watch.elapsed_ms();
+  return result;
+}
+
+}  // namespace nudge::learning

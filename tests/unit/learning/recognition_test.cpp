@@ -1,0 +1,206 @@
+// nudge_learning: SIFT features, background pruning (thesis sec. 7.3.3), recognition with the
+// ratio test, the >= 3 matches rule and the geometric check (sec. 7.3.4), the match picture.
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include <map>
+#include <tuple>
+
+#include "nudge/learning/recognizer.hpp"
+#include "nudge/learning/synthetic.hpp"
+
+using namespace nudge::learning;
+
+namespace {
+
+const cv::Size kImage(400, 300);
+const cv::Rect kBox(150, 50, 100, 200);
+const cv::Size kSurface(400, 200);
+
+// One object learned on the turntable in front of `background_seed`'s scene.
+std::shared_ptr<ObjectModel> learn(const std::string& name, uint64_t surface_seed, uint64_t background_seed,
+                                   LearnStats* stats = nullptr) {
+  const cv::Mat surface = synthetic::random_texture(kSurface, surface_seed);
+  const cv::Mat background = synthetic::random_texture(kImage, background_seed);
+  ObjectInfo info;
+  info.name = name;
+  return std::make_shared<ObjectModel>(
+      learn_object(info, synthetic::turntable_views(surface, background, kBox, 12), {}, stats));
+}
+
+// Learned once per process: SIFT on twelve views costs more than the tests that use them.
+std::shared_ptr<const ObjectModel> learned(const std::string& name, uint64_t surface_seed, uint64_t background_seed) {
+  static std::map<std::tuple<std::string, uint64_t, uint64_t>, std::shared_ptr<const ObjectModel>> cache;
+  auto& model = cache[{name, surface_seed, background_seed}];
+  if (!model) model = learn(name, surface_seed, background_seed);
+  return model;
+}
+
+// The part of view `view` of a turntable object (seed) that shows the object.
+cv::Mat object_face(uint64_t surface_seed, int view) {
+  const cv::Mat surface = synthetic::random_texture(kSurface, surface_seed);
+  const cv::Mat plain(kImage, CV_8UC3, cv::Scalar(128, 128, 128));
+  return synthetic::turntable_views(surface, plain, kBox, 12)[view].image(kBox).clone();
+}
+
+}  // namespace
+
+TEST(LearningFeatures, SiftFindsTextureAndNothingOnABlankImage) {
+  EXPECT_GT(detect_features(synthetic::random_texture(kImage, 1)).size(), 100);
+  EXPECT_EQ(detect_features(cv::Mat(kImage, CV_8UC1, cv::Scalar(90))).size(), 0);
+  EXPECT_THROW(detect_features(cv::Mat()), std::invalid_argument);
+  EXPECT_THROW(detect_features(cv::Mat(kImage, CV_32F, cv::Scalar(0))), std::invalid_argument);
+}
+
+TEST(LearningFeatures, GenerousBoxGrowsAndClips) {
+  EXPECT_EQ(generous_box({100, 100, 40, 80}, 0.25, {640, 480}), cv::Rect(90, 80, 60, 120));
+  EXPECT_EQ(generous_box({0, 0, 40, 80}, 0.5, {640, 480}), cv::Rect(0, 0, 60, 120));
+  const Features all = detect_features(synthetic::random_texture(kImage, 2));
+  const Features inside = features_inside(all, kBox);
+  EXPECT_LT(inside.size(), all.size());
+  EXPECT_EQ(inside.descriptors.rows, inside.size());
+  for (const auto& k : inside.keypoints) EXPECT_TRUE(cv::Rect2f(kBox).contains(k.pt));
+}
+
+TEST(LearningPruning, DescriptorsOfTheStaticSceneAreBackgroundTheTurningObjectsStay) {
+  const cv::Mat surface = synthetic::random_texture(kSurface, 3);
+  const cv::Mat background = synthetic::random_texture(kImage, 4);
+  // No box pruning here: the rule across views alone must tell scene from object.
+  std::vector<Features> views;
+  for (const auto& t : synthetic::turntable_views(surface, background, kBox, 12)) views.push_back(detect_features(t.image));
+  const auto background_flags = background_descriptors(views, 0.6, 3);
+  int scene = 0, scene_flagged = 0, object = 0, object_kept = 0;
+  const cv::Rect inner(kBox.x + 8, kBox.y + 8, kBox.width - 16, kBox.height - 16);  // clear of the seams
+  const cv::Rect outer(kBox.x - 8, kBox.y - 8, kBox.width + 16, kBox.height + 16);
+  for (size_t v = 0; v < views.size(); ++v) {
+    for (int k = 0; k < views[v].size(); ++k) {
+      const cv::Point p(views[v].keypoints[k].pt);
+      if (inner.contains(p)) {
+        ++object;
+        object_kept += !background_flags[v][k];
+      } else if (!outer.contains(p)) {
+        ++scene;
+        scene_flagged += background_flags[v][k];
+      }
+    }
+  }
+  ASSERT_GT(scene, 500);
+  ASSERT_GT(object, 300);
+  EXPECT_GT(scene_flagged, 0.9 * scene);
+  EXPECT_GT(object_kept, 0.9 * object);
+}
+
+TEST(LearningPruning, LearnCountsWhatEachStepRemoved) {
+  LearnStats stats;
+  const auto model = learn("cup", 5, 6, &stats);
+  EXPECT_EQ(model->views.size(), 12u);
+  EXPECT_EQ(stats.detected, stats.outside_box + stats.background + stats.kept);
+  EXPECT_GT(stats.outside_box, 0);
+  EXPECT_GT(stats.background, 0);  // the generous box still holds some scene
+  EXPECT_EQ(stats.kept, model->descriptor_count());
+  EXPECT_THROW(learn_object({}, {}), std::invalid_argument);
+}
+
+TEST(LearningRecognizer, FindsTheRightObjectAndViewInANewScene) {
+  Recognizer recognizer;
+  recognizer.add(learned("red", 10, 20));
+  recognizer.add(learned("blue", 11, 20));
+  recognizer.add(learned("green", 12, 20));
+  ASSERT_EQ(recognizer.size(), 3);
+  // View 7 of "blue", turned 15 degrees and shrunk, in a scene the robot never saw.
+  const cv::Mat scene = synthetic::place_in_scene(object_face(11, 7), synthetic::random_texture({640, 480}, 99), 15,
+                                                  0.8, {300, 250});
+  const Recognition r = recognizer.recognize(scene);
+  ASSERT_TRUE(r.recognised()) << r.reason;
+  EXPECT_EQ(r.best_score()->name, "blue");
+  EXPECT_NEAR(r.best_score()->best_view, 7, 1);
+  EXPECT_GE(r.best_score()->verified_matches, 15);
+  for (const auto& s : r.scores) {
+    if (s.name != "blue") EXPECT_LT(s.verified_matches, r.best_score()->verified_matches / 3);
+  }
+}
+
+TEST(LearningRecognizer, SameAnswerWithBruteForceAndFlann) {
+  const auto model = learned("red", 10, 20);
+  const cv::Mat scene = synthetic::place_in_scene(object_face(10, 3), synthetic::random_texture({640, 480}, 98), -10,
+                                                  1.1, {320, 240});
+  for (MatcherKind kind : {MatcherKind::BruteForce, MatcherKind::Flann}) {
+    RecognizeParams params;
+    params.matcher = kind;
+    Recognizer recognizer(params);
+    recognizer.add(model);
+    const Recognition r = recognizer.recognize(scene);
+    ASSERT_TRUE(r.recognised()) << matcher_name(kind) << ": " << r.reason;
+    EXPECT_EQ(r.best_score()->name, "red");
+  }
+  EXPECT_EQ(matcher_from_name("bf"), MatcherKind::BruteForce);
+  EXPECT_THROW(matcher_from_name("kd"), std::invalid_argument);
+}
+
+TEST(LearningRecognizer, UnknownObjectEmptyDatabaseAndRegionOfInterest) {
+  Recognizer recognizer;
+  const cv::Mat unknown = synthetic::random_texture({640, 480}, 77);
+  Recognition r = recognizer.recognize(unknown);
+  EXPECT_FALSE(r.recognised());
+  EXPECT_EQ(r.reason, "empty database");
+  recognizer.add(learned("red", 10, 20));
+  r = recognizer.recognize(unknown);
+  EXPECT_FALSE(r.recognised());
+  EXPECT_EQ(r.reason, "no object matched 3 or more features");
+  // The object in the left half: a region on the right sees nothing of it.
+  const cv::Mat scene = synthetic::place_in_scene(object_face(10, 0), unknown, 0, 1.0, {160, 240});
+  EXPECT_TRUE(recognizer.recognize(scene, {0, 0, 320, 480}).recognised());
+  EXPECT_FALSE(recognizer.recognize(scene, {330, 0, 310, 480}).recognised());
+  EXPECT_THROW(recognizer.recognize(scene, {700, 0, 10, 10}), std::invalid_argument);
+}
+
+TEST(LearningRecognizer, GeometricCheckRejectsMatchesThatAgreeOnlyInDescriptor) {
+  const auto model = learned("red", 10, 20);
+  // The descriptors of view 2, each at a random place: the ratio test passes every one of them,
+  // but no mapping of the training view puts them there.
+  Features scrambled = model->views[2].features;
+  cv::RNG rng(5);
+  for (auto& k : scrambled.keypoints) k.pt = cv::Point2f(rng.uniform(0.f, 640.f), rng.uniform(0.f, 480.f));
+  RecognizeParams unchecked;
+  unchecked.geometric_check = false;
+  Recognizer without(unchecked), with;
+  without.add(model);
+  with.add(model);
+  const Recognition loose = without.recognize(scrambled), strict = with.recognize(scrambled);
+  ASSERT_TRUE(loose.recognised());
+  EXPECT_GT(loose.scores[0].verified_matches, 30);
+  EXPECT_LT(strict.scores[0].verified_matches, loose.scores[0].verified_matches / 5);
+  // The same descriptors where they belong are all verified.
+  const Recognition exact = with.recognize(model->views[2].features);
+  EXPECT_EQ(exact.scores[0].best_view, 2);
+  // (fewer than all: keypoints sharing a location count once)
+  EXPECT_GT(exact.scores[0].verified_matches, 0.75 * model->views[2].features.size());
+}
+
+TEST(LearningRecognizer, AddingANameAgainReplacesTheModel) {
+  Recognizer recognizer;
+  recognizer.add(learned("cup", 10, 20));
+  recognizer.add(learned("cup", 11, 20));
+  EXPECT_EQ(recognizer.size(), 1);
+  EXPECT_NE(recognizer.find("cup"), nullptr);
+  EXPECT_TRUE(recognizer.remove("cup"));
+  EXPECT_EQ(recognizer.size(), 0);
+}
+
+TEST(LearningMatchPicture, QueryAboveTrainingViewWithRedMatchLines) {
+  Recognizer recognizer;
+  const auto model = learned("red", 10, 20);
+  recognizer.add(model);
+  const cv::Mat scene = synthetic::place_in_scene(object_face(10, 4), synthetic::random_texture({640, 480}, 97), 5,
+                                                  1.0, {320, 240});
+  const Recognition r = recognizer.recognize(scene);
+  ASSERT_TRUE(r.recognised());
+  const ModelView& view = model->views[r.best_score()->best_view];
+  const cv::Mat picture = draw_match_picture(scene, view.image, view.features, r);
+  EXPECT_EQ(picture.rows, scene.rows + view.image.rows);
+  EXPECT_EQ(picture.cols, 640);
+  cv::Mat red;
+  cv::inRange(picture, cv::Scalar(0, 0, 250), cv::Scalar(10, 10, 255), red);
+  EXPECT_GT(cv::countNonZero(red), 100);
+}
