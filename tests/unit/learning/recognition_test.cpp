@@ -117,7 +117,7 @@ TEST(LearningRecognizer, FindsTheRightObjectAndViewInANewScene) {
   EXPECT_NEAR(r.best_score()->best_view, 7, 1);
   EXPECT_GE(r.best_score()->verified_matches, 15);
   for (const auto& s : r.scores) {
-    if (s.name != "blue") EXPECT_LT(s.verified_matches, r.best_score()->verified_matches / 3);
+    if (s.name != "blue") { EXPECT_LT(s.verified_matches, r.best_score()->verified_matches / 3); }
   }
 }
 
