@@ -1,0 +1,41 @@
+// learner: learns objects from the training views the supervisor sends (LEARN_VIEW, LEARN_COMMIT
+// -> LEARNED), keeps them in the object database (--db), and says which known object an image
+// shows (RECOGNIZE_REQUEST -> RECOGNITION). Thesis ch. 7; docs/learning.md.
+#include "learner/handlers.hpp"
+#include "nudge/bus/service.hpp"
+#include "nudge/flags.hpp"
+
+using namespace nudge;
+
+int main(int argc, char** argv) {
+  return bus::guarded_main("learner", [&] {
+    bus::Service service("learner", "Object learning from training views and recognition (thesis ch. 7).");
+    learner_service::Options options;
+    std::string matcher = learning::matcher_name(options.recognize.matcher);
+    auto& f = service.flags();
+    f.add_string("db", &options.db_dir, "the object database's folder (created if missing); required");
+    f.add_string("matcher", &matcher, "descriptor matching: flann or bf (docs/benchmarks.md)");
+    f.add_double("ratio", &options.recognize.ratio, "Lowe's ratio test: d1 < RATIO * d2 (thesis 0.6)");
+    f.add_int("min-matches", &options.recognize.min_matches, "verified matches the best object needs (thesis 3)");
+    f.add_double("ransac-px", &options.recognize.ransac_px, "geometric check: inlier distance, pixels");
+    f.add_double("box-margin", &options.learn.box_margin, "training box grown by this fraction each side");
+    f.add_int("background-matches", &options.learn.background_matches,
+              "a descriptor matching this many other views is background (thesis 3)");
+    f.add_double("view-expiry", &options.view_expiry_s, "drop views not committed within SECONDS of message time");
+    if (!service.parse(argc, argv)) return 0;
+    if (options.db_dir.empty()) throw FlagError("--db DIR is required");
+    try {
+      options.recognize.matcher = learning::matcher_from_name(matcher);
+    } catch (const std::invalid_argument& e) {
+      throw FlagError(std::string("--matcher: ") + e.what());
+    }
+    if (options.recognize.ratio <= 0 || options.recognize.ratio > 1) throw FlagError("--ratio must be in (0, 1]");
+    if (options.recognize.min_matches < 1) throw FlagError("--min-matches must be >= 1");
+    if (options.learn.background_matches < 1) throw FlagError("--background-matches must be >= 1");
+    if (options.view_expiry_s <= 0) throw FlagError("--view-expiry must be > 0");
+    options.learn.ratio = options.recognize.ratio;
+    service.start();
+    const learner_service::Handlers handlers(service, options);
+    return service.run();
+  });
+}

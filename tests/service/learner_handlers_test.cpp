@@ -1,0 +1,237 @@
+// The learner service's handlers in-process (memq://): training views in, LEARNED out, the object
+// in the database; RECOGNIZE_REQUEST in, RECOGNITION out with a match picture; bad input (an
+// undecodable image, views never committed, an unknown key) reported naming it while the service
+// keeps answering.
+#include <gtest/gtest.h>
+#include <lcm/lcm-cpp.hpp>
+#include <unistd.h>
+
+#include <filesystem>
+#include <memory>
+
+#include "learner/handlers.hpp"
+#include "nudge/bus/channels.hpp"
+#include "nudge/bus/image.hpp"
+#include "nudge/bus/latest.hpp"
+#include "nudge/learn_result_t.hpp"
+#include "nudge/learning/synthetic.hpp"
+#include "nudge/recognition_t.hpp"
+
+namespace fs = std::filesystem;
+namespace syn = nudge::learning::synthetic;
+namespace channel = nudge::bus::channel;
+using nudge::bus::Latest;
+
+namespace {
+
+const cv::Rect kBox(150, 50, 100, 200);
+constexpr int64_t kSecond = 1000000;
+
+std::vector<nudge::learning::TrainingImage> turntable(uint64_t seed) {
+  return syn::turntable_views(syn::random_texture({400, 200}, seed), syn::random_texture({400, 300}, 500), kBox, 12);
+}
+
+nudge::learn_view_t view_message(const std::string& run, const std::string& key, int index,
+                                 const nudge::learning::TrainingImage& view, int64_t utime) {
+  nudge::learn_view_t msg{};
+  msg.utime = utime;
+  msg.run_id = run;
+  msg.object_key = key;
+  msg.view_index = index;
+  msg.wrist_angle = view.wrist_angle;
+  msg.box[0] = view.box.x;
+  msg.box[1] = view.box.y;
+  msg.box[2] = view.box.width;
+  msg.box[3] = view.box.height;
+  msg.image = nudge::bus::to_message(view.image, index % 2 ? nudge::image_t::FORMAT_PNG : nudge::image_t::FORMAT_BGR8,
+                                     utime, index, "right");
+  return msg;
+}
+
+nudge::learn_commit_t commit_message(const std::string& run, const std::string& key, const std::string& name,
+                                     int views, int64_t utime, int64_t seq) {
+  nudge::learn_commit_t msg{};
+  msg.utime = utime;
+  msg.seq = seq;
+  msg.run_id = run;
+  msg.object_key = key;
+  msg.object_name = name;
+  msg.num_views = views;
+  msg.height = 0.2;
+  msg.radius = 0.03;
+  return msg;
+}
+
+nudge::recognize_request_t request(const cv::Mat& image, int64_t seq, bool picture) {
+  nudge::recognize_request_t msg{};
+  msg.utime = 9000 * kSecond;
+  msg.seq = seq;
+  msg.want_match_picture = picture;
+  msg.image = nudge::bus::to_message(image, nudge::image_t::FORMAT_PNG, msg.utime, seq, "right");
+  return msg;
+}
+
+// A scene the robot never saw with view `view` of turntable object `seed` in it.
+cv::Mat scene_with(uint64_t seed, int view) {
+  return syn::place_in_scene(turntable(seed)[view].image(kBox), syn::random_texture({640, 480}, 900), 10, 0.9,
+                             {350, 240});
+}
+
+// A learner on a bus of the test's own, with the test's end subscribed to its answers.
+struct InProcess {
+  explicit InProcess(const std::string& db)
+      : service("learner", "in-process test"),
+        started((service.start(bus), true)),
+        handlers(std::make_unique<nudge::learner_service::Handlers>(service, options(db))),
+        probe(bus, probe_counters),
+        learned(probe, channel::LEARNED),
+        recognition(probe, channel::RECOGNITION) {}
+  static nudge::learner_service::Options options(const std::string& db) {
+    nudge::learner_service::Options o;
+    o.db_dir = db;
+    o.view_expiry_s = 60;
+    return o;
+  }
+  void teach(const std::string& run, const std::string& key, uint64_t seed, int64_t t0) {
+    const auto views = turntable(seed);
+    for (int i = 0; i < static_cast<int>(views.size()); ++i) {
+      const auto msg = view_message(run, key, i, views[i], t0 + i * kSecond);
+      bus.publish(channel::LEARN_VIEW, &msg);
+    }
+  }
+  lcm::LCM bus{"memq://"};
+  nudge::bus::Service service;
+  bool started;
+  std::unique_ptr<nudge::learner_service::Handlers> handlers;
+  nudge::bus::Counters probe_counters;
+  nudge::bus::Subscriptions probe;
+  Latest<nudge::learn_result_t> learned;
+  Latest<nudge::recognition_t> recognition;
+};
+
+std::string fresh_db(const std::string& name) {
+  const std::string dir = fs::temp_directory_path().string() + "/nudge_learner_" + name + "_" + std::to_string(::getpid());
+  fs::remove_all(dir);
+  return dir;
+}
+
+}  // namespace
+
+TEST(LearnerHandlers, LearnsStoresAndRecognisesWithAMatchPicture) {
+  const std::string db = fresh_db("learn");
+  InProcess run(db);
+  EXPECT_EQ(run.handlers->known_objects(), 0);
+  run.teach("run_1", "attempt_01", 11, 100 * kSecond);
+  const auto commit = commit_message("run_1", "attempt_01", "cereal", 12, 120 * kSecond, 7);
+  run.bus.publish(channel::LEARN_COMMIT, &commit);
+  run.service.handle_pending();
+  ASSERT_TRUE(run.learned.has());
+  const nudge::learn_result_t result = run.learned.get();
+  EXPECT_TRUE(result.ok) << result.reason;
+  EXPECT_EQ(result.seq, 7);
+  EXPECT_EQ(result.object_name, "cereal");
+  EXPECT_EQ(result.views_used, 12);
+  EXPECT_GT(result.descriptors, 500);
+  EXPECT_GT(result.descriptors_pruned, 500);  // the static scene around the object
+  EXPECT_TRUE(fs::exists(db + "/cereal/object.json"));
+  EXPECT_EQ(run.handlers->known_objects(), 1);
+  EXPECT_EQ(run.handlers->pending_objects(), 0);
+
+  const auto ask = request(scene_with(11, 5), 8, true);
+  run.bus.publish(channel::RECOGNIZE_REQUEST, &ask);
+  run.service.handle_pending();
+  ASSERT_TRUE(run.recognition.has());
+  const nudge::recognition_t answer = run.recognition.get();
+  EXPECT_EQ(answer.seq, 8);
+  EXPECT_EQ(answer.label, "cereal") << answer.reason;
+  EXPECT_NEAR(answer.best_view, 5, 1);
+  EXPECT_EQ(answer.learned_utime, 120 * kSecond);
+  ASSERT_EQ(answer.num_objects, 1);
+  EXPECT_EQ(answer.names[0], "cereal");
+  EXPECT_GE(answer.matches[0], 15);
+  EXPECT_GT(answer.elapsed_ms, 0);
+  ASSERT_GT(answer.match_picture.size, 0);
+  const cv::Mat picture = nudge::bus::to_mat(answer.match_picture);
+  EXPECT_EQ(picture.rows, 480 + 300);  // the scene above the training view
+  EXPECT_EQ(run.service.counters().errors, 0);
+
+  // Another learner on the same folder knows the object from the start.
+  InProcess again(db);
+  EXPECT_EQ(again.handlers->known_objects(), 1);
+  const auto plain = request(scene_with(11, 5), 9, false);
+  again.bus.publish(channel::RECOGNIZE_REQUEST, &plain);
+  again.service.handle_pending();
+  ASSERT_TRUE(again.recognition.has());
+  EXPECT_EQ(again.recognition.get().label, "cereal");
+  EXPECT_EQ(again.recognition.get().match_picture.size, 0) << "no picture unless asked for";
+  fs::remove_all(db);
+}
+
+TEST(LearnerHandlers, BadInputIsReportedAndTheServiceKeepsAnswering) {
+  const std::string db = fresh_db("bad");
+  InProcess run(db);
+  // An undecodable training image and a view index out of range: refused, named at the commit.
+  auto views = turntable(12);
+  auto broken = view_message("run_2", "attempt_01", 0, views[0], 10 * kSecond);
+  broken.image.pixel_format = nudge::image_t::FORMAT_PNG;
+  broken.image.data.assign(100, 0x42);
+  broken.image.size = 100;
+  broken.image.row_stride = 0;
+  run.bus.publish(channel::LEARN_VIEW, &broken);
+  auto outside = view_message("run_2", "attempt_01", 500, views[1], 11 * kSecond);
+  run.bus.publish(channel::LEARN_VIEW, &outside);
+  auto commit = commit_message("run_2", "attempt_01", "", 2, 12 * kSecond, 1);
+  run.bus.publish(channel::LEARN_COMMIT, &commit);
+  run.service.handle_pending();
+  ASSERT_TRUE(run.learned.has());
+  nudge::learn_result_t result = run.learned.get();
+  EXPECT_FALSE(result.ok);
+  EXPECT_EQ(result.object_name, "run_2_attempt_01");
+  EXPECT_NE(result.reason.find("no usable views received for run 'run_2' object 'attempt_01'"), std::string::npos)
+      << result.reason;
+  EXPECT_NE(result.reason.find("view 0: undecodable image"), std::string::npos) << result.reason;
+  EXPECT_NE(result.reason.find("view 500: view_index outside"), std::string::npos) << result.reason;
+  EXPECT_EQ(run.service.counters().errors, 3);
+
+  // A commit for a key never sent.
+  commit = commit_message("run_9", "nobody", "", 12, 13 * kSecond, 2);
+  run.bus.publish(channel::LEARN_COMMIT, &commit);
+  run.service.handle_pending();
+  result = run.learned.get();
+  EXPECT_EQ(result.seq, 2);
+  EXPECT_FALSE(result.ok);
+  EXPECT_NE(result.reason.find("run 'run_9' object 'nobody'"), std::string::npos) << result.reason;
+
+  // Views never committed expire after --view-expiry of message time; their commit then fails.
+  auto early = view_message("run_3", "attempt_01", 0, views[0], 20 * kSecond);
+  run.bus.publish(channel::LEARN_VIEW, &early);
+  run.service.handle_pending();
+  EXPECT_EQ(run.handlers->pending_objects(), 1);
+  auto later = view_message("run_3", "attempt_02", 0, views[0], 200 * kSecond);
+  run.bus.publish(channel::LEARN_VIEW, &later);
+  run.service.handle_pending();
+  EXPECT_EQ(run.handlers->pending_objects(), 1) << "attempt_01 expired, attempt_02 waits";
+  commit = commit_message("run_3", "attempt_01", "", 1, 201 * kSecond, 3);
+  run.bus.publish(channel::LEARN_COMMIT, &commit);
+  run.service.handle_pending();
+  EXPECT_FALSE(run.learned.get().ok);
+  EXPECT_EQ(run.learned.get().seq, 3);
+
+  // An undecodable image to recognise, then a good one: both answered.
+  auto bad_request = request(syn::random_texture({64, 48}, 1), 20, false);
+  bad_request.image.data.assign(bad_request.image.data.size(), 0);
+  run.bus.publish(channel::RECOGNIZE_REQUEST, &bad_request);
+  run.service.handle_pending();
+  ASSERT_TRUE(run.recognition.has());
+  EXPECT_EQ(run.recognition.get().seq, 20);
+  EXPECT_EQ(run.recognition.get().label, "");
+  EXPECT_NE(run.recognition.get().reason.find("undecodable image"), std::string::npos);
+  const auto good = request(syn::random_texture({320, 240}, 2), 21, true);
+  run.bus.publish(channel::RECOGNIZE_REQUEST, &good);
+  run.service.handle_pending();
+  EXPECT_EQ(run.recognition.get().seq, 21);
+  EXPECT_EQ(run.recognition.get().reason, "empty database");
+  EXPECT_EQ(run.recognition.get().match_picture.size, 0);
+  EXPECT_TRUE(fs::is_empty(db)) << "nothing stored from bad input";
+  fs::remove_all(db);
+}
