@@ -5,11 +5,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <set>
 #include <stdexcept>
 
 #include "nudge/timing.hpp"
-#include "ratio_match.hpp"
 
 namespace nudge::learning {
 
@@ -21,12 +21,12 @@ MatcherKind matcher_from_name(const std::string& name) {
 
 std::string matcher_name(MatcherKind kind) { return kind == MatcherKind::BruteForce ? "bf" : "flann"; }
 
-// One object's descriptor sets, one matcher per training view. The ratio test runs per view, not
-// over the object's whole set as the thesis did: neighbouring views show the same surface point,
-// whose second neighbour would then often be itself one turn step on, failing a true match.
+// One object's descriptor set: every view's descriptors in one matcher index, each row knowing
+// its view and its index within that view.
 struct Recognizer::Entry {
   std::shared_ptr<const ObjectModel> model;
-  std::vector<cv::Ptr<cv::DescriptorMatcher>> view_matchers;  // null for a view of < 2 descriptors
+  std::vector<int> row_view, row_index;
+  cv::Ptr<cv::DescriptorMatcher> matcher;  // null for a set of < 2 descriptors
 };
 
 namespace {
@@ -36,6 +36,35 @@ cv::Ptr<cv::DescriptorMatcher> make_matcher(MatcherKind kind) {
   // Randomised k-d trees: 4 trees, 32 leaves checked (Lowe's and OpenCV's usual setting for SIFT).
   return cv::makePtr<cv::FlannBasedMatcher>(cv::makePtr<cv::flann::KDTreeIndexParams>(4),
                                            cv::makePtr<cv::flann::SearchParams>(32));
+}
+
+// Neighbours looked at per query descriptor (see view_ratio_matches).
+constexpr int kNeighbours = 4;
+
+// Lowe's ratio test within one training view. Neighbouring views show the same surface point, so
+// over the object's whole set (as the thesis matched) the second neighbour is often the same point
+// one turn step on, failing a true match. Here d2 is the nearest neighbour in the same view as the
+// nearest one; when none of the kNeighbours nearest is, the last of them stands in for it (the
+// true d2 is no smaller, so the test is only stricter).
+std::vector<cv::DMatch> view_ratio_matches(cv::DescriptorMatcher& matcher, const std::vector<int>& row_view,
+                                           const cv::Mat& query, double ratio) {
+  std::vector<cv::DMatch> out;
+  if (query.empty()) return out;
+  std::vector<std::vector<cv::DMatch>> knn;
+  matcher.knnMatch(query, knn, kNeighbours);
+  for (const auto& neighbours : knn) {
+    if (neighbours.size() < 2) continue;
+    const cv::DMatch& nearest = neighbours[0];
+    float second = neighbours.back().distance;
+    for (size_t i = 1; i < neighbours.size(); ++i) {
+      if (row_view[neighbours[i].trainIdx] == row_view[nearest.trainIdx]) {
+        second = neighbours[i].distance;
+        break;
+      }
+    }
+    if (nearest.distance < ratio * second) out.push_back(nearest);
+  }
+  return out;
 }
 
 // One match per training point and per query point. SIFT gives a point several keypoints when it
@@ -104,14 +133,19 @@ Recognizer& Recognizer::operator=(Recognizer&&) noexcept = default;
 
 void Recognizer::add(std::shared_ptr<const ObjectModel> model) {
   auto entry = std::make_unique<Entry>();
-  for (const ModelView& view : model->views) {
-    cv::Ptr<cv::DescriptorMatcher> matcher;
-    if (view.features.size() >= 2) {
-      matcher = make_matcher(params_.matcher);
-      matcher->add(view.features.descriptors);
-      matcher->train();  // builds FLANN's trees now, not on the first query
+  cv::Mat all(0, 128, CV_32F);
+  for (size_t v = 0; v < model->views.size(); ++v) {
+    const Features& f = model->views[v].features;
+    for (int k = 0; k < f.size(); ++k) {
+      entry->row_view.push_back(static_cast<int>(v));
+      entry->row_index.push_back(k);
     }
-    entry->view_matchers.push_back(matcher);
+    if (!f.descriptors.empty()) all.push_back(f.descriptors);
+  }
+  if (all.rows >= 2) {
+    entry->matcher = make_matcher(params_.matcher);
+    entry->matcher->add(all);
+    entry->matcher->train();  // builds FLANN's trees now, not on the first query
   }
   entry->model = std::move(model);
   for (auto& e : entries_) {
@@ -161,18 +195,28 @@ Recognition Recognizer::recognize(const Features& query) const {
   for (const auto& entry : entries_) {
     ObjectScore score;
     score.name = entry->model->info.name;
-    for (size_t view = 0; view < entry->view_matchers.size(); ++view) {
-      if (!entry->view_matchers[view]) continue;
+    if (!entry->matcher) {
+      result.scores.push_back(std::move(score));
+      continue;
+    }
+    // Ratio-test matches, grouped by training view, trainIdx into that view's own features.
+    std::map<int, std::vector<cv::DMatch>> by_view;
+    for (cv::DMatch m : view_ratio_matches(*entry->matcher, entry->row_view, query.descriptors, params_.ratio)) {
+      const int view = entry->row_view[m.trainIdx];
+      m.trainIdx = entry->row_index[m.trainIdx];
+      m.imgIdx = view;
+      by_view[view].push_back(m);
+    }
+    for (auto& [view, view_matches] : by_view) {
       const Features& features = entry->model->views[view].features;
-      const std::vector<cv::DMatch> matches = one_per_point(
-          detail::ratio_matches(*entry->view_matchers[view], query.descriptors, features.size(), params_.ratio), query,
-          features);
+      const std::vector<cv::DMatch> matches = one_per_point(view_matches, query, features);
       score.ratio_matches += static_cast<int>(matches.size());
       const std::vector<cv::DMatch> kept =
-          params_.geometric_check ? geometric_inliers(matches, query, features, params_.ransac_px, params_.min_support) : matches;
+          params_.geometric_check ? geometric_inliers(matches, query, features, params_.ransac_px, params_.min_support)
+                                  : matches;
       if (static_cast<int>(kept.size()) > score.verified_matches) {
         score.verified_matches = static_cast<int>(kept.size());
-        score.best_view = static_cast<int>(view);
+        score.best_view = view;
         score.matches = kept;
       }
     }

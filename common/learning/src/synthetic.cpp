@@ -68,4 +68,20 @@ cv::Mat place_in_scene(const cv::Mat& object, const cv::Mat& scene, double angle
   return out;
 }
 
+ObjectModel object_model(const std::string& name, uint64_t seed, int views, cv::Size face) {
+  const cv::Mat surface = random_texture({face.width * 4, face.height}, seed);
+  const cv::Mat no_scene(face, CV_8UC3, cv::Scalar(128, 128, 128));
+  ObjectModel model;
+  model.info.name = name;
+  for (const TrainingImage& t : turntable_views(surface, no_scene, cv::Rect(cv::Point(0, 0), face), views)) {
+    ModelView view;
+    view.image = t.image;
+    view.features = detect_features(t.image);
+    view.box = t.box;
+    view.wrist_angle = t.wrist_angle;
+    model.views.push_back(std::move(view));
+  }
+  return model;
+}
+
 }  // namespace nudge::learning::synthetic

@@ -174,8 +174,9 @@ TEST(LearningRecognizer, GeometricCheckRejectsMatchesThatAgreeOnlyInDescriptor) 
   // The same descriptors where they belong are all verified.
   const Recognition exact = with.recognize(model->views[2].features);
   EXPECT_EQ(exact.scores[0].best_view, 2);
-  // (fewer than all: keypoints sharing a location count once)
-  EXPECT_GT(exact.scores[0].verified_matches, 0.75 * model->views[2].features.size());
+  // (fewer than all: keypoints sharing a location count once, and a point seen identically in the
+  // neighbouring views may have no same-view second neighbour among the four nearest)
+  EXPECT_GT(exact.scores[0].verified_matches, 0.6 * model->views[2].features.size());
 }
 
 TEST(LearningRecognizer, AddingANameAgainReplacesTheModel) {

@@ -3,6 +3,7 @@
 #include <opencv2/core.hpp>
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "nudge/learning/model.hpp"
@@ -24,5 +25,9 @@ std::vector<TrainingImage> turntable_views(const cv::Mat& surface, const cv::Mat
 // copy of `scene`.
 cv::Mat place_in_scene(const cv::Mat& object, const cv::Mat& scene, double angle_deg, double scale,
                        cv::Point2f centre);
+
+// A model of an object whose unrolled label is random_texture(seed): `views` turntable views of
+// `face` pixels each (the object alone, no scene: nothing to prune). For databases of many objects.
+ObjectModel object_model(const std::string& name, uint64_t seed, int views = 12, cv::Size face = {120, 240});
 
 }  // namespace nudge::learning::synthetic
