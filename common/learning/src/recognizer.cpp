@@ -109,7 +109,10 @@ std::vector<cv::DMatch> geometric_inliers(const std::vector<cv::DMatch>& matches
   }
   std::vector<cv::DMatch> best;
   std::vector<uchar> mask;
-  if (!cv::estimateAffinePartial2D(from, to, mask, cv::RANSAC, ransac_px, 2000, 0.995).empty()) {
+  // A few matches have few pairs to try: no need for RANSAC's full 2000 random draws.
+  const int n = static_cast<int>(matches.size());
+  const int similarity_iterations = std::min(2000, std::max(50, 3 * n * (n - 1) / 2));
+  if (!cv::estimateAffinePartial2D(from, to, mask, cv::RANSAC, ransac_px, similarity_iterations, 0.995).empty()) {
     auto inliers = inliers_of(matches, mask);
     if (static_cast<int>(inliers.size()) >= 2 + min_support) best = std::move(inliers);
   }
@@ -207,10 +210,17 @@ Recognition Recognizer::recognize(const Features& query) const {
       m.imgIdx = view;
       by_view[view].push_back(m);
     }
-    for (auto& [view, view_matches] : by_view) {
-      const Features& features = entry->model->views[view].features;
-      const std::vector<cv::DMatch> matches = one_per_point(view_matches, query, features);
+    std::vector<std::pair<int, std::vector<cv::DMatch>>> views;
+    for (auto& [view, view_matches] : by_view)
+      views.emplace_back(view, one_per_point(view_matches, query, entry->model->views[view].features));
+    // Most matches first: a view with no more matches than the best verified count cannot beat it,
+    // so its geometric check is skipped.
+    std::stable_sort(views.begin(), views.end(),
+                     [](const auto& x, const auto& y) { return x.second.size() > y.second.size(); });
+    for (const auto& [view, matches] : views) {
       score.ratio_matches += static_cast<int>(matches.size());
+      if (static_cast<int>(matches.size()) <= score.verified_matches) continue;
+      const Features& features = entry->model->views[view].features;
       const std::vector<cv::DMatch> kept =
           params_.geometric_check ? geometric_inliers(matches, query, features, params_.ransac_px, params_.min_support)
                                   : matches;
