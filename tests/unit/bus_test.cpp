@@ -263,3 +263,36 @@ TEST(PoseConvert, BadPosesAreRefused) {
   ASSERT_TRUE(bus::from_message(nearly_unit, &pose));
   EXPECT_LT((pose.linear() - Eigen::Matrix3d::Identity()).norm(), 1e-12);
 }
+
+// ---- compressed images: the header is read before the pixels (issue 12) -----------------------
+
+TEST(Image, HugeDeclaredPngIsRefusedBeforeDecoding) {
+  // A real PNG whose IHDR is rewritten to 20000x20000: decoding it would allocate 1.2 GB.
+  image_t msg = bus::to_message(test_image(), image_t::FORMAT_PNG, 0, 9, "left");
+  for (size_t at : {16, 20}) {
+    msg.data[at] = 0;
+    msg.data[at + 1] = 0;
+    msg.data[at + 2] = 0x4E;  // 20000 = 0x4E20
+    msg.data[at + 3] = 0x20;
+  }
+  msg.width = msg.height = 20000;
+  try {
+    bus::to_mat(msg);
+    FAIL() << "a 20000x20000 PNG was decoded";
+  } catch (const bus::ImageError& e) {
+    EXPECT_NE(std::string(e.what()).find("'left' frame 9: PNG data refused: PNG header declares 20000x20000"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(Image, TruncatedJpegIsRefusedNotDecodedInPart) {
+  image_t msg = bus::to_message(test_image(), image_t::FORMAT_MJPEG, 0, 2, "right");
+  msg.data.resize(msg.data.size() * 2 / 3);  // libjpeg would return the top of the image with a warning
+  try {
+    bus::to_mat(msg);
+    FAIL() << "a truncated JPEG was decoded";
+  } catch (const bus::ImageError& e) {
+    EXPECT_NE(std::string(e.what()).find("truncated"), std::string::npos) << e.what();
+  }
+}

@@ -7,6 +7,7 @@
 #include "nudge/atomic_file.hpp"
 #include "nudge/bus_clock.hpp"
 #include "nudge/flags.hpp"
+#include "nudge/image_header.hpp"
 #include "nudge/json.hpp"
 
 using namespace nudge;
@@ -180,4 +181,67 @@ TEST(Pacer, RunsSimulatedTimeAtItsFactorAndFallsBehindWithoutRushing) {
   wall.utime += 10000;
   EXPECT_NEAR(pacer.target(0.1), 0.12, 1e-12);
   EXPECT_THROW(nudge::Pacer(0.0), std::invalid_argument);
+}
+
+namespace {
+// A PNG's signature, IHDR chunk (CRC not checked by the header reader) and IEND chunk.
+std::vector<uint8_t> png_header(uint32_t width, uint32_t height, bool with_end) {
+  std::vector<uint8_t> b = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n', 0, 0, 0, 13, 'I', 'H', 'D', 'R'};
+  for (uint32_t v : {width, height})
+    for (int shift = 24; shift >= 0; shift -= 8) b.push_back(static_cast<uint8_t>(v >> shift));
+  b.insert(b.end(), {8, 0, 0, 0, 0, 0, 0, 0, 0});  // depth, colour, compression, filter, interlace, CRC
+  b.insert(b.end(), 20, 0);                         // stands for the IDAT chunks
+  if (with_end) b.insert(b.end(), {0, 0, 0, 0, 'I', 'E', 'N', 'D', 0xAE, 0x42, 0x60, 0x82});
+  return b;
+}
+// SOI, an APP0 segment, SOF0 with the size, SOS, scan bytes (with an escaped FF 00), EOI.
+std::vector<uint8_t> jpeg_bytes(uint16_t width, uint16_t height, bool with_end) {
+  std::vector<uint8_t> b = {0xFF, 0xD8, 0xFF, 0xE0, 0, 4, 'J', 'F'};
+  b.insert(b.end(), {0xFF, 0xC0, 0, 11, 8, static_cast<uint8_t>(height >> 8), static_cast<uint8_t>(height),
+                     static_cast<uint8_t>(width >> 8), static_cast<uint8_t>(width), 1, 1, 0x11, 0});
+  b.insert(b.end(), {0xFF, 0xDA, 0, 8, 1, 1, 0, 0, 63, 0, 0x12, 0xFF, 0x00, 0x34, 0xFF, 0xD0, 0x56});
+  if (with_end) b.insert(b.end(), {0xFF, 0xD9});
+  return b;
+}
+}  // namespace
+
+TEST(ImageHeader, ReadsPngAndJpegSizesWithoutDecoding) {
+  const auto png = png_header(640, 480, true);
+  const ImageHeader p = read_image_header(png.data(), png.size());
+  EXPECT_EQ(p.format, ImageHeader::Format::Png);
+  EXPECT_EQ(p.width, 640);
+  EXPECT_EQ(p.height, 480);
+  EXPECT_TRUE(p.complete);
+  EXPECT_EQ(check_compressed_image(png.data(), png.size()), "");
+
+  const auto jpeg = jpeg_bytes(1280, 960, true);
+  const ImageHeader j = read_image_header(jpeg.data(), jpeg.size());
+  EXPECT_EQ(j.format, ImageHeader::Format::Jpeg);
+  EXPECT_EQ(j.width, 1280);
+  EXPECT_EQ(j.height, 960);
+  EXPECT_TRUE(j.complete);
+  EXPECT_EQ(check_compressed_image(jpeg.data(), jpeg.size()), "");
+}
+
+TEST(ImageHeader, RefusesHugeDeclaredSizes) {
+  const auto png = png_header(20000, 20000, true);  // the 389 KB PNG of issue 12 has this header
+  const std::string problem = check_compressed_image(png.data(), png.size());
+  EXPECT_NE(problem.find("20000x20000"), std::string::npos) << problem;
+  const auto zero = png_header(0, 10, true);
+  EXPECT_NE(check_compressed_image(zero.data(), zero.size()).find("0x10"), std::string::npos);
+  const auto jpeg = jpeg_bytes(65535, 65535, true);
+  EXPECT_NE(check_compressed_image(jpeg.data(), jpeg.size()).find("65535x65535"), std::string::npos);
+  EXPECT_EQ(check_compressed_image(jpeg.data(), jpeg.size(), int64_t{65535} * 65535), "");
+}
+
+TEST(ImageHeader, RefusesTruncatedAndForeignData) {
+  const auto png = png_header(64, 64, false);
+  EXPECT_NE(check_compressed_image(png.data(), png.size()).find("truncated"), std::string::npos);
+  const auto jpeg = jpeg_bytes(64, 64, false);
+  EXPECT_NE(check_compressed_image(jpeg.data(), jpeg.size()).find("truncated"), std::string::npos);
+  for (size_t cut = 0; cut < 20; ++cut)  // cut inside the header: never a size read past the end
+    EXPECT_NE(check_compressed_image(jpeg.data(), cut), "") << cut;
+  const std::vector<uint8_t> text = {'h', 'e', 'l', 'l', 'o'};
+  EXPECT_NE(check_compressed_image(text.data(), text.size()).find("not a PNG or JPEG"), std::string::npos);
+  EXPECT_NE(check_compressed_image(nullptr, 0), "");
 }

@@ -12,8 +12,10 @@
 #include <opencv2/imgproc.hpp>
 
 #include <iostream>
+#include <map>
 #include <stdexcept>
 
+#include "nudge/camera/image_file.hpp"
 #include "nudge/flags.hpp"
 #include "nudge/geometry/stereo_rig.hpp"
 #include "nudge/geometry/workspace.hpp"
@@ -51,9 +53,7 @@ BoardSize parse_board(const std::string& text) {
 }
 
 cv::Mat read_grey(const std::string& path) {
-  const cv::Mat image = cv::imread(path, cv::IMREAD_GRAYSCALE);
-  if (image.empty()) throw std::runtime_error(path + ": cannot read the image (missing, unreadable or not an image)");
-  return image;
+  return camera::read_image_file(path, cv::IMREAD_GRAYSCALE);  // throws naming the file
 }
 
 // Inner corners to sub-pixel precision, or empty when the board is not (fully) visible. The
@@ -71,26 +71,48 @@ struct Views {
   std::vector<std::vector<cv::Point2f>> left, right;  // one entry per usable pair
 };
 
-void check_size(const cv::Mat& image, const std::string& path, cv::Size* expected, const std::string& first) {
-  if (expected->empty()) {
-    *expected = image.size();
-  } else if (image.size() != *expected) {
-    throw std::runtime_error(path + ": image size " + std::to_string(image.cols) + "x" + std::to_string(image.rows) +
-                             " differs from " + first + " (" + std::to_string(expected->width) + "x" +
-                             std::to_string(expected->height) + "); all images of a camera must share one size");
+// The size most of a camera's images share (the earliest of equally common ones): a glob that
+// also matches an image of another size (opencv-doc's left.jpg) should lose that image, not the run.
+cv::Size common_size(const std::vector<cv::Mat>& images) {
+  std::map<std::pair<int, int>, int> count;
+  for (const auto& image : images) ++count[{image.cols, image.rows}];
+  cv::Size best;
+  int best_count = 0;
+  for (const auto& image : images) {
+    const int n = count[{image.cols, image.rows}];
+    if (n > best_count) {
+      best_count = n;
+      best = image.size();
+    }
   }
+  return best;
 }
+
+std::string size_text(cv::Size size) { return std::to_string(size.width) + "x" + std::to_string(size.height); }
 
 Views collect_views(const std::vector<std::string>& left, const std::vector<std::string>& right,
                     const BoardSize& board) {
   if (left.size() != right.size())
     throw std::runtime_error("--left matches " + std::to_string(left.size()) + " files but --right matches " +
                              std::to_string(right.size()) + "; images pair up in sorted order");
-  Views views;
+  std::vector<cv::Mat> left_images, right_images;
   for (size_t i = 0; i < left.size(); ++i) {
-    const cv::Mat l = read_grey(left[i]), r = read_grey(right[i]);
-    check_size(l, left[i], &views.left_size, left.front());
-    check_size(r, right[i], &views.right_size, right.front());
+    left_images.push_back(read_grey(left[i]));
+    right_images.push_back(read_grey(right[i]));
+  }
+  Views views;
+  views.left_size = common_size(left_images);
+  views.right_size = common_size(right_images);
+  for (size_t i = 0; i < left.size(); ++i) {
+    const cv::Mat &l = left_images[i], &r = right_images[i];
+    const bool left_odd = l.size() != views.left_size, right_odd = r.size() != views.right_size;
+    if (left_odd || right_odd) {
+      const std::string& path = left_odd ? left[i] : right[i];
+      const cv::Size size = left_odd ? l.size() : r.size(), usual = left_odd ? views.left_size : views.right_size;
+      log::warn() << path << ": image size " << size_text(size) << " differs from the " << size_text(usual) << " of most "
+                  << (left_odd ? "left" : "right") << " images; pair " << i + 1 << " skipped";
+      continue;
+    }
     auto lc = find_corners(l, board), rc = find_corners(r, board);
     if (lc.empty() || rc.empty()) {
       const char* where = lc.empty() && rc.empty() ? "either image" : lc.empty() ? "the left image" : "the right image";

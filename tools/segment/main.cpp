@@ -7,6 +7,7 @@
 #include <cmath>
 #include <iostream>
 
+#include "nudge/camera/image_file.hpp"
 #include "nudge/flags.hpp"
 #include "nudge/json.hpp"
 #include "nudge/log.hpp"
@@ -90,9 +91,11 @@ std::string json_for(const std::string& path, const sym::Result& r, const std::v
 }
 
 bool process(const std::string& path, size_t index, size_t count, const Options& opt) {
-  const cv::Mat image = cv::imread(path, cv::IMREAD_COLOR);
-  if (image.empty()) {
-    log::error() << path << ": cannot read the image (missing, unreadable or not an image)";
+  cv::Mat image;
+  try {
+    image = camera::read_image_file(path, cv::IMREAD_COLOR);  // refuses truncated and oversized files
+  } catch (const camera::ImageFileError& e) {
+    log::error() << e.what();
     return false;
   }
   const sym::PhotoDetection detected = sym::detect_photo(image, opt.photo);

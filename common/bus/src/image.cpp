@@ -3,6 +3,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "nudge/image_header.hpp"
+
 namespace nudge::bus {
 
 namespace {
@@ -15,6 +17,13 @@ cv::Mat to_mat(const nudge::image_t& msg) {
   const int8_t f = msg.pixel_format;
   if (f == image_t::FORMAT_MJPEG || f == image_t::FORMAT_PNG) {
     if (msg.data.empty()) throw ImageError(describe(msg) + ": compressed data is empty");
+    // The header first: a small message must not make us decode a huge or half image.
+    const std::string problem = check_compressed_image(msg.data.data(), msg.data.size());
+    if (!problem.empty()) {
+      const bool known = read_image_header(msg.data.data(), msg.data.size()).format != ImageHeader::Format::Unknown;
+      throw ImageError(describe(msg) + ": " + format_name(f) + " data " + (known ? "refused: " : "does not decode: ") +
+                       problem);
+    }
     cv::Mat decoded = cv::imdecode(msg.data, cv::IMREAD_UNCHANGED);
     if (decoded.empty()) throw ImageError(describe(msg) + ": " + format_name(f) + " data does not decode");
     if (decoded.depth() != CV_8U) throw ImageError(describe(msg) + ": only 8-bit images are supported");

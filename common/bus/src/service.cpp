@@ -93,9 +93,60 @@ bool Service::spin_once(int timeout_ms) {
 
 bool Service::stop_requested() const { return stop_requested_ || g_signalled; }
 
-void Service::publish_heartbeat(int8_t state) {
+int64_t Service::wall_utime_now() { return wall_utime(); }
+
+void Service::watch_heartbeats(std::vector<std::string> services) {
+  if (!subscriptions_) throw std::logic_error("service " + name_ + ": watch_heartbeats() before start()");
+  watch_ = std::make_unique<HeartbeatWatch>(std::move(services), static_cast<int32_t>(getpid()));
+  subscriptions_->subscribe_timed<heartbeat_t>(
+      channel::HEARTBEAT, [this](const heartbeat_t& hb, const std::string&, int64_t receive_utime) {
+        watch_->on_heartbeat(hb, receive_utime);
+      });
+}
+
+std::vector<HeartbeatWatch::Silent> Service::check_heartbeats(int64_t now_utime) {
+  if (!watch_ || input_is_log()) return {};
+  auto silent = watch_->silent(now_utime);
+  std::string names;
+  for (const auto& s : silent) names += s.source + " ";
+  if (names != reported_silent_) {  // log changes only, not every tick
+    if (!silent.empty()) log::warn() << "no heartbeat: " << describe(silent) << " (stopped or hung?)";
+    else log::info() << "every watched service is sending heartbeats again";
+    reported_silent_ = names;
+  }
+  if (!silent.empty()) last_problem_utime_ = now_utime;
+  return silent;
+}
+
+std::string Service::describe_status(const std::vector<HeartbeatWatch::Silent>& silent) const {
+  std::string text = status_;
+  const auto add = [&text](const std::string& part) { text += (text.empty() ? "" : "; ") + part; };
+  if (!silent.empty()) add(describe(silent));
+  for (const auto& [channel, g] : counters_.gaps())
+    if (g.missed > 0)
+      add(channel + " missed " + std::to_string(g.missed) + " of " + std::to_string(g.missed + g.received));
+  if (counters_.errors > 0) {
+    std::string last = counters_.last_error();
+    if (last.size() > 160) last = last.substr(0, 157) + "...";
+    add(std::to_string(counters_.errors) + " errors" + (last.empty() ? "" : ", last: " + last));
+  }
+  return text.empty() ? "ok" : text;
+}
+
+void Service::publish_heartbeat_at(int64_t now_utime) {
+  const std::vector<HeartbeatWatch::Silent> silent = check_heartbeats(now_utime);
+  const int64_t problems = counters_.errors + counters_.missed;
+  if (problems != problems_seen_) {
+    problems_seen_ = problems;
+    last_problem_utime_ = now_utime;
+  }
+  const bool degraded = last_problem_utime_ >= 0 && now_utime - last_problem_utime_ < kDegradedHoldUs;
+  publish_heartbeat(degraded ? heartbeat_t::STATE_DEGRADED : heartbeat_t::STATE_RUNNING, now_utime);
+}
+
+void Service::publish_heartbeat(int8_t state, int64_t now_utime) {
   heartbeat_t hb;
-  hb.utime = wall_utime();
+  hb.utime = now_utime;
   hb.service = name_;
   hb.instance = instance_;
   hb.pid = static_cast<int32_t>(getpid());
@@ -103,13 +154,13 @@ void Service::publish_heartbeat(int8_t state) {
   hb.messages_in = counters_.messages_in;
   hb.messages_out = counters_.messages_out;
   hb.errors = counters_.errors;
-  hb.status = status_;
+  hb.status = describe_status(watch_ && !input_is_log() ? watch_->silent(now_utime) : std::vector<HeartbeatWatch::Silent>{});
   output().publish(channel::HEARTBEAT, &hb);
 }
 
 int Service::run(const std::function<int()>& tick, int wait_ms) {
   const bool from_log = input_is_log();
-  publish_heartbeat(heartbeat_t::STATE_RUNNING);
+  publish_heartbeat(heartbeat_t::STATE_RUNNING, wall_utime());
   int64_t next_heartbeat = wall_utime() + 1000000;
   int exit_code = 0;
   int wait = wait_ms;
@@ -127,12 +178,13 @@ int Service::run(const std::function<int()>& tick, int wait_ms) {
     }
     wait = tick ? std::min(wait_ms, tick()) : wait_ms;
     const int64_t now = wall_utime();
+    check_heartbeats(now);  // a silent peer is logged when noticed, not at the next heartbeat
     if (now >= next_heartbeat) {
-      publish_heartbeat(counters_.errors > 0 ? heartbeat_t::STATE_DEGRADED : heartbeat_t::STATE_RUNNING);
+      publish_heartbeat_at(now);
       next_heartbeat = now + 1000000;
     }
   }
-  publish_heartbeat(heartbeat_t::STATE_STOPPING);
+  publish_heartbeat(heartbeat_t::STATE_STOPPING, wall_utime());
   log::info() << "stopping: " << counters_.messages_in << " in, " << counters_.messages_out << " out, "
               << counters_.errors << " errors";
   return exit_code;

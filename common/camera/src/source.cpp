@@ -8,6 +8,7 @@
 #include <opencv2/videoio.hpp>
 #include <stdexcept>
 
+#include "nudge/camera/image_file.hpp"
 #include "nudge/flags.hpp"
 #include "nudge/log.hpp"
 
@@ -34,9 +35,12 @@ class ImageFiles : public FrameSource {
   bool read(cv::Mat* frame) override {
     while (next_ < files_.size()) {
       const std::string& path = files_[next_++];
-      *frame = cv::imread(path, cv::IMREAD_COLOR);
-      if (!frame->empty()) return true;
-      log::error() << "skipped " << path << ": not a readable image";  // one bad file is not fatal
+      try {
+        *frame = read_image_file(path, cv::IMREAD_COLOR);
+        return true;
+      } catch (const ImageFileError& e) {
+        log::error() << "skipped " << e.what();  // one bad file is not fatal
+      }
     }
     return false;
   }

@@ -11,7 +11,15 @@
 #include <opencv2/imgproc.hpp>
 
 #include <cstdio>
+#include <filesystem>
+#include <stdexcept>
 #include <iostream>
+
+namespace {
+void write_png(const std::string& path, const cv::Mat& image) {
+  if (!cv::imwrite(path, image)) throw std::runtime_error(path + ": cannot write the image");
+}
+}  // namespace
 
 int main(int argc, char** argv) {
   nudge::log::set_component("sim-render");
@@ -33,6 +41,8 @@ int main(int argc, char** argv) {
     if (!flags.parse(argc, argv)) return 0;
     if (flags.positional().size() != 1) throw nudge::FlagError("expected one SCENE file");
     if (repeat < 1) throw nudge::FlagError("--repeat must be >= 1");
+    // Checked before the slow part, and not created: a typo should not scatter files.
+    if (!std::filesystem::is_directory(out)) throw nudge::FlagError("--out " + out + ": no such directory (create it first)");
   } catch (const nudge::FlagError& e) {
     std::cerr << e.what() << "\n" << flags.help();
     return 2;
@@ -59,12 +69,12 @@ int main(int argc, char** argv) {
     }
     const char* names[2] = {"left", "right"};
     for (int c = 0; c < 2; ++c) {
-      cv::imwrite(out + "/" + names[c] + ".png", first.colour[c]);
-      cv::imwrite(out + "/" + names[c] + "_still.png", still[c]);
+      write_png(out + "/" + names[c] + ".png", first.colour[c]);
+      write_png(out + "/" + names[c] + "_still.png", still[c]);
       if (masks) {
         cv::Mat scaled;
         first.mask[c].convertTo(scaled, CV_8U, 255.0 / std::max(1, world.num_objects()));
-        cv::imwrite(out + "/" + names[c] + "_mask.png", scaled);
+        write_png(out + "/" + names[c] + "_mask.png", scaled);
       }
       if (surface)
         cv::imwrite(out + "/" + names[c] + "_surface.png", nudge::sim::encode_surface(world.render_surface(c)));
@@ -76,15 +86,15 @@ int main(int argc, char** argv) {
           cv::line(drawn, cv::Point2d(line.bottom.x(), line.bottom.y()),
                    cv::Point2d(line.top.x(), line.top.y()), cv::Scalar(0, 0, 255), 1, cv::LINE_AA);
         }
-        cv::imwrite(out + "/" + names[c] + "_axes.png", drawn);
+        write_png(out + "/" + names[c] + "_axes.png", drawn);
       }
     }
     if (mjcf) {
       std::FILE* f = std::fopen((out + "/world.xml").c_str(), "w");
-      if (f) {
-        std::fputs(world.mjcf().c_str(), f);
-        std::fclose(f);
-      }
+      bool written = f && std::fputs(world.mjcf().c_str(), f) >= 0;
+      if (f && std::fclose(f) != 0) written = false;
+      if (!written)
+        throw std::runtime_error(out + "/world.xml: cannot write the model");
     }
     std::printf("scene %s: %d objects, %dx%d\n", scene.source.c_str(), world.num_objects(),
                 scene.rig.width, scene.rig.height);

@@ -11,6 +11,8 @@
 #include "nudge/bus/latest.hpp"
 #include "nudge/bus/service.hpp"
 #include "nudge/heartbeat_t.hpp"
+#include "nudge/image_t.hpp"
+#include "nudge/timing.hpp"
 
 using nudge::heartbeat_t;
 using nudge::bus::Latest;
@@ -97,7 +99,8 @@ TEST(ServiceInProcess, BadInputsAreCountedAndTheServiceKeepsHandling) {
   EXPECT_EQ(hb.state + 0, heartbeat_t::STATE_DEGRADED + 0);
   EXPECT_EQ(hb.errors, 2);
   EXPECT_EQ(hb.messages_in, 3);
-  EXPECT_EQ(hb.status, "checking");
+  // The service's own status first, then what went wrong (issue 12: the status was always empty).
+  EXPECT_EQ(hb.status.rfind("checking; 2 errors, last: skipped a ", 0), 0u) << hb.status;
 }
 
 TEST(ServiceInProcess, FlagsStillApplyWhenTheTransportIsInjected) {
@@ -164,4 +167,120 @@ TEST(ServiceInProcess, ABadUrlOrNoStartIsAClearError) {
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("nosuchprovider://x"), std::string::npos) << e.what();
   }
+}
+
+// ---- drops, recovery and silent peers (issue 12) ----------------------------------------------
+
+namespace {
+nudge::image_t frame(int64_t frame_id) {
+  nudge::image_t image{};
+  image.frame_id = frame_id;
+  image.camera = "left";
+  image.width = image.height = image.row_stride = 1;
+  image.pixel_format = nudge::image_t::FORMAT_GRAY8;
+  image.data = {7};
+  image.size = 1;
+  return image;
+}
+}  // namespace
+
+TEST(ServiceInProcess, FrameIdGapsAreCountedPerChannelAndShownInTheHeartbeat) {
+  lcm::LCM bus("memq://");
+  Service service("sink", "test service");
+  service.start(bus);
+  int handled = 0;
+  service.subscriptions().subscribe<nudge::image_t>("CAM", [&](const nudge::image_t&, const std::string&) { ++handled; });
+  Probe probe(bus);
+  for (int64_t id : {0, 1, 4, 5, 9}) {  // 2, 3, 6, 7, 8 lost on the way
+    const nudge::image_t image = frame(id);
+    bus.publish("CAM", &image);
+  }
+  const nudge::image_t restarted = frame(0);  // a source that restarts is not a loss
+  bus.publish("CAM", &restarted);
+  service.handle_pending();
+  EXPECT_EQ(handled, 6);
+  EXPECT_EQ(service.counters().missed, 5);
+  const auto gaps = service.counters().gaps();
+  ASSERT_EQ(gaps.count("CAM"), 1u);
+  EXPECT_EQ(gaps.at("CAM").received, 6);
+  EXPECT_EQ(gaps.at("CAM").missed, 5);
+  EXPECT_EQ(gaps.at("CAM").restarts, 1);
+
+  const int64_t now = nudge::wall_utime();
+  service.publish_heartbeat_at(now);
+  service.handle_pending();
+  ASSERT_TRUE(probe.heartbeats.has());
+  EXPECT_EQ(probe.heartbeats.get().state + 0, heartbeat_t::STATE_DEGRADED + 0);
+  EXPECT_NE(probe.heartbeats.get().status.find("CAM missed 5 of 11"), std::string::npos)
+      << probe.heartbeats.get().status;
+
+  // No new loss for longer than the hold: RUNNING again, the totals still in the status.
+  service.publish_heartbeat_at(now + nudge::bus::kDegradedHoldUs + 1);
+  service.handle_pending();
+  EXPECT_EQ(probe.heartbeats.get().state + 0, heartbeat_t::STATE_RUNNING + 0);
+  EXPECT_NE(probe.heartbeats.get().status.find("CAM missed 5 of 11"), std::string::npos);
+}
+
+TEST(ServiceInProcess, ADegradedHeartbeatRecoversWhenInputsAreGoodAgain) {
+  lcm::LCM bus("memq://");
+  Service service("echo", "test service");
+  service.start(bus);
+  install_echo(service);
+  Probe probe(bus);
+  const heartbeat_t refused = heartbeat(1, "bad");
+  bus.publish("IN", &refused);
+  service.handle_pending();
+  const int64_t now = nudge::wall_utime();
+  service.publish_heartbeat_at(now);
+  service.handle_pending();
+  EXPECT_EQ(probe.heartbeats.get().state + 0, heartbeat_t::STATE_DEGRADED + 0);
+  EXPECT_NE(probe.heartbeats.get().status.find("status 'bad' refused"), std::string::npos);
+
+  const heartbeat_t good = heartbeat(2, "good");
+  bus.publish("IN", &good);
+  service.handle_pending();
+  service.publish_heartbeat_at(now + nudge::bus::kDegradedHoldUs / 2);
+  service.handle_pending();
+  EXPECT_EQ(probe.heartbeats.get().state + 0, heartbeat_t::STATE_DEGRADED + 0) << "still within the hold";
+  service.publish_heartbeat_at(now + nudge::bus::kDegradedHoldUs + 1);
+  service.handle_pending();
+  EXPECT_EQ(probe.heartbeats.get().state + 0, heartbeat_t::STATE_RUNNING + 0);
+  EXPECT_EQ(probe.heartbeats.get().errors, 1) << "the count stays: it is a total";
+}
+
+TEST(ServiceInProcess, AWatchedServiceThatFallsSilentIsNamedUntilItIsHeardAgain) {
+  lcm::LCM bus("memq://");
+  Service service("monitor", "test service");
+  service.start(bus);
+  service.watch_heartbeats({"camera"});
+  Probe probe(bus);
+  heartbeat_t camera = heartbeat(1, "");
+  camera.service = camera.instance = "camera";
+  camera.pid = 999999;
+  heartbeat_t arm = camera;
+  arm.service = arm.instance = "arm";  // not watched
+  bus.publish(nudge::bus::channel::HEARTBEAT, &camera);
+  bus.publish(nudge::bus::channel::HEARTBEAT, &arm);
+  service.handle_pending();
+  const int64_t heard = nudge::wall_utime();
+  EXPECT_TRUE(service.check_heartbeats(heard).empty());
+
+  const auto silent = service.check_heartbeats(heard + nudge::bus::kSilentAfterUs + 500000);
+  ASSERT_EQ(silent.size(), 1u);
+  EXPECT_EQ(silent[0].source, "camera");
+  EXPECT_GT(silent[0].seconds, 2.5);
+  EXPECT_LT(silent[0].seconds, 3.5);
+  service.publish_heartbeat_at(heard + 3000000);
+  service.handle_pending();
+  EXPECT_EQ(probe.heartbeats.get().state + 0, heartbeat_t::STATE_DEGRADED + 0);
+  EXPECT_NE(probe.heartbeats.get().status.find("camera silent for"), std::string::npos)
+      << probe.heartbeats.get().status;
+
+  bus.publish(nudge::bus::channel::HEARTBEAT, &camera);  // heard again
+  service.handle_pending();
+  EXPECT_TRUE(service.check_heartbeats(nudge::wall_utime()).empty());
+  camera.state = heartbeat_t::STATE_STOPPING;  // a goodbye: then silence is expected
+  bus.publish(nudge::bus::channel::HEARTBEAT, &camera);
+  service.handle_pending();
+  EXPECT_TRUE(service.check_heartbeats(nudge::wall_utime() + 60000000).empty());
 }

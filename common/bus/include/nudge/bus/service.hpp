@@ -12,6 +12,7 @@
 #include <memory>
 #include <string>
 
+#include "nudge/bus/heartbeat_watch.hpp"
 #include "nudge/bus/subscribe.hpp"
 #include "nudge/flags.hpp"
 #include "nudge/heartbeat_t.hpp"
@@ -19,7 +20,14 @@
 namespace nudge::bus {
 
 // ttl=0 keeps default traffic on this host; override with --lcm-url for a real network.
-constexpr const char* kDefaultLcmUrl = "udpm://239.255.76.67:7667?ttl=0";
+// recv_buf_size: a 300 KB image does not fit the kernel's default socket buffer (208 KB), and
+// LCM drops what does not fit silently; 4 MB holds a second of 640x480 stereo at 10 Hz. The
+// kernel caps it at net.core.rmem_max (LCM then prints a warning naming both sizes).
+constexpr const char* kDefaultLcmUrl = "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304";
+
+// A heartbeat stays DEGRADED this long after the last bad input, missed frame or silent peer,
+// then recovers to RUNNING.
+constexpr int64_t kDegradedHoldUs = 5000000;
 
 class Service {
  public:
@@ -62,18 +70,29 @@ class Service {
   int handle_pending(int max_messages = 10000);
   // Waits up to timeout_ms for one message and handles it. Returns whether one was handled.
   bool spin_once(int timeout_ms = 0);
-  // Publishes a heartbeat with the current counters and status (run() does once a second).
-  void publish_heartbeat() {
-    publish_heartbeat(counters_.errors > 0 ? heartbeat_t::STATE_DEGRADED : heartbeat_t::STATE_RUNNING);
-  }
+  // Publishes a heartbeat with the current counters and status (run() does once a second):
+  // DEGRADED within kDegradedHoldUs of an error, a missed frame or a silent watched service, else
+  // RUNNING. `status` is the service's own (set_status) followed by what went wrong, or "ok".
+  void publish_heartbeat() { publish_heartbeat_at(wall_utime_now()); }
+  // The same at a given wall-clock time (tests step time instead of sleeping).
+  void publish_heartbeat_at(int64_t now_utime);
+
+  // Watches the HEARTBEAT of these services (all others when empty), after start(): one that was
+  // heard and then stays silent for kSilentAfterUs is logged, named in the status and makes this
+  // service DEGRADED until it is heard again. Live inputs only (a log's pace is not the sender's).
+  void watch_heartbeats(std::vector<std::string> services = {});
+  // What watch_heartbeats() finds silent at now_utime; logs sources that went silent or came back.
+  std::vector<HeartbeatWatch::Silent> check_heartbeats(int64_t now_utime);
 
   void request_stop() { stop_requested_ = true; }
   bool stop_requested() const;
   void set_status(const std::string& status) { status_ = status; }
 
  private:
-  void publish_heartbeat(int8_t state);
+  void publish_heartbeat(int8_t state, int64_t now_utime);
   void attach(lcm::LCM& input, lcm::LCM& output);
+  static int64_t wall_utime_now();
+  std::string describe_status(const std::vector<HeartbeatWatch::Silent>& silent) const;
 
   std::string name_;
   Flags flags_;
@@ -86,6 +105,10 @@ class Service {
   Counters counters_;
   std::string status_;
   bool stop_requested_ = false;
+  std::unique_ptr<HeartbeatWatch> watch_;
+  std::string reported_silent_;      // what check_heartbeats() last logged
+  int64_t problems_seen_ = 0;        // errors + missed frames at the last heartbeat
+  int64_t last_problem_utime_ = -1;  // when that count last grew, or a watched service was silent
 };
 
 // Runs `body` and turns flag errors into a usage message and exit code 2, other exceptions into

@@ -2,13 +2,17 @@
 // Typed LCM subscriptions for Debian's LCM 1.3.1, which has no lambda subscribe.
 // A message that fails to decode (wrong size, truncated, lengths that decode() throws on or that
 // exceed the bytes sent: decode.hpp) or whose handler throws is reported naming the channel,
-// counted, and skipped; the service keeps running.
+// counted, and skipped; the service keeps running. LCM numbers nothing and drops silently when a
+// socket buffer or queue is full, so gaps in a channel's frame_id sequence are counted instead.
 #include <lcm/lcm-cpp.hpp>
 
 #include <atomic>
 #include <functional>
+#include <map>
 #include <memory>
+#include <mutex>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "nudge/bus/decode.hpp"
@@ -16,11 +20,57 @@
 
 namespace nudge::bus {
 
+// A channel's frame_id sequence as received: how many arrived and how many were skipped over.
+struct SequenceGaps {
+  int64_t last_id = -1;  // -1: none yet
+  int64_t received = 0, missed = 0, restarts = 0;  // restarts: the id went back (a source restarted)
+};
+
 struct Counters {
   std::atomic<int64_t> messages_in{0};
   std::atomic<int64_t> messages_out{0};
   std::atomic<int64_t> errors{0};
+  std::atomic<int64_t> missed{0};  // frame_ids skipped over, all channels together
+
+  // Counts an error and keeps its description for the heartbeat's status.
+  void note_error(const std::string& what) {
+    ++errors;
+    const std::lock_guard<std::mutex> lock(mutex_);
+    last_error_ = what;
+  }
+  std::string last_error() const {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    return last_error_;
+  }
+  // Records a frame_id received on `channel`; returns how many ids it skipped over.
+  int64_t note_frame_id(const std::string& channel, int64_t id) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    SequenceGaps& g = gaps_[channel];
+    int64_t skipped = 0;
+    if (g.last_id >= 0 && id > g.last_id + 1) skipped = id - g.last_id - 1;
+    if (g.last_id >= 0 && id <= g.last_id) ++g.restarts;  // a repeat or a restart, not a loss
+    ++g.received;
+    g.missed += skipped;
+    g.last_id = id;
+    missed += skipped;
+    return skipped;
+  }
+  std::map<std::string, SequenceGaps> gaps() const {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    return gaps_;
+  }
+
+ private:
+  mutable std::mutex mutex_;  // handlers and the heartbeat need not share a thread
+  std::string last_error_;
+  std::map<std::string, SequenceGaps> gaps_;
 };
+
+// Messages that carry a per-source sequence number (image_t, symmetry_lines_t, track_t, ...).
+template <typename Msg, typename = void>
+struct HasFrameId : std::false_type {};
+template <typename Msg>
+struct HasFrameId<Msg, std::void_t<decltype(std::declval<Msg>().frame_id)>> : std::true_type {};
 
 class Subscriptions {
  public:
@@ -65,19 +115,30 @@ class Subscriptions {
       Msg msg;
       const std::string problem = decode_message(rbuf->data, static_cast<int>(rbuf->data_size), &msg);
       if (!problem.empty()) {
-        ++counters.errors;
-        log::error() << "skipped a malformed message on " << channel << ": " << problem;
+        const std::string what = "skipped a malformed message on " + channel + ": " + problem;
+        counters.note_error(what);
+        log::error() << what;
         return;
+      }
+      if constexpr (HasFrameId<Msg>::value) {
+        const int64_t skipped = counters.note_frame_id(channel, msg.frame_id);
+        if (skipped > 0 && rbuf->recv_utime >= next_gap_warning) {  // at most one line a second
+          log::warn() << channel << ": " << skipped << " message(s) missing before frame " << msg.frame_id
+                      << " (dropped by the network or a slow receiver; totals in the heartbeat)";
+          next_gap_warning = rbuf->recv_utime + 1000000;
+        }
       }
       try {
         fn(msg, channel, rbuf->recv_utime);
       } catch (const std::exception& e) {
-        ++counters.errors;
-        log::error() << "skipped a message on " << channel << ": " << e.what();
+        const std::string what = "skipped a message on " + channel + ": " + e.what();
+        counters.note_error(what);
+        log::error() << what;
       }
     }
     Handler fn;
     Counters& counters;
+    int64_t next_gap_warning = 0;
   };
 
   lcm::LCM& lcm_;
