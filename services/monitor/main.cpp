@@ -71,6 +71,7 @@ int main(int argc, char** argv) {
     if (list.empty()) throw FlagError("--channels is empty");
     if (!draw_dir.empty()) ::mkdir(draw_dir.c_str(), 0755);
     service.start();
+    service.watch_heartbeats();  // every service: a killed one is named within 3 s
 
     std::map<std::string, std::map<int64_t, cv::Mat>> frames;  // camera channel -> utime -> image
     std::map<std::string, std::set<int64_t>> seen;

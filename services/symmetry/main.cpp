@@ -58,6 +58,7 @@ int main(int argc, char** argv) {
     if (options.contours < 0) throw FlagError("--contours must be >= 0");
     options.inputs = split_list(inputs);
     service.start();
+    service.watch_heartbeats({"camera"});  // its input: say so when the camera goes quiet
     const symmetry_service::Handlers handlers(service, options);
     return service.run();
   });

@@ -99,6 +99,7 @@ int main(int argc, char** argv) {
     }
 
     service.start();
+    service.watch_heartbeats({"camera"});  // its input: say so when the camera goes quiet
     for (auto& stream : streams) {
       Stream* s = stream.get();
       service.subscriptions().subscribe<image_t>(s->input, [&, s, send_mask](const image_t& msg, const std::string&) {

@@ -238,6 +238,7 @@ int main(int argc, char** argv) {
     opt.locations.max_range_m = opt.filter.max_range_m;
     Triangulation triangulation(service, opt);  // loads the rig: a bad file ends here, naming the field
     service.start();
+    service.watch_heartbeats({"symmetry"});  // its input: say so when line detection goes quiet
     triangulation.subscribe();
     return service.run();
   });

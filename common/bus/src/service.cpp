@@ -97,6 +97,7 @@ int64_t Service::wall_utime_now() { return wall_utime(); }
 
 void Service::watch_heartbeats(std::vector<std::string> services) {
   if (!subscriptions_) throw std::logic_error("service " + name_ + ": watch_heartbeats() before start()");
+  if (input_is_log()) return;  // a log's heartbeats come at the log's pace, not the senders'
   watch_ = std::make_unique<HeartbeatWatch>(std::move(services), static_cast<int32_t>(getpid()));
   subscriptions_->subscribe_timed<heartbeat_t>(
       channel::HEARTBEAT, [this](const heartbeat_t& hb, const std::string&, int64_t receive_utime) {

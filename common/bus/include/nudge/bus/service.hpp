@@ -79,7 +79,7 @@ class Service {
 
   // Watches the HEARTBEAT of these services (all others when empty), after start(): one that was
   // heard and then stays silent for kSilentAfterUs is logged, named in the status and makes this
-  // service DEGRADED until it is heard again. Live inputs only (a log's pace is not the sender's).
+  // service DEGRADED until it is heard again. Does nothing when the input is a log.
   void watch_heartbeats(std::vector<std::string> services = {});
   // What watch_heartbeats() finds silent at now_utime; logs sources that went silent or came back.
   std::vector<HeartbeatWatch::Silent> check_heartbeats(int64_t now_utime);
