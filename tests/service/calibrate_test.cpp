@@ -184,3 +184,24 @@ TEST(CalibrateTool, BadInputGivesClearErrors) {
             2);
   EXPECT_NE(err.find("--table-left and --table-right go together"), std::string::npos) << err;
 }
+
+// Issue 12: opencv-doc's 'left*.jpg' also matches left.jpg, an image of another size; the run
+// used to abort. The odd pair is skipped with a warning naming the file, the rest calibrate.
+TEST(CalibrateTool, AnImageOfAnotherSizeIsSkippedWithAWarning) {
+  ASSERT_NO_FATAL_FAILURE(require_opencv_doc());
+  const std::string dir = scratch_dir("calibrate_odd_size");
+  for (const std::string n : {"01", "02", "03", "04"}) {
+    ASSERT_TRUE(cv::imwrite(dir + "/left" + n + ".png", cv::imread(kData + "/left" + n + ".jpg")));
+    ASSERT_TRUE(cv::imwrite(dir + "/right" + n + ".png", cv::imread(kData + "/right" + n + ".jpg")));
+  }
+  // Sorted first, like left.jpg: the size most images share wins, not the first one's.
+  ASSERT_TRUE(cv::imwrite(dir + "/left.png", cv::Mat(240, 320, CV_8UC3, cv::Scalar::all(0))));
+  ASSERT_TRUE(cv::imwrite(dir + "/right.png", cv::imread(kData + "/right05.jpg")));
+  std::string out, err;
+  EXPECT_EQ(run(calibrate_cmd(dir + "/left*.png", dir + "/right*.png", dir + "/rig.yaml"), &out, &err), 0) << err;
+  EXPECT_NE(err.find(dir + "/left.png: image size 320x240 differs from the 640x480 of most left images; pair 1 skipped"),
+            std::string::npos)
+      << err;
+  EXPECT_NE(last_line(out).find("rms_px="), std::string::npos) << out;
+  EXPECT_TRUE(std::ifstream(dir + "/rig.yaml").good());
+}

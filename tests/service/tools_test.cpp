@@ -123,3 +123,42 @@ TEST(DetectTool, FindsKnownAxesAndReportsUnreadableFiles) {
   }
   EXPECT_TRUE(cv::imread(dir + "/drawn_1.png").data != nullptr) << "--draw numbers files for several images";
 }
+
+// Issue 12: a truncated JPEG gave exit 0 and lines from the top half of the image; a 389 KB PNG
+// declaring 20000x20000 was decoded in full (1.2 GB) before anything refused it.
+TEST(DetectTool, TruncatedAndHugeImagesAreErrorsNamingTheFile) {
+  const std::string dir = scratch_dir("detect_tool_bad");
+  cv::Mat img(300, 400, CV_8UC3, cv::Scalar(210, 220, 230));
+  syn::draw_shape(img, syn::bottle_profile(200, 36), 10, 0, 0, cv::Scalar(50, 40, 30));
+  std::vector<uint8_t> jpeg;
+  ASSERT_TRUE(cv::imencode(".jpg", img, jpeg));
+  jpeg.resize(jpeg.size() / 2);
+  const std::string truncated = dir + "/truncated.jpg";
+  std::FILE* f = std::fopen(truncated.c_str(), "wb");
+  ASSERT_TRUE(f);
+  std::fwrite(jpeg.data(), 1, jpeg.size(), f);
+  std::fclose(f);
+  std::string out;
+  EXPECT_EQ(run(bin("nudge-detect") + " --lines 1 " + truncated, &out), 1);
+  EXPECT_NE(out.find(truncated + ": cannot read the image (JPEG data of " + std::to_string(jpeg.size()) +
+                     " bytes is truncated"),
+            std::string::npos)
+      << out;
+  EXPECT_EQ(out.find("\"lines\""), std::string::npos) << "no lines from half an image:\n" << out;
+
+  std::vector<uint8_t> png;
+  ASSERT_TRUE(cv::imencode(".png", img, png));
+  for (size_t at : {16, 20}) {  // IHDR's width and height: 20000 = 0x4E20
+    png[at] = 0;
+    png[at + 1] = 0;
+    png[at + 2] = 0x4E;
+    png[at + 3] = 0x20;
+  }
+  const std::string huge = dir + "/huge.png";
+  f = std::fopen(huge.c_str(), "wb");
+  ASSERT_TRUE(f);
+  std::fwrite(png.data(), 1, png.size(), f);
+  std::fclose(f);
+  EXPECT_EQ(run(bin("nudge-detect") + " --lines 1 " + huge, &out), 1);
+  EXPECT_NE(out.find(huge + ": cannot read the image (PNG header declares 20000x20000"), std::string::npos) << out;
+}
