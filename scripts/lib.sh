@@ -50,14 +50,27 @@ nudge_build() {
   rm -f "$log"
 }
 
+# LCM asks for recv_buf_size (the scripts: 16 MB) but the kernel caps every socket at
+# net.core.rmem_max, which is global: a network namespace can neither raise it nor hide it (the
+# sysctl fails there). Below 4 MB a burst of 300 KB images overflows and LCM drops frames
+# silently, so say so (the services count the frame_id gaps in their heartbeats).
+nudge_check_receive_buffers() {
+  local max
+  max=$(cat /proc/sys/net/core/rmem_max 2>/dev/null || echo 0)
+  if [ "$max" -lt 4194304 ]; then
+    nudge_log "warning: net.core.rmem_max is $max bytes; LCM receive buffers are capped there and images may be" \
+      "dropped. Raise it on the host (as root): sysctl -w net.core.rmem_max=16777216"
+  fi
+}
+
 # Runs "$@" where LCM multicast stays private: inside a new network namespace with only
 # loopback when we can make one (root), otherwise on this host with ttl=0.
 nudge_in_private_network() {
+  nudge_check_receive_buffers
   if [ "$(id -u)" = 0 ] && unshare -n true 2>/dev/null && [ -z "${NUDGE_HOST_NETWORK:-}" ]; then
     unshare -n bash -c '
       ip link set lo up multicast on
       ip route add 224.0.0.0/4 dev lo
-      sysctl -qw net.core.rmem_max=16777216 net.core.rmem_default=16777216 2>/dev/null || true
       exec "$@"' nudge-private-network "$@"
   else
     "$@"
