@@ -291,6 +291,8 @@ class Shell {
   // ---- time and health ----
   void advance(int64_t now) {
     now_ = std::max(now_, now);
+    // Live, listen for another supervisor's heartbeat (1 Hz) before taking the arm.
+    if (!started_ && !service_.input_is_log() && wall_utime() < listen_until_) return;
     if (!started_) {
       started_ = true;
       const int64_t first_seq = opt_.first_seq > 0 ? opt_.first_seq : 1000 * (wall_utime() / 1000000 % 1000000) + 1;
@@ -496,6 +498,7 @@ class Shell {
   std::map<std::string, int64_t> last_beat_;
   int64_t newest_beat_ = 0, now_ = 0, next_state_publish_ = 0, first_seq_ = 0;
   bool started_ = false, finished_ = false, refused_ = false;
+  const int64_t listen_until_ = wall_utime() + 1500000;  // 1.5 heartbeat periods after start-up
   std::vector<std::string> attempts_json_;
 };
 
