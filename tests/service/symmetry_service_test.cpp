@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <map>
 #include <string>
 
@@ -136,4 +137,18 @@ TEST(SymmetryService, BadFlagsAreRefusedWithAUsageError) {
   const std::string bin = nudge::test::bin_dir() + "/nudge-symmetry";
   for (const std::string args : {" --dmin 300 --dmax 100", " --theta-min -200", " --lines x", " --no-such-flag"})
     EXPECT_EQ(nudge::test::run_command(bin + args + " 2>/dev/null"), 2) << args;
+}
+
+// Issue 12: a log that ends in the middle of a message (a recorder killed, a disk that filled up)
+// is played up to its last whole message; the service then ends as at the end of any log.
+TEST(SymmetryService, ALogThatEndsMidMessageIsPlayedUpToItsLastWholeMessage) {
+  const std::string in = nudge::test::temp_path("symmetry_cut_in.lcmlog");
+  const auto truth = write_input_log(in);
+  const auto size = std::filesystem::file_size(in);
+  std::filesystem::resize_file(in, size - 60);  // inside the last message (the 114-byte one)
+  const auto run = run_from_log("nudge-symmetry", "--inputs CAMERA --lines 3 --dmin 10 --dmax 0 --theta-min -30 --theta-max 30",
+                                in, nudge::test::temp_path("symmetry_cut_out.lcmlog"));
+  ASSERT_EQ(run.exit_code, 0) << run.command;
+  EXPECT_EQ(nudge::test::messages_on<nudge::symmetry_lines_t>(run.output, channel::SYMMETRY).size(), truth.size());
+  EXPECT_EQ(nudge::test::last_heartbeat_errors(run.output), 3) << "the cut message is not half-decoded";
 }
