@@ -2,12 +2,21 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
+
 #include "nudge/bus/channels.hpp"
 #include "nudge/bus/decode.hpp"
 #include "nudge/bus/image.hpp"
 #include "nudge/bus/pose_convert.hpp"
 #include "nudge/bus/subscribe.hpp"
+#include "nudge/arm_command_t.hpp"
+#include "nudge/axes_t.hpp"
+#include "nudge/candidates_t.hpp"
+#include "nudge/contours_t.hpp"
 #include "nudge/heartbeat_t.hpp"
+#include "nudge/sim_state_t.hpp"
+#include "nudge/symmetry_lines_t.hpp"
+#include "nudge/track_t.hpp"
 
 using namespace nudge;
 
@@ -295,4 +304,102 @@ TEST(Image, TruncatedJpegIsRefusedNotDecodedInPart) {
   } catch (const bus::ImageError& e) {
     EXPECT_NE(std::string(e.what()).find("truncated"), std::string::npos) << e.what();
   }
+}
+
+// ---- declared array lengths (issue 12, found by fuzz_messages) -------------------------------
+
+namespace {
+// Where a big-endian int32 `count` is followed by `next` (the first element's first bytes).
+size_t find_count(const Bytes& bytes, int32_t count, const Bytes& next) {
+  Bytes pattern(4);
+  put_int32(&pattern, 0, count);
+  pattern.insert(pattern.end(), next.begin(), next.end());
+  const auto it = std::search(bytes.begin(), bytes.end(), pattern.begin(), pattern.end());
+  return it == bytes.end() ? std::string::npos : static_cast<size_t>(it - bytes.begin());
+}
+
+// Valid messages with 0 and 3 elements (and strings of several lengths) pass the pre-decode
+// check and decode: the layouts in decode.cpp match the types.
+template <typename Msg, typename Fill>
+void expect_valid_pass(Fill fill) {
+  for (int n : {0, 3}) {
+    for (const std::string text : {"", "left", "a longer camera name"}) {
+      Msg msg{};
+      fill(&msg, n, text);
+      const Bytes bytes = encode(msg);
+      Msg back;
+      EXPECT_EQ(bus::decode_message(bytes.data(), static_cast<int>(bytes.size()), &back), "")
+          << Msg::getTypeName() << " with " << n << " elements, string '" << text << "'";
+    }
+  }
+}
+}  // namespace
+
+TEST(Decode, ValidMessagesWithArraysPassTheLengthChecks) {
+  expect_valid_pass<arm_command_t>([](arm_command_t* m, int n, const std::string&) {
+    m->num_joints = n;
+    m->joints.assign(n, 0.5);
+  });
+  expect_valid_pass<candidates_t>([](candidates_t* m, int n, const std::string&) {
+    m->num_candidates = n;
+    m->position.assign(n, std::vector<double>(3, 0.1));
+    m->cluster_size.assign(n, 4);
+  });
+  expect_valid_pass<axes_t>([](axes_t* m, int n, const std::string&) {
+    m->num_axes = n;
+    m->axes.resize(n);
+  });
+  expect_valid_pass<symmetry_lines_t>([](symmetry_lines_t* m, int n, const std::string& text) {
+    m->camera = text;
+    m->num_lines = n;
+    m->lines.resize(n);
+  });
+  expect_valid_pass<track_t>([](track_t* m, int n, const std::string& text) {
+    m->camera = text;
+    m->reason = text + text;
+    m->num_blocks = n;
+    m->motion_mask.assign(n, 1);
+  });
+  expect_valid_pass<sim_state_t>([](sim_state_t* m, int n, const std::string& text) {
+    m->num_objects = n;
+    m->objects.resize(n);
+    for (auto& o : m->objects) o.name = text;
+  });
+  expect_valid_pass<contours_t>([](contours_t* m, int n, const std::string& text) {
+    m->camera = text;
+    m->num_contours = n;
+    m->contours.resize(n);
+  });
+}
+
+TEST(Decode, ArrayCountsBeyondTheBytesAreRefusedBeforeAllocating) {
+  arm_command_t command{};
+  command.num_joints = 3;
+  command.joints = {1.5, 1.5, 1.5};
+  Bytes bytes = encode(command);
+  const size_t at = find_count(bytes, 3, {0x3F, 0xF8});  // 1.5 = 0x3FF8...
+  ASSERT_NE(at, std::string::npos);
+  put_int32(&bytes, at, 2000000000);  // 16 GB of doubles in 157 bytes
+  arm_command_t back;
+  const std::string problem = bus::decode_message(bytes.data(), static_cast<int>(bytes.size()), &back);
+  EXPECT_NE(problem.find("arm_command_t of " + std::to_string(bytes.size()) + " bytes: num_joints declares 2000000000"),
+            std::string::npos)
+      << problem;
+  put_int32(&bytes, at, -1);
+  EXPECT_NE(bus::decode_message(bytes.data(), static_cast<int>(bytes.size()), &back).find("declares -1"),
+            std::string::npos);
+
+  symmetry_lines_t lines{};
+  lines.camera = "right";
+  lines.num_lines = 2;
+  lines.lines.resize(2);
+  lines.lines[0].r = 1.5f;  // 0x3FC00000
+  Bytes line_bytes = encode(lines);
+  const size_t lines_at = find_count(line_bytes, 2, {0x3F, 0xC0, 0x00, 0x00});
+  ASSERT_NE(lines_at, std::string::npos);
+  put_int32(&line_bytes, lines_at, 3);  // one more line than the bytes hold
+  symmetry_lines_t lines_back;
+  EXPECT_NE(bus::decode_message(line_bytes.data(), static_cast<int>(line_bytes.size()), &lines_back)
+                .find("num_lines declares 3"),
+            std::string::npos);
 }

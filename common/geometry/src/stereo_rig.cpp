@@ -112,9 +112,19 @@ struct Reader {
     return static_cast<int>(n);
   }
   cv::Mat matrix(const std::string& field) const {
+    const cv::FileNode n = node(field);
+    // OpenCV allocates rows x cols before reading the data: a file declaring 100000 columns
+    // would cost gigabytes (found by fuzz_calibration). A rig's matrices are at most 3x3 or 1x5.
+    constexpr int kMaxSide = 16;
+    const cv::FileNode rows = n["rows"], cols = n["cols"];
+    if (!n.isMap() || !rows.isInt() || !cols.isInt()) fail(field, "is not an OpenCV matrix");
+    if (static_cast<int>(rows) < 1 || static_cast<int>(rows) > kMaxSide || static_cast<int>(cols) < 1 ||
+        static_cast<int>(cols) > kMaxSide)
+      fail(field, "declares " + std::to_string(static_cast<int>(rows)) + "x" + std::to_string(static_cast<int>(cols)) +
+                      " elements (at most " + std::to_string(kMaxSide) + " a side)");
     cv::Mat m;
     try {
-      node(field) >> m;
+      n >> m;
     } catch (const cv::Exception&) {
       fail(field, "is not an OpenCV matrix");
     }

@@ -17,12 +17,18 @@ namespace nudge::bus {
 // declares more bytes than `size_bytes` holds, or a negative length; "" when they fit.
 std::string check_encoded_image(const void* data, int size_bytes);
 
-// Length checks done before decoding: those of image_t (the large payload on the bus); other
-// types rely on decode() and its exceptions.
+// What is wrong with the element count of a variable-length array in an encoded message of the
+// named type (arm_command_t, candidates_t, axes_t, symmetry_lines_t, track_t, sim_state_t,
+// contours_t): negative, or more elements than the bytes left could hold. decode() would
+// allocate the declared count first: 157 bytes of arm_command_t could ask for 16 GB (found by
+// fuzz_messages). "" when they fit or the type has no such array.
+std::string check_declared_lengths(const std::string& type_name, const void* data, int size_bytes);
+
+// Length checks done before decoding, so that no declared length is allocated unchecked.
 template <typename Msg>
 std::string check_before_decode(const void* data, int size_bytes) {
   if constexpr (std::is_same_v<Msg, image_t>) return check_encoded_image(data, size_bytes);
-  return {};
+  return check_declared_lengths(Msg::getTypeName(), data, size_bytes);
 }
 
 // Decodes `size_bytes` bytes into *msg. Returns "" on success, else why the bytes are not a Msg.
