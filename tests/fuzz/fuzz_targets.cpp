@@ -16,6 +16,8 @@
 #include "nudge/geometry/stereo_rig.hpp"
 #include "nudge/heartbeat_t.hpp"
 #include "nudge/image_t.hpp"
+#include "nudge/learn_result_t.hpp"
+#include "nudge/recognition_t.hpp"
 #include "nudge/robot/workspace.hpp"
 #include "nudge/sim_state_t.hpp"
 #include "nudge/snapshot_request_t.hpp"
@@ -72,6 +74,8 @@ int fuzz_messages(const uint8_t* data, size_t size) {
   decode_as<candidates_request_t>(data, size);
   decode_as<candidates_t>(data, size);
   decode_as<heartbeat_t>(data, size);
+  decode_as<learn_result_t>(data, size);
+  decode_as<recognition_t>(data, size);
   decode_as<sim_state_t>(data, size);
   decode_as<snapshot_request_t>(data, size);
   decode_as<supervisor_state_t>(data, size);

@@ -14,6 +14,7 @@
 #include "nudge/candidates_t.hpp"
 #include "nudge/contours_t.hpp"
 #include "nudge/heartbeat_t.hpp"
+#include "nudge/recognition_t.hpp"
 #include "nudge/sim_state_t.hpp"
 #include "nudge/symmetry_lines_t.hpp"
 #include "nudge/track_t.hpp"
@@ -364,6 +365,14 @@ TEST(Decode, ValidMessagesWithArraysPassTheLengthChecks) {
     m->num_objects = n;
     m->objects.resize(n);
     for (auto& o : m->objects) o.name = text;
+  });
+  expect_valid_pass<recognition_t>([](recognition_t* m, int n, const std::string& text) {
+    m->label = text;
+    m->reason = text + "!";
+    m->num_objects = n;
+    m->names.assign(n, text);
+    m->matches.assign(n, 7);
+    m->match_picture.camera = text;
   });
   expect_valid_pass<contours_t>([](contours_t* m, int n, const std::string& text) {
     m->camera = text;

@@ -89,6 +89,11 @@ const std::map<std::string, std::vector<Field>>& array_layouts() {
       // fingerprint, utime, step, joints[6], gripper
       {"sim_state_t", {{Field::Fixed, 8 + 8 + 8 + 6 * 8 + 8}, {Field::Count, 1, "num_objects"}}},
       {"contours_t", {{Field::Fixed, 8 + 8 + 8}, {Field::String, 0, "camera"}, {Field::Count, 1, "num_contours"}}},
+      // ..., seq, label, reason, best_view, learned_utime; names[n] (each at least a length and
+      // a NUL) and matches[n]. The match_picture image after them is not checked.
+      {"recognition_t",
+       {{Field::Fixed, 8 + 8 + 8}, {Field::String, 0, "label"}, {Field::String, 0, "reason"}, {Field::Fixed, 4 + 8},
+        {Field::Count, 5 + 4, "num_objects"}}},
   };
   return layouts;
 }

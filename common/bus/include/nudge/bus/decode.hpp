@@ -19,7 +19,7 @@ std::string check_encoded_image(const void* data, int size_bytes);
 
 // What is wrong with the element count of a variable-length array in an encoded message of the
 // named type (arm_command_t, candidates_t, axes_t, symmetry_lines_t, track_t, sim_state_t,
-// contours_t): negative, or more elements than the bytes left could hold. decode() would
+// contours_t, recognition_t): negative, or more elements than the bytes left could hold. decode() would
 // allocate the declared count first: 157 bytes of arm_command_t could ask for 16 GB (found by
 // fuzz_messages). "" when they fit or the type has no such array.
 std::string check_declared_lengths(const std::string& type_name, const void* data, int size_bytes);
