@@ -25,7 +25,9 @@ for target in "${targets[@]}"; do
   crashes="$NUDGE_ROOT/tests/fuzz/crashes/$target"
   mkdir -p "$crashes"
   log="$build/fuzz_$target.log"
-  if "$build/bin/fuzz_$target" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
+  # NUDGE_FUZZ_SEED (CI: 1) makes a run repeatable: the same inputs in the same order, so a red CI
+  # is a crash anyone can reproduce, not a roll of the dice (explore with the default: a new seed).
+  if "$build/bin/fuzz_$target" -max_total_time="$seconds" ${NUDGE_FUZZ_SEED:+-seed=$NUDGE_FUZZ_SEED} -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
       -artifact_prefix="$crashes/" "$corpus" "$NUDGE_ROOT/tests/fuzz/corpus/$target" >"$log" 2>&1; then
     nudge_log "fuzz_$target: $(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$') inputs in ${seconds} s, no crash"
   else
