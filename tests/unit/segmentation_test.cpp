@@ -146,6 +146,36 @@ TEST(SegmentationSept, RejectsPairsWiderThanMaxWidth) {
   EXPECT_FLOAT_EQ(Segmenter(params).sept(edges, line).weights.at<float>(-sept.first_row, 40), 1.0f);
 }
 
+TEST(SegmentationSept, PairsExactlyAtTheLimitsAreInsideOrOutAsAlgorithm2Says) {
+  // Line at x = 50; the pair (10, 90) is exactly MAXw = 80 wide: kept (width <= MAXw), one pixel
+  // narrower a limit drops it. A pair whose midpoint is exactly MAXmid off the line is dropped
+  // (d < MAXmid), a hair closer it is kept with weight 1 - d / (2 MAXmid).
+  sym::EdgeSet edges;
+  edges.width = 101;
+  edges.height = 1;
+  edges.points = {{10, 0}, {90, 0}};
+  sym::Line line;
+  SegmentParams params;
+  params.max_width = 80;
+  SeptBuffer sept = Segmenter(params).sept(edges, line);
+  EXPECT_EQ(sept.num_pairs, 1);
+  EXPECT_FLOAT_EQ(sept.weights.at<float>(-sept.first_row, 40), 1.0f);
+  params.max_width = 79;
+  sept = Segmenter(params).sept(edges, line);
+  EXPECT_EQ(sept.num_pairs, 0);
+  EXPECT_EQ(cv::countNonZero(sept.weights >= 0), 0);
+
+  edges.points = {{40, 0}, {80, 0}};  // midpoint 60: d = 10
+  params.max_width = 80;
+  params.max_mid = 10;
+  sept = Segmenter(params).sept(edges, line);
+  EXPECT_EQ(sept.num_pairs, 1);
+  EXPECT_EQ(cv::countNonZero(sept.weights >= 0), 0);
+  params.max_mid = 10.5;
+  sept = Segmenter(params).sept(edges, line);
+  EXPECT_FLOAT_EQ(sept.weights.at<float>(-sept.first_row, 20), static_cast<float>(1.0 - 10 / 21.0));
+}
+
 TEST(SegmentationDp, PrefersTallContourAndBridgesGaps) {
   // A column of weights at half-width 5 over rows 2..29 with a gap at rows 12..15, a flat wide run
   // in row 20, and an isolated cell. The contour must be the tall column.

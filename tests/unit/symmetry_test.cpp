@@ -2,6 +2,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include <array>
 #include <cmath>
 #include <random>
 
@@ -569,13 +570,86 @@ TEST(SymmetryDetect, RecoversSkewAngle) {
 }
 
 TEST(SymmetryDetect, OrientationLimitsExcludeOtherAngles) {
+  // Two bottles, axes at 5 and 30 deg: the limits keep the first and must drop the second.
   cv::Mat img = blank();
-  syn::draw_shape(img, syn::bottle_profile(150, 28), 0, 30 * kDeg, 0, cv::Scalar(40));
+  syn::draw_shape(img, syn::bottle_profile(150, 28), -70, 5 * kDeg, 0, cv::Scalar(40));
+  syn::draw_shape(img, syn::bottle_profile(150, 28), 70, 30 * kDeg, 0, cv::Scalar(40));
+  auto has_axis = [](const Result& res, double r, double theta_deg) {
+    for (const auto& l : res.lines)
+      if (angle_diff_deg(l.theta, theta_deg * kDeg) < 1.0 && r_diff(l, r, theta_deg * kDeg) < 1.5) return true;
+    return false;
+  };
   Params p = synthetic_params();
+  EXPECT_TRUE(has_axis(Detector(p).detect(img), 70, 30));  // without limits the 30 deg axis is found
   p.theta_min_deg = -15;
   p.theta_max_deg = 15;
   const Result res = Detector(p).detect(img);
+  ASSERT_FALSE(res.lines.empty());
+  EXPECT_TRUE(has_axis(res, -70, 5));
   for (const auto& l : res.lines) EXPECT_LE(std::fabs(l.theta) / kDeg, 16.0);
+}
+
+// Sub-bin refinement (eq. 3.1-3.2) on hand-made accumulators, checked against the Newton step and
+// the 1D parabola vertices worked out here.
+namespace {
+Accumulator one_peak(int r_max, int theta_bin, int r_bin, const std::array<std::array<int, 3>, 3>& votes) {
+  Accumulator acc;
+  acc.r_max = r_max;
+  acc.votes = {cv::Mat(kThetaBins, acc.num_r(), CV_32S, cv::Scalar(0))};
+  for (int dt = -1; dt <= 1; ++dt)
+    for (int dr = -1; dr <= 1; ++dr) acc.votes[0].at<int32_t>(theta_bin + dt, r_bin + dr) = votes[dt + 1][dr + 1];
+  return acc;
+}
+}  // namespace
+
+TEST(SymmetryPeaks, SubBinNewtonStepRecoversAQuadraticPeak) {
+  // V(dr, dt) = 10000 - 1000 (2 (dr - 0.3)^2 + 1.5 (dt + 0.2)^2 + 0.8 (dr - 0.3)(dt + 0.2)): a
+  // quadratic, so the 3x3 finite differences are exact and the Newton step lands on its top.
+  const double r0 = 0.3, t0 = -0.2;
+  auto v = [&](int dr, int dt) {
+    const double x = dr - r0, y = dt - t0;
+    return static_cast<int>(std::lround(10000 - 1000 * (2 * x * x + 1.5 * y * y + 0.8 * x * y)));
+  };
+  std::array<std::array<int, 3>, 3> votes{};
+  for (int dt = -1; dt <= 1; ++dt)
+    for (int dr = -1; dr <= 1; ++dr) votes[dt + 1][dr + 1] = v(dr, dt);
+  const Accumulator acc = one_peak(50, 100, 70, votes);
+  Params p;
+  p.num_lines = 1;
+  p.refine_log = false;
+  const std::vector<Line> lines = Detector(p).find_peaks(acc, 101, 101);
+  ASSERT_EQ(lines.size(), 1u);
+  EXPECT_NEAR(lines[0].r, 70 + r0 - 50, 2e-3);
+  EXPECT_NEAR(lines[0].theta / kDeg, theta_of_bin_deg(100 + t0), 2e-3);
+  EXPECT_EQ(lines[0].r_bin, 70);
+  EXPECT_EQ(lines[0].theta_bin, 100);
+}
+
+TEST(SymmetryPeaks, NewtonStepOutsideTheBinFallsBackToSeparateParabolas) {
+  // Centre 100; along R 60 | 100 | 90, along theta 70 | 100 | 80; strong corners (hrt = 40 against
+  // hrr = htt = -50) put the Newton step outside the bin (dr = 950 / 900), so each direction gets
+  // its own parabola: dr = -gr / hrr = 15 / 50 = 0.3, dt = -gt / htt = 5 / 50 = 0.1.
+  const std::array<std::array<int, 3>, 3> votes = {{{95, 70, 15}, {60, 100, 90}, {15, 80, 95}}};
+  Params p;
+  p.num_lines = 1;
+  p.refine_log = false;
+  std::vector<Line> lines = Detector(p).find_peaks(one_peak(50, 90, 60, votes), 101, 101);
+  ASSERT_EQ(lines.size(), 1u);
+  EXPECT_NEAR(lines[0].r, 60 + 0.3 - 50, 1e-9);
+  EXPECT_NEAR(lines[0].theta / kDeg, theta_of_bin_deg(90 + 0.1), 1e-9);
+
+  // The same on log(1 + V) (the default), corners 75 / 25 (log Newton step 2.45 bins): the
+  // vertices of the parabolas through the log votes.
+  const std::array<std::array<int, 3>, 3> log_votes = {{{75, 70, 25}, {60, 100, 90}, {25, 80, 75}}};
+  p.refine_log = true;
+  lines = Detector(p).find_peaks(one_peak(50, 90, 60, log_votes), 101, 101);
+  ASSERT_EQ(lines.size(), 1u);
+  auto vertex = [](double minus, double centre, double plus) {
+    const double a = std::log1p(minus), b = std::log1p(centre), c = std::log1p(plus);
+    return -((c - a) / 2) / (c + a - 2 * b);
+  };
+  EXPECT_NEAR(lines[0].r, 60 + vertex(60, 100, 90) - 50, 1e-6);
+  EXPECT_NEAR(lines[0].theta / kDeg, theta_of_bin_deg(90 + vertex(70, 100, 80)), 1e-6);
 }
 
 TEST(SymmetryBadInput, EmptyImageIsAClearError) {

@@ -2,6 +2,7 @@
 // theta wrap-around, the automatic start, mask refinement, and the whole tracker on synthetic video.
 #include <gtest/gtest.h>
 
+#include <Eigen/Dense>
 #include <opencv2/imgproc.hpp>
 
 #include <cmath>
@@ -161,6 +162,48 @@ TEST(Kalman, ConvergesOnAKnownConstantAccelerationTrajectory) {
   EXPECT_GT(kf.covariance().diagonal().minCoeff(), 0);
 }
 
+// The filter against a textbook Kalman filter written out here: the same model (eq. 5.1), the
+// optimal-gain covariance update P = (I - K H) P instead of the Joseph form. The two agree exactly
+// only if every term of the Joseph form (K R K' included) is right.
+TEST(Kalman, MatchesATextbookFilterStepByStep) {
+  KalmanParams params;
+  LineKalman kf(params);
+  Eigen::Matrix<double, 6, 6> a = Eigen::Matrix<double, 6, 6>::Identity();
+  for (int i = 0; i < 4; ++i) a(i, i + 2) = 1.0;  // position += velocity, velocity += acceleration
+  a(0, 4) = a(1, 5) = 0.5;                         // position += acceleration / 2
+  Eigen::Matrix<double, 2, 6> h = Eigen::Matrix<double, 2, 6>::Zero();
+  h(0, 0) = h(1, 1) = 1.0;
+  const Eigen::Matrix2d r = Eigen::Vector2d(params.measurement_var_r, params.measurement_var_theta).asDiagonal();
+  Eigen::Matrix<double, 6, 6> q = Eigen::Matrix<double, 6, 6>::Zero();
+  for (int i = 0; i < 6; ++i) q(i, i) = params.process_noise[i];
+
+  const LineMeasurement first{40.0, 10.0};
+  kf.initialise(first);
+  KalmanState x = KalmanState::Zero();
+  x(0) = first.r;
+  x(1) = first.theta_deg;
+  KalmanCovariance p = KalmanCovariance::Zero();
+  for (int i = 0; i < 6; ++i) p(i, i) = params.initial_variance[i];
+
+  std::mt19937 rng(11);
+  std::normal_distribution<double> noise(0.0, 3.0);
+  for (int t = 1; t <= 30; ++t) {
+    kf.predict();
+    x = a * x;
+    p = a * p * a.transpose() + q;
+    const Eigen::Vector2d z(40.0 + 1.5 * t + noise(rng), 10.0 + 0.8 * t + noise(rng));  // stays inside +-90
+    const Eigen::Matrix2d s = h * p * h.transpose() + r;
+    const Eigen::Vector2d nu = z - h * x;
+    EXPECT_NEAR(kf.gate_error({z(0), z(1)}), nu.dot(s.inverse() * nu), 1e-9) << t;
+    kf.update({z(0), z(1)});
+    const Eigen::Matrix<double, 6, 2> k = p * h.transpose() * s.inverse();
+    x += k * nu;
+    p = (Eigen::Matrix<double, 6, 6>::Identity() - k * h) * p;
+    EXPECT_LT((kf.state() - x).norm(), 1e-9 * (1 + x.norm())) << t;
+    EXPECT_LT((kf.covariance() - p).norm(), 1e-9 * (1 + p.norm())) << t << "\n" << kf.covariance() << "\n" << p;
+  }
+}
+
 TEST(Kalman, NoisyMeasurementsAreSmoothed) {
   std::mt19937 rng(7);
   std::normal_distribution<double> noise(0.0, 3.0);  // sigma^2 = 9: the thesis' measurement noise
@@ -176,7 +219,8 @@ TEST(Kalman, NoisyMeasurementsAreSmoothed) {
       filtered += std::fabs(kf.state()(0) - t);
     }
   }
-  EXPECT_LT(filtered, 0.85 * raw);
+  // kalman.hpp promises smoothing to 0.75 of the raw error with the default process noise.
+  EXPECT_LT(filtered, 0.75 * raw) << filtered / raw;
 }
 
 TEST(Kalman, HoldStopsTheLineWhereItIs) {
