@@ -167,6 +167,8 @@ TEST(Kalman, ConvergesOnAKnownConstantAccelerationTrajectory) {
 // only if every term of the Joseph form (K R K' included) is right.
 TEST(Kalman, MatchesATextbookFilterStepByStep) {
   KalmanParams params;
+  params.measurement_var_theta = 4.0;  // unlike var_r, so that swapping the two shows
+  params.process_noise = {1.0, 0.8, 0.5, 0.4, 0.05, 0.03};
   LineKalman kf(params);
   Eigen::Matrix<double, 6, 6> a = Eigen::Matrix<double, 6, 6>::Identity();
   for (int i = 0; i < 4; ++i) a(i, i + 2) = 1.0;  // position += velocity, velocity += acceleration
