@@ -345,8 +345,9 @@ def main():
         for x in chosen:
             print(f"{x['id']:45s} {x['file']}")
         return 0
-    # SIGTERM (and SIGHUP) unwind like Ctrl-C, through every restoring with-block.
-    for sig in (signal.SIGTERM, signal.SIGHUP):
+    # SIGTERM and SIGHUP unwind like Ctrl-C, through every restoring with-block (SIGINT too when
+    # started in the background, where the shell would have it ignored).
+    for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
         signal.signal(sig, lambda *_: (_ for _ in ()).throw(KeyboardInterrupt()))
     restore_backups()
     if not os.path.exists(os.path.join(BUILD, "CMakeCache.txt")):
