@@ -4,6 +4,7 @@
 
 #include <Eigen/Dense>
 #include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
 
 #include <cmath>
 #include <random>
@@ -484,10 +485,22 @@ TEST(Tracker, StartsAtAGivenLineAndFollowsTheObject) {
   nudge::symmetry::Line nowhere;
   nowhere.r = 250;  // far right of the moving bottle, in empty background
   wrong.start_at(nowhere);
-  TrackState last;
-  for (int i = video.still_frames; i < 40; ++i) last = wrong.feed(video.frame(i), i * kFramePeriodUs);
-  EXPECT_NE(last.status, TrackStatus::Tracking);
-  EXPECT_FALSE(last.reason.empty());
+  bool lost = false;
+  for (int i = video.still_frames; i < 40; ++i) {
+    const TrackState s = wrong.feed(video.frame(i), i * kFramePeriodUs);
+    if (s.status == TrackStatus::Lost && !lost) {
+      lost = true;
+      EXPECT_NE(s.reason.find("validation gate"), std::string::npos) << s.reason;
+    }
+    if (s.status != TrackStatus::Tracking) continue;
+    if (!lost) {  // the started track never jumps to the object...
+      EXPECT_EQ(s.tracks_started, 1);
+      EXPECT_NEAR(s.line.r, nowhere.r, 15.0) << i;
+    } else {  // ...but after its loss a new automatic start (re-acquisition) may find it
+      EXPECT_EQ(s.tracks_started, 2) << i;
+    }
+  }
+  EXPECT_TRUE(lost);
 }
 
 // The thesis' pendulum setting (sec. 5.4), harder: a shaded bottle swings at up to 11 px/frame in
@@ -661,6 +674,79 @@ TEST(Tracker, GoesLostWithAReasonWhenTheObjectVanishes) {
   st = tracker.feed(empty_scene, i * kFramePeriodUs);
   EXPECT_EQ(st.status, TrackStatus::Lost) << "stays lost while nothing moves";
   EXPECT_FALSE(st.reason.empty());
+}
+
+// The bottle vanishes while a cup far from it keeps moving, through the loss and after it: no new
+// jump in motion ever comes, yet the tracker re-acquires (on the cup) rearm_frames after the loss,
+// and says so (tracks_started 2, "re-acquiring" while it starts). With rearm_frames = 0 (the
+// thesis' jump rule alone) it stays lost.
+TEST(Tracker, ReacquiresAfterALossWhileMotionGoesOn) {
+  const Video video;
+  constexpr int kVanish = 20;
+  auto cup = [](int i) { return Pose{150.0 - 3.0 * std::max(0, i - kVanish), 4 * kDeg}; };
+  auto frame = [&](int i) {
+    cv::Mat img = static_scene(640, 480);
+    if (i < kVanish) draw_bottle(img, video.truth(i), 1.0);
+    for (int k = 0; k < 3; ++k)  // nested outlines: the inside changes as it moves
+      syn::draw_shape(img, syn::cup_profile(150, 55 - 12 * k, 40 - 9 * k), cup(i).r, cup(i).theta, 0,
+                      cv::Scalar(50 + 30 * k));
+    return img;
+  };
+  for (const int rearm_frames : {TrackerParams{}.start.rearm_frames, 0}) {
+    TrackerParams params;
+    params.start.rearm_frames = rearm_frames;
+    SymmetryTracker tracker(params);
+    TrackState s;
+    int lost_at = -1, reacquired_at = -1;
+    bool said_reacquiring = false;
+    for (int i = 0; i < 70 && reacquired_at < 0; ++i) {
+      s = tracker.feed(frame(i), i * kFramePeriodUs);
+      if (i == kVanish - 1) {
+        ASSERT_EQ(s.status, TrackStatus::Tracking) << s.reason;
+        ASSERT_EQ(s.tracks_started, 1);
+      }
+      if (lost_at < 0 && s.status == TrackStatus::Lost) lost_at = i;
+      said_reacquiring |= s.status == TrackStatus::Initialising && s.reason.find("re-acquiring") != std::string::npos;
+      if (lost_at >= 0 && s.status == TrackStatus::Tracking) reacquired_at = i;
+    }
+    ASSERT_GE(lost_at, kVanish) << "the bottle's track ends";
+    if (rearm_frames == 0) {
+      EXPECT_EQ(reacquired_at, -1) << "without re-arming, continuing motion is no jump";
+      EXPECT_EQ(s.tracks_started, 1);
+      continue;
+    }
+    ASSERT_GE(reacquired_at, 0) << s.reason;
+    std::printf("lost at frame %d, re-acquired at frame %d\n", lost_at, reacquired_at);
+    EXPECT_LE(reacquired_at, lost_at + rearm_frames + 1 + 3 + 3) << "rearm, then the three start frames";
+    EXPECT_TRUE(said_reacquiring);
+    EXPECT_EQ(s.tracks_started, 2);
+    EXPECT_NEAR(s.line.r, cup(reacquired_at).r, 3.0) << "on the cup";
+    EXPECT_LT(theta_error_deg(s.line.theta, cup(reacquired_at).theta), 3.0);
+  }
+}
+
+// A real video (opencv-doc's Megamind.avi, 270 frames of a hand-held toy): the first track is
+// lost early on (frame ~58) while the camera and the toy keep moving; the tracker must not stay
+// lost for the rest of the video but start again, more than once if need be.
+TEST(Tracker, ReacquiresInMegamindAfterTheFirstLoss) {
+  const std::string path = "/usr/share/doc/opencv-doc/examples/data/Megamind.avi";  // scripts/lib.sh installs it
+  cv::VideoCapture video(path);
+  if (!video.isOpened()) GTEST_SKIP() << path << " not found (Debian package opencv-doc)";
+  SymmetryTracker tracker;
+  cv::Mat frame;
+  int frames = 0, first_loss = -1, tracking_after_loss = 0, max_started = 0;
+  for (; video.read(frame); ++frames) {
+    const TrackState s = tracker.feed(frame, frames * kFramePeriodUs);
+    if (first_loss < 0 && s.status == TrackStatus::Lost) first_loss = frames;
+    if (first_loss >= 0 && s.status == TrackStatus::Tracking) ++tracking_after_loss;
+    max_started = std::max(max_started, s.tracks_started);
+  }
+  ASSERT_GT(frames, 200);
+  ASSERT_GE(first_loss, 0) << "the first track is expected to be lost (the video's premise)";
+  std::printf("Megamind: %d frames, first loss at %d, %d frames tracking after it, %d tracks started\n", frames,
+              first_loss, tracking_after_loss, max_started);
+  EXPECT_GE(max_started, 2) << "re-acquired after the loss";
+  EXPECT_GE(tracking_after_loss, (frames - first_loss) / 4) << "tracking again for a good part of the rest";
 }
 
 TEST(Tracker, ReinitialisesAfterASizeChange) {
