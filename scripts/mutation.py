@@ -214,9 +214,18 @@ MUTANTS = [
 ]
 
 
-def run(cmd, timeout=None, **kw):
-    return subprocess.run(cmd, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-                          timeout=timeout, **kw)
+def run(cmd, timeout=None):
+    """Runs cmd in a process group of its own, killed whole on a timeout or an interrupt: a
+    compiler left running would write an object of the mutated source after it was restored."""
+    proc = subprocess.Popen(cmd, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                            start_new_session=True)
+    try:
+        out, _ = proc.communicate(timeout=timeout)
+    except BaseException:
+        os.killpg(proc.pid, signal.SIGKILL)
+        proc.wait()
+        raise
+    return subprocess.CompletedProcess(cmd, proc.returncode, out)
 
 
 def restore_backups():
@@ -257,6 +266,7 @@ class Mutated:
     def __exit__(self, *exc):
         with open(self.path, "w") as f:
             f.write(self.original)
+        os.utime(self.path, None)  # newer than any object built from the mutant
         os.remove(self.backup)
         return False
 
@@ -350,6 +360,9 @@ def main():
     for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
         signal.signal(sig, lambda *_: (_ for _ in ()).throw(KeyboardInterrupt()))
     restore_backups()
+    # Objects of an earlier, interrupted run may hold a mutant: touching the sources rebuilds them.
+    for path in sorted({x["file"] for x in MUTANTS}):
+        os.utime(os.path.join(ROOT, path), None)
     if not os.path.exists(os.path.join(BUILD, "CMakeCache.txt")):
         r = run(["cmake", "-S", ROOT, "-B", BUILD, "-DCMAKE_BUILD_TYPE=Release"])
         if r.returncode != 0:
