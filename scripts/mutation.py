@@ -14,6 +14,8 @@ algorithm (docs/testing.md):
     scripts/mutation.py                 # every mutant; writes docs/results/mutation.{json,md}
     scripts/mutation.py --only kalman   # the mutants whose id contains "kalman" (no results written)
     scripts/mutation.py --list          # the mutants, without running anything
+    scripts/mutation.py --rerun-survivors  # after adding tests: only the last run's survivors (and
+                                           # mutants new to the list), merged into the results
 
 Survivors must be explained: a mutant that survives without a `harmless` reason in the list
 below makes the script exit 1 (either add a test that kills it or say why it cannot matter).
@@ -349,8 +351,15 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--only", help="run only the mutants whose id contains this text (no results written)")
     parser.add_argument("--list", action="store_true", help="list the mutants and exit")
+    parser.add_argument("--rerun-survivors", action="store_true",
+                        help="run only the survivors of docs/results/mutation.json and mutants it lacks; merge")
     args = parser.parse_args()
     chosen = [x for x in MUTANTS if not args.only or args.only in x["id"]]
+    previous = {}
+    if args.rerun_survivors:
+        with open(os.path.join(RESULTS, "mutation.json")) as f:
+            previous = {o["id"]: o for o in json.load(f)["outcomes"]}
+        chosen = [x for x in chosen if x["id"] not in previous or previous[x["id"]]["status"] != "killed"]
     if args.list:
         for x in chosen:
             print(f"{x['id']:45s} {x['file']}")
@@ -398,6 +407,10 @@ def main():
     finally:
         build(targets)  # leave the mutation build matching the restored sources
     seconds = time.time() - start
+    if previous:  # the earlier outcomes, in list order, with the rerun ones replaced
+        rerun = {o["id"]: o for o in outcomes}
+        outcomes = [rerun.get(x["id"], dict(previous.get(x["id"]), harmless=x["harmless"]))
+                    for x in MUTANTS if x["id"] in rerun or x["id"] in previous]
     scored = [o for o in outcomes if o["status"] in ("killed", "survived")]
     killed = sum(o["status"] == "killed" for o in scored)
     print(f"{killed}/{len(scored)} mutants killed in {seconds:.0f} s")
