@@ -8,8 +8,8 @@ makes the rebuilds cheap) and run with a timeout. A mutant is killed when a test
 out. Every source file is restored afterwards, whatever happens (Ctrl-C, a crash: a copy of the
 file being mutated waits in build-mutation/backup/ and is put back at the next start).
 
-Not a CI step (about half an hour on 2 cores): run it before releasing a change to a core
-algorithm (docs/testing.md):
+Not a CI step (about an hour on 2 shared cores): run it before releasing a change to a core
+algorithm (docs/architecture.md, "Tests, in layers"):
 
     scripts/mutation.py                 # every mutant; writes docs/results/mutation.{json,md}
     scripts/mutation.py --only kalman   # the mutants whose id contains "kalman" (no results written)
