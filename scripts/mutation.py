@@ -118,9 +118,15 @@ MUTANTS = [
     m("dp.horizontal_reward_swapped", CONTOUR, "sept[c] * p.reward_horizontal : p.penalty_horizontal;",
       "sept[c] * p.reward_vertical : p.penalty_horizontal;", SEGMENTATION),
     m("dp.start_anywhere_dropped", CONTOUR, "double best = std::max(0.0, reward);", "double best = reward;",
-      SEGMENTATION),
+      SEGMENTATION,
+      harmless="equivalent: it changes only cells whose score stays <= 0 (0 becomes a negative value). Such a "
+               "cell is never a predecessor (above > 0), never the best cell, and a positive cell's own vertical "
+               "score (>= w Rver) always beats a run arriving from it (<= w Rhor, Rhor < Rver), so best_path's "
+               "cells and score are the same"),
     m("dp.zero_predecessor", CONTOUR, "if (above[k] > 0 && above[k] + reward > best) {",
-      "if (above[k] >= 0 && above[k] + reward > best) {", SEGMENTATION),
+      "if (above[k] >= 0 && above[k] + reward > best) {", SEGMENTATION,
+      harmless="equivalent: best starts at max(0, reward), so 0 + reward > best never holds and a cell scoring "
+               "0 is never chosen as a predecessor either way"),
     m("dp.vertical_penalty_swapped", CONTOUR, "sept[c] * p.reward_vertical : p.penalty_vertical;",
       "sept[c] * p.reward_vertical : p.penalty_horizontal;", SEGMENTATION),
     m("dp.backtrack_direction", CONTOUR, "t.from_left.at<uint8_t>(r, c)) {\n      --c;",

@@ -193,6 +193,22 @@ TEST(SegmentationDp, PrefersTallContourAndBridgesGaps) {
   EXPECT_NEAR(score, 24 * 1.0 + 4 * -0.5, 1e-9);
 }
 
+TEST(SegmentationDp, GapsCostTheVerticalPenaltyPerRow) {
+  // PrefersTallContourAndBridgesGaps with Pver != Phor: the 4-row gap costs 4 Pver, not 4 Phor.
+  cv::Mat sept(32, 20, CV_32F, cv::Scalar(-1));
+  for (int r = 2; r < 30; ++r)
+    if (r < 12 || r > 15) sept.at<float>(r, 5) = 1.0f;
+  SegmentParams params;
+  params.penalty_vertical = -2.0;
+  params.penalty_horizontal = -0.3;
+  double score = 0;
+  const std::vector<Cell> path = Segmenter(params).best_path(sept, &score);
+  ASSERT_FALSE(path.empty());
+  EXPECT_EQ(path.front().row, 2);  // 10 - 8 > 0: the gap is still bridged
+  EXPECT_EQ(path.back().row, 29);
+  EXPECT_NEAR(score, 24 * 1.0 + 4 * -2.0, 1e-9);
+}
+
 TEST(SegmentationDp, FollowsHorizontalRunsWithoutCycles) {
   // A U shape: a horizontal bottom run joined to two... one side only (half-width columns): top run
   // from column 1 to 6 in row 0, down column 6, bottom run back to column 1.
@@ -284,6 +300,30 @@ TEST(Segmentation, RefinementSnapsOntoEdgePixels) {
   const Contour unrefined = segment(sym::edges_from_mask(edges), cup.line, raw);
   EXPECT_EQ(unrefined.cells.size(), contour.cells.size());
   EXPECT_GE(outline_coverage(cup.outline, unrefined, 2.5), 0.85);
+}
+
+TEST(Segmentation, UnrefinedContourLiesOnTheEdgePixelsRows) {
+  // Edge pixels at x = 40 and 60 on rows 10..30, line x = 50: without refinement the contour's
+  // points are placed from the SEPT cells alone, exactly on those pixels.
+  sym::EdgeSet edges;
+  edges.width = 101;
+  edges.height = 41;
+  for (int y = 10; y <= 30; ++y) {
+    edges.points.push_back({40, y});
+    edges.points.push_back({60, y});
+  }
+  sym::Line line;  // x = 50
+  SegmentParams params;
+  params.refine = false;
+  const Contour contour = Segmenter(params).segment(edges, line);
+  ASSERT_EQ(contour.left.size(), 21u);
+  ASSERT_EQ(contour.right.size(), 21u);
+  for (size_t i = 0; i < contour.left.size(); ++i) {
+    EXPECT_NEAR(contour.left[i].y, 10 + static_cast<double>(i), 1e-9);
+    EXPECT_NEAR(contour.right[i].y, 10 + static_cast<double>(i), 1e-9);
+    EXPECT_NEAR(std::min(contour.left[i].x, contour.right[i].x), 40, 1e-9);
+    EXPECT_NEAR(std::max(contour.left[i].x, contour.right[i].x), 60, 1e-9);
+  }
 }
 
 TEST(Segmentation, MaskAndDrawing) {
