@@ -369,7 +369,9 @@ def main():
     if args.rerun_survivors:
         with open(os.path.join(RESULTS, "mutation.json")) as f:
             previous = {o["id"]: o for o in json.load(f)["outcomes"]}
-        chosen = [x for x in chosen if x["id"] not in previous or previous[x["id"]]["status"] != "killed"]
+        # (survivors already explained as harmless are not rerun)
+        chosen = [x for x in chosen if x["id"] not in previous or
+                  (previous[x["id"]]["status"] != "killed" and not x["harmless"])]
     if args.list:
         for x in chosen:
             print(f"{x['id']:45s} {x['file']}")
