@@ -365,10 +365,12 @@ def main():
                         help="run only the survivors of docs/results/mutation.json and mutants it lacks; merge")
     args = parser.parse_args()
     chosen = [x for x in MUTANTS if not args.only or args.only in x["id"]]
-    previous = {}
+    previous, previous_seconds = {}, 0
     if args.rerun_survivors:
         with open(os.path.join(RESULTS, "mutation.json")) as f:
-            previous = {o["id"]: o for o in json.load(f)["outcomes"]}
+            earlier = json.load(f)
+        previous = {o["id"]: o for o in earlier["outcomes"]}
+        previous_seconds = earlier.get("runtime_s", 0)  # the results report the whole check's time
         # (survivors already explained as harmless are not rerun)
         chosen = [x for x in chosen if x["id"] not in previous or
                   (previous[x["id"]]["status"] != "killed" and not x["harmless"])]
@@ -418,7 +420,7 @@ def main():
         return 130
     finally:
         build(targets)  # leave the mutation build matching the restored sources
-    seconds = time.time() - start
+    seconds = time.time() - start + previous_seconds
     if previous:  # the earlier outcomes, in list order, with the rerun ones replaced
         rerun = {o["id"]: o for o in outcomes}
         outcomes = [rerun.get(x["id"], dict(previous.get(x["id"]), harmless=x["harmless"]))
