@@ -132,9 +132,9 @@ int main(int argc, char** argv) {
     const auto rows = read_annotations(annotations);
     const double default_tolerance = sym::PhotoOptions{}.params.mirror_tolerance_deg;
     const std::vector<double> sweep = {5, 10, 15, 20, 30, 45};
-    Method fast{"fast", "fast symmetry (defaults: mirror rule " + format_number(default_tolerance) + "°)", {}, {}, {}};
-    Method plain{"fast_locations_only", "fast symmetry, locations only (Algorithm 1)", {}, {}, {}};
-    Method le{"loy_eklundh", "Loy & Eklundh", {}, {}, {}};
+    Method fast{"fast", "fast symmetry (defaults: mirror rule " + format_number(default_tolerance) + "°)", {}, {}, {}, {}};
+    Method plain{"fast_locations_only", "fast symmetry, locations only (Algorithm 1)", {}, {}, {}, {}};
+    Method le{"loy_eklundh", "Loy & Eklundh", {}, {}, {}, {}};
     std::vector<int> sweep_hits(sweep.size(), 0), polarity_hits(sweep.size(), 0);  // polarity: Params::mirror_polarity
     std::vector<std::string> files;
     for (const auto& row : rows) {

@@ -163,7 +163,9 @@ TEST(InverseKinematics, ThesisConfigurationSolvesOrExplains) {
     // q itself is a solution in the thesis configuration within the limits: it must be found.
     const bool q_is_thesis_configuration = configuration_of(model, q) == kThesisConfiguration;
     in_thesis_configuration += q_is_thesis_configuration;
-    if (q_is_thesis_configuration) EXPECT_TRUE(ik.ok()) << "sample " << i << ": " << ik.reason;
+    if (q_is_thesis_configuration) {
+      EXPECT_TRUE(ik.ok()) << "sample " << i << ": " << ik.reason;
+    }
     if (ik.ok()) {
       ++solved;
       EXPECT_EQ(configuration_of(model, ik.q), kThesisConfiguration);
