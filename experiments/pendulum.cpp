@@ -59,6 +59,7 @@ double g_steady_fraction = 0.6;
 // Canny on the colour image (beyond the thesis, which used grey edges): a red bottle in front of
 // red distracters of the same brightness keeps its outline. --grey-edges restores the thesis'.
 bool g_colour_edges = true;
+std::string g_name = "pendulum";  // result file names (--name)
 
 // The rig (metres, world frame). The swing plane is x = kPivot.x(): face-on to the cameras.
 const Eigen::Vector3d kPivot(-0.25, 0.0, 1.20);
@@ -533,7 +534,7 @@ void write_results(const std::vector<BackgroundResult>& rs, int frames) {
     j.end_object();
   }
   j.end_object();
-  write_result("pendulum.json", j.str() + "\n");
+  write_result(g_name + ".json", j.str() + "\n");
 
   const double thesis52[4][2] = {{0.39, 0.0014}, {0.76, 0.0021}, {1.82, 0.0025}, {0.51, 0.0014}};
   const double thesis53[4][2] = {{1.13, 0.0057}, {2.06, 0.0134}, {1.21, 0.0078}, {3.41, 0.0192}};
@@ -595,7 +596,7 @@ void write_results(const std::vector<BackgroundResult>& rs, int frames) {
   for (const auto& r : rs) md << "[" << r.name << "](pendulum_" << r.name << ".png) ";
   md << "\n";
   for (const auto& r : rs) md << "\n![" << r.name << "](pendulum_" << r.name << ".png)\n";
-  write_result("pendulum.md", md.str());
+  write_result(g_name + ".md", md.str());
   for (const auto& r : rs) {
     cv::Mat out = r.plot_image;
     if (!r.example.empty()) {
@@ -603,7 +604,7 @@ void write_results(const std::vector<BackgroundResult>& rs, int frames) {
       cv::resize(r.example, ex, {out.cols, out.cols * r.example.rows / r.example.cols}, 0, 0, cv::INTER_AREA);
       cv::vconcat(out, ex, out);
     }
-    write_png("pendulum_" + r.name + ".png", out);
+    write_png(g_name + "_" + r.name + ".png", out);
   }
 }
 
@@ -620,6 +621,9 @@ int main(int argc, char** argv) {
                    "only detections with at least this fraction of the typical motion re-centre the limits");
   bool grey_edges = false;
   flags.add_bool("grey-edges", &grey_edges, "Canny on the grey image, as the thesis (default: colour edges)");
+  flags.add_string("name", &g_name,
+                   "result files docs/results/NAME.{json,md} and NAME_<background>.png (pendulum_thesis_settings: "
+                   "run with --grey-edges --steady 0, the thesis' choices)");
   flags.add_string("only", &only, "run only this background (white, red, edge, mixed; results are not written)");
   try {
     if (!flags.parse(argc, argv)) return 0;

@@ -74,6 +74,8 @@ int main(int argc, char** argv) {
     f.add_int("block-size", &params.motion.block_size, "SB: motion block side, px");
     f.add_int("start-min-blocks", &params.start.min_blocks, "moving blocks needed to start tracking");
     f.add_double("gate-sigmas", &params.gate_sigmas, "angle limits = prediction +- this many sigma");
+    f.add_int("rearm-frames", &params.start.rearm_frames,
+              "after a loss, any motion starts a new track once this many frames passed (0: only a jump)");
     f.add_int("max-missed", &params.max_missed_frames, "predict-only (or held) frames before a track is lost");
     f.add_double("still-fraction", &params.still_fraction,
                  "hold the line when less than this fraction of the track's blocks moves (0 = always predict)");

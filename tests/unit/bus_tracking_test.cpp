@@ -21,6 +21,7 @@ tracking::TrackState tracking_state() {
   s.has_box = true;
   s.box = {cv::Point2d(1, 2), cv::Point2d(3, 4), cv::Point2d(5, 6), cv::Point2d(7, 8)};
   s.block_size = 8;
+  s.tracks_started = 3;
   s.blocks = cv::Mat::zeros(3, 4, CV_8U);
   s.blocks.at<uint8_t>(1, 2) = 1;
   s.blocks.at<uint8_t>(2, 3) = 1;
@@ -50,6 +51,8 @@ TEST(TrackConvert, TrackingStateRoundTrips) {
   ASSERT_TRUE(back.has_box);
   EXPECT_FLOAT_EQ(back.box[3].x, 7);
   EXPECT_EQ(back.block_size, 8);
+  EXPECT_EQ(msg.tracks_started, 3);
+  EXPECT_EQ(back.tracks_started, 3);
   ASSERT_EQ(back.blocks.size(), s.blocks.size());
   EXPECT_EQ(cv::norm(back.blocks, s.blocks, cv::NORM_INF), 0);
 }

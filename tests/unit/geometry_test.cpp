@@ -254,6 +254,26 @@ TEST(GeometryTriangulation, FittedPlaneCorrectsWhatBorderEndpointsMissUnderStron
   EXPECT_LT(worst_fitted * 5, worst_thesis);
 }
 
+TEST(GeometryTriangulation, BackProjectedTriangleReachesZmaxAlongTheEndRays) {
+  // eq. 4.4: the triangle is the focal point and the two end points' rays, each cut at depth zmax.
+  const StereoRig rig = verged_rig(Lens::None);
+  sym::Line line;
+  line.r = 60;
+  line.theta = 25 * M_PI / 180;  // tilted: its two ends lie at different depths along their rays
+  TriangulationParams params;
+  params.plane_samples = 0;
+  const auto triangle = backproject_line(rig.left, line, params);
+  ASSERT_TRUE(triangle.ok()) << triangle.reason();
+  EXPECT_LT(triangle->a.norm(), 1e-12);
+  EXPECT_NEAR(triangle->b.z(), params.zmax, 1e-9);
+  EXPECT_NEAR(triangle->c.z(), params.zmax, 1e-9);
+  const auto ends = line_endpoints(line.r, line.theta, rig.left.width, rig.left.height);
+  ASSERT_TRUE(ends.ok());
+  const Eigen::Vector2d n1 = rig.left.normalise(ends->first).value(), n2 = rig.left.normalise(ends->second).value();
+  EXPECT_LT((triangle->b - params.zmax * Eigen::Vector3d(n1.x(), n1.y(), 1)).norm(), 1e-9);
+  EXPECT_LT((triangle->c - params.zmax * Eigen::Vector3d(n2.x(), n2.y(), 1)).norm(), 1e-9);
+}
+
 TEST(GeometryTriangulation, TriangleIntersectionOfKnownTriangles) {
   // Two triangles crossing along the x axis, overlapping on [0, 1] there.
   const Triangle horizontal{{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}};  // z = 0, covers x in [-1, 1] at y = 0

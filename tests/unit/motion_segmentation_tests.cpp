@@ -364,3 +364,90 @@ TEST(MotionSegmentation, LinesTooDifferentAreReportedNotSegmented) {
   EXPECT_NE(result.reason.find("max_rotation_deg"), std::string::npos) << result.reason;
   EXPECT_EQ(cv::countNonZero(result.mask), 0);
 }
+
+// ---- Exact cases: flat grey rectangles, no noise, no blur, no noise floor: the answer is known
+// to the pixel.
+
+namespace {
+
+MotionParams exact_params() {
+  MotionParams p;
+  p.blur_sigma = 0;
+  p.subtract_noise_floor = false;
+  p.attach_rigid_parts = false;
+  return p;
+}
+
+// Grey background 100; rectangles (rows first..last, half-width w about the line) of grey `value`,
+// moved sideways from x = 300 to x = 320.
+struct Rect {
+  int first, last, half_width;
+};
+struct ExactNudge {
+  cv::Mat before, after, truth;
+};
+ExactNudge exact_nudge(const std::vector<Rect>& rects, int value, int truth_index = 0) {
+  ExactNudge n;
+  n.before = cv::Mat(kSize, CV_8UC1, cv::Scalar(100));
+  n.after = n.before.clone();
+  n.truth = cv::Mat::zeros(kSize, CV_8UC1);
+  for (size_t i = 0; i < rects.size(); ++i) {
+    const Rect& r = rects[i];
+    n.before(cv::Range(r.first, r.last + 1), cv::Range(300 - r.half_width, 300 + r.half_width + 1)).setTo(value);
+    n.after(cv::Range(r.first, r.last + 1), cv::Range(320 - r.half_width, 320 + r.half_width + 1)).setTo(value);
+    if (static_cast<int>(i) == truth_index)
+      n.truth(cv::Range(r.first, r.last + 1), cv::Range(320 - r.half_width, 320 + r.half_width + 1)).setTo(255);
+  }
+  return n;
+}
+
+const sym::Line kExactBefore = make_line(300 - 319.5, 0), kExactAfter = make_line(320 - 319.5, 0);
+
+}  // namespace
+
+TEST(MotionSegmentation, ExactRectangleGivesItsOwnMask) {
+  const ExactNudge n = exact_nudge({{150, 300, 40}}, 160);
+  const MotionSegmentation result =
+      MotionSegmenter(exact_params()).segment(n.before, n.after, kExactBefore, kExactAfter);
+  ASSERT_TRUE(result.found) << result.reason;
+  // Every pixel of the rectangle, and nothing more than one pixel beyond it (the filled staircase
+  // polygon's edges are inclusive: one column and one row more than the truth).
+  EXPECT_EQ(cv::countNonZero(n.truth & ~result.mask), 0) << "rectangle pixels left out";
+  cv::Mat near_truth;
+  cv::dilate(n.truth, near_truth, cv::Mat::ones(3, 3, CV_8U));
+  EXPECT_EQ(cv::countNonZero(result.mask & ~near_truth), 0) << "mask pixels more than 1 px off the rectangle";
+  EXPECT_LE(result.area, (81 + 1) * (151 + 1));
+}
+
+TEST(MotionSegmentation, ChangeOfExactlyTheThresholdCounts) {
+  // The difference is 15 grey levels = the threshold: segmented (>= threshold); 14: nothing.
+  const MotionParams params = exact_params();
+  ASSERT_EQ(params.threshold, 15);
+  ExactNudge n = exact_nudge({{150, 300, 40}}, 115);
+  EXPECT_TRUE(MotionSegmenter(params).segment(n.before, n.after, kExactBefore, kExactAfter).found);
+  n = exact_nudge({{150, 300, 40}}, 114);
+  EXPECT_FALSE(MotionSegmenter(params).segment(n.before, n.after, kExactBefore, kExactAfter).found);
+}
+
+TEST(MotionSegmentation, TheLargestAreaAlongTheLineIsTheObjectNotTheLongestRun) {
+  // A wide short rectangle (61 rows x 81 px) and, far below along the same line, a long thin one
+  // (151 rows x 11 px) moved alike: the object is the one with the larger area.
+  const ExactNudge n = exact_nudge({{60, 120, 40}, {250, 400, 5}}, 160);
+  const MotionSegmentation result =
+      MotionSegmenter(exact_params()).segment(n.before, n.after, kExactBefore, kExactAfter);
+  ASSERT_TRUE(result.found) << result.reason;
+  EXPECT_GT(iou(result.mask, n.truth), 0.95);
+}
+
+TEST(MotionSegmentation, ChangeOnlyInTheThirdColourChannelIsSeen) {
+  // The same rectangle in colour, different from the background only in channel 2 (red).
+  const ExactNudge grey = exact_nudge({{150, 300, 40}}, 160);
+  cv::Mat before, after;
+  cv::Mat flat(kSize, CV_8UC1, cv::Scalar(100));
+  cv::merge(std::vector<cv::Mat>{flat, flat, grey.before}, before);
+  cv::merge(std::vector<cv::Mat>{flat, flat, grey.after}, after);
+  const MotionSegmentation result =
+      MotionSegmenter(exact_params()).segment(before, after, kExactBefore, kExactAfter);
+  ASSERT_TRUE(result.found) << result.reason;
+  EXPECT_GT(iou(result.mask, grey.truth), 0.95);
+}

@@ -154,22 +154,31 @@ TEST(InverseKinematics, ThesisConfigurationSolvesOrExplains) {
   // either an exact solution or a joint-limit reason, never NaN.
   const ArmModel model = puma260();
   std::mt19937 rng(11);
-  int solved = 0;
+  int solved = 0, in_thesis_configuration = 0;
   for (int i = 0; i < 2000; ++i) {
     const JointVector q = random_joints_within_limits(model, rng);
     const Eigen::Isometry3d pose = forward_kinematics(model, q);
     const IkResult ik = inverse_kinematics(model, pose);
     ASSERT_TRUE(ik.q.allFinite());
+    // q itself is a solution in the thesis configuration within the limits: it must be found.
+    const bool q_is_thesis_configuration = configuration_of(model, q) == kThesisConfiguration;
+    in_thesis_configuration += q_is_thesis_configuration;
+    if (q_is_thesis_configuration) {
+      EXPECT_TRUE(ik.ok()) << "sample " << i << ": " << ik.reason;
+    }
     if (ik.ok()) {
       ++solved;
       EXPECT_EQ(configuration_of(model, ik.q), kThesisConfiguration);
       EXPECT_LT(position_error(pose, forward_kinematics(model, ik.q)), kPoseTolerance);
+      EXPECT_LT(rotation_error(pose, forward_kinematics(model, ik.q)), kPoseTolerance);
     } else {
       EXPECT_EQ(ik.failure, IkFailure::JointLimit);
       EXPECT_TRUE(contains(ik.reason, "joint")) << ik.reason;
     }
   }
-  EXPECT_GT(solved, 0);
+  // One configuration of eight: about 2000 / 8 samples start in it (and are solved, above).
+  EXPECT_GT(in_thesis_configuration, 150);
+  EXPECT_GE(solved, in_thesis_configuration);
 }
 
 TEST(InverseKinematics, ConfigurationsAreDistinctAndRecognised) {
@@ -207,6 +216,28 @@ TEST(InverseKinematics, WristSingularityIsSolvedOrRefusedOnRequest) {
   const IkResult refused = inverse_kinematics(model, pose, options);
   EXPECT_EQ(refused.failure, IkFailure::WristSingular);
   EXPECT_TRUE(contains(refused.reason, "singular")) << refused.reason;
+}
+
+TEST(InverseKinematics, WristFlippedOverIsSolvedLikeTheUpright) {
+  // theta5 = pi (the PUMA 260's joint 5 stops at +-100 deg, so widen it): joints 4 and 6 then
+  // turn about the same axis in opposite senses; joint 4 stays at the seed, joint 6 makes up the rest.
+  ArmModel model = puma260();
+  model.limits.lower[4] = -1.1 * kPi;
+  model.limits.upper[4] = 1.1 * kPi;
+  for (double theta4_deg : {25.0, -60.0}) {
+    const JointVector q = joints_from_degrees(10, 60, -150, theta4_deg, 180, 40);
+    const Eigen::Isometry3d pose = forward_kinematics(model, q);
+    IkOptions options;
+    options.configuration = configuration_of(model, q);
+    options.seed = q;
+    const IkResult solved = inverse_kinematics(model, pose, options);
+    ASSERT_TRUE(solved.ok()) << solved.reason;
+    EXPECT_TRUE(solved.wrist_singular);
+    EXPECT_NEAR(solved.q[3], deg_to_rad(theta4_deg), 1e-9);
+    EXPECT_NEAR(std::fabs(solved.q[4]), kPi, 1e-9);
+    EXPECT_LT(position_error(pose, forward_kinematics(model, solved.q)), kPoseTolerance);
+    EXPECT_LT(rotation_error(pose, forward_kinematics(model, solved.q)), kPoseTolerance) << theta4_deg;
+  }
 }
 
 TEST(InverseKinematics, RejectsTooFarWithReason) {

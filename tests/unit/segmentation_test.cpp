@@ -146,6 +146,36 @@ TEST(SegmentationSept, RejectsPairsWiderThanMaxWidth) {
   EXPECT_FLOAT_EQ(Segmenter(params).sept(edges, line).weights.at<float>(-sept.first_row, 40), 1.0f);
 }
 
+TEST(SegmentationSept, PairsExactlyAtTheLimitsAreInsideOrOutAsAlgorithm2Says) {
+  // Line at x = 50; the pair (10, 90) is exactly MAXw = 80 wide: kept (width <= MAXw), one pixel
+  // narrower a limit drops it. A pair whose midpoint is exactly MAXmid off the line is dropped
+  // (d < MAXmid), a hair closer it is kept with weight 1 - d / (2 MAXmid).
+  sym::EdgeSet edges;
+  edges.width = 101;
+  edges.height = 1;
+  edges.points = {{10, 0}, {90, 0}};
+  sym::Line line;
+  SegmentParams params;
+  params.max_width = 80;
+  SeptBuffer sept = Segmenter(params).sept(edges, line);
+  EXPECT_EQ(sept.num_pairs, 1);
+  EXPECT_FLOAT_EQ(sept.weights.at<float>(-sept.first_row, 40), 1.0f);
+  params.max_width = 79;
+  sept = Segmenter(params).sept(edges, line);
+  EXPECT_EQ(sept.num_pairs, 0);
+  EXPECT_EQ(cv::countNonZero(sept.weights >= 0), 0);
+
+  edges.points = {{40, 0}, {80, 0}};  // midpoint 60: d = 10
+  params.max_width = 80;
+  params.max_mid = 10;
+  sept = Segmenter(params).sept(edges, line);
+  EXPECT_EQ(sept.num_pairs, 1);
+  EXPECT_EQ(cv::countNonZero(sept.weights >= 0), 0);
+  params.max_mid = 10.5;
+  sept = Segmenter(params).sept(edges, line);
+  EXPECT_FLOAT_EQ(sept.weights.at<float>(-sept.first_row, 20), static_cast<float>(1.0 - 10 / 21.0));
+}
+
 TEST(SegmentationDp, PrefersTallContourAndBridgesGaps) {
   // A column of weights at half-width 5 over rows 2..29 with a gap at rows 12..15, a flat wide run
   // in row 20, and an isolated cell. The contour must be the tall column.
@@ -161,6 +191,22 @@ TEST(SegmentationDp, PrefersTallContourAndBridgesGaps) {
   EXPECT_EQ(path.back().row, 29);
   for (const Cell& cell : path) EXPECT_EQ(cell.column, 5);
   EXPECT_NEAR(score, 24 * 1.0 + 4 * -0.5, 1e-9);
+}
+
+TEST(SegmentationDp, GapsCostTheVerticalPenaltyPerRow) {
+  // PrefersTallContourAndBridgesGaps with Pver != Phor: the 4-row gap costs 4 Pver, not 4 Phor.
+  cv::Mat sept(32, 20, CV_32F, cv::Scalar(-1));
+  for (int r = 2; r < 30; ++r)
+    if (r < 12 || r > 15) sept.at<float>(r, 5) = 1.0f;
+  SegmentParams params;
+  params.penalty_vertical = -2.0;
+  params.penalty_horizontal = -0.3;
+  double score = 0;
+  const std::vector<Cell> path = Segmenter(params).best_path(sept, &score);
+  ASSERT_FALSE(path.empty());
+  EXPECT_EQ(path.front().row, 2);  // 10 - 8 > 0: the gap is still bridged
+  EXPECT_EQ(path.back().row, 29);
+  EXPECT_NEAR(score, 24 * 1.0 + 4 * -2.0, 1e-9);
 }
 
 TEST(SegmentationDp, FollowsHorizontalRunsWithoutCycles) {
@@ -254,6 +300,30 @@ TEST(Segmentation, RefinementSnapsOntoEdgePixels) {
   const Contour unrefined = segment(sym::edges_from_mask(edges), cup.line, raw);
   EXPECT_EQ(unrefined.cells.size(), contour.cells.size());
   EXPECT_GE(outline_coverage(cup.outline, unrefined, 2.5), 0.85);
+}
+
+TEST(Segmentation, UnrefinedContourLiesOnTheEdgePixelsRows) {
+  // Edge pixels at x = 40 and 60 on rows 10..30, line x = 50: without refinement the contour's
+  // points are placed from the SEPT cells alone, exactly on those pixels.
+  sym::EdgeSet edges;
+  edges.width = 101;
+  edges.height = 41;
+  for (int y = 10; y <= 30; ++y) {
+    edges.points.push_back({40, y});
+    edges.points.push_back({60, y});
+  }
+  sym::Line line;  // x = 50
+  SegmentParams params;
+  params.refine = false;
+  const Contour contour = Segmenter(params).segment(edges, line);
+  ASSERT_EQ(contour.left.size(), 21u);
+  ASSERT_EQ(contour.right.size(), 21u);
+  for (size_t i = 0; i < contour.left.size(); ++i) {
+    EXPECT_NEAR(contour.left[i].y, 10 + static_cast<double>(i), 1e-9);
+    EXPECT_NEAR(contour.right[i].y, 10 + static_cast<double>(i), 1e-9);
+    EXPECT_NEAR(std::min(contour.left[i].x, contour.right[i].x), 40, 1e-9);
+    EXPECT_NEAR(std::max(contour.left[i].x, contour.right[i].x), 60, 1e-9);
+  }
 }
 
 TEST(Segmentation, MaskAndDrawing) {

@@ -2,6 +2,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include <array>
 #include <cmath>
 #include <random>
 
@@ -569,13 +570,199 @@ TEST(SymmetryDetect, RecoversSkewAngle) {
 }
 
 TEST(SymmetryDetect, OrientationLimitsExcludeOtherAngles) {
+  // Two bottles, axes at 5 and 30 deg: the limits keep the first and must drop the second.
   cv::Mat img = blank();
-  syn::draw_shape(img, syn::bottle_profile(150, 28), 0, 30 * kDeg, 0, cv::Scalar(40));
+  syn::draw_shape(img, syn::bottle_profile(150, 28), -70, 5 * kDeg, 0, cv::Scalar(40));
+  syn::draw_shape(img, syn::bottle_profile(150, 28), 70, 30 * kDeg, 0, cv::Scalar(40));
+  auto has_axis = [](const Result& res, double r, double theta_deg) {
+    for (const auto& l : res.lines)
+      if (angle_diff_deg(l.theta, theta_deg * kDeg) < 1.0 && r_diff(l, r, theta_deg * kDeg) < 1.5) return true;
+    return false;
+  };
   Params p = synthetic_params();
+  EXPECT_TRUE(has_axis(Detector(p).detect(img), 70, 30));  // without limits the 30 deg axis is found
   p.theta_min_deg = -15;
   p.theta_max_deg = 15;
   const Result res = Detector(p).detect(img);
+  ASSERT_FALSE(res.lines.empty());
+  EXPECT_TRUE(has_axis(res, -70, 5));
   for (const auto& l : res.lines) EXPECT_LE(std::fabs(l.theta) / kDeg, 16.0);
+}
+
+// Sub-bin refinement (eq. 3.1-3.2) on hand-made accumulators, checked against the Newton step and
+// the 1D parabola vertices worked out here.
+namespace {
+Accumulator one_peak(int r_max, int theta_bin, int r_bin, const std::array<std::array<int, 3>, 3>& votes) {
+  Accumulator acc;
+  acc.r_max = r_max;
+  acc.votes = {cv::Mat(kThetaBins, acc.num_r(), CV_32S, cv::Scalar(0))};
+  for (int dt = -1; dt <= 1; ++dt)
+    for (int dr = -1; dr <= 1; ++dr) acc.votes[0].at<int32_t>(theta_bin + dt, r_bin + dr) = votes[dt + 1][dr + 1];
+  return acc;
+}
+}  // namespace
+
+TEST(SymmetryPeaks, SubBinNewtonStepRecoversAQuadraticPeak) {
+  // V(dr, dt) = 10000 - 1000 (2 (dr - 0.3)^2 + 1.5 (dt + 0.2)^2 + 0.8 (dr - 0.3)(dt + 0.2)): a
+  // quadratic, so the 3x3 finite differences are exact and the Newton step lands on its top.
+  const double r0 = 0.3, t0 = -0.2;
+  auto v = [&](int dr, int dt) {
+    const double x = dr - r0, y = dt - t0;
+    return static_cast<int>(std::lround(10000 - 1000 * (2 * x * x + 1.5 * y * y + 0.8 * x * y)));
+  };
+  std::array<std::array<int, 3>, 3> votes{};
+  for (int dt = -1; dt <= 1; ++dt)
+    for (int dr = -1; dr <= 1; ++dr) votes[dt + 1][dr + 1] = v(dr, dt);
+  const Accumulator acc = one_peak(50, 100, 70, votes);
+  Params p;
+  p.num_lines = 1;
+  p.refine_log = false;
+  const std::vector<Line> lines = Detector(p).find_peaks(acc, 101, 101);
+  ASSERT_EQ(lines.size(), 1u);
+  EXPECT_NEAR(lines[0].r, 70 + r0 - 50, 2e-3);
+  EXPECT_NEAR(lines[0].theta / kDeg, theta_of_bin_deg(100 + t0), 2e-3);
+  EXPECT_EQ(lines[0].r_bin, 70);
+  EXPECT_EQ(lines[0].theta_bin, 100);
+}
+
+TEST(SymmetryPeaks, NewtonStepOutsideTheBinFallsBackToSeparateParabolas) {
+  // Centre 100; along R 60 | 100 | 90, along theta 70 | 100 | 80; strong corners (hrt = 40 against
+  // hrr = htt = -50) put the Newton step outside the bin (dr = 950 / 900), so each direction gets
+  // its own parabola: dr = -gr / hrr = 15 / 50 = 0.3, dt = -gt / htt = 5 / 50 = 0.1.
+  const std::array<std::array<int, 3>, 3> votes = {{{95, 70, 15}, {60, 100, 90}, {15, 80, 95}}};
+  Params p;
+  p.num_lines = 1;
+  p.refine_log = false;
+  std::vector<Line> lines = Detector(p).find_peaks(one_peak(50, 90, 60, votes), 101, 101);
+  ASSERT_EQ(lines.size(), 1u);
+  EXPECT_NEAR(lines[0].r, 60 + 0.3 - 50, 1e-9);
+  EXPECT_NEAR(lines[0].theta / kDeg, theta_of_bin_deg(90 + 0.1), 1e-9);
+
+  // The same on log(1 + V) (the default), corners 75 / 25 (log Newton step 2.45 bins): the
+  // vertices of the parabolas through the log votes.
+  const std::array<std::array<int, 3>, 3> log_votes = {{{75, 70, 25}, {60, 100, 90}, {25, 80, 75}}};
+  p.refine_log = true;
+  lines = Detector(p).find_peaks(one_peak(50, 90, 60, log_votes), 101, 101);
+  ASSERT_EQ(lines.size(), 1u);
+  auto vertex = [](double minus, double centre, double plus) {
+    const double a = std::log1p(minus), b = std::log1p(centre), c = std::log1p(plus);
+    return -((c - a) / 2) / (c + a - 2 * b);
+  };
+  EXPECT_NEAR(lines[0].r, 60 + vertex(60, 100, 90) - 50, 1e-6);
+  EXPECT_NEAR(lines[0].theta / kDeg, theta_of_bin_deg(90 + vertex(70, 100, 80)), 1e-6);
+}
+
+TEST(SymmetryPeaks, RefinementAcrossTheThetaWrapReadsTheMirroredRow) {
+  // Peak in theta bin 0 (-89 deg): its theta neighbour below is bin 179 with R mirrored (column
+  // num_r - 1 - b). Along R 60 | 100 | 60, along theta 70 (bin 179, mirrored) | 100 | 80 (bin 1),
+  // corners 0: dr = 0, dt = -gt / htt = 5 / 50 = 0.1 (plain votes).
+  const int r_max = 50, b = 60;
+  Accumulator acc = one_peak(r_max, 1, b, {{{0, 0, 0}, {0, 0, 0}, {0, 0, 0}}});  // zeros
+  cv::Mat& v = acc.votes[0];
+  v.at<int32_t>(0, b) = 100;
+  v.at<int32_t>(0, b - 1) = v.at<int32_t>(0, b + 1) = 60;
+  v.at<int32_t>(1, b) = 80;
+  v.at<int32_t>(kThetaBins - 1, acc.num_r() - 1 - b) = 70;
+  Params p;
+  p.num_lines = 1;
+  p.refine_log = false;
+  std::vector<Line> lines = Detector(p).find_peaks(acc, 101, 101);
+  ASSERT_EQ(lines.size(), 1u);
+  EXPECT_NEAR(lines[0].r, b - r_max, 1e-9);
+  EXPECT_NEAR(lines[0].theta / kDeg, theta_of_bin_deg(0.1), 1e-9);
+
+  // The same peak in bin 179 (+90 deg), rising towards bin 0: refined past +90 deg, the line is
+  // reported as theta - 180 with R negated.
+  Accumulator top = one_peak(r_max, 1, b, {{{0, 0, 0}, {0, 0, 0}, {0, 0, 0}}});
+  cv::Mat& t = top.votes[0];
+  t.at<int32_t>(kThetaBins - 1, b) = 100;
+  t.at<int32_t>(kThetaBins - 1, b - 1) = t.at<int32_t>(kThetaBins - 1, b + 1) = 60;
+  t.at<int32_t>(kThetaBins - 2, b) = 70;
+  t.at<int32_t>(0, top.num_r() - 1 - b) = 80;
+  lines = Detector(p).find_peaks(top, 101, 101);
+  ASSERT_EQ(lines.size(), 1u);
+  EXPECT_NEAR(lines[0].theta / kDeg, theta_of_bin_deg(kThetaBins - 1 + 0.1) - 180, 1e-9);
+  EXPECT_NEAR(lines[0].r, -(b - r_max), 1e-9);
+}
+
+TEST(SymmetryPeaks, PeaksBelowTheRatioOfTheHighestAreDropped) {
+  // Peaks of 1000 and 60 far apart: with min_peak_ratio 0.1 only the first is a line, with 0.05 both.
+  Accumulator acc = one_peak(50, 40, 20, {{{0, 0, 0}, {0, 1000, 0}, {0, 0, 0}}});
+  acc.votes[0].at<int32_t>(120, 80) = 60;
+  Params p;
+  p.num_lines = 5;
+  p.min_peak_ratio = 0.1;
+  EXPECT_EQ(Detector(p).find_peaks(acc, 101, 101).size(), 1u);
+  p.min_peak_ratio = 0.05;
+  const std::vector<Line> lines = Detector(p).find_peaks(acc, 101, 101);
+  ASSERT_EQ(lines.size(), 2u);
+  EXPECT_NEAR(lines[1].r, 80 - 50, 1e-9);
+  EXPECT_NEAR(lines[1].theta / kDeg, theta_of_bin_deg(120), 1e-9);
+}
+
+TEST(SymmetryDetect, RecoversTheSkewAxisOffTheCentre) {
+  // RecoversSkewAngle's sheared bottle 60 px right of the centre: the axis x' = 60.5 + y' tan(phi)
+  // is the line (60.5 cos(phi), -phi).
+  EdgeSet edges;
+  edges.width = 320;
+  edges.height = 240;
+  const double skew = 20 * kDeg;
+  const syn::Profile profile = syn::bottle_profile(140, 40);
+  for (size_t i = 0; i < profile.half_width.size(); ++i) {
+    const int y = 50 + static_cast<int>(i);
+    const double mid = 220 + (y - 119.5) * std::tan(skew);
+    edges.points.emplace_back(static_cast<int>(std::lround(mid - profile.half_width[i])), y);
+    edges.points.emplace_back(static_cast<int>(std::lround(mid + profile.half_width[i])), y);
+  }
+  Params p = synthetic_params();
+  p.num_lines = 1;
+  p.skew_deg = {-20, -10, 10, 20};
+  p.once_per_row = true;
+  const Result res = Detector(p).detect(edges);
+  ASSERT_EQ(res.lines.size(), 1u);
+  EXPECT_LT(angle_diff_deg(res.lines[0].theta, -skew), 1.0);
+  EXPECT_LT(r_diff(res.lines[0], 60.5 * std::cos(skew), -skew), 1.5);
+}
+
+TEST(SymmetryPeaks, NonMaximumSuppressionCoversItsWholeWindow) {
+  // Around the peak (theta bin 90, R bin 50) every bin within suppress_r = 10 R bins and
+  // suppress_theta = 10 theta bins is suppressed, the window's edges included; 11 bins off is not.
+  Accumulator acc = one_peak(50, 90, 50, {{{0, 0, 0}, {0, 1000, 0}, {0, 0, 0}}});
+  cv::Mat& v = acc.votes[0];
+  v.at<int32_t>(90, 60) = 900;   // R edge of the window
+  v.at<int32_t>(100, 50) = 800;  // theta edge of the window
+  v.at<int32_t>(90, 40) = 850;   // the other R edge
+  v.at<int32_t>(80, 50) = 820;   // the other theta edge
+  v.at<int32_t>(90, 61) = 700;   // just outside
+  Params p;
+  p.num_lines = 5;
+  const std::vector<Line> lines = Detector(p).find_peaks(acc, 101, 101);
+  ASSERT_EQ(lines.size(), 2u);
+  EXPECT_EQ(lines[0].r_bin, 50);
+  EXPECT_EQ(lines[1].r_bin, 61);
+  EXPECT_EQ(lines[1].theta_bin, 90);
+}
+
+TEST(SymmetryVote, PairDistanceLimitsAreInclusiveAndInPixels) {
+  // One pair 20 px apart on a row: at theta = 0 (bin 89) it votes iff Dmin <= 20 <= Dmax.
+  EdgeSet edges;
+  edges.width = 320;
+  edges.height = 240;
+  edges.points = {{100, 50}, {120, 50}};
+  auto votes_at_theta0 = [&](double dmin, double dmax) {
+    Params p;
+    p.dmin = dmin;
+    p.dmax = dmax;
+    const int plain = cv::countNonZero(reference_vote(edges, p).votes[0].row(89));
+    Detector fast(p);
+    EXPECT_EQ(cv::countNonZero(fast.vote(edges).votes[0].row(89)), plain) << dmin << " " << dmax;
+    return plain;
+  };
+  EXPECT_EQ(votes_at_theta0(25, 250), 0);  // too close
+  EXPECT_EQ(votes_at_theta0(20, 250), 1);  // exactly Dmin
+  EXPECT_EQ(votes_at_theta0(21, 250), 0);
+  EXPECT_EQ(votes_at_theta0(5, 20), 1);    // exactly Dmax
+  EXPECT_EQ(votes_at_theta0(5, 19.5), 0);  // too far
 }
 
 TEST(SymmetryBadInput, EmptyImageIsAClearError) {

@@ -2,7 +2,9 @@
 // theta wrap-around, the automatic start, mask refinement, and the whole tracker on synthetic video.
 #include <gtest/gtest.h>
 
+#include <Eigen/Dense>
 #include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
 
 #include <cmath>
 #include <random>
@@ -161,6 +163,50 @@ TEST(Kalman, ConvergesOnAKnownConstantAccelerationTrajectory) {
   EXPECT_GT(kf.covariance().diagonal().minCoeff(), 0);
 }
 
+// The filter against a textbook Kalman filter written out here: the same model (eq. 5.1), the
+// optimal-gain covariance update P = (I - K H) P instead of the Joseph form. The two agree exactly
+// only if every term of the Joseph form (K R K' included) is right.
+TEST(Kalman, MatchesATextbookFilterStepByStep) {
+  KalmanParams params;
+  params.measurement_var_theta = 4.0;  // unlike var_r, so that swapping the two shows
+  params.process_noise = {1.0, 0.8, 0.5, 0.4, 0.05, 0.03};
+  LineKalman kf(params);
+  Eigen::Matrix<double, 6, 6> a = Eigen::Matrix<double, 6, 6>::Identity();
+  for (int i = 0; i < 4; ++i) a(i, i + 2) = 1.0;  // position += velocity, velocity += acceleration
+  a(0, 4) = a(1, 5) = 0.5;                         // position += acceleration / 2
+  Eigen::Matrix<double, 2, 6> h = Eigen::Matrix<double, 2, 6>::Zero();
+  h(0, 0) = h(1, 1) = 1.0;
+  const Eigen::Matrix2d r = Eigen::Vector2d(params.measurement_var_r, params.measurement_var_theta).asDiagonal();
+  Eigen::Matrix<double, 6, 6> q = Eigen::Matrix<double, 6, 6>::Zero();
+  for (int i = 0; i < 6; ++i) q(i, i) = params.process_noise[i];
+
+  const LineMeasurement first{40.0, 10.0};
+  kf.initialise(first);
+  KalmanState x = KalmanState::Zero();
+  x(0) = first.r;
+  x(1) = first.theta_deg;
+  KalmanCovariance p = KalmanCovariance::Zero();
+  for (int i = 0; i < 6; ++i) p(i, i) = params.initial_variance[i];
+
+  std::mt19937 rng(11);
+  std::normal_distribution<double> noise(0.0, 3.0);
+  for (int t = 1; t <= 30; ++t) {
+    kf.predict();
+    x = a * x;
+    p = a * p * a.transpose() + q;
+    const Eigen::Vector2d z(40.0 + 1.5 * t + noise(rng), 10.0 + 0.8 * t + noise(rng));  // stays inside +-90
+    const Eigen::Matrix2d s = h * p * h.transpose() + r;
+    const Eigen::Vector2d nu = z - h * x;
+    EXPECT_NEAR(kf.gate_error({z(0), z(1)}), nu.dot(s.inverse() * nu), 1e-9) << t;
+    kf.update({z(0), z(1)});
+    const Eigen::Matrix<double, 6, 2> k = p * h.transpose() * s.inverse();
+    x += k * nu;
+    p = (Eigen::Matrix<double, 6, 6>::Identity() - k * h) * p;
+    EXPECT_LT((kf.state() - x).norm(), 1e-9 * (1 + x.norm())) << t;
+    EXPECT_LT((kf.covariance() - p).norm(), 1e-9 * (1 + p.norm())) << t << "\n" << kf.covariance() << "\n" << p;
+  }
+}
+
 TEST(Kalman, NoisyMeasurementsAreSmoothed) {
   std::mt19937 rng(7);
   std::normal_distribution<double> noise(0.0, 3.0);  // sigma^2 = 9: the thesis' measurement noise
@@ -176,7 +222,8 @@ TEST(Kalman, NoisyMeasurementsAreSmoothed) {
       filtered += std::fabs(kf.state()(0) - t);
     }
   }
-  EXPECT_LT(filtered, 0.85 * raw);
+  // kalman.hpp promises smoothing to 0.75 of the raw error with the default process noise.
+  EXPECT_LT(filtered, 0.75 * raw) << filtered / raw;
 }
 
 TEST(Kalman, HoldStopsTheLineWhereItIs) {
@@ -438,10 +485,22 @@ TEST(Tracker, StartsAtAGivenLineAndFollowsTheObject) {
   nudge::symmetry::Line nowhere;
   nowhere.r = 250;  // far right of the moving bottle, in empty background
   wrong.start_at(nowhere);
-  TrackState last;
-  for (int i = video.still_frames; i < 40; ++i) last = wrong.feed(video.frame(i), i * kFramePeriodUs);
-  EXPECT_NE(last.status, TrackStatus::Tracking);
-  EXPECT_FALSE(last.reason.empty());
+  bool lost = false;
+  for (int i = video.still_frames; i < 40; ++i) {
+    const TrackState s = wrong.feed(video.frame(i), i * kFramePeriodUs);
+    if (s.status == TrackStatus::Lost && !lost) {
+      lost = true;
+      EXPECT_NE(s.reason.find("validation gate"), std::string::npos) << s.reason;
+    }
+    if (s.status != TrackStatus::Tracking) continue;
+    if (!lost) {  // the started track never jumps to the object...
+      EXPECT_EQ(s.tracks_started, 1);
+      EXPECT_NEAR(s.line.r, nowhere.r, 15.0) << i;
+    } else {  // ...but after its loss a new automatic start (re-acquisition) may find it
+      EXPECT_EQ(s.tracks_started, 2) << i;
+    }
+  }
+  EXPECT_TRUE(lost);
 }
 
 // The thesis' pendulum setting (sec. 5.4), harder: a shaded bottle swings at up to 11 px/frame in
@@ -615,6 +674,79 @@ TEST(Tracker, GoesLostWithAReasonWhenTheObjectVanishes) {
   st = tracker.feed(empty_scene, i * kFramePeriodUs);
   EXPECT_EQ(st.status, TrackStatus::Lost) << "stays lost while nothing moves";
   EXPECT_FALSE(st.reason.empty());
+}
+
+// The bottle vanishes while a cup far from it keeps moving, through the loss and after it: no new
+// jump in motion ever comes, yet the tracker re-acquires (on the cup) rearm_frames after the loss,
+// and says so (tracks_started 2, "re-acquiring" while it starts). With rearm_frames = 0 (the
+// thesis' jump rule alone) it stays lost.
+TEST(Tracker, ReacquiresAfterALossWhileMotionGoesOn) {
+  const Video video;
+  constexpr int kVanish = 20;
+  auto cup = [](int i) { return Pose{150.0 - 3.0 * std::max(0, i - kVanish), 4 * kDeg}; };
+  auto frame = [&](int i) {
+    cv::Mat img = static_scene(640, 480);
+    if (i < kVanish) draw_bottle(img, video.truth(i), 1.0);
+    for (int k = 0; k < 3; ++k)  // nested outlines: the inside changes as it moves
+      syn::draw_shape(img, syn::cup_profile(150, 55 - 12 * k, 40 - 9 * k), cup(i).r, cup(i).theta, 0,
+                      cv::Scalar(50 + 30 * k));
+    return img;
+  };
+  for (const int rearm_frames : {TrackerParams{}.start.rearm_frames, 0}) {
+    TrackerParams params;
+    params.start.rearm_frames = rearm_frames;
+    SymmetryTracker tracker(params);
+    TrackState s;
+    int lost_at = -1, reacquired_at = -1;
+    bool said_reacquiring = false;
+    for (int i = 0; i < 70 && reacquired_at < 0; ++i) {
+      s = tracker.feed(frame(i), i * kFramePeriodUs);
+      if (i == kVanish - 1) {
+        ASSERT_EQ(s.status, TrackStatus::Tracking) << s.reason;
+        ASSERT_EQ(s.tracks_started, 1);
+      }
+      if (lost_at < 0 && s.status == TrackStatus::Lost) lost_at = i;
+      said_reacquiring |= s.status == TrackStatus::Initialising && s.reason.find("re-acquiring") != std::string::npos;
+      if (lost_at >= 0 && s.status == TrackStatus::Tracking) reacquired_at = i;
+    }
+    ASSERT_GE(lost_at, kVanish) << "the bottle's track ends";
+    if (rearm_frames == 0) {
+      EXPECT_EQ(reacquired_at, -1) << "without re-arming, continuing motion is no jump";
+      EXPECT_EQ(s.tracks_started, 1);
+      continue;
+    }
+    ASSERT_GE(reacquired_at, 0) << s.reason;
+    std::printf("lost at frame %d, re-acquired at frame %d\n", lost_at, reacquired_at);
+    EXPECT_LE(reacquired_at, lost_at + rearm_frames + 1 + 3 + 3) << "rearm, then the three start frames";
+    EXPECT_TRUE(said_reacquiring);
+    EXPECT_EQ(s.tracks_started, 2);
+    EXPECT_NEAR(s.line.r, cup(reacquired_at).r, 3.0) << "on the cup";
+    EXPECT_LT(theta_error_deg(s.line.theta, cup(reacquired_at).theta), 3.0);
+  }
+}
+
+// A real video (opencv-doc's Megamind.avi, 270 frames of a hand-held toy): the first track is
+// lost early on (frame ~58) while the camera and the toy keep moving; the tracker must not stay
+// lost for the rest of the video but start again, more than once if need be.
+TEST(Tracker, ReacquiresInMegamindAfterTheFirstLoss) {
+  const std::string path = "/usr/share/doc/opencv-doc/examples/data/Megamind.avi";  // scripts/lib.sh installs it
+  cv::VideoCapture video(path);
+  if (!video.isOpened()) GTEST_SKIP() << path << " not found (Debian package opencv-doc)";
+  SymmetryTracker tracker;
+  cv::Mat frame;
+  int frames = 0, first_loss = -1, tracking_after_loss = 0, max_started = 0;
+  for (; video.read(frame); ++frames) {
+    const TrackState s = tracker.feed(frame, frames * kFramePeriodUs);
+    if (first_loss < 0 && s.status == TrackStatus::Lost) first_loss = frames;
+    if (first_loss >= 0 && s.status == TrackStatus::Tracking) ++tracking_after_loss;
+    max_started = std::max(max_started, s.tracks_started);
+  }
+  ASSERT_GT(frames, 200);
+  ASSERT_GE(first_loss, 0) << "the first track is expected to be lost (the video's premise)";
+  std::printf("Megamind: %d frames, first loss at %d, %d frames tracking after it, %d tracks started\n", frames,
+              first_loss, tracking_after_loss, max_started);
+  EXPECT_GE(max_started, 2) << "re-acquired after the loss";
+  EXPECT_GE(tracking_after_loss, (frames - first_loss) / 4) << "tracking again for a good part of the rest";
 }
 
 TEST(Tracker, ReinitialisesAfterASizeChange) {

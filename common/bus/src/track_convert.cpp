@@ -45,6 +45,7 @@ track_t to_message(const tracking::TrackState& s, int64_t utime, int64_t frame_i
     m.box[i][0] = s.has_box ? static_cast<float>(s.box[i].x) : 0.f;
     m.box[i][1] = s.has_box ? static_cast<float>(s.box[i].y) : 0.f;
   }
+  m.tracks_started = s.tracks_started;
   m.block_size = s.block_size;
   m.blocks_w = s.blocks.cols;
   m.blocks_h = s.blocks.rows;
@@ -69,6 +70,7 @@ tracking::TrackState from_message(const track_t& m) {
     for (int j = 0; j < 2; ++j) s.covariance(i, j) = m.covariance[i][j];
   s.has_box = !all_zero(m.box);
   for (int i = 0; i < 4; ++i) s.box[i] = {m.box[i][0], m.box[i][1]};
+  s.tracks_started = m.tracks_started;
   s.block_size = m.block_size;
   s.blocks = cv::Mat::zeros(m.num_blocks ? m.blocks_h : 0, m.num_blocks ? m.blocks_w : 0, CV_8U);
   for (int i = 0; i < m.num_blocks; ++i) s.blocks.at<uint8_t>(i / m.blocks_w, i % m.blocks_w) = m.motion_mask[i] ? 1 : 0;

@@ -120,6 +120,7 @@ void validate(const TrackerParams& p) {
           "tracker start baseline_smoothing must be in (0, 1]");
   require(p.start.max_frames >= 3, "tracker start max_frames must be >= 3");
   require(std::isfinite(p.start.tie_margin) && p.start.tie_margin >= 0, "tracker start tie_margin must be >= 0");
+  require(p.start.rearm_frames >= 0, "tracker start rearm_frames must be >= 0");
   require(std::isfinite(p.gate_sigmas) && p.gate_sigmas > 0, "tracker gate_sigmas must be > 0");
   require(std::isfinite(p.min_half_width_deg) && p.min_half_width_deg >= 0.5 && p.min_half_width_deg <= 90,
           "tracker min_half_width_deg must be in [0.5, 90]");
@@ -207,6 +208,7 @@ void SymmetryTracker::reset(TrackStatus status, const std::string& reason) {
   start_window_.clear();
   start_frames_ = 0;
   missed_ = 0;
+  frames_since_loss_ = -1;  // the past frames are forgotten: any motion starts a track
   object_blocks_.release();
 }
 
@@ -222,6 +224,8 @@ void SymmetryTracker::start_at(const symmetry::Line& line) {
   status_ = TrackStatus::Tracking;
   reason_.clear();
   missed_ = 0;
+  frames_since_loss_ = -1;
+  ++tracks_started_;
   start_window_.clear();
   start_frames_ = 0;
   object_blocks_.release();  // the first frame's motion about the line becomes the object's
@@ -246,6 +250,7 @@ TrackState SymmetryTracker::feed(const cv::Mat& frame, int64_t utime) {
           std::string("internal error, tracker restarted: ") + e.what());
   }
   state.status = status_;
+  state.tracks_started = tracks_started_;
   if (state.reason.empty()) state.reason = reason_;
   return state;
 }
@@ -305,10 +310,16 @@ bool SymmetryTracker::accept_frame(const cv::Mat& frame, int64_t utime, cv::Mat*
 
 void SymmetryTracker::watch_for_start(const BlockMotion& motion) {
   const double count = motion.moving_blocks;
-  const bool jump = count >= params_.start.min_blocks && count >= params_.start.jump_factor * idle_baseline_;
+  // After a loss, motion that went on through it counts as new once rearm_frames have passed.
+  const bool after_loss = frames_since_loss_ >= 0;
+  const bool rearmed = after_loss && params_.start.rearm_frames > 0 && ++frames_since_loss_ > params_.start.rearm_frames;
+  const bool jump = count >= params_.start.min_blocks &&
+                    (rearmed || count >= params_.start.jump_factor * idle_baseline_);
   if (jump) {
     status_ = TrackStatus::Initialising;
-    reason_ = "motion started: collecting three frames for the automatic start";
+    reason_ = after_loss ? "re-acquiring: motion after the loss, collecting three frames for a new automatic start"
+                         : "motion started: collecting three frames for the automatic start";
+    frames_since_loss_ = -1;
     start_window_.clear();
     start_frames_ = 0;
     return;
@@ -352,6 +363,7 @@ void SymmetryTracker::initialise(const cv::Mat& grey, const BlockMotion& motion,
     status_ = TrackStatus::Tracking;
     reason_.clear();
     missed_ = 0;
+    ++tracks_started_;
     state->measurement_used = true;
     state->gate_error = error;
     state->ms.kalman_ms = watch.lap_ms();
@@ -363,7 +375,8 @@ void SymmetryTracker::initialise(const cv::Mat& grey, const BlockMotion& motion,
     status_ = TrackStatus::Idle;
     reason_ = "automatic start failed: no consistent symmetry line in " + std::to_string(start_frames_) +
               " frames of motion";
-    idle_baseline_ = motion.moving_blocks;  // only a new jump in motion tries again
+    idle_baseline_ = motion.moving_blocks;  // a new jump in motion tries again, or any after rearm_frames
+    frames_since_loss_ = 0;
   }
 }
 
@@ -422,7 +435,8 @@ void SymmetryTracker::track(const cv::Mat& grey, const BlockMotion& motion, Trac
 void SymmetryTracker::end_track(const std::string& reason, TrackState* state) {
   status_ = TrackStatus::Lost;
   reason_ = reason;
-  idle_baseline_ = state->moving_blocks;  // a new start needs a new jump in motion
+  idle_baseline_ = state->moving_blocks;  // a new start needs a new jump in motion, or rearm_frames
+  frames_since_loss_ = 0;
   start_window_.clear();
   missed_ = 0;
   object_blocks_.release();

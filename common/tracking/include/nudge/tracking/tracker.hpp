@@ -13,9 +13,12 @@
 //                 `holding` = the object stood still this frame (line held, nothing detected)
 //   Lost          the track ended; `reason` says why (no gated line for N frames, the line left the
 //                 image, or bad input: a size change, a frame out of order, a time jump, or a
-//                 restart request). The tracker re-arms itself: after a loss of the line, a new
-//                 jump in motion starts a new initialisation; after bad input or a restart (which
-//                 forget the past frames), any motion does.
+//                 restart request). The tracker re-arms itself: after a loss of the line (or a
+//                 failed automatic start), a new jump in motion starts a new initialisation, and
+//                 so does any motion once StartParams::rearm_frames have passed (motion that never
+//                 stopped, as in a hand-held video, would otherwise never count as a jump); after
+//                 bad input or a restart (which forget the past frames), any motion does.
+//                 TrackState::tracks_started counts the tracks begun: a new value is a re-acquisition.
 #include <opencv2/core.hpp>
 
 #include <array>
@@ -49,6 +52,11 @@ struct StartParams {
   // frame (shading bands, a label) gives a chain of secondary lines exactly as consistent as the
   // true one; the thesis' rule alone then picks either.
   double tie_margin = 1.0;
+  // Not in the thesis: after a lost track or a failed automatic start, any motion of at least
+  // min_blocks starts a new initialisation once this many frames have passed, jump or not (the
+  // thesis' jump rule alone never re-acquires an object whose motion goes on through the loss).
+  // 0 = only a new jump re-arms.
+  int rearm_frames = 5;
 };
 
 struct TrackerParams {
@@ -124,6 +132,7 @@ struct TrackState {
   AngleLimits limits;              // detection angle limits used for this frame, degrees
   double object_motion = -1;       // fraction of the track's blocks moving this frame (-1: not tracking)
   bool holding = false;            // the object stood still: line held, no detection this frame
+  int tracks_started = 0;          // tracks begun since construction (automatic starts and start_at)
   TrackTiming ms;
 };
 
@@ -170,6 +179,8 @@ class SymmetryTracker {
   int start_frames_ = 0;
   LineKalman kalman_;
   int missed_ = 0;
+  int frames_since_loss_ = -1;  // counting towards StartParams::rearm_frames; -1 = not after a loss
+  int tracks_started_ = 0;
   cv::Mat object_blocks_;  // the track's symmetry-refined blocks of its last frame with motion
 };
 
