@@ -14,7 +14,9 @@
 #include "nudge/candidates_t.hpp"
 #include "nudge/contours_t.hpp"
 #include "nudge/heartbeat_t.hpp"
+#include "nudge/learn_view_t.hpp"
 #include "nudge/recognition_t.hpp"
+#include "nudge/recognize_request_t.hpp"
 #include "nudge/sim_state_t.hpp"
 #include "nudge/symmetry_lines_t.hpp"
 #include "nudge/track_t.hpp"
@@ -379,6 +381,47 @@ TEST(Decode, ValidMessagesWithArraysPassTheLengthChecks) {
     m->num_contours = n;
     m->contours.resize(n);
   });
+  expect_valid_pass<learn_view_t>([](learn_view_t* m, int n, const std::string& text) {
+    m->run_id = text;
+    m->object_key = text + "x";
+    m->image.camera = text;
+    m->image.size = n;
+    m->image.data.assign(n, 9);
+  });
+  expect_valid_pass<recognize_request_t>([](recognize_request_t* m, int n, const std::string& text) {
+    m->image.camera = text;
+    m->image.size = n;
+    m->image.data.assign(n, 9);
+  });
+}
+
+// The learner's inputs carry an image_t inside: its declared size is checked before LCM's
+// decode() allocates it (a 2 GB claim in a hundred bytes).
+TEST(Decode, NestedImageSizesBeyondTheBytesAreRefusedBeforeAllocating) {
+  learn_view_t view{};
+  view.run_id = "run";
+  view.object_key = "attempt_01";
+  view.image.camera = "right";
+  view.image.size = 3;
+  view.image.data = {0xAB, 0xAB, 0xAB};
+  Bytes bytes = encode(view);
+  size_t at = find_count(bytes, 3, {0xAB});
+  ASSERT_NE(at, std::string::npos);
+  put_int32(&bytes, at, 2000000000);
+  learn_view_t back;
+  EXPECT_NE(bus::decode_message(bytes.data(), static_cast<int>(bytes.size()), &back).find("image.size declares 2000000000"),
+            std::string::npos);
+  recognize_request_t request{};
+  request.image.camera = "right";
+  request.image.size = 3;
+  request.image.data = {0xAB, 0xAB, 0xAB};
+  bytes = encode(request);
+  at = find_count(bytes, 3, {0xAB});
+  ASSERT_NE(at, std::string::npos);
+  put_int32(&bytes, at, -1);
+  recognize_request_t request_back;
+  EXPECT_NE(bus::decode_message(bytes.data(), static_cast<int>(bytes.size()), &request_back).find("image.size declares -1"),
+            std::string::npos);
 }
 
 TEST(Decode, ArrayCountsBeyondTheBytesAreRefusedBeforeAllocating) {

@@ -94,6 +94,16 @@ const std::map<std::string, std::vector<Field>>& array_layouts() {
       {"recognition_t",
        {{Field::Fixed, 8 + 8 + 8}, {Field::String, 0, "label"}, {Field::String, 0, "reason"}, {Field::Fixed, 4 + 8},
         {Field::Count, 5 + 4, "num_objects"}}},
+      // Messages that end in an image_t (nested: no fingerprint of its own): utime, frame_id,
+      // camera, width, height, row_stride, pixel_format, then size bytes of data.
+      // fingerprint, utime, run_id, object_key, view_index, wrist_angle, box[4]
+      {"learn_view_t",
+       {{Field::Fixed, 8 + 8}, {Field::String, 0, "run_id"}, {Field::String, 0, "object_key"}, {Field::Fixed, 4 + 8 + 16},
+        {Field::Fixed, 8 + 8}, {Field::String, 0, "image.camera"}, {Field::Fixed, 3 * 4 + 1}, {Field::Count, 1, "image.size"}}},
+      // fingerprint, utime, seq, roi[4], want_match_picture
+      {"recognize_request_t",
+       {{Field::Fixed, 8 + 8 + 8 + 16 + 1}, {Field::Fixed, 8 + 8}, {Field::String, 0, "image.camera"}, {Field::Fixed, 3 * 4 + 1},
+        {Field::Count, 1, "image.size"}}},
   };
   return layouts;
 }
