@@ -28,6 +28,7 @@
 #include "nudge/test/process.hpp"
 
 using nudge::test::Process;
+using nudge::test::read_file;
 namespace channel = nudge::bus::channel;
 
 namespace {
@@ -36,13 +37,6 @@ const std::string kBin = NUDGE_BIN_DIR;
 const std::string kSource = NUDGE_SOURCE_DIR;
 const std::string kUrl = "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=16777216";
 const std::string kCalibration = kSource + "/config/calibration_sim.yaml";
-
-std::string read_file(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
 
 int json_int(const std::string& json, const std::string& key) {
   std::smatch m;

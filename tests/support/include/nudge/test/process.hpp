@@ -4,6 +4,8 @@
 // when the object goes.
 #include <sys/types.h>
 
+#include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -32,5 +34,13 @@ class Process {
  private:
   pid_t pid_ = -1;
 };
+
+// The whole of a text file (a process's log, a summary); "" when it cannot be read.
+inline std::string read_file(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
 
 }  // namespace nudge::test
