@@ -232,6 +232,9 @@ TEST(ImageHeader, RefusesHugeDeclaredSizes) {
   const auto jpeg = jpeg_bytes(65535, 65535, true);
   EXPECT_NE(check_compressed_image(jpeg.data(), jpeg.size()).find("65535x65535"), std::string::npos);
   EXPECT_EQ(check_compressed_image(jpeg.data(), jpeg.size(), int64_t{65535} * 65535), "");
+  // Two 32-bit dimensions whose product overflows an int64 (found by fuzzing): still refused.
+  const auto vast = png_header(2701197311u, 4294967295u, true);
+  EXPECT_NE(check_compressed_image(vast.data(), vast.size()).find("more than"), std::string::npos);
 }
 
 TEST(ImageHeader, RefusesTruncatedAndForeignData) {

@@ -84,7 +84,8 @@ std::string check_compressed_image(const uint8_t* data, size_t size, int64_t max
   const std::string name = header.format == ImageHeader::Format::Png ? "PNG" : "JPEG";
   const std::string dims = std::to_string(header.width) + "x" + std::to_string(header.height);
   if (header.width <= 0 || header.height <= 0) return name + " header declares a size of " + dims;
-  if (header.width * header.height > max_pixels)
+  // Divided, not multiplied: two 32-bit dimensions overflow an int64 product (found by fuzzing).
+  if (header.width > max_pixels / header.height)
     return name + " header declares " + dims + ", more than the " + std::to_string(max_pixels) + " pixels accepted";
   if (!header.complete) return name + " data of " + std::to_string(size) + " bytes is truncated (no end marker)";
   return {};
