@@ -6,7 +6,10 @@
 # move, cuts it out of the stills and goes on until nothing is left, printing every state change.
 # It leaves in out/runs/<run>/ the run's LCM log, summary.json and per attempt the stills, the mask,
 # the cut-out, the fig. 6.6 picture and the fig. 6.7 stages, and report.html (nudge-report).
-#   scripts/demo.sh                       # the loop (NUDGE_DEMO_SCENE, default arm_three_objects.yaml)
+#   scripts/demo.sh                       # the loop (NUDGE_DEMO_SCENE, default arm_three_objects.yaml);
+#                                         # each segmented object is then grasped, turned, learned
+#                                         # (nudge-learner, thesis ch. 7) and put back
+#                                         # (NUDGE_DEMO_LEARN=0: segmentation only)
 #   scripts/demo.sh perception            # perception only: world -> camera -> symmetry -> monitor
 #   scripts/demo.sh 'images:/data/left/*.png' 'images:/data/right/*.png'   # recorded stereo data
 #   scripts/demo.sh synthetic             # the synthetic image sequence (generated into out/scenes)
@@ -94,14 +97,15 @@ if [ $# -eq 0 ]; then
   scene=${NUDGE_DEMO_SCENE:-$NUDGE_ROOT/common/sim/scenes/arm_three_objects.yaml}
   run="run-$(date +%Y%m%d-%H%M%S)"
   export -f nudge_run_loop
-  nudge_log "autonomous segmentation of $(basename "$scene"): world, camera, symmetry, triangulation, arm and supervisor over LCM; run $run"
+  export NUDGE_LOOP_LEARN=${NUDGE_DEMO_LEARN:-1}
+  nudge_log "autonomous segmentation of $(basename "$scene"): world, camera, symmetry, triangulation, arm, learner and supervisor over LCM; run $run"
   status=0
   nudge_in_private_network bash -c 'nudge_run_loop "$@"' loop "$NUDGE_BUILD_DIR/bin" "$scene" \
     "$NUDGE_ROOT/config/calibration_sim.yaml" "$NUDGE_ROOT/config/workspace.yaml" "$out/runs" "$run" || status=$?
   dir="$out/runs/$run"
   if [ -f "$dir/summary.json" ]; then
     nudge_log "run $run: $(grep -o '"segmented":[0-9]*' "$dir/summary.json" | head -1 | cut -d: -f2) objects segmented in $(grep -o '"attempts":[0-9]*' "$dir/summary.json" | head -1 | cut -d: -f2) nudges"
-    nudge_log "files: $dir/ (LCM log $run.lcmlog, summary.json, attempt_NN/ with before/after stills, mask, cutout, workspace.png, stages/)"
+    nudge_log "files: $dir/ (LCM log $run.lcmlog, summary.json, attempt_NN/ with before/after stills, mask, cutout, workspace.png, stages/, views/; objects/: what was learned)"
     "$NUDGE_BUILD_DIR/bin/nudge-report" "$dir" >/dev/null && nudge_log "report: $dir/report.html (opens in a browser, docs/operator.md)"
     nudge_log "replay the decisions: build/bin/nudge-supervisor --lcm-in 'file://$dir/$run.lcmlog?speed=0' --lcm-out 'file:///tmp/replay.lcmlog?mode=w' --calibration config/calibration_sim.yaml --first-seq $(grep -o '"first_command_seq":[0-9]*' "$dir/summary.json" | cut -d: -f2)"
   fi

@@ -85,6 +85,10 @@ nudge_in_private_network() {
 # The run's files land in OUT_DIR/RUN_ID/ (LCM log, summary.json, attempt_NN/), the services' logs
 # in OUT_DIR/RUN_ID/services/. Returns the supervisor's exit code. NUDGE_LOOP_RATE (10 Hz) and
 # NUDGE_LOOP_REALTIME (1) set the world's pace, NUDGE_LOOP_TIMEOUT (900 s) bounds the run.
+# NUDGE_LOOP_LEARN=1 adds learning by interaction (thesis ch. 7): nudge-learner with its object
+# database in NUDGE_OBJECT_DB (default OUT_DIR/RUN_ID/objects: each run starts knowing nothing; name
+# one folder to keep what was learned across runs) and the world's one hand carrying the pad and
+# the gripper (--tool auto); the supervisor (--learn auto) then recognises, grasps, turns and learns.
 nudge_run_loop() {
   local bin=$1 scene=$2 calibration=$3 workspace=$4 out=$5 run=$6
   shift 6
@@ -96,6 +100,12 @@ nudge_run_loop() {
   # back-off if one crashes, all stopped together (SIGINT, then SIGKILL), their status on
   # PROCESS_STATUS. NUDGE_VIEWER=PORT adds the operator's page on http://127.0.0.1:PORT/ (reachable
   # from this host's browser with NUDGE_HOST_NETWORK=1).
+  local learner= tool=pad
+  if [ "${NUDGE_LOOP_LEARN:-0}" = 1 ]; then
+    learner=",
+    {\"name\": \"learner\", \"command\": [\"$bin/nudge-learner\", \"--db\", \"${NUDGE_OBJECT_DB:-$out/$run/objects}\"]}"
+    tool=auto
+  fi
   local viewer=
   [ -n "${NUDGE_VIEWER:-}" ] && viewer=",
     {\"name\": \"viewer\", \"command\": [\"$bin/nudge-viewer\", \"--port\", \"$NUDGE_VIEWER\"]}"
@@ -108,7 +118,7 @@ nudge_run_loop() {
                                    "--snapshot-format", "png"]},
     {"name": "triangulation", "command": ["$bin/nudge-triangulation", "--calibration", "$calibration",
                                           "--workspace", "$workspace"]},
-    {"name": "arm", "command": ["$bin/nudge-arm", "--backend", "sim", "--clock", "sim", "--workspace", "$workspace"]}$viewer
+    {"name": "arm", "command": ["$bin/nudge-arm", "--backend", "sim", "--clock", "sim", "--workspace", "$workspace"]}$learner$viewer
  ]}
 EOF
   "$bin/nudge-launch" "$logs/launch.json" 2>"$logs/launch.log" & pids+=($!)
@@ -118,7 +128,7 @@ EOF
     sleep 0.1
   done
   "$bin/nudge-world" --lcm-url "$url" --scene "$scene" --workspace "$workspace" --realtime-factor "${NUDGE_LOOP_REALTIME:-1}" \
-    --rate "${NUDGE_LOOP_RATE:-10}" 2>"$logs/world.log" & pids+=($!)
+    --rate "${NUDGE_LOOP_RATE:-10}" --tool "$tool" 2>"$logs/world.log" & pids+=($!)
   local status=0
   timeout -s INT "${NUDGE_LOOP_TIMEOUT:-900}" "$bin/nudge-supervisor" --lcm-url "$url" --calibration "$calibration" \
     --workspace "$workspace" --out "$out" --run-id "$run" "$@" || status=$?
