@@ -44,7 +44,10 @@ int run_sim_camera(bus::Service& service, const SimOptions& options) {
               << scene.rig.height << ", noise " << noise_sigma << ")";
   service.start();
 
-  int64_t frame_id = 0, snapshot_id = 0;
+  int64_t frame_id = 0;
+  // Each camera numbers its own stills (image_t.frame_id is per camera): a right-only still (the
+  // learning views) is no gap on SNAPSHOT_LEFT, and a gap is a lost still.
+  int64_t snapshot_ids[2] = {0, 0};
   std::optional<int64_t> last_state_utime;
   std::optional<sim::PoseSnapshot> previous;
   // One camera's frame: sharp, or the mean of renders spread over the interval since the last
@@ -88,9 +91,8 @@ int run_sim_camera(bus::Service& service, const SimOptions& options) {
             if (request.cameras != snapshot_request_t::CAMERAS_BOTH && request.cameras != this_camera) continue;
             service.publish(kSnapshotChannels[c],
                             bus::to_message(world.render_snapshot(c), options.snapshot_format, *last_state_utime,
-                                            snapshot_id, kCameraNames[c], options.jpeg_quality));
+                                            snapshot_ids[c]++, kCameraNames[c], options.jpeg_quality));
           }
-          ++snapshot_id;
         });
   }
   return service.run();
