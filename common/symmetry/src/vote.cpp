@@ -534,7 +534,8 @@ void Detector::vote_thetas(const EdgeSet& edges, const std::vector<int>& thetas,
           }
           const int32_t* x32 = s.sorted.data() + s.starts[r];
           int32_t* out32 = s.pairs.data() + pending;
-          const int16_t* a16 = s.angle16.data() + s.starts[r];
+          // Orientations exist only with the mirror rule (no offset on an empty vector's null data).
+          const int16_t* a16 = s.angle16.empty() ? nullptr : s.angle16.data() + s.starts[r];
           if (sorted_rows && count > kWindowedRowPixels)
             pending += row_pair_bins_windowed(doubled(x32, count, s.doubled_x), doubled(a16, count, s.doubled_angle),
                                               count, rule, mirror_rule, starts_of(a16, count), out32);
