@@ -55,7 +55,9 @@ namespace {
 
 struct Options {
   std::string calibration, run_id, out_dir = "out/runs", clock = "sim", require;
-  double service_timeout_s = 3.0;
+  // Two missed beats (heartbeats at 1 Hz): a killed service is noticed within 3 s whatever its
+  // heartbeat's phase (as the services' own watch, kSilentAfterUs).
+  double service_timeout_s = 2.5;
   int first_seq = 0;
   // A gentle push: tall objects (bottles) tip when the pad meets them at the arm's usual speed.
   double nudge_speed_scale = 0.25;
