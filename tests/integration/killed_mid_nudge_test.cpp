@@ -143,8 +143,10 @@ double joint_travel(const std::vector<Heard<Msg>>& heard) {
   return travel;
 }
 
-// The command line of each service the supervisor needs (its --require set with --clock sim).
-std::vector<std::string> command_of(const std::string& service) {
+// The command line of each service the supervisor needs (its --require set with --clock sim; the
+// learner when the run requires it, its object database in `dir`).
+std::vector<std::string> command_of(const std::string& service, const std::string& dir) {
+  if (service == "learner") return {kBin + "/nudge-learner", "--lcm-url", kUrl, "--db", dir + "/objects"};
   if (service == "symmetry")
     return {kBin + "/nudge-symmetry", "--lcm-url", kUrl, "--lines", "5", "--theta-min", "-25", "--theta-max", "25",
             "--once-per-row", "--mirror-tolerance", "15"};
@@ -186,15 +188,19 @@ TEST_P(KilledMidNudge, SupervisorPausesStopsTheArmAndResumesSafely) {
 
   std::map<std::string, std::unique_ptr<Process>> services;
   const auto start = [&](const std::string& name) {
-    services[name] = std::make_unique<Process>(command_of(name), dir + "/" + name + ".log");
+    services[name] = std::make_unique<Process>(command_of(name, dir), dir + "/" + name + ".log");
     return services[name]->started();
   };
-  for (const char* name : {"symmetry", "camera", "triangulation", "arm"}) ASSERT_TRUE(start(name)) << name;
+  // The learner is needed only by a run that learns: it joins the run (and --require) when it is the one killed.
+  std::vector<std::string> fleet = {"symmetry", "camera", "triangulation", "arm"};
+  if (victim == "learner") fleet.push_back("learner");
+  for (const std::string& name : fleet) ASSERT_TRUE(start(name)) << name;
   sleep(3);  // every subscriber listens before the world's first state (the camera builds its scene)
   ASSERT_TRUE(start("world"));
   // --max-attempts 1: after the aborted attempt and the arm's parking the run ends by itself.
   Process supervisor({kBin + "/nudge-supervisor", "--lcm-url", kUrl, "--calibration", kCalibration, "--out", dir,
-                      "--run-id", "kill", "--first-seq", "1000", "--max-attempts", "1"},
+                      "--run-id", "kill", "--first-seq", "1000", "--max-attempts", "1", "--require",
+                      std::string("camera,symmetry,triangulation,arm,world") + (victim == "learner" ? ",learner" : "")},
                      dir + "/supervisor.log");
   ASSERT_TRUE(supervisor.started());
   const auto logs = [&] {
@@ -294,6 +300,7 @@ std::string name_of(const ::testing::TestParamInfo<std::string>& info) { return 
 
 // In CI: a sensor and the actuator. The rest of the matrix: experiments/kill_mid_nudge.sh.
 INSTANTIATE_TEST_SUITE_P(InCi, KilledMidNudge, ::testing::Values("camera", "arm"), name_of);
-INSTANTIATE_TEST_SUITE_P(DISABLED_Matrix, KilledMidNudge, ::testing::Values("symmetry", "triangulation", "world"), name_of);
+INSTANTIATE_TEST_SUITE_P(DISABLED_Matrix, KilledMidNudge, ::testing::Values("symmetry", "triangulation", "world", "learner"),
+                         name_of);
 
 }  // namespace
