@@ -13,9 +13,11 @@
 //     (MOTION_STOPPED, joints unchanged) is what stopped means;
 //   - the run pauses (nothing but STOPs is commanded while the service is silent), and once the
 //     service is started again it resumes from a safe state: the attempt ends "aborted", the arm
-//     parks (COMMAND_HOME) and, with --max-attempts 1, the run ends by itself with its reason;
+//     parks (COMMAND_HOME answered MOTION_DONE) and, with --max-attempts 1, the run ends by itself
+//     with its reason;
 //   - the run's log and summary are complete: summary.json whole (one object, its end reason and
-//     the aborted attempt), RUN.lcmlog readable to its end, no *.partial left.
+//     the aborted attempt), attempt_01/attempt.json "aborted", RUN.lcmlog readable to its end, no
+//     *.partial or *.tmp left.
 // Two services run in CI (the camera: a sensor; the arm: the actuator); the whole matrix runs in
 // experiments/kill_mid_nudge.sh (--gtest_also_run_disabled_tests), which writes docs/results.
 // With NUDGE_KILL_RESULTS=FILE each case appends its measurements to FILE as a JSON line.
@@ -265,7 +267,11 @@ TEST_P(KilledMidNudge, SupervisorPausesStopsTheArmAndResumesSafely) {
   const auto home = bus.wait_for<nudge::arm_command_t>(restarted, 60, [](const auto& m) {
     return m.command == nudge::arm_command_t::COMMAND_HOME;
   });
-  EXPECT_TRUE(home) << "the arm was not parked after the pause\n" << logs();
+  ASSERT_TRUE(home) << "the arm was not sent home after the pause\n" << logs();
+  const int64_t home_seq = home->msg.seq;
+  EXPECT_TRUE(bus.wait_for<nudge::arm_state_t>(home->at, 60, [&](const auto& m) {
+    return m.command_seq == home_seq && m.motion == nudge::arm_state_t::MOTION_DONE;
+  })) << "the arm did not report itself parked (MOTION_DONE for seq " << home_seq << ")\n" << logs();
   const int code = supervisor.wait_exit(90);
   EXPECT_EQ(code, 0) << "the run did not end by itself after " << victim << " came back\n" << logs();
 
@@ -278,6 +284,8 @@ TEST_P(KilledMidNudge, SupervisorPausesStopsTheArmAndResumesSafely) {
   EXPECT_EQ(json_int(summary, "attempts"), 1) << summary;
   EXPECT_NE(summary.find("\"aborted\""), std::string::npos) << summary;
   EXPECT_NE(summary.find("\"end_reason\""), std::string::npos) << summary;
+  const std::string attempt = read_file(run + "/attempt_01/attempt.json");
+  EXPECT_NE(attempt.find("\"outcome\":\"aborted\""), std::string::npos) << attempt;
   EXPECT_FALSE(std::filesystem::exists(run + "/kill.lcmlog.partial"));
   const int events = count_log_events(run + "/kill.lcmlog");
   EXPECT_GT(events, 100) << "the run's log is missing or empty";
