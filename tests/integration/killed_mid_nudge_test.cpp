@@ -199,11 +199,12 @@ TEST_P(KilledMidNudge, SupervisorPausesStopsTheArmAndResumesSafely) {
   for (const std::string& name : fleet) ASSERT_TRUE(start(name)) << name;
   sleep(3);  // every subscriber listens before the world's first state (the camera builds its scene)
   ASSERT_TRUE(start("world"));
-  // --max-attempts 1: after the aborted attempt and the arm's parking the run ends by itself.
-  Process supervisor({kBin + "/nudge-supervisor", "--lcm-url", kUrl, "--calibration", kCalibration, "--out", dir,
-                      "--run-id", "kill", "--first-seq", "1000", "--max-attempts", "1", "--require",
-                      std::string("camera,symmetry,triangulation,arm,world") + (victim == "learner" ? ",learner" : "")},
-                     dir + "/supervisor.log");
+  // --max-attempts 1: after the aborted attempt and the arm's parking the run ends by itself. The
+  // required services are the default set (--clock sim), plus the learner when it is the victim.
+  std::vector<std::string> supervisor_argv = {kBin + "/nudge-supervisor", "--lcm-url", kUrl, "--calibration", kCalibration,
+                                              "--out", dir, "--run-id", "kill", "--first-seq", "1000", "--max-attempts", "1"};
+  if (victim == "learner") supervisor_argv.insert(supervisor_argv.end(), {"--require", "camera,symmetry,triangulation,arm,world,learner"});
+  Process supervisor(supervisor_argv, dir + "/supervisor.log");
   ASSERT_TRUE(supervisor.started());
   const auto logs = [&] {
     std::string text;
@@ -302,6 +303,7 @@ TEST_P(KilledMidNudge, SupervisorPausesStopsTheArmAndResumesSafely) {
         << ", \"log_events\": " << events << ", \"passed\": " << (HasFailure() ? "false" : "true") << "}\n";
   }
   for (auto& [name, process] : services) process->stop();
+  if (!HasFailure()) std::filesystem::remove_all(dir);  // kept for a look when something failed
 }
 
 std::string name_of(const ::testing::TestParamInfo<std::string>& info) { return info.param; }
