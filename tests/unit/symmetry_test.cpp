@@ -302,6 +302,33 @@ TEST(SymmetryVote, MirrorWindowsEqualPlainOnEdgeCases) {
   }
 }
 
+TEST(SymmetryVote, MirrorWindowsEqualPlainWhenEveryPixelHasOneOrientation) {
+  // Every pixel in one orientation bucket (the other buckets of every row empty: their starts come
+  // from the bucket after them), at a bucket's last and first unit, just below the 0 / 180 deg wrap
+  // and mid-range; as orientations and, with polarity, as gradient directions (mod 360 deg). Dense
+  // rows (1500 pixels in 100 x 75) so that windows are long; pairs vote only where 2 theta is
+  // within the tolerance of twice the orientation.
+  Params p = synthetic_params();
+  p.dmin = 2;
+  p.mirror_tolerance_deg = 10;
+  const int bucket_units = 65536 / 64;  // vote.cpp's orientation buckets (6 bits)
+  for (const int angle : {bucket_units - 1, bucket_units, -1, 12345}) {
+    for (const bool polarity : {false, true}) {
+      SCOPED_TRACE("angle units " + std::to_string(angle) + ", polarity " + std::to_string(polarity));
+      EdgeSet edges = random_edges(100, 75, 1500, 21, [&](std::mt19937&) { return static_cast<int16_t>(angle); });
+      Params q = p;
+      q.mirror_polarity = polarity;
+      if (polarity) {
+        edges.direction = edges.orientation;
+        // Half the pixels with the opposite contrast (direction + 180 deg): the same orientation.
+        for (size_t i = 0; i < edges.direction.size(); i += 2)
+          edges.direction[i] = static_cast<int16_t>(static_cast<uint16_t>(edges.direction[i]) + 32768u);
+      }
+      expect_mirror_variants_equal_plain(edges, q);
+    }
+  }
+}
+
 TEST(SymmetryVote, MirrorWindowsKeepExactlyThePairsWithinTheTolerance) {
   // One row of Rot at theta = 0 (image row y = 10) holding pixels of every orientation: the
   // windowed checks must keep a pair exactly when |a + b| <= tolerance (mod 180 deg), on both
