@@ -69,6 +69,7 @@ void write_learning(JsonWriter& j, const Attempt& a) {
   } else {
     j.raw("null");
   }
+  j.field("grasp_plan_ms", a.grasp_plan_ms);
   j.key("views").begin_array();
   for (const LearnView& v : a.views)
     j.begin_object().field("index", v.index).field("wrist_angle", v.angle).field("utime", static_cast<long long>(v.utime))

@@ -1,6 +1,7 @@
 #include "nudge/supervisor/supervisor.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <future>
@@ -297,6 +298,7 @@ bool Supervisor::verify_by_axes(int64_t now) {
 }
 
 void Supervisor::segment(int64_t now) {
+  const auto started = std::chrono::steady_clock::now();
   Attempt& a = *attempt_;
   enter(State::Segment, now, "motion segmentation of the stills");
   const auto predicted_before = scene_.right_axis_line(a.target.position, config_.object_height_m, config_.still_size);
@@ -325,6 +327,8 @@ void Supervisor::segment(int64_t now) {
   }
   if (a.learn) {
     plan_grasp(now);
+    if (state_ == State::Grasp)
+      a.grasp_plan_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started).count();
     return;
   }
   end_attempt(Outcome::Segmented, "segmented", now);

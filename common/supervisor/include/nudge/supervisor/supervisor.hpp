@@ -181,6 +181,10 @@ struct Attempt {
   std::string learning;                    // "learned", "not grasped", "dropped", "learner silent", ...
   std::string learning_reason;
   std::string learned_name;                // the learner's name for it
+  // Wall time from the after stills to the grasp command (both segmentations, the top, the grasp
+  // and its arm plan; thesis 160 ms), -1 when no grasp was commanded. Measured for the report
+  // only: no decision depends on it.
+  double grasp_plan_ms = -1;
   std::string object_key() const;          // "attempt_NN"
 };
 struct AttemptEnded { std::shared_ptr<const Attempt> attempt; };

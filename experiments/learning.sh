@@ -1,0 +1,55 @@
+#!/usr/bin/env bash
+# Thesis sec. 7.4 (Table 7.1) in simulation: each of the seven bottles of
+# experiments/scenes/learning/train*.yaml learned by the whole chain (survey -> nudge -> segment ->
+# grasp -> rotate -> learn -> place), one run per scene, no retries, all into ONE object database
+# (out/experiments/learning/objects: the later runs first ask whether their bottle is already known).
+# Then nudge-exp-learning scores the database on the 28 test and 10 never-learned images into
+# docs/results/learning.{json,md} (docs/learning.md, "The experiment"). Runs land in
+# out/experiments/learning/<scene>/. A few minutes per scene.
+#   experiments/learning.sh                 the seven runs (a fresh database), then the scoring
+#   experiments/learning.sh --runs-only     the seven runs only
+#   experiments/learning.sh --score-only    the scoring of the runs already in out/ only
+set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/../scripts/lib.sh"
+runs=1 score=1
+case "${1:-}" in
+  --runs-only) score=0 ;;
+  --score-only) runs=0 ;;
+  "") ;;
+  *) echo "usage: $0 [--runs-only | --score-only]" >&2; exit 2 ;;
+esac
+scenes_dir="$NUDGE_ROOT/experiments/scenes/learning"
+runs_dir="$NUDGE_ROOT/out/experiments/learning"
+calibration="$NUDGE_ROOT/config/calibration_sim.yaml"
+targets=(nudge-launch nudge-world nudge-camera nudge-symmetry nudge-triangulation nudge-arm nudge-learner nudge-supervisor)
+[ $score = 1 ] && targets+=(nudge-exp-learning)
+nudge_install_packages
+[ -f "$NUDGE_BUILD_DIR/CMakeCache.txt" ] || cmake -S "$NUDGE_ROOT" -B "$NUDGE_BUILD_DIR" -DCMAKE_BUILD_TYPE=Release >/dev/null
+nudge_log "building ${targets[*]}"
+cmake --build "$NUDGE_BUILD_DIR" -j "$NUDGE_JOBS" --target "${targets[@]}" >/dev/null
+
+names=()
+for f in "$scenes_dir"/train*.yaml; do names+=("$(basename "$f" .yaml)"); done
+if [ $runs = 1 ]; then
+  # One database for all seven, started empty: what a run learns, the next ones know.
+  rm -rf "${runs_dir:?}"
+  mkdir -p "$runs_dir/objects"
+  export -f nudge_run_loop
+  export NUDGE_LOOP_LEARN=1 NUDGE_OBJECT_DB="$runs_dir/objects"
+  i=0
+  for name in "${names[@]}"; do
+    i=$((i + 1))
+    mkdir -p "$runs_dir/$name"
+    start=$(date +%s)
+    status=0
+    nudge_in_private_network bash -c 'nudge_run_loop "$@"' loop "$NUDGE_BUILD_DIR/bin" "$scenes_dir/$name.yaml" \
+      "$calibration" "$NUDGE_ROOT/config/workspace.yaml" "$runs_dir/$name" "$name" --learn on --first-seq 1000 \
+      2>"$runs_dir/$name/supervisor.log" || status=$?
+    [ -d "$runs_dir/$name/$name" ] && echo $(($(date +%s) - start)) > "$runs_dir/$name/$name/wall_seconds.txt"
+    learned=$(grep -ho '"learned_name":"[^"]*"' "$runs_dir/$name/$name/summary.json" 2>/dev/null | grep -v '""' | head -1 || true)
+    nudge_log "[$i/${#names[@]}] $name: $(grep -h "ended:" "$runs_dir/$name/supervisor.log" | sed 's/^.*ended: //') ${learned:-nothing learned} ($(($(date +%s) - start)) s, exit $status)"
+  done
+fi
+if [ $score = 1 ]; then
+  "$NUDGE_BUILD_DIR/bin/nudge-exp-learning" --runs "$runs_dir" --scenes "$scenes_dir" --out "$NUDGE_ROOT/docs/results"
+fi
