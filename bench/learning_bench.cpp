@@ -15,12 +15,7 @@ namespace {
 
 // Objects 0..99, made once (SIFT on 1200 views takes a while).
 const std::vector<std::shared_ptr<const ObjectModel>>& objects() {
-  static const auto all = [] {
-    std::vector<std::shared_ptr<const ObjectModel>> out;
-    for (int i = 0; i < 100; ++i)
-      out.push_back(std::make_shared<const ObjectModel>(synthetic::object_model("object_" + std::to_string(i), 1000 + i)));
-    return out;
-  }();
+  static const auto all = synthetic::object_models("object_", 100, 1000);
   return all;
 }
 

@@ -7,8 +7,6 @@
 // Writes docs/results/NAME.{json,md} and NAME.png.
 #include <opencv2/imgcodecs.hpp>
 
-#include <ctime>
-#include <fstream>
 #include <iostream>
 
 #include "nudge/flags.hpp"
@@ -16,6 +14,7 @@
 #include "nudge/learning/recognizer.hpp"
 #include "nudge/learning/synthetic.hpp"
 #include "nudge/timing.hpp"
+#include "learning_timing.hpp"
 #include "report.hpp"
 
 using namespace nudge;
@@ -29,48 +28,11 @@ const std::vector<std::string> kNegatives = {"baboon.jpg",  "building.jpg", "but
                                              "leuvenA.jpg", "aero1.jpg"};
 constexpr int kTimingRuns = 3;
 
-// The 1-minute load average, to say how shared the machine was while timing.
-std::string load_average() {
-  std::ifstream in("/proc/loadavg");
-  std::string first;
-  in >> first;
-  return first.empty() ? "unknown" : first;
-}
-
 cv::Mat read_image(const std::string& path) {
   cv::Mat image = cv::imread(path, cv::IMREAD_GRAYSCALE);
   if (image.empty())
     throw std::runtime_error("cannot read " + path + " (Debian: apt-get install opencv-doc; or pass --data DIR)");
   return image;
-}
-
-struct Timing {
-  std::string matcher;
-  double median_ms = 0;      // wall clock
-  double median_cpu_ms = 0;  // this process's CPU time: what a shared, loaded machine distorts least
-  std::string label;
-};
-
-// Median time of recognising `scene` (SIFT included) against 100 objects.
-Timing time_at_100(const std::vector<std::shared_ptr<const learning::ObjectModel>>& objects, const cv::Mat& scene,
-                   learning::MatcherKind kind) {
-  learning::RecognizeParams params;
-  params.matcher = kind;
-  learning::Recognizer recognizer(params);
-  for (const auto& o : objects) recognizer.add(o);
-  std::vector<double> ms, cpu_ms;
-  Timing t;
-  t.matcher = learning::matcher_name(kind);
-  for (int i = 0; i < kTimingRuns; ++i) {
-    const std::clock_t start = std::clock();
-    const learning::Recognition r = recognizer.recognize(scene);
-    cpu_ms.push_back(1000.0 * static_cast<double>(std::clock() - start) / CLOCKS_PER_SEC);
-    ms.push_back(r.elapsed_ms);
-    t.label = r.recognised() ? r.best_score()->name : "";
-  }
-  t.median_ms = median(ms);
-  t.median_cpu_ms = median(cpu_ms);
-  return t;
 }
 
 }  // namespace
@@ -107,15 +69,13 @@ int main(int argc, char** argv) {
     negatives.end_array();
 
     std::vector<std::shared_ptr<const learning::ObjectModel>> objects = {model};
-    for (int i = 0; i < 99; ++i)
-      objects.push_back(std::make_shared<const learning::ObjectModel>(
-          learning::synthetic::object_model("synthetic_" + std::to_string(i), 2000 + i)));
+    for (auto& stand_in : learning::synthetic::object_models("synthetic_", 99, 2000)) objects.push_back(stand_in);
     int descriptors = 0;
     for (const auto& o : objects) descriptors += o->descriptor_count();
-    const Timing flann = time_at_100(objects, scene, learning::MatcherKind::Flann);
-    const Timing bf = time_at_100(objects, scene, learning::MatcherKind::BruteForce);
+    const RecognitionTiming flann = time_recognition(objects, scene, learning::MatcherKind::Flann, kTimingRuns);
+    const RecognitionTiming bf = time_recognition(objects, scene, learning::MatcherKind::BruteForce, kTimingRuns);
     const learning::RecognizeParams defaults;
-    const Timing& chosen = defaults.matcher == learning::MatcherKind::Flann ? flann : bf;
+    const RecognitionTiming& chosen = defaults.matcher == learning::MatcherKind::Flann ? flann : bf;
 
     JsonWriter j;
     j.begin_object();

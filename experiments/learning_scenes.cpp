@@ -1,10 +1,15 @@
 #include "learning_scenes.hpp"
 
 #include "nudge/sim/camera.hpp"
+#include "nudge/sim/truth_images.hpp"
+
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 #include <Eigen/Geometry>
 
 #include <cmath>
+#include <fstream>
 #include <iomanip>
 #include <locale>
 #include <random>
@@ -319,6 +324,55 @@ std::vector<TestImage> make_test_images(const std::string& source_dir, const std
     if (!done) throw std::runtime_error("test image " + name.str() + ": no seed of " + std::to_string(kTries) + " drew it");
   }
   return images;
+}
+
+namespace {
+
+cv::Mat read_png(const std::string& path, int flags) {
+  cv::Mat image = cv::imread(path, flags);
+  if (image.empty()) throw std::runtime_error(path + ": missing or not an image");
+  return image;
+}
+
+TestVariant variant_from_name(const std::string& name, const std::string& file) {
+  for (TestVariant v : {TestVariant::Plain, TestVariant::Cluttered, TestVariant::Orientation, TestVariant::Occluded,
+                        TestVariant::Unknown})
+    if (name == variant_name(v)) return v;
+  throw std::runtime_error(file + ": unknown variant '" + name + "'");
+}
+
+}  // namespace
+
+std::vector<TestImage> read_test_images(const std::string& dir, const std::string& set) {
+  const std::string file = dir + "/manifest.json";
+  std::ifstream in(file);
+  if (!in) throw std::runtime_error(file + ": missing (write it with nudge-exp-learning-scenes --out " + dir + ")");
+  nlohmann::json manifest;
+  try {
+    manifest = nlohmann::json::parse(in);
+    if (manifest.at("set").get<std::string>() != set)
+      throw std::runtime_error("holds the '" + manifest.at("set").get<std::string>() + "' set, not '" + set + "'");
+    std::vector<TestImage> images;
+    for (const auto& entry : manifest.at("images")) {
+      TestImage t;
+      t.name = entry.at("name").get<std::string>();
+      t.target = entry.at("target").get<std::string>();
+      t.variant = variant_from_name(entry.at("variant").get<std::string>(), file);
+      t.seed = entry.at("seed").get<uint64_t>();
+      t.visible_fraction = entry.at("visible_fraction").get<double>();
+      t.colour = read_png(dir + "/" + entry.at("colour").get<std::string>(), cv::IMREAD_COLOR);
+      t.mask = read_png(dir + "/" + entry.at("mask").get<std::string>(), cv::IMREAD_GRAYSCALE);
+      t.surface = sim::decode_surface(read_png(dir + "/" + entry.at("surface").get<std::string>(), cv::IMREAD_UNCHANGED));
+      images.push_back(std::move(t));
+    }
+    return images;
+  } catch (const nlohmann::json::exception& e) {
+    throw std::runtime_error(file + ": " + e.what());
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    if (what.rfind(dir, 0) == 0) throw;  // already names its file
+    throw std::runtime_error(file + ": " + what);
+  }
 }
 
 }  // namespace nudge::experiments

@@ -56,4 +56,10 @@ struct TestImage {
 // drawn within its retries.
 std::vector<TestImage> make_test_images(const std::string& source_dir, const std::string& set);
 
+// The images nudge-exp-learning-scenes --out DIR wrote, read back from DIR/manifest.json: name,
+// target, variant, seed, visible fraction, colour, mask and surface (not the scene). `set` is
+// what manifest.json must say it holds. Throws std::runtime_error naming the file that is
+// missing, unreadable or of another set.
+std::vector<TestImage> read_test_images(const std::string& dir, const std::string& set);
+
 }  // namespace nudge::experiments

@@ -106,6 +106,10 @@ nudge_run_loop() {
     {\"name\": \"learner\", \"command\": [\"$bin/nudge-learner\", \"--db\", \"${NUDGE_OBJECT_DB:-$out/$run/objects}\"]}"
     tool=auto
   fi
+  # NUDGE_LOOP_ARM_WATCHDOG=S: the arm stops when the supervisor's heartbeat is missing S seconds
+  # (nudge-arm --supervisor-timeout; a loaded, shared machine may starve the supervisor that long).
+  local arm_watchdog=
+  [ -n "${NUDGE_LOOP_ARM_WATCHDOG:-}" ] && arm_watchdog=", \"--supervisor-timeout\", \"$NUDGE_LOOP_ARM_WATCHDOG\""
   local viewer=
   [ -n "${NUDGE_VIEWER:-}" ] && viewer=",
     {\"name\": \"viewer\", \"command\": [\"$bin/nudge-viewer\", \"--port\", \"$NUDGE_VIEWER\"]}"
@@ -118,7 +122,7 @@ nudge_run_loop() {
                                    "--snapshot-format", "png"]},
     {"name": "triangulation", "command": ["$bin/nudge-triangulation", "--calibration", "$calibration",
                                           "--workspace", "$workspace"]},
-    {"name": "arm", "command": ["$bin/nudge-arm", "--backend", "sim", "--clock", "sim", "--workspace", "$workspace"]}$learner$viewer
+    {"name": "arm", "command": ["$bin/nudge-arm", "--backend", "sim", "--clock", "sim", "--workspace", "$workspace"$arm_watchdog]}$learner$viewer
  ]}
 EOF
   "$bin/nudge-launch" "$logs/launch.json" 2>"$logs/launch.log" & pids+=($!)

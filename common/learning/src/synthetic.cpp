@@ -84,4 +84,11 @@ ObjectModel object_model(const std::string& name, uint64_t seed, int views, cv::
   return model;
 }
 
+std::vector<std::shared_ptr<const ObjectModel>> object_models(const std::string& prefix, int count, uint64_t first_seed) {
+  std::vector<std::shared_ptr<const ObjectModel>> models;
+  for (int i = 0; i < count; ++i)
+    models.push_back(std::make_shared<const ObjectModel>(object_model(prefix + std::to_string(i), first_seed + i)));
+  return models;
+}
+
 }  // namespace nudge::learning::synthetic

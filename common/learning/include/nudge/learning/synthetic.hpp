@@ -3,6 +3,7 @@
 #include <opencv2/core.hpp>
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -29,5 +30,9 @@ cv::Mat place_in_scene(const cv::Mat& object, const cv::Mat& scene, double angle
 // A model of an object whose unrolled label is random_texture(seed): `views` turntable views of
 // `face` pixels each (the object alone, no scene: nothing to prune). For databases of many objects.
 ObjectModel object_model(const std::string& name, uint64_t seed, int views = 12, cv::Size face = {120, 240});
+
+// `count` such models named prefix + 0, 1, ... from seeds first_seed, first_seed + 1, ...: the
+// stand-ins that fill a database to a size (benchmark, experiments' time at 100 objects).
+std::vector<std::shared_ptr<const ObjectModel>> object_models(const std::string& prefix, int count, uint64_t first_seed);
 
 }  // namespace nudge::learning::synthetic

@@ -1,0 +1,525 @@
+// The object-learning experiment (thesis sec. 7.4, Table 7.1; issue 11), scored. The seven
+// bottles were learned by experiments/learning.sh, one run of the whole chain each, into one object
+// database; this program
+//   - reads each run's summary (learned or not, and why; the grasp's plan time),
+//   - recognises the 28 test images and the 10 images of objects never learned (written by
+//     nudge-exp-learning-scenes --set eval, seeds fixed in advance) with the learner's Recognizer,
+//   - judges every verified match against the simulator's truth: good when the test image's
+//     keypoint and the training view's keypoint lie on the same surface point of the object
+//     (learning::judge_matches). The test side's surface coordinates were rendered with the test
+//     image; the training side's are rendered again from the run's LCM log: the camera service
+//     drew each training view as World::render_snapshot(right) after apply_poses(SIM_STATE at the
+//     view's utime), and the same calls on the same scene give that view's render_snapshot_surface,
+//   - times recognition of one test image against the learned objects padded to 100.
+//   nudge-exp-learning --runs DIR --scenes DIR --test-images DIR [--tolerance-mm 5] [--name learning]
+// Writes docs/results/NAME.{json,md}, NAME_views.png (the training views of one object) and
+// NAME_match_*.png (fig. 7.10).
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cstdio>
+#include <iomanip>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include <lcm/lcm-cpp.hpp>
+#include <nlohmann/json.hpp>
+
+#include "learning_scenes.hpp"
+#include "learning_timing.hpp"
+#include "nudge/bus/sim_convert.hpp"
+#include "nudge/flags.hpp"
+#include "nudge/json.hpp"
+#include "nudge/learning/database.hpp"
+#include "nudge/learning/match_truth.hpp"
+#include "nudge/learning/recognizer.hpp"
+#include "nudge/learning/synthetic.hpp"
+#include "nudge/sim/scene.hpp"
+#include "nudge/sim/state_sync.hpp"
+#include "nudge/sim/world.hpp"
+#include "nudge/sim_state_t.hpp"
+#include "report.hpp"
+
+using namespace nudge;
+using namespace nudge::experiments;
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr int kTimingRuns = 3;
+constexpr int kPaddedObjects = 100;
+constexpr uint64_t kStandInSeed = 3000;  // synthetic stand-ins 3000..3099: unused by tests, bench, learning_box
+
+// Thesis Table 7.1 (real bottles; sec. 7.4): 28/28 correct, no false recognition; its match counts.
+constexpr int kThesisCorrect = 28;
+
+struct Options {
+  std::string runs, scenes, test_images, name = "learning";
+  double tolerance_mm = 5;
+};
+
+// One training scene's run, as its summary tells it.
+struct Run {
+  std::string scene, bottle;          // train1_white_bottle, white_bottle
+  fs::path folder;                    // runs/<scene>/<scene>
+  std::string learned_name;           // in the database; "" when not learned
+  std::string why_not;                // what happened instead
+  std::vector<int64_t> view_utimes;   // of the learning attempt's views, in view order
+  std::vector<double> grasp_plan_ms;  // every grasp the run commanded
+  int attempts = 0;
+  double wall_s = 0;
+  fs::path most_views;                // attempt_NN/views of the attempt that took the most views
+  int most_views_count = 0;
+};
+
+// One test image recognised and judged.
+struct Judged {
+  std::string image, target, variant, label, bottle;  // bottle: what the label is (a learned bottle)
+  int verified = 0, good = 0, bad = 0, best_view = -1;
+  std::vector<double> distances_m;
+  learning::Recognition recognition;
+};
+
+std::string read_text(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::string attempt_story(const nlohmann::json& a) {
+  std::string story = "attempt " + std::to_string(a.value("attempt", 0)) + ": " + a.value("reason", std::string());
+  if (a.contains("learning") && !a["learning"].value("recognised", std::string()).empty())
+    story += " (recognised as " + a["learning"]["recognised"].get<std::string>() + ")";
+  return story;
+}
+
+Run read_run(const fs::path& runs, const fs::path& scene_file) {
+  Run run;
+  run.scene = scene_file.stem().string();
+  run.bottle = sim::load_scene(scene_file.string()).objects.at(0).name;
+  run.folder = runs / run.scene / run.scene;
+  const fs::path summary_file = run.folder / "summary.json";
+  if (!fs::exists(summary_file)) {
+    run.why_not = "no run (" + summary_file.string() + " missing)";
+    return run;
+  }
+  const nlohmann::json summary = nlohmann::json::parse(read_text(summary_file));
+  run.attempts = summary.value("attempts", 0);
+  std::string stories;
+  for (const auto& a : summary.at("attempt_list")) {
+    stories += (stories.empty() ? "" : "; ") + attempt_story(a);
+    if (!a.contains("learning")) continue;
+    const auto& l = a["learning"];
+    if (l.value("grasp_plan_ms", -1.0) >= 0) run.grasp_plan_ms.push_back(l["grasp_plan_ms"].get<double>());
+    const int views = static_cast<int>(l.value("views", nlohmann::json::array()).size());
+    if (views > run.most_views_count) {
+      run.most_views_count = views;
+      char folder[32];
+      std::snprintf(folder, sizeof folder, "attempt_%02d", a.value("attempt", 0));
+      run.most_views = run.folder / folder / "views";
+    }
+    if (l.value("outcome", std::string()) != "learned" || !run.learned_name.empty()) continue;
+    run.learned_name = l.value("learned_name", std::string());
+    for (const auto& v : l.at("views")) run.view_utimes.push_back(v.at("utime").get<int64_t>());
+  }
+  if (run.learned_name.empty())
+    run.why_not = (stories.empty() ? "no attempt" : stories) + "; run ended: " + summary.value("end_reason", std::string());
+  const std::string wall = read_text(run.folder / "wall_seconds.txt");
+  run.wall_s = wall.empty() ? 0 : std::stod(wall);
+  return run;
+}
+
+// The right camera's training views of a run as the camera service drew them: the view's colour
+// image and surface truth, re-rendered from the SIM_STATE the view was taken at.
+struct TrainingTruth {
+  std::vector<learning::SurfaceTruth> views;
+  std::vector<double> colour_difference;  // mean |re-render - stored view| per view, grey levels
+};
+
+TrainingTruth render_training_views(const Run& run, const fs::path& scene_file, const learning::ObjectDatabase& db) {
+  std::map<int64_t, sim_state_t> states;
+  for (int64_t t : run.view_utimes) states[t];
+  const std::string log_file = (run.folder / (run.scene + ".lcmlog")).string();
+  lcm::LogFile log(log_file, "r");
+  if (!log.good()) throw std::runtime_error(log_file + ": cannot open the run's log");
+  std::set<int64_t> found;
+  while (const lcm::LogEvent* e = log.readNextEvent()) {
+    if (e->channel != "SIM_STATE") continue;
+    sim_state_t s;
+    if (s.decode(e->data, 0, e->datalen) < 0 || !states.count(s.utime)) continue;
+    states[s.utime] = s;
+    found.insert(s.utime);
+  }
+  sim::World world(sim::load_scene(scene_file.string()));
+  TrainingTruth truth;
+  for (size_t k = 0; k < run.view_utimes.size(); ++k) {
+    const int64_t t = run.view_utimes[k];
+    if (!found.count(t)) throw std::runtime_error(log_file + ": no SIM_STATE at view " + std::to_string(k) + "'s utime " + std::to_string(t));
+    sim::apply_poses(world, bus::poses_of(states[t]));
+    learning::SurfaceTruth view;
+    view.surface = world.render_snapshot_surface(1, &view.mask);
+    view.label = 1;  // the training scene's one object
+    view.object = run.bottle;
+    // Check of the re-render: the stored training view against the same state drawn again.
+    cv::Mat stored = db.load_view_image(run.learned_name, static_cast<int>(k)), drawn = world.render_snapshot(1);
+    if (stored.channels() == 1) cv::cvtColor(stored, stored, cv::COLOR_GRAY2BGR);
+    if (stored.size() != drawn.size())
+      throw std::runtime_error(run.learned_name + " view " + std::to_string(k) + ": stored " + std::to_string(stored.cols) +
+                               " px wide, the re-render " + std::to_string(drawn.cols));
+    cv::Mat diff;
+    cv::absdiff(stored, drawn, diff);
+    const cv::Scalar per_channel = cv::mean(diff);
+    truth.colour_difference.push_back((per_channel[0] + per_channel[1] + per_channel[2]) / 3);
+    truth.views.push_back(std::move(view));
+  }
+  return truth;
+}
+
+Judged recognise_and_judge(const learning::Recognizer& recognizer, const TestImage& t,
+                           const std::map<std::string, std::string>& bottle_of,
+                           std::map<std::string, TrainingTruth>& training, double tolerance_m) {
+  Judged j;
+  j.image = t.name;
+  j.target = t.target;
+  j.variant = variant_name(t.variant);
+  j.recognition = recognizer.recognize(t.colour);
+  const learning::ObjectScore* best = j.recognition.best_score();
+  if (!best) return j;
+  j.label = best->name;
+  j.bottle = bottle_of.at(best->name);
+  j.verified = best->verified_matches;
+  j.best_view = best->best_view;
+  const learning::SurfaceTruth query{t.surface, t.mask, 1, t.target.empty() ? t.name : t.target};
+  const TrainingTruth& views = training.at(best->name);
+  if (best->best_view < 0 || best->best_view >= static_cast<int>(views.views.size()))
+    throw std::runtime_error(best->name + ": best view " + std::to_string(best->best_view) + " has no re-rendered truth");
+  const learning::MatchVerdicts v =
+      learning::judge_matches(best->matches, j.recognition.query.keypoints, query,
+                              recognizer.find(best->name)->views[best->best_view].features.keypoints,
+                              views.views[best->best_view], tolerance_m);
+  j.good = v.good;
+  j.bad = v.bad;
+  j.distances_m = v.distances_m;
+  return j;
+}
+
+cv::Mat thumbnail(cv::Mat view, int k) {
+  if (view.channels() == 1) cv::cvtColor(view, view, cv::COLOR_GRAY2BGR);
+  cv::Mat small;
+  cv::resize(view, small, cv::Size(320, 240), 0, 0, cv::INTER_AREA);
+  cv::putText(small, "view " + std::to_string(k), cv::Point(5, 20), cv::FONT_HERSHEY_SIMPLEX, 0.6, cv::Scalar(0, 0, 0), 2);
+  return small;
+}
+
+// The training views of one object, 6 a row, each with its box (green) and the descriptors kept
+// (red) (thesis fig. 7.6).
+cv::Mat views_sheet(const learning::ObjectDatabase& db, const learning::ObjectModel& m) {
+  std::vector<cv::Mat> thumbs;
+  for (size_t k = 0; k < m.views.size(); ++k) {
+    cv::Mat view = db.load_view_image(m.info.name, static_cast<int>(k));
+    if (view.channels() == 1) cv::cvtColor(view, view, cv::COLOR_GRAY2BGR);
+    cv::rectangle(view, m.views[k].box, cv::Scalar(0, 200, 0), 3);
+    for (const cv::KeyPoint& p : m.views[k].features.keypoints) cv::circle(view, p.pt, 4, cv::Scalar(0, 0, 255), 2);
+    thumbs.push_back(thumbnail(view, static_cast<int>(k)));
+  }
+  return tile(thumbs, 6);
+}
+
+// Nothing learned: the views a run took before its attempt ended, as the supervisor saved them.
+cv::Mat taken_views_sheet(const Run& run) {
+  std::vector<cv::Mat> thumbs;
+  for (int k = 0; k < run.most_views_count; ++k) {
+    char file[32];
+    std::snprintf(file, sizeof file, "view_%02d.png", k);
+    const cv::Mat view = cv::imread((run.most_views / file).string());
+    if (!view.empty()) thumbs.push_back(thumbnail(view, k));
+  }
+  return thumbs.empty() ? cv::Mat() : tile(thumbs, 6);
+}
+
+std::string fixed(double v, int decimals = 1) {
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(decimals) << v;
+  return s.str();
+}
+
+cv::Mat at_most_wide(const cv::Mat& image, int width) {
+  if (image.cols <= width) return image;
+  cv::Mat out;
+  cv::resize(image, out, cv::Size(), static_cast<double>(width) / image.cols, static_cast<double>(width) / image.cols,
+             cv::INTER_AREA);
+  return out;
+}
+
+double max_of(const std::vector<double>& v) { return v.empty() ? 0 : *std::max_element(v.begin(), v.end()); }
+
+struct Totals {
+  int objects_learned = 0, test_images = 0, correct = 0, wrong = 0, unrecognised = 0, good = 0, bad = 0;
+  int unknown_images = 0, false_recognitions = 0, correct_of_learned = 0, test_images_of_learned = 0;
+  std::vector<double> grasp_plan_ms, distances_m;
+};
+
+Totals add_up(const std::vector<Run>& runs, const std::vector<Judged>& judged) {
+  Totals t;
+  std::set<std::string> learned;
+  for (const Run& r : runs) {
+    if (!r.learned_name.empty()) learned.insert(r.bottle);
+    t.grasp_plan_ms.insert(t.grasp_plan_ms.end(), r.grasp_plan_ms.begin(), r.grasp_plan_ms.end());
+  }
+  t.objects_learned = static_cast<int>(learned.size());
+  for (const Judged& j : judged) {
+    t.good += j.good;
+    t.bad += j.bad;
+    t.distances_m.insert(t.distances_m.end(), j.distances_m.begin(), j.distances_m.end());
+    if (j.target.empty()) {
+      ++t.unknown_images;
+      t.false_recognitions += !j.label.empty();
+      continue;
+    }
+    ++t.test_images;
+    const bool ok = !j.label.empty() && j.bottle == j.target;
+    t.correct += ok;
+    t.wrong += !j.label.empty() && !ok;
+    t.unrecognised += j.label.empty();
+    if (learned.count(j.target)) {
+      ++t.test_images_of_learned;
+      t.correct_of_learned += ok;
+    }
+  }
+  return t;
+}
+
+std::string json_report(const Options& o, const std::vector<Run>& runs, const std::vector<Judged>& judged,
+                        const Totals& t, const RecognitionTiming& timing, int padded_descriptors) {
+  JsonWriter j(2);
+  j.begin_object();
+  j.field("machine", machine_description()).field("date", today()).field("load_average_after_timing", load_average());
+  j.field("objects_learned", t.objects_learned).field("objects", static_cast<int>(runs.size()));
+  j.field("test_images", t.test_images).field("correct", t.correct).field("wrong", t.wrong).field("unrecognised", t.unrecognised);
+  j.field("test_images_of_learned_objects", t.test_images_of_learned).field("correct_of_learned_objects", t.correct_of_learned);
+  j.field("good_matches", t.good).field("bad_matches", t.bad).field("match_tolerance_mm", o.tolerance_mm);
+  j.field("median_match_distance_mm", t.distances_m.empty() ? -1.0 : 1e3 * median(t.distances_m));
+  j.field("unknown_images", t.unknown_images).field("false_recognitions", t.false_recognitions);
+  j.key("grasp_plan_ms").begin_object().field("median", t.grasp_plan_ms.empty() ? -1.0 : median(t.grasp_plan_ms))
+      .field("max", t.grasp_plan_ms.empty() ? -1.0 : max_of(t.grasp_plan_ms)).field("grasps", static_cast<int>(t.grasp_plan_ms.size()))
+      .field("thesis", 160).field("target", 50).end_object();
+  j.field("recognition_ms_at_100_objects", timing.median_ms).field("recognition_cpu_ms_at_100_objects", timing.median_cpu_ms);
+  j.field("recognition_at_100_objects_matcher", timing.matcher).field("recognition_at_100_objects_descriptors", padded_descriptors);
+  j.field("recognition_at_100_objects_answer", timing.label);
+  j.key("thesis").begin_object().field("objects_learned", 7).field("test_images", 28).field("correct", kThesisCorrect)
+      .field("false_recognitions", 0).field("grasp_plan_ms", 160).end_object();
+  j.key("objects").begin_array();
+  for (const Run& r : runs) {
+    int correct = 0, good = 0, bad = 0;
+    for (const Judged& x : judged)
+      if (x.target == r.bottle) {
+        correct += !x.label.empty() && x.bottle == x.target;
+        good += x.good;
+        bad += x.bad;
+      }
+    j.begin_object().field("bottle", r.bottle).field("scene", r.scene).field("learned", !r.learned_name.empty())
+        .field("learned_name", r.learned_name).field("why_not", r.why_not).field("attempts", r.attempts)
+        .field("views", static_cast<int>(r.view_utimes.size())).field("run_wall_s", r.wall_s)
+        .field("correct_of_4", correct).field("good_matches", good).field("bad_matches", bad).end_object();
+  }
+  j.end_array();
+  j.key("images").begin_array();
+  for (const Judged& x : judged)
+    j.begin_object().field("image", x.image).field("target", x.target).field("variant", x.variant).field("label", x.label)
+        .field("recognised_as", x.bottle).field("reason", x.recognition.reason).field("verified_matches", x.verified)
+        .field("best_view", x.best_view).field("good_matches", x.good).field("bad_matches", x.bad).end_object();
+  j.end_array();
+  j.end_object();
+  return j.str() + "\n";
+}
+
+std::string markdown_report(const Options& o, const std::vector<Run>& runs, const std::vector<Judged>& judged,
+                            const Totals& t, const RecognitionTiming& timing, int padded_objects,
+                            const std::string& sheet_of, const std::vector<std::string>& match_pictures,
+                            const std::map<std::string, TrainingTruth>& training) {
+  std::ostringstream md;
+  md << "# Object learning by interaction (thesis sec. 7.4, Table 7.1)\n\n"
+     << "`experiments/learning.sh`: each of the seven bottles of `experiments/scenes/learning/` learned in simulation by "
+        "one run of the whole chain (survey, nudge, segment, grasp, rotate, learn, place; `nudge_run_loop` with "
+        "`NUDGE_LOOP_LEARN=1`, `--learn on`), all into one object database, no retries; then `nudge-exp-learning` "
+        "recognises the 28 test images (4 per bottle) and the 10 images of objects never learned "
+        "(`nudge-exp-learning-scenes --set eval`, seeds fixed in advance: `learning_scenes.md`) with the learner's "
+        "`Recognizer` (defaults: ratio 0.6, >= 3 verified matches, RANSAC check, " << timing.matcher << ").\n\n"
+     << machine_description() << ", " << today() << ".\n\n"
+     << "| | here | thesis |\n|---|---|---|\n"
+     << "| objects learned | " << t.objects_learned << " of " << runs.size() << " | 7 of 7 |\n"
+     << "| test images recognised correctly | " << t.correct << " of " << t.test_images << " (" << t.wrong << " wrong, "
+     << t.unrecognised << " unrecognised) | 28 of 28 |\n"
+     << "| ... of the learned bottles' images | " << t.correct_of_learned << " of " << t.test_images_of_learned << " | |\n"
+     << "| good / bad matches (verified, tolerance " << o.tolerance_mm << " mm) | " << t.good << " / " << t.bad << " | |\n"
+     << "| false recognitions on " << t.unknown_images << " never-learned objects | " << t.false_recognitions << " | 0 |\n"
+     << "| grasp plan time, median / max of " << t.grasp_plan_ms.size() << " grasps | "
+     << (t.grasp_plan_ms.empty() ? std::string("none") : fixed(median(t.grasp_plan_ms)) + " / " + fixed(max_of(t.grasp_plan_ms)) + " ms")
+     << " | 160 ms |\n"
+     << "| recognition at " << padded_objects << " objects (one test image, SIFT included) | " << fixed(timing.median_ms, 0)
+     << " ms wall, " << fixed(timing.median_cpu_ms, 0) << " ms CPU | |\n\n"
+     << "## Table 7.1 in simulation\n\n"
+     << "| bottle | learned? | correct of 4 | good matches | bad matches |\n|---|---|---|---|---|\n";
+  for (const Run& r : runs) {
+    int correct = 0, good = 0, bad = 0;
+    for (const Judged& x : judged)
+      if (x.target == r.bottle) {
+        correct += !x.label.empty() && x.bottle == x.target;
+        good += x.good;
+        bad += x.bad;
+      }
+    md << "| " << r.bottle << " | " << (r.learned_name.empty() ? "no: " + r.why_not : "yes (" + std::to_string(r.view_utimes.size()) + " views)")
+       << " | " << correct << " | " << good << " | " << bad << " |\n";
+  }
+  md << "\n## Every image\n\n| image | recognised as | verified matches | good | bad |\n|---|---|---|---|---|\n";
+  for (const Judged& x : judged)
+    md << "| " << x.image << " | " << (x.label.empty() ? "nothing (" + x.recognition.reason + ")" : x.bottle) << " | "
+       << x.verified << " | " << x.good << " | " << x.bad << " |\n";
+  md << "\n**Good and bad matches.** A verified match (the recognised object's best training view, after the RANSAC "
+        "check) is good when the test image's keypoint and the training view's keypoint show the same surface point "
+        "of the same object: both within one pixel of that object's pixels, their object-frame coordinates within "
+        << o.tolerance_mm << " mm (about three pixel footprints of a 640x480 test image at the bottles' distance). "
+        "The test side's coordinates were rendered with the test image (`World::render_surface`). The training side's "
+        "are rendered again from the run's LCM log: the camera service drew each view as `render_snapshot(right)` "
+        "after `apply_poses` of the `SIM_STATE` with the view's utime, and the same calls on the same scene give "
+        "`render_snapshot_surface` of exactly that view.";
+  std::vector<double> diffs;
+  for (const auto& [name, tt] : training) diffs.insert(diffs.end(), tt.colour_difference.begin(), tt.colour_difference.end());
+  if (!diffs.empty())
+    md << " Check: the re-rendered colour views differ from the stored training views by " << fixed(median(diffs), 2)
+       << " grey levels on average (median over " << diffs.size() << " views; max " << fixed(max_of(diffs), 2) << ").";
+  md << "\n\n**Grasp plan time**: wall time from the after-nudge stills to the grasp command in the supervisor (both "
+        "cameras' motion segmentations, the object's top, the grasp and the arm's plan), as each run's "
+        "`attempt.json` records it (`learning.grasp_plan_ms`), on a machine shared with other jobs.\n\n"
+     << "**Recognition at " << padded_objects << " objects**: the learned objects padded with synthetic textured "
+        "objects of 12 views (`synthetic::object_models`, seeds " << kStandInSeed << "+), the first cluttered test "
+        "image recognised " << timing.runs << " times (median; SIFT of the image included; load average " << load_average()
+     << " afterwards). Answer: " << (timing.label.empty() ? "nothing" : timing.label) << ".\n\n";
+  if (!sheet_of.empty())
+    md << "## The training views of " << sheet_of << "\n\n![training views](" << o.name << "_views.png)\n\n";
+  if (!match_pictures.empty()) {
+    md << "## Match pictures (fig. 7.10)\n\nThe test image above, the best training view below, verified matches in red.\n\n";
+    for (const std::string& p : match_pictures) md << "![" << p << "](" << p << ")\n\n";
+  }
+  return md.str();
+}
+
+// Up to three correct recognitions, the hardest variants first, drawn by the library (fig. 7.10).
+std::vector<std::string> write_match_pictures(const Options& o, const std::vector<Judged>& judged,
+                                              const std::vector<TestImage>& images, const learning::ObjectDatabase& db,
+                                              const learning::Recognizer& recognizer) {
+  std::vector<std::string> written;
+  for (const char* variant : {"occluded", "cluttered", "orientation"}) {
+    for (size_t i = 0; i < judged.size(); ++i) {
+      const Judged& x = judged[i];
+      if (x.variant != variant || x.label.empty() || x.bottle != x.target) continue;
+      const cv::Mat training = db.load_view_image(x.label, x.best_view);
+      const cv::Mat picture = learning::draw_match_picture(images[i].colour, training,
+                                                           recognizer.find(x.label)->views[x.best_view].features, x.recognition);
+      const std::string file = o.name + "_match_" + variant + ".png";
+      write_png(file, at_most_wide(picture, 800));
+      written.push_back(file);
+      break;
+    }
+  }
+  return written;
+}
+
+int run(const Options& o) {
+  std::vector<fs::path> scene_files;
+  for (const auto& e : fs::directory_iterator(o.scenes))
+    if (e.path().extension() == ".yaml" && e.path().filename().string().rfind("train", 0) == 0) scene_files.push_back(e.path());
+  std::sort(scene_files.begin(), scene_files.end());
+  if (scene_files.empty()) throw std::runtime_error(o.scenes + ": no train*.yaml scenes");
+  std::vector<Run> runs;
+  for (const fs::path& f : scene_files) runs.push_back(read_run(o.runs, f));
+
+  const learning::ObjectDatabase db(o.runs + "/objects");
+  const learning::LoadReport loaded = db.load_all();
+  for (const std::string& e : loaded.errors) std::cerr << "nudge-exp-learning: database: " << e << "\n";
+  learning::Recognizer recognizer;
+  std::map<std::string, std::string> bottle_of;  // learned name -> bottle
+  std::map<std::string, TrainingTruth> training;
+  for (const auto& m : loaded.models) {
+    const auto run = std::find_if(runs.begin(), runs.end(), [&](const Run& r) { return r.learned_name == m->info.name; });
+    if (run == runs.end()) throw std::runtime_error(db.root() + "/" + m->info.name + ": learned by no run's learning attempt");
+    if (run->view_utimes.size() != m->views.size())
+      throw std::runtime_error(db.root() + "/" + m->info.name + ": " + std::to_string(m->views.size()) + " views, the run sent " +
+                               std::to_string(run->view_utimes.size()));
+    recognizer.add(m);
+    bottle_of[m->info.name] = run->bottle;
+    training[m->info.name] = render_training_views(*run, scene_files[run - runs.begin()], db);
+    std::cerr << "learned " << run->bottle << " as " << m->info.name << " (" << m->descriptor_count() << " descriptors)\n";
+  }
+
+  const std::vector<TestImage> images = read_test_images(o.test_images, "eval");
+  std::vector<Judged> judged;
+  for (const TestImage& t : images) {
+    judged.push_back(recognise_and_judge(recognizer, t, bottle_of, training, o.tolerance_mm / 1e3));
+    const Judged& x = judged.back();
+    std::cerr << x.image << ": " << (x.label.empty() ? "nothing (" + x.recognition.reason + ")" : x.bottle) << ", " << x.good
+              << " good / " << x.bad << " bad\n";
+  }
+  const Totals totals = add_up(runs, judged);
+
+  std::vector<std::shared_ptr<const learning::ObjectModel>> padded = loaded.models;
+  for (auto& stand_in : learning::synthetic::object_models("stand_in_", kPaddedObjects - static_cast<int>(padded.size()), kStandInSeed))
+    padded.push_back(stand_in);
+  int descriptors = 0;
+  for (const auto& m : padded) descriptors += m->descriptor_count();
+  const auto cluttered = std::find_if(images.begin(), images.end(), [](const TestImage& t) { return t.variant == TestVariant::Cluttered; });
+  const RecognitionTiming timing = time_recognition(padded, (cluttered == images.end() ? images.front() : *cluttered).colour,
+                                                    learning::RecognizeParams{}.matcher, kTimingRuns);
+
+  std::string sheet_of;
+  if (!loaded.models.empty()) {
+    const auto most = std::max_element(loaded.models.begin(), loaded.models.end(),
+                                       [](const auto& a, const auto& b) { return a->views.size() < b->views.size(); });
+    write_png(o.name + "_views.png", views_sheet(db, **most));
+    sheet_of = bottle_of.at((*most)->info.name) + " (" + (*most)->info.name + ")\n\nAs learned: the box (green) and the "
+               "descriptors kept after pruning (red).";
+  } else {
+    const auto most = std::max_element(runs.begin(), runs.end(), [](const Run& a, const Run& b) { return a.most_views_count < b.most_views_count; });
+    const cv::Mat sheet = taken_views_sheet(*most);
+    if (!sheet.empty()) {
+      write_png(o.name + "_views.png", sheet);
+      sheet_of = most->bottle + " (not learned)\n\nNo object was learned: the " + std::to_string(most->most_views_count) +
+                 " views its run took before the attempt ended (" + most->why_not + "), as the supervisor saved them.";
+    }
+  }
+  const std::vector<std::string> pictures = write_match_pictures(o, judged, images, db, recognizer);
+  write_result(o.name + ".json", json_report(o, runs, judged, totals, timing, descriptors));
+  write_result(o.name + ".md", markdown_report(o, runs, judged, totals, timing, static_cast<int>(padded.size()), sheet_of,
+                                               pictures, training));
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  Flags flags("nudge-exp-learning", "Score the object-learning experiment's runs (thesis Table 7.1).");
+  flags.add_string("runs", &o.runs, "experiments/learning.sh's runs folder (one folder per scene, objects/ the database)");
+  flags.add_string("scenes", &o.scenes, "the training scenes' folder (train*.yaml)");
+  flags.add_string("test-images", &o.test_images, "nudge-exp-learning-scenes --set eval's output folder");
+  flags.add_double("tolerance-mm", &o.tolerance_mm, "a good match's two surface points lie within this distance, mm");
+  flags.add_string("name", &o.name, "result name (docs/results/NAME.*)");
+  try {
+    if (!flags.parse(argc, argv)) return 0;
+    if (o.runs.empty() || o.scenes.empty() || o.test_images.empty()) throw FlagError("--runs, --scenes and --test-images are required");
+    if (!(o.tolerance_mm > 0)) throw FlagError("--tolerance-mm must be positive");
+    return run(o);
+  } catch (const FlagError& e) {
+    std::cerr << "nudge-exp-learning: " << e.what() << "\n" << flags.help();
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "nudge-exp-learning: " << e.what() << "\n";
+    return 1;
+  }
+}
