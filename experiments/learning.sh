@@ -5,7 +5,8 @@
 # (out/experiments/learning/objects: the later runs first ask whether their bottle is already known).
 # Then nudge-exp-learning scores the database on the 28 test and 10 never-learned images into
 # docs/results/learning.{json,md} (docs/learning.md, "The experiment"). Runs land in
-# out/experiments/learning/<scene>/. A few minutes per scene.
+# out/experiments/learning/<scene>/, the test images in out/experiments/learning_test_images/
+# (rendered when missing). A few minutes per scene.
 #   experiments/learning.sh                 the seven runs (a fresh database), then the scoring
 #   experiments/learning.sh --runs-only     the seven runs only
 #   experiments/learning.sh --score-only    the scoring of the runs already in out/ only
@@ -22,7 +23,7 @@ scenes_dir="$NUDGE_ROOT/experiments/scenes/learning"
 runs_dir="$NUDGE_ROOT/out/experiments/learning"
 calibration="$NUDGE_ROOT/config/calibration_sim.yaml"
 targets=(nudge-launch nudge-world nudge-camera nudge-symmetry nudge-triangulation nudge-arm nudge-learner nudge-supervisor)
-[ $score = 1 ] && targets+=(nudge-exp-learning)
+[ $score = 1 ] && targets+=(nudge-exp-learning nudge-exp-learning-scenes)
 nudge_install_packages
 [ -f "$NUDGE_BUILD_DIR/CMakeCache.txt" ] || cmake -S "$NUDGE_ROOT" -B "$NUDGE_BUILD_DIR" -DCMAKE_BUILD_TYPE=Release >/dev/null
 nudge_log "building ${targets[*]}"
@@ -57,5 +58,11 @@ if [ $runs = 1 ]; then
   done
 fi
 if [ $score = 1 ]; then
-  "$NUDGE_BUILD_DIR/bin/nudge-exp-learning" --runs "$runs_dir" --scenes "$scenes_dir" --out "$NUDGE_ROOT/docs/results"
+  # The test images, rendered once from the evaluation seeds (docs/results/learning_scenes.md).
+  test_images="$NUDGE_ROOT/out/experiments/learning_test_images"
+  if [ ! -f "$test_images/manifest.json" ]; then
+    nudge_log "rendering the 38 test images into $test_images"
+    "$NUDGE_BUILD_DIR/bin/nudge-exp-learning-scenes" --out "$test_images" --set eval
+  fi
+  "$NUDGE_BUILD_DIR/bin/nudge-exp-learning" --runs "$runs_dir" --scenes "$scenes_dir" --test-images "$test_images"
 fi
