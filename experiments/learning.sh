@@ -53,7 +53,8 @@ if [ $runs = 1 ]; then
       "$calibration" "$NUDGE_ROOT/config/workspace.yaml" "$runs_dir/$name" "$name" --learn on --first-seq 1000 --service-timeout "${NUDGE_LOOP_SERVICE_TIMEOUT:-10}" \
       2>"$runs_dir/$name/supervisor.log" || status=$?
     [ -d "$runs_dir/$name/$name" ] && echo $(($(date +%s) - start)) > "$runs_dir/$name/$name/wall_seconds.txt"
-    learned=$(grep -ho '"learned_name":"[^"]*"' "$runs_dir/$name/$name/summary.json" 2>/dev/null | grep -v '""' | head -1 || true)
+    learned=$(grep -ho '"learned_name":"[^"]*"' "$runs_dir/$name/$name/summary.json" 2>/dev/null | grep -v '""' | head -1 |
+              sed 's/^.*:"\(.*\)"$/learned as \1/' || true)
     nudge_log "[$i/${#names[@]}] $name: $(grep -h "ended:" "$runs_dir/$name/supervisor.log" | sed 's/^.*ended: //') ${learned:-nothing learned} ($(($(date +%s) - start)) s, exit $status)"
   done
 fi
