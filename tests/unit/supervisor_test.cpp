@@ -678,6 +678,7 @@ TEST_F(LearningTest, GraspsTurnsTwelveTimesLearnsAndPutsTheObjectBack) {
   EXPECT_EQ(a->learned_name, "object_1");
   EXPECT_EQ(a->views.size(), 12u);
   ASSERT_TRUE(a->top[0] && a->top[1] && a->grasp);
+  EXPECT_GE(a->grasp_plan_ms, 0.0) << "the grasp's plan time is recorded for the report";
   EXPECT_EQ(outputs_of<sv::HomeCommand>(out).size(), 1u) << "the arm parks after putting it back";
   EXPECT_EQ(s.summary().learned, 1);
 }
