@@ -315,7 +315,7 @@ Totals add_up(const std::vector<Run>& runs, const std::vector<Judged>& judged) {
 
 std::string json_report(const Options& o, const std::vector<Run>& runs, const std::vector<Judged>& judged,
                         const Totals& t, const RecognitionTiming& timing, int padded_descriptors) {
-  JsonWriter j(2);
+  JsonWriter j;  // 6 significant digits
   j.begin_object();
   j.field("machine", machine_description()).field("date", today()).field("load_average_after_timing", load_average());
   j.field("objects_learned", t.objects_learned).field("objects", static_cast<int>(runs.size()));
