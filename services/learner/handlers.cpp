@@ -43,6 +43,7 @@ Handlers::Handlers(bus::Service& service, const Options& options)
   learning::LoadReport loaded = db_.load_all();
   for (const std::string& error : loaded.errors) report("skipped: " + error);
   for (auto& model : loaded.models) recognizer_.add(model);
+  recognizer_.build_index();  // once for the whole database, not on the first request
   log::info() << "object database " << db_.root() << ": " << recognizer_.size() << " objects";
   auto& subs = service_.subscriptions();
   subs.subscribe<learn_view_t>(bus::channel::LEARN_VIEW, [this](const learn_view_t& m, const std::string&) { on_view(m); });
@@ -148,6 +149,7 @@ void Handlers::on_commit(const learn_commit_t& msg) {
     learning::ObjectModel model = learning::learn_object(info, images, options_.learn, &stats);
     db_.store(model);
     recognizer_.add(without_images(std::move(model)));
+    recognizer_.build_index();  // the new object is found from the next request on
   } catch (const std::exception& e) {  // a bad view or the database refusing: reported, nothing half-stored
     return fail(e.what());
   }

@@ -6,9 +6,11 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <mutex>
 #include <set>
 #include <stdexcept>
 
+#include "database_index.hpp"
 #include "nudge/timing.hpp"
 
 namespace nudge::learning {
@@ -16,17 +18,34 @@ namespace nudge::learning {
 MatcherKind matcher_from_name(const std::string& name) {
   if (name == "bf") return MatcherKind::BruteForce;
   if (name == "flann") return MatcherKind::Flann;
-  throw std::invalid_argument("unknown matcher '" + name + "' (bf or flann)");
+  if (name == "shared-flann") return MatcherKind::SharedFlann;
+  throw std::invalid_argument("unknown matcher '" + name + "' (bf, flann or shared-flann)");
 }
 
-std::string matcher_name(MatcherKind kind) { return kind == MatcherKind::BruteForce ? "bf" : "flann"; }
+std::string matcher_name(MatcherKind kind) {
+  switch (kind) {
+    case MatcherKind::BruteForce: return "bf";
+    case MatcherKind::Flann: return "flann";
+    case MatcherKind::SharedFlann: return "shared-flann";
+  }
+  return "unknown";
+}
 
-// One object's descriptor set: every view's descriptors in one matcher index, each row knowing
-// its view and its index within that view.
+// One object's descriptor set: every view's descriptors stacked (in one matcher index of its own
+// unless the database's index holds them), each row knowing its view and its index within that view.
 struct Recognizer::Entry {
   std::shared_ptr<const ObjectModel> model;
   std::vector<int> row_view, row_index;
-  cv::Ptr<cv::DescriptorMatcher> matcher;  // null for a set of < 2 descriptors
+  cv::Ptr<cv::DescriptorMatcher> matcher;  // null for a set of < 2 descriptors, and for SharedFlann
+};
+
+// SharedFlann: the index over every entry's descriptors, rebuilt after the entries change. Built
+// lazily so that loading a database of n objects builds it once, not n times; the mutex lets
+// concurrent const recognitions share that build.
+struct Recognizer::SharedIndex {
+  std::mutex mutex;
+  bool stale = true;
+  detail::DatabaseIndex index;
 };
 
 namespace {
@@ -39,7 +58,7 @@ cv::Ptr<cv::DescriptorMatcher> make_matcher(MatcherKind kind) {
 }
 
 // Neighbours looked at per query descriptor (see view_ratio_matches).
-constexpr int kNeighbours = 4;
+constexpr int kNeighbours = detail::kObjectNeighbours;
 
 // Lowe's ratio test within one training view. Neighbouring views show the same surface point, so
 // over the object's whole set (as the thesis matched) the second neighbour is often the same point
@@ -129,7 +148,9 @@ std::vector<cv::DMatch> geometric_inliers(const std::vector<cv::DMatch>& matches
 
 }  // namespace
 
-Recognizer::Recognizer(const RecognizeParams& params) : params_(params) {}
+Recognizer::Recognizer(const RecognizeParams& params)
+    : params_(params),
+      shared_(params.matcher == MatcherKind::SharedFlann ? std::make_unique<SharedIndex>() : nullptr) {}
 Recognizer::~Recognizer() = default;
 Recognizer::Recognizer(Recognizer&&) noexcept = default;
 Recognizer& Recognizer::operator=(Recognizer&&) noexcept = default;
@@ -145,12 +166,13 @@ void Recognizer::add(std::shared_ptr<const ObjectModel> model) {
     }
     if (!f.descriptors.empty()) all.push_back(f.descriptors);
   }
-  if (all.rows >= 2) {
+  if (all.rows >= 2 && !shared_) {
     entry->matcher = make_matcher(params_.matcher);
     entry->matcher->add(all);
     entry->matcher->train();  // builds FLANN's trees now, not on the first query
   }
   entry->model = std::move(model);
+  if (shared_) shared_->stale = true;
   for (auto& e : entries_) {
     if (e->model->info.name == entry->model->info.name) {
       e = std::move(entry);
@@ -164,10 +186,42 @@ bool Recognizer::remove(const std::string& name) {
   for (auto it = entries_.begin(); it != entries_.end(); ++it) {
     if ((*it)->model->info.name == name) {
       entries_.erase(it);
+      if (shared_) shared_->stale = true;
       return true;
     }
   }
   return false;
+}
+
+void Recognizer::build_index() const {
+  if (!shared_) return;
+  std::lock_guard<std::mutex> lock(shared_->mutex);
+  if (!shared_->stale) return;
+  std::vector<detail::IndexedObject> objects(entries_.size());
+  for (size_t i = 0; i < entries_.size(); ++i) {
+    for (const auto& view : entries_[i]->model->views) objects[i].view_descriptors.push_back(view.features.descriptors);
+    objects[i].row_view = &entries_[i]->row_view;
+  }
+  shared_->index.build(objects);
+  shared_->stale = false;
+}
+
+// Per entry, the query descriptors passing its ratio test, trainIdx the row in the entry's stack.
+std::vector<std::vector<cv::DMatch>> Recognizer::ratio_matches_per_object(const Features& query) const {
+  if (shared_) {
+    build_index();
+    detail::IndexSearch search;
+    search.neighbours = params_.shared_neighbours;
+    search.checks = params_.shared_checks;
+    search.ratio = params_.ratio;
+    return shared_->index.ratio_matches(query.descriptors, search);
+  }
+  std::vector<std::vector<cv::DMatch>> out;
+  for (const auto& entry : entries_) {
+    out.push_back(entry->matcher ? view_ratio_matches(*entry->matcher, entry->row_view, query.descriptors, params_.ratio)
+                                 : std::vector<cv::DMatch>{});
+  }
+  return out;
 }
 
 int Recognizer::size() const { return static_cast<int>(entries_.size()); }
@@ -195,16 +249,14 @@ Recognition Recognizer::recognize(const Features& query) const {
   Stopwatch watch;
   Recognition result;
   result.query = query;
-  for (const auto& entry : entries_) {
+  const std::vector<std::vector<cv::DMatch>> object_matches = ratio_matches_per_object(query);
+  for (size_t e = 0; e < entries_.size(); ++e) {
+    const auto& entry = entries_[e];
     ObjectScore score;
     score.name = entry->model->info.name;
-    if (!entry->matcher) {
-      result.scores.push_back(std::move(score));
-      continue;
-    }
     // Ratio-test matches, grouped by training view, trainIdx into that view's own features.
     std::map<int, std::vector<cv::DMatch>> by_view;
-    for (cv::DMatch m : view_ratio_matches(*entry->matcher, entry->row_view, query.descriptors, params_.ratio)) {
+    for (cv::DMatch m : object_matches[e]) {
       const int view = entry->row_view[m.trainIdx];
       m.trainIdx = entry->row_index[m.trainIdx];
       m.imgIdx = view;

@@ -12,10 +12,13 @@
 
 namespace nudge::learning {
 
-// How descriptors are matched: exhaustively, or approximately by FLANN's randomised k-d trees.
-// bench/learning_bench.cpp measures both against database size (docs/benchmarks.md).
-enum class MatcherKind { BruteForce, Flann };
-MatcherKind matcher_from_name(const std::string& name);  // "bf" | "flann"; throws std::invalid_argument
+// How descriptors are matched: per object exhaustively (BruteForce) or by FLANN's randomised k-d
+// trees (Flann), one index per object searched in turn; or (SharedFlann) one FLANN index over the
+// whole database, searched once per query, each object's ratio test on its own neighbours among the
+// results. bench/learning_bench.cpp measures them against database size (docs/benchmarks.md).
+enum class MatcherKind { BruteForce, Flann, SharedFlann };
+// "bf" | "flann" | "shared-flann"; throws std::invalid_argument naming the unknown name.
+MatcherKind matcher_from_name(const std::string& name);
 std::string matcher_name(MatcherKind kind);
 
 struct RecognizeParams {
@@ -24,7 +27,11 @@ struct RecognizeParams {
   bool geometric_check = true;  // RANSAC similarity or homography per training view
   int min_support = 2;          // matches agreeing with a mapping beyond those that fixed it
   double ransac_px = 6.0;       // reprojection error an inlier may have, pixels
-  MatcherKind matcher = MatcherKind::Flann;
+  MatcherKind matcher = MatcherKind::SharedFlann;  // fastest at every database size measured
+  // SharedFlann only: neighbours fetched per query descriptor over the whole database (enough that
+  // an object's two nearest are usually among them) and k-d tree leaves checked to find them.
+  int shared_neighbours = 16;
+  int shared_checks = 64;
 };
 
 // How one object scored against the query.
@@ -54,9 +61,14 @@ class Recognizer {
   Recognizer(Recognizer&&) noexcept;
   Recognizer& operator=(Recognizer&&) noexcept;
 
-  // Adds a model, or replaces the one of the same name; builds its matcher index now.
+  // Adds a model, or replaces the one of the same name. Per-object matchers build the object's
+  // index now; SharedFlann marks the database's index stale (build_index or the next recognize
+  // rebuilds it), so that loading many objects builds it once.
   void add(std::shared_ptr<const ObjectModel> model);
   bool remove(const std::string& name);
+  // Builds the shared index now if it is stale, so that the next recognition does not pay for it;
+  // nothing to do for per-object matchers.
+  void build_index() const;
   int size() const;
   const ObjectModel& model(int index) const;
   const ObjectModel* find(const std::string& name) const;
@@ -70,8 +82,11 @@ class Recognizer {
 
  private:
   struct Entry;
+  struct SharedIndex;
+  std::vector<std::vector<cv::DMatch>> ratio_matches_per_object(const Features& query) const;
   RecognizeParams params_;
   std::vector<std::unique_ptr<Entry>> entries_;
+  std::unique_ptr<SharedIndex> shared_;  // SharedFlann only
 };
 
 // Thesis fig. 7.10: the query image above the best training view, the verified matches as red

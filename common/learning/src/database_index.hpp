@@ -1,0 +1,47 @@
+#pragma once
+// One FLANN index over every object's descriptors (private to nudge_learning): a query is searched
+// once for the whole database instead of once per object, and each object's ratio test is done on
+// its own neighbours among the results (issue 11; docs/learning.md, "Recognition").
+#include <opencv2/core.hpp>
+#include <opencv2/flann.hpp>
+
+#include <memory>
+#include <vector>
+
+namespace nudge::learning::detail {
+
+// Neighbours an object's ratio test looks at (see view_ratio_test): the same for per-object and
+// shared indexes, so both decide alike.
+constexpr int kObjectNeighbours = 4;
+
+// One object as the index sees it: its views' descriptors stacked, and the view of each row.
+struct IndexedObject {
+  std::vector<cv::Mat> view_descriptors;  // CV_32F, 128 wide; empty views allowed
+  const std::vector<int>* row_view = nullptr;
+};
+
+struct IndexSearch {
+  int neighbours = 16;  // fetched per query descriptor over the whole database
+  int checks = 64;      // k-d tree leaves visited
+  double ratio = 0.6;
+};
+
+class DatabaseIndex {
+ public:
+  // Rebuilds from scratch (cheap next to learning an object: docs/benchmarks.md). An object with
+  // fewer than two descriptors has no second neighbour to compare with: it is left out.
+  void build(const std::vector<IndexedObject>& objects);
+  int rows() const { return descriptors_.rows; }
+
+  // Per object (in build order), the query rows passing its ratio test: queryIdx into the query,
+  // trainIdx the row in that object's stack, distance the L2 distance.
+  std::vector<std::vector<cv::DMatch>> ratio_matches(const cv::Mat& query, const IndexSearch& search) const;
+
+ private:
+  cv::Mat descriptors_;                   // the index points into it: kept alive with it
+  std::vector<int> row_object_, row_local_, row_view_;
+  std::vector<int> object_rows_;          // rows per object (0 for one left out)
+  std::unique_ptr<cv::flann::Index> index_;
+};
+
+}  // namespace nudge::learning::detail
