@@ -75,6 +75,7 @@ struct Row {
   std::vector<double> cpu_ms;
   int queries = 0, correct = 0;
   int verified_on_first = 0;  // verified matches of the right object on the timed query
+  std::vector<std::string> answers;  // per query: "truth -> answer (verified matches)"
 };
 
 bool answered_right(const learning::Recognition& r, const Query& q) {
@@ -101,6 +102,9 @@ Row measure(learning::MatcherKind kind, const std::vector<std::shared_ptr<const 
     const learning::Recognition r = recognizer.recognize(q->features);
     ++row.queries;
     row.correct += answered_right(r, *q);
+    row.answers.push_back((q->truth.empty() ? std::string("unknown") : q->truth) + " -> " +
+                          (r.recognised() ? r.best_score()->name + " (" + std::to_string(r.best_score()->verified_matches) + ")"
+                                          : std::string("nothing")));
   }
   // The timed query: the first object's scene (in every database).
   for (int i = 0; i < runs; ++i) {
@@ -194,6 +198,9 @@ int main(int argc, char** argv) {
       j.end_array();
       j.field("index_build_cpu_ms", r.index_build_cpu_ms);
       j.field("queries", r.queries).field("correct", r.correct).field("verified_matches_first_query", r.verified_on_first);
+      j.key("answers").begin_array();
+      for (const std::string& a : r.answers) j.value(a);
+      j.end_array();
       j.end_object();
     }
     j.end_array();
@@ -210,12 +217,15 @@ int main(int argc, char** argv) {
           "scenes of the database's first, middle and last object recognised as that object, and a scene of "
           "an object not in the database recognised as nothing. *Index build*: adding the database and "
           "building the matcher indexes.\n\n"
-       << "| matcher | objects | descriptors | recognition CPU ms | right | verified matches (object 0) | index build CPU ms |\n"
-       << "|---|---|---|---|---|---|---|\n";
-    for (const Row& r : rows)
+       << "| matcher | objects | descriptors | recognition CPU ms | right | verified matches (object 0) | index build CPU ms | answers: truth -> recognised (verified matches) |\n"
+       << "|---|---|---|---|---|---|---|---|\n";
+    for (const Row& r : rows) {
       md << "| " << learning::matcher_name(r.matcher) << " | " << r.objects << " | " << r.descriptors << " | "
          << fixed(r.median_cpu_ms) << " | " << r.correct << "/" << r.queries << " | " << r.verified_on_first << " | "
-         << fixed(r.index_build_cpu_ms, 0) << " |\n";
+         << fixed(r.index_build_cpu_ms, 0) << " | ";
+      for (size_t a = 0; a < r.answers.size(); ++a) md << (a ? "; " : "") << r.answers[a];
+      md << " |\n";
+    }
     md << "\nThe default matcher is `" << learning::matcher_name(defaults.matcher) << "` ("
        << defaults.shared_neighbours << " neighbours per query descriptor over the database, "
        << defaults.shared_checks << " k-d tree checks): `recognition_ms_at_100_objects` = "

@@ -150,7 +150,14 @@ std::vector<cv::DMatch> geometric_inliers(const std::vector<cv::DMatch>& matches
 
 Recognizer::Recognizer(const RecognizeParams& params)
     : params_(params),
-      shared_(params.matcher == MatcherKind::SharedFlann ? std::make_unique<SharedIndex>() : nullptr) {}
+      shared_(params.matcher == MatcherKind::SharedFlann ? std::make_unique<SharedIndex>() : nullptr) {
+  // Fewer than two neighbours leave no second one for the ratio test: nothing would ever match.
+  if (shared_ && params.shared_neighbours < 2)
+    throw std::invalid_argument("RecognizeParams::shared_neighbours must be >= 2, not " +
+                                std::to_string(params.shared_neighbours));
+  if (shared_ && params.shared_checks < 1)
+    throw std::invalid_argument("RecognizeParams::shared_checks must be >= 1, not " + std::to_string(params.shared_checks));
+}
 Recognizer::~Recognizer() = default;
 Recognizer::Recognizer(Recognizer&&) noexcept = default;
 Recognizer& Recognizer::operator=(Recognizer&&) noexcept = default;
@@ -160,11 +167,18 @@ void Recognizer::add(std::shared_ptr<const ObjectModel> model) {
   cv::Mat all(0, 128, CV_32F);
   for (size_t v = 0; v < model->views.size(); ++v) {
     const Features& f = model->views[v].features;
+    if (!f.descriptors.empty() && (f.descriptors.type() != CV_32F || f.descriptors.cols != 128))
+      throw std::invalid_argument("object '" + model->info.name + "' view " + std::to_string(v) +
+                                  ": descriptors are not SIFT's (CV_32F, 128 wide)");
+    if (f.descriptors.rows != f.size())
+      throw std::invalid_argument("object '" + model->info.name + "' view " + std::to_string(v) + ": " +
+                                  std::to_string(f.size()) + " keypoints but " + std::to_string(f.descriptors.rows) +
+                                  " descriptors");
     for (int k = 0; k < f.size(); ++k) {
       entry->row_view.push_back(static_cast<int>(v));
       entry->row_index.push_back(k);
     }
-    if (!f.descriptors.empty()) all.push_back(f.descriptors);
+    if (!f.descriptors.empty() && !shared_) all.push_back(f.descriptors);
   }
   if (all.rows >= 2 && !shared_) {
     entry->matcher = make_matcher(params_.matcher);

@@ -238,6 +238,37 @@ TEST(LearningRecognizer, SharedIndexKeepsAMatchAnotherObjectAlsoHas) {
   }
 }
 
+TEST(LearningRecognizer, BadSettingsAndBadModelsAreRefusedByName) {
+  RecognizeParams params;
+  params.shared_neighbours = 1;
+  try {
+    Recognizer r(params);
+    ADD_FAILURE() << "one neighbour accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("shared_neighbours"), std::string::npos) << e.what();
+  }
+  params.shared_neighbours = 16;
+  params.shared_checks = 0;
+  EXPECT_THROW(Recognizer{params}, std::invalid_argument);
+  auto bad = std::make_shared<ObjectModel>();
+  bad->info.name = "odd";
+  bad->views.resize(2);
+  bad->views[1].features.keypoints.resize(3);
+  bad->views[1].features.descriptors = cv::Mat(3, 64, CV_32F, cv::Scalar(0));
+  for (MatcherKind kind : {MatcherKind::BruteForce, MatcherKind::SharedFlann}) {
+    RecognizeParams p;
+    p.matcher = kind;
+    Recognizer recognizer(p);
+    try {
+      recognizer.add(bad);
+      ADD_FAILURE() << "a 64-wide descriptor accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("object 'odd' view 1"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(recognizer.size(), 0);
+  }
+}
+
 // Loading builds the index once; learning (add) and forgetting (remove) change what it finds.
 TEST(LearningRecognizer, SharedIndexFollowsAddAndRemove) {
   RecognizeParams params;

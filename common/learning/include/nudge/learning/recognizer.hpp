@@ -56,12 +56,14 @@ struct Recognition {
 
 class Recognizer {
  public:
+  // Throws std::invalid_argument naming the parameter when a SharedFlann setting is out of range.
   explicit Recognizer(const RecognizeParams& params = {});
   ~Recognizer();
   Recognizer(Recognizer&&) noexcept;
   Recognizer& operator=(Recognizer&&) noexcept;
 
-  // Adds a model, or replaces the one of the same name. Per-object matchers build the object's
+  // Adds a model, or replaces the one of the same name; throws std::invalid_argument naming the
+  // object and view when a view's descriptors are not SIFT's or do not match its keypoints. Per-object matchers build the object's
   // index now; SharedFlann marks the database's index stale (build_index or the next recognize
   // rebuilds it), so that loading many objects builds it once.
   void add(std::shared_ptr<const ObjectModel> model);
