@@ -10,8 +10,12 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <iomanip>
+#include <sstream>
 #include <utility>
 
+#include "nudge/sim/clutter.hpp"
+#include "nudge/sim/objects.hpp"
 #include "nudge/timing.hpp"
 
 namespace nudge::experiments {
@@ -19,6 +23,7 @@ namespace nudge::experiments {
 namespace {
 
 using Eigen::Quaterniond;
+using Eigen::Vector2d;
 using Eigen::Vector3d;
 
 constexpr double kDeg = M_PI / 180.0;
@@ -352,6 +357,96 @@ Scenario cluttered_swing() {
   return sc;
 }
 
+// ---- The scenario generator (issue 15): everything drawn from the seed.
+
+class Draw {
+ public:
+  explicit Draw(uint64_t seed) : rng_(seed * 0x9E3779B97F4A7C15ULL + 15) {}
+  double uniform(double lo, double hi) { return lo + (hi - lo) * rng_.uniform(0.0, 1.0); }
+  int index(size_t n) { return rng_.uniform(0, static_cast<int>(n)); }
+  bool chance(double p) { return rng_.uniform(0.0, 1.0) < p; }
+  double sign() { return chance(0.5) ? 1.0 : -1.0; }
+  // A colour of random hue, saturation and brightness (RGB in [0, 1]).
+  Vector3d colour(double min_value = 0.25) {
+    cv::Mat hsv(1, 1, CV_32FC3, cv::Scalar(uniform(0, 360), uniform(0, 0.9), uniform(min_value, 0.95)));
+    cv::Mat rgb;
+    cv::cvtColor(hsv, rgb, cv::COLOR_HSV2RGB);
+    const cv::Vec3f c = rgb.at<cv::Vec3f>(0, 0);
+    return Vector3d(c[0], c[1], c[2]);
+  }
+
+ private:
+  cv::RNG rng_;
+};
+
+// Radius of an object's footprint seen from above (a mug's handle included).
+double footprint(const std::string& kind) {
+  return sim::make_object(kind, 12).max_radius + (kind == "mug" ? 0.02 : 0.0);
+}
+
+std::string stem(const std::string& path) { return std::filesystem::path(path).stem().string(); }
+
+// The target's look; `what` gets a word for the description.
+sim::ObjectSpec drawn_object(Draw& d, const std::string& kind, const std::string& name, std::string* what) {
+  sim::ObjectSpec o = object(kind, name, 0.25, 0, d.colour());
+  o.appearance.specular = d.uniform(0.1, 0.9);
+  o.appearance.shininess = d.uniform(0.1, 0.9);
+  const double look = d.uniform(0, 1);
+  if (look < 0.4 || kind == "marker") {
+    *what = "plain";
+  } else if (look < 0.55) {
+    o = checkered(o, d.colour(), d.index(5) + 4);
+    *what = "checker";
+  } else if (look < 0.7) {
+    o = textured(o, "patches.png", d.index(2) + 1);
+    o.appearance.colour = Vector3d(1, 1, 1);
+    *what = "patches";
+  } else {
+    o.label.file = texture_file(d.chance(0.5) ? "label.png" : "patches.png");
+    *what = "label " + stem(o.label.file);
+  }
+  return o;
+}
+
+sim::ObjectSpec plain_object(Draw& d, const std::string& name) {
+  const auto kinds = sim::object_kinds();
+  sim::ObjectSpec o = object(kinds[d.index(kinds.size())], name, 0, 0, d.colour());
+  o.appearance.specular = d.uniform(0.1, 0.9);
+  return o;
+}
+
+// A wall or table look: plain, checker or a photograph.
+std::string draw_surface(Draw& d, sim::Appearance* a, const std::vector<std::string>& photographs,
+                         double photo_share, double checker_share) {
+  const double look = d.uniform(0, 1);
+  if (look < photo_share) {
+    a->kind = sim::Appearance::Kind::Image;
+    a->file = photographs[d.index(photographs.size())];
+    a->colour = Vector3d(1, 1, 1);
+    a->repeat = d.index(3) + 1;
+    return stem(a->file);
+  }
+  a->colour = d.colour(0.3);
+  if (look < photo_share + checker_share) {
+    a->kind = sim::Appearance::Kind::Checker;
+    a->colour2 = d.colour(0.3);
+    a->repeat = d.index(10) + 4;
+    return "checker";
+  }
+  return "plain";
+}
+
+// Progress of a stop-and-go motion: three equal moves with two pauses of `pause` frames.
+double stop_and_go(double s, int moving_frames, int pause) {
+  const double p = std::clamp(static_cast<double>(pause) / std::max(1, moving_frames), 0.0, 0.3);
+  const double move = (1.0 - 2 * p) / 3.0;
+  if (s < move) return s / move / 3.0;
+  if (s < move + p) return 1.0 / 3.0;
+  if (s < 2 * move + p) return 1.0 / 3.0 + (s - move - p) / move / 3.0;
+  if (s < 2 * move + 2 * p) return 2.0 / 3.0;
+  return std::min(1.0, 2.0 / 3.0 + (s - 2 * move - 2 * p) / move / 3.0);
+}
+
 }  // namespace
 
 std::vector<Scenario> tracking_scenarios() {
@@ -390,6 +485,176 @@ Video render_video(const Scenario& scenario, int camera, int max_frames) {
   }
   video.render_ms = watch.elapsed_ms();
   return video;
+}
+
+
+std::vector<std::string> generator_photographs(const std::string& directory) {
+  // Chosen before any evaluation run; building, home, graf1, fruits and box are kept out (reserved
+  // for the evaluation on photographs).
+  const char* names[] = {"baboon.jpg",   "starry_night.jpg", "stuff.jpg",  "messi5.jpg",  "butterfly.jpg",
+                         "board.jpg",    "smarties.png",     "aero3.jpg",  "leuvenA.jpg", "orange.jpg",
+                         "rubberwhale1.png", "lena.jpg",     "HappyFish.jpg", "pic3.png", "sudoku.png"};
+  std::vector<std::string> files;
+  for (const char* name : names) {
+    const std::string path = directory + "/" + name;
+    if (!std::filesystem::exists(path)) continue;  // opencv-doc versions differ; at least 8 needed
+    if (sim::is_reserved_picture(path)) throw std::logic_error(path + " is reserved for the evaluation on photographs");
+    files.push_back(path);
+  }
+  if (files.size() < 8)
+    throw std::runtime_error(directory + ": fewer than 8 of the generator's photographs found (Debian: opencv-doc)");
+  return files;
+}
+
+Scenario generated_scenario(uint64_t seed, const std::vector<std::string>& photographs) {
+  if (photographs.empty()) throw std::invalid_argument("generated_scenario: no photographs");
+  Draw d(seed);
+  Scenario sc;
+  sc.name = "seed_" + std::to_string(seed);
+  sc.thesis_video = "-";
+  sc.scene = base_scene(d.uniform(0.5, 2.5));
+  sc.scene.seed = seed;
+  sc.scene.source = "generated_scenario " + std::to_string(seed);
+  sc.scene.render.ambient = d.uniform(0.2, 0.5);
+  sc.scene.render.light = d.uniform(0.35, 0.75);
+  sc.scene.render.shadows = d.chance(0.5);
+  const std::string wall = draw_surface(d, &sc.scene.background, photographs, 0.5, 0.2);
+  const std::string table = draw_surface(d, &sc.scene.table, photographs, 0.3, 0.2);
+
+  const auto kinds = sim::object_kinds();
+  const std::string kind = kinds[d.index(kinds.size())];
+  std::string look;
+  sc.scene.objects = {drawn_object(d, kind, "target", &look)};
+  sc.frames = 90 + d.index(41);
+  const int moving_frames = sc.frames - 1 - sc.still_frames;
+
+  // The path: from A on one side to B on the other (world y), at any depth x.
+  const Vector3d a(d.uniform(0.1, 0.38), d.sign() * d.uniform(0.08, 0.2), 0);
+  const Vector3d b(d.uniform(0.1, 0.38), -(a.y() / std::abs(a.y())) * d.uniform(0.05, 0.2), 0);
+  const double height = sim::make_object(kind, 12).height;
+  const char* paths[] = {"linear", "swing", "turning", "stop-and-go"};
+  const int path = d.index(4);
+  const double spin = d.uniform(-90, 90) * kDeg;                    // linear, stop-and-go: yaw turned
+  const double lift = d.uniform(0.02, 0.06);                        // swing, turning: held up
+  const double roll0 = d.uniform(-40, 40) * kDeg, roll = d.sign() * d.uniform(40, 100) * kDeg;
+  const double amplitude = d.uniform(15, 35) * kDeg, cycles = d.uniform(1, 2.5);
+  const double rod = d.uniform(0.12, 0.2);                          // swing: pendulum length
+  const int pause = 8 + d.index(8);
+  std::ostringstream what;
+  what << kind << " (" << look << ") " << paths[path] << ", wall " << wall << ", table " << table;
+
+  // Occluder in front of the middle of the path; distractor crossing behind (or, with no occluder,
+  // in front). Both keep clear of the target's path by their radii and a gap.
+  sc.scene.objects[0].position = a.head<2>();
+  const double target_radius = footprint(kind);
+  const bool occluded = d.chance(0.5);
+  const double at = d.uniform(0.35, 0.65);
+  sim::ObjectSpec occluder = plain_object(d, "occluder");
+  const Vector3d occluder_at =
+      a + at * (b - a) + Vector3d(target_radius + footprint(occluder.kind) + d.uniform(0.01, 0.03), d.uniform(-0.03, 0.03), 0);
+  if (occluded) {
+    occluder.position = occluder_at.head<2>();
+    occluder.yaw = d.uniform(-M_PI, M_PI);
+    sc.scene.objects.push_back(occluder);
+    what << ", occluder " << occluder.kind;
+  }
+  const bool crossing = d.chance(0.5);
+  sim::ObjectSpec crosser = plain_object(d, "distractor");
+  const double side = !occluded && d.chance(0.3) ? 1.0 : -1.0;
+  const double depth = side * (target_radius + footprint(crosser.kind) + d.uniform(0.01, 0.05));
+  const int delay = d.index(26);
+  const int distractor = static_cast<int>(sc.scene.objects.size());
+  if (crossing) {
+    crosser.position = Vector2d(b.x() + depth, b.y());
+    sc.scene.objects.push_back(crosser);
+    what << ", " << crosser.kind << " crossing " << (depth < 0 ? "behind" : "in front") << " after " << delay << " frames";
+  }
+  // Static clutter further back, clear of each other.
+  const int clutter = d.index(3);
+  std::vector<std::pair<Vector2d, double>> standing;
+  for (int i = 0; i < clutter; ++i) {
+    sim::ObjectSpec o = plain_object(d, "clutter" + std::to_string(i));
+    o.yaw = d.uniform(-M_PI, M_PI);
+    const double r = footprint(o.kind);
+    for (int attempt = 0; attempt < 50; ++attempt) {
+      o.position = Vector2d(d.uniform(-0.35, -0.2), d.uniform(-0.3, 0.3));
+      bool clear = true;
+      for (const auto& [p, pr] : standing) clear = clear && (p - o.position).norm() > r + pr + 0.01;
+      if (clear) {
+        standing.emplace_back(o.position, r);
+        sc.scene.objects.push_back(o);
+        break;
+      }
+    }
+  }
+  if (standing.size() > 0) what << ", " << standing.size() << " behind";
+  what << ", light " << std::setprecision(2) << sc.scene.render.ambient << "/" << sc.scene.render.light
+       << (sc.scene.render.shadows ? " shadows" : "") << ", noise " << sc.scene.render.noise_sigma;
+  sc.description = what.str();
+
+  sc.pose = [sc, a, b, path, spin, lift, roll0, roll, amplitude, cycles, rod, pause, height, crossing, depth,
+             delay, distractor, moving_frames](sim::World& w, int k) {
+    const double s = progress(sc, k);
+    const Vector3d along = a + s * (b - a);
+    if (path == 0) {
+      pose_base(w, 0, along.x(), along.y(), about(Vector3d::UnitZ(), spin * s));
+    } else if (path == 1) {
+      // A pendulum hung from a pivot carried from above A to above B.
+      const Vector3d pivot = along + Vector3d(0, 0, rod + 0.5 * height + lift);
+      const Quaterniond q = about(view_axis(w, pivot), amplitude * std::sin(2 * M_PI * cycles * s));
+      pose_centre(w, 0, pivot + q * Vector3d(0, 0, -rod), q);
+    } else if (path == 2) {
+      const Vector3d c = along + Vector3d(0, 0, 0.5 * height + lift);
+      pose_centre(w, 0, c, about(view_axis(w, c), roll0 + roll * ease(s)));
+    } else {
+      const Vector3d p = a + stop_and_go(s, moving_frames, pause) * (b - a);
+      pose_base(w, 0, p.x(), p.y(), about(Vector3d::UnitZ(), spin * stop_and_go(s, moving_frames, pause)));
+    }
+    if (crossing) {
+      Scenario later = sc;
+      later.still_frames = sc.still_frames + delay;
+      const Vector3d p = b + progress(later, k) * (a - b) + Vector3d(depth, 0, 0);
+      pose_base(w, distractor, p.x(), p.y());
+    }
+  };
+  return sc;
+}
+
+std::array<Video, 2> render_stereo_video(const Scenario& scenario, int max_frames) {
+  sim::World world(scenario.scene);
+  world.pusher_visible = false;
+  world.park_pusher();
+  const int n = max_frames > 0 ? std::min(max_frames, scenario.frames) : scenario.frames;
+  std::array<Video, 2> videos;
+  Eigen::Vector3d last_pos = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond last_q = Eigen::Quaterniond::Identity();
+  Stopwatch watch;
+  for (int k = 0; k < n; ++k) {
+    scenario.pose(world, k);
+    const sim::StereoImages images = world.render_stereo(/*masks=*/true);
+    const sim::ObjectState st = world.object(scenario.target);
+    const bool moving =
+        k > 0 && ((st.position - last_pos).norm() > 1e-6 || st.orientation.angularDistance(last_q) > 1e-6);
+    last_pos = st.position;
+    last_q = st.orientation;
+    for (int camera = 0; camera < 2; ++camera) {
+      VideoFrame f;
+      f.image = images.colour[camera];
+      f.target_mask = images.mask[camera] == scenario.target + 1;
+      f.truth = world.axis_in_image(scenario.target, camera);
+      f.target_moving = moving;
+      Video& video = videos[camera];
+      if (k == 0) {
+        video.first_mask = f.target_mask.clone();
+        video.first_box = cv::boundingRect(video.first_mask);
+        if (video.first_box.area() == 0)
+          throw std::runtime_error(scenario.name + ": target not visible in frame 0 of camera " + std::to_string(camera));
+      }
+      video.frames.push_back(std::move(f));
+    }
+  }
+  videos[0].render_ms = videos[1].render_ms = 0.5 * watch.elapsed_ms();
+  return videos;
 }
 
 double distance_to_line(const cv::Point2d& p, const sim::ImageLine& truth, int width, int height) {

@@ -10,6 +10,8 @@
 //   }
 #include <opencv2/core.hpp>
 
+#include <array>
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
@@ -32,6 +34,7 @@ struct Scenario {
 
 struct VideoFrame {
   cv::Mat image;             // BGR, the rig's size (640x480)
+  cv::Mat target_mask;       // CV_8U 255 on the target's visible pixels (render_stereo_video only)
   sim::ImageLine truth;      // the target's axis in this camera
   bool target_moving = false;// the target's pose differs from the previous frame's
 };
@@ -48,6 +51,25 @@ std::vector<Scenario> tracking_scenarios();
 
 // Renders a scenario from camera `camera` (0 = left). max_frames > 0 shortens the video.
 Video render_video(const Scenario& scenario, int camera = 0, int max_frames = 0);
+
+// Both cameras' videos of a scenario from one pass of the world, each frame with the target's
+// true mask (target_mask). max_frames > 0 shortens the videos.
+std::array<Video, 2> render_stereo_video(const Scenario& scenario, int max_frames = 0);
+
+// A scenario drawn from `seed` (issue 15's evaluation videos, never re-staged): the target is any
+// object kind of the simulator (one size per kind: its size in the image varies with its distance
+// from the camera) in a random colour, checker, printed texture or wrapped label; it moves along a
+// linear, swing (pendulum), turning (held up and rolled) or stop-and-go path; a static occluder
+// in front of the middle of its path, a distractor crossing behind or in front of it, static
+// clutter behind; a plain, checkered or photographed wall and table; ambient and diffuse light,
+// shadows and sensor noise drawn too. `photographs`: pictures for walls and tables (none of
+// sim::is_reserved_picture's). Same seed, same pictures: the same scenario.
+Scenario generated_scenario(uint64_t seed, const std::vector<std::string>& photographs);
+
+// The photographs the generator uses, fixed in advance: opencv-doc pictures in `directory`
+// (Debian: /usr/share/doc/opencv-doc/examples/data), none of them reserved for the evaluation on
+// photographs. Throws std::runtime_error naming a missing file.
+std::vector<std::string> generator_photographs(const std::string& directory);
 
 // Distance (px) from an image point to the true line.
 double distance_to_line(const cv::Point2d& p, const sim::ImageLine& truth, int width, int height);
