@@ -11,6 +11,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <stdexcept>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -72,6 +73,12 @@ struct HasFrameId : std::false_type {};
 template <typename Msg>
 struct HasFrameId<Msg, std::void_t<decltype(std::declval<Msg>().frame_id)>> : std::true_type {};
 
+// Messages LCM holds per subscription, received but not yet handled, before it drops new ones
+// (LCM's own default is 30). Chosen by measurement (docs/reliability.md, "Soak"): a receiver that
+// falls behind a 25 Hz stereo stream then handles frames at most this many behind, instead of
+// working through 30 stale ones (1.2 s at 25 Hz) while the newest are dropped anyway.
+constexpr int kDefaultQueueCapacity = 30;
+
 class Subscriptions {
  public:
   Subscriptions(lcm::LCM& lcm, Counters& counters) : lcm_(lcm), counters_(counters) {}
@@ -98,7 +105,16 @@ class Subscriptions {
                        std::function<void(const Msg&, const std::string& channel, int64_t receive_utime)> handler) {
     auto h = std::make_unique<Typed<Msg>>(std::move(handler), counters_);
     h->subscription = lcm_.subscribe(channel, &Typed<Msg>::on_raw, h.get());
+    if (queue_capacity_ >= 0) h->subscription->setQueueCapacity(queue_capacity_);
     handlers_.push_back(std::move(h));
+  }
+
+  // Messages held per subscription before LCM drops new ones (0: no limit), for the
+  // subscriptions made so far and those to come. Untouched, LCM's default (30) holds.
+  void set_queue_capacity(int messages) {
+    if (messages < 0) throw std::invalid_argument("queue capacity must be >= 0, not " + std::to_string(messages));
+    queue_capacity_ = messages;
+    for (auto& h : handlers_) h->subscription->setQueueCapacity(messages);
   }
 
  private:
@@ -144,6 +160,7 @@ class Subscriptions {
   lcm::LCM& lcm_;
   Counters& counters_;
   std::vector<std::unique_ptr<Base>> handlers_;
+  int queue_capacity_ = -1;  // -1: LCM's default
 };
 
 }  // namespace nudge::bus
