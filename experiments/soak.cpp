@@ -269,7 +269,7 @@ int record(int argc, char** argv) {
   std::map<std::string, ProcessRecord> processes = parse_pids(pids);
 
   service.start();
-  service.subscriptions().set_queue_capacity(0);  // the recorder must not drop what it measures
+  service.subscriptions().set_stream_queue_capacity(0);  // the recorder must not drop what it measures
   const int64_t start = wall_utime();
   Recorder rec(start, static_cast<int64_t>(warmup_s * 1e6));
   auto& subs = service.subscriptions();

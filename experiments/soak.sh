@@ -12,11 +12,12 @@
 #   --out DIR     where the run's files go (default out/soak/<label>): run.json (the recorder's),
 #                 rss.csv, the services' logs
 #   --label NAME  the run's name (default normal or slowest, with -qN)
+#   --warmup S    latencies and RSS growth count from S seconds on (default 30, at most half the run)
 # Needs root (a private network namespace). Run it with nice on a shared machine.
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 bin=${NUDGE_BIN:-$here/build/bin}
-seconds=600 slowest=0 queue= out= label=
+seconds=600 slowest=0 queue= out= label= warmup=30
 while [ $# -gt 0 ]; do
   case $1 in
     --minutes) seconds=$(awk -v m="$2" 'BEGIN { printf "%d", m * 60 }'); shift 2 ;;
@@ -25,10 +26,12 @@ while [ $# -gt 0 ]; do
     --queue) queue=$2; shift 2 ;;
     --out) out=$2; shift 2 ;;
     --label) label=$2; shift 2 ;;
+    --warmup) warmup=$2; shift 2 ;;
     *) echo "soak.sh: unknown argument '$1' (see the usage at the top of $0)" >&2; exit 2 ;;
   esac
 done
 [ "$seconds" -gt 0 ] 2>/dev/null || { echo "soak.sh: the run must last at least a second, not '$seconds'" >&2; exit 2; }
+[ $((2 * warmup)) -le "$seconds" ] 2>/dev/null || warmup=$((seconds / 2))
 [ -z "$label" ] && label=$([ $slowest = 1 ] && echo slowest || echo normal)${queue:+-q$queue}
 out=${out:-$here/out/soak/$label}
 for b in nudge-world nudge-camera nudge-symmetry nudge-tracker nudge-triangulation nudge-exp-soak; do
@@ -42,9 +45,9 @@ mkdir -p "$out"
 rm -f "$out/run.json" "$out/rss.csv"
 echo "soak: $label, $seconds s, files in $out" >&2
 
-unshare -n bash -s "$bin" "$here" "$out" "$seconds" "$slowest" "$queue" "$label" <<'INNER'
+unshare -n bash -s "$bin" "$here" "$out" "$seconds" "$slowest" "$queue" "$label" "$warmup" <<'INNER'
 set -euo pipefail
-bin=$1; here=$2; out=$3; seconds=$4; slowest=$5; queue=$6; label=$7
+bin=$1; here=$2; out=$3; seconds=$4; slowest=$5; queue=$6; label=$7; warmup=$8
 ip link set lo up multicast on
 ip route add 224.0.0.0/4 dev lo
 url="udpm://239.255.76.67:7667?ttl=0&recv_buf_size=16777216"
@@ -85,7 +88,7 @@ done
 start world "$bin/nudge-world" "${common[@]}" --scene "$scene" --realtime-factor 1 --rate 25
 sleep 1
 pid_list=$(IFS=,; echo "${names[*]}")
-"$bin/nudge-exp-soak" record --lcm-url "$url" --seconds "$seconds" --pids "$pid_list" --label "$label" \
+"$bin/nudge-exp-soak" record --lcm-url "$url" --seconds "$seconds" --warmup "$warmup" --pids "$pid_list" --label "$label" \
   --out "$out/run.json" --csv "$out/rss.csv" 2>"$out/recorder.log"
 INNER
 echo "soak: wrote $out/run.json" >&2

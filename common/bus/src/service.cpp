@@ -27,7 +27,8 @@ Service::Service(std::string name, std::string summary)
   flags_.add_string("instance", &instance_, "instance name in heartbeats");
   flags_.add_bool("verbose", &verbose_, "log every message");
   flags_.add_int("queue", &queue_capacity_,
-                 "messages held per subscription before new ones are dropped, on a udpm:// input (0: no limit)");
+                 "on a udpm:// input: messages of a stream (images, lines, tracks, SIM_STATE) held per subscription "
+                 "before new ones are dropped (0: no limit)");
 }
 
 Service::~Service() {
@@ -63,7 +64,7 @@ void Service::start(const std::string& in_url, const std::string& requested_out_
   attach(*owned_in_, owned_out_ ? *owned_out_ : *owned_in_);
   // Only a live network input drops what a slow receiver cannot hold; a log (file://) or an
   // in-process bus (memq://, tests that publish a burst and then pump) keeps LCM's default.
-  if (in_url.rfind("udpm://", 0) == 0) subscriptions_->set_queue_capacity(queue_capacity_);
+  if (in_url.rfind("udpm://", 0) == 0) subscriptions_->set_stream_queue_capacity(queue_capacity_);
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   log::info() << "started: in " << in_url << ", out " << out_url;

@@ -18,6 +18,7 @@
 
 #include "nudge/bus/decode.hpp"
 #include "nudge/log.hpp"
+#include "nudge/sim_state_t.hpp"
 
 namespace nudge::bus {
 
@@ -73,11 +74,18 @@ struct HasFrameId : std::false_type {};
 template <typename Msg>
 struct HasFrameId<Msg, std::void_t<decltype(std::declval<Msg>().frame_id)>> : std::true_type {};
 
-// Messages LCM holds per subscription, received but not yet handled, before it drops new ones
-// (LCM's own default is 30). Chosen by measurement (docs/reliability.md, "Soak"): a receiver that
-// falls behind a 25 Hz stereo stream then handles frames at most this many behind, instead of
-// working through 30 stale ones (1.2 s at 25 Hz) while the newest are dropped anyway.
-constexpr int kDefaultQueueCapacity = 30;
+// Streams: periodic messages of which a newer one supersedes an older one (camera frames and what
+// is computed from them, the simulated world's state). A receiver that falls behind a stream is
+// better off skipping to the newest than working through a backlog of stale ones; commands,
+// requests, states and heartbeats are never skipped that way (they keep LCM's queue of 30).
+template <typename Msg>
+struct IsStream : HasFrameId<Msg> {};
+template <>
+struct IsStream<sim_state_t> : std::true_type {};
+
+// Messages LCM holds per stream subscription, received but not yet handled, before it drops new
+// ones (LCM's own default is 30). Chosen by measurement (docs/reliability.md, "Soak").
+constexpr int kDefaultQueueCapacity = 3;
 
 class Subscriptions {
  public:
@@ -105,22 +113,25 @@ class Subscriptions {
                        std::function<void(const Msg&, const std::string& channel, int64_t receive_utime)> handler) {
     auto h = std::make_unique<Typed<Msg>>(std::move(handler), counters_);
     h->subscription = lcm_.subscribe(channel, &Typed<Msg>::on_raw, h.get());
-    if (queue_capacity_ >= 0) h->subscription->setQueueCapacity(queue_capacity_);
+    h->stream = IsStream<Msg>::value;
+    if (h->stream && stream_queue_capacity_ >= 0) h->subscription->setQueueCapacity(stream_queue_capacity_);
     handlers_.push_back(std::move(h));
   }
 
-  // Messages held per subscription before LCM drops new ones (0: no limit), for the
-  // subscriptions made so far and those to come. Untouched, LCM's default (30) holds.
-  void set_queue_capacity(int messages) {
+  // Messages held per stream subscription (IsStream) before LCM drops new ones (0: no limit), for
+  // the subscriptions made so far and those to come. Untouched, LCM's default (30) holds.
+  void set_stream_queue_capacity(int messages) {
     if (messages < 0) throw std::invalid_argument("queue capacity must be >= 0, not " + std::to_string(messages));
-    queue_capacity_ = messages;
-    for (auto& h : handlers_) h->subscription->setQueueCapacity(messages);
+    stream_queue_capacity_ = messages;
+    for (auto& h : handlers_)
+      if (h->stream) h->subscription->setQueueCapacity(messages);
   }
 
  private:
   struct Base {
     virtual ~Base() = default;
     lcm::Subscription* subscription = nullptr;
+    bool stream = false;  // IsStream: its queue is stream_queue_capacity_
   };
   template <typename Msg>
   struct Typed : Base {
@@ -160,7 +171,7 @@ class Subscriptions {
   lcm::LCM& lcm_;
   Counters& counters_;
   std::vector<std::unique_ptr<Base>> handlers_;
-  int queue_capacity_ = -1;  // -1: LCM's default
+  int stream_queue_capacity_ = -1;  // -1: LCM's default
 };
 
 }  // namespace nudge::bus
