@@ -43,14 +43,18 @@ def mean(values):
 
 
 def drops(run):
-    """Camera frames each stage never answered, per output channel, and where they were lost."""
+    """Per output channel, the camera frames its stage never answered (a camera channel: its
+    frame_id gaps as the recorder heard them)."""
     out = {}
     for channel, c in sorted(run["channels"].items()):
-        if c["stage"] == "camera":
-            out[channel] = {"frame_id_gaps": c.get("frame_id_gaps", 0)}
-        else:
-            out[channel] = {"unanswered": c.get("camera_frames_unanswered", -1)}
+        key = "frame_id_gaps" if c["stage"] == "camera" else "camera_frames_unanswered"
+        out[channel] = c.get(key, -1)
     return out
+
+
+def drop_lines(d):
+    return [f"- `{ch}`: {n}" + (" frame_id gaps" if ch.startswith("CAMERA") else " camera frames unanswered")
+            for ch, n in d.items()]
 
 
 def summary(run):
@@ -101,8 +105,8 @@ def markdown(soak, slowest, sweep, cpu):
         "sockets' kernel drop counters (`/proc/net/udp`) tell the socket buffer from LCM's queue.",
         "",
         f"Machine: {cpu}. **Shared and loaded**: the mean 1-minute load average during the soak was",
-        f"{s['load_average_mean']} on 2 cores (seven other engineers building and running their own",
-        "pipelines), so the figures are those of a starved machine, not of the code alone.",
+        f"{s['load_average_mean']} on 2 cores (other engineers building and running their own pipelines),",
+        "so the figures are those of a starved machine, not of the code alone. Analysis: docs/reliability.md, \"Soak\".",
         "",
         f"## The soak: {s['seconds'] / 60:.0f} minutes at the defaults",
         "",
@@ -120,8 +124,7 @@ def markdown(soak, slowest, sweep, cpu):
     for p in sorted(s["rss_mb_last"]):
         lines.append(f"| {p} | {s['rss_mb_last'][p]} | {s['rss_growth_mb'][p]} | {s['cpu_percent_mean'][p]} | {s['socket_drops'][p]} |")
     lines += ["", "Frames not answered (camera frames a stage never sent a result for):", ""]
-    for ch, d in s["drops"].items():
-        lines.append(f"- `{ch}`: {d}")
+    lines += drop_lines(s["drops"])
     lines += ["", "What each service's last heartbeat said:", ""]
     for p, status in sorted(s["heartbeat_status"].items()):
         lines.append(f"- {p}: {status}")
@@ -163,8 +166,7 @@ def markdown(soak, slowest, sweep, cpu):
     for p in sorted(w["cpu_percent_mean"]):
         lines.append(f"| {p} | {w['cpu_percent_mean'][p]} | {w['rss_mb_last'][p]} | {w['socket_drops'][p]} |")
     lines += ["", "Frames not answered:", ""]
-    for ch, d in w["drops"].items():
-        lines.append(f"- `{ch}`: {d}")
+    lines += drop_lines(w["drops"])
     lines += ["", "Heartbeats:", ""]
     for p, status in sorted(w["heartbeat_status"].items()):
         lines.append(f"- {p}: {status}")
