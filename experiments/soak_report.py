@@ -217,7 +217,9 @@ def main():
     rel["soak_note"] = (f"docs/results/soak.md: {s['camera_frames']} camera frames at {s['camera_hz']} Hz stereo on a "
                         f"shared machine (load average {s['load_average_mean']} on 2 cores); soak_drops = camera "
                         "frames symmetry and the tracker never answered (dropped from LCM's subscription queue, "
-                        "no socket drops); soak_rss_growth_mb = the largest growth of one process after warm-up")
+                        "no socket drops); soak_rss_growth_mb = the largest growth of one process after warm-up; "
+                        "the soak ran with the simulated camera's SIM_STATE queue at 3, the final rule keeps 30 "
+                        "there (one pair per world state): see final-rule-check in soak.md and docs/reliability.md")
     write_atomically(path, json.dumps(rel, indent=2, ensure_ascii=False) + "\n")
 
 
