@@ -95,6 +95,10 @@ int run_sim_camera(bus::Service& service, const SimOptions& options) {
           }
         });
   }
+  // One pair per world state (README; the integration tests count them): SIM_STATE keeps LCM's
+  // queue of 30 whatever --queue says, so a camera that falls behind renders its backlog late
+  // instead of skipping states (docs/reliability.md, "Soak").
+  service.subscriptions().set_stream_queue_capacity(30);
   return service.run();
 }
 

@@ -258,7 +258,7 @@ class Shell {
       const Eigen::Vector3d foot(a.table_point[0], a.table_point[1], a.table_point[2]);
       if (foot.allFinite() && std::isfinite(a.angle_to_normal)) axes.push_back({scene_.table_to_world(foot), a.angle_to_normal});
     }
-    supervisor_.on_axes(axes, now_);
+    supervisor_.on_axes(axes, m.utime, now_);
     drain();
   }
 
@@ -266,7 +266,7 @@ class Shell {
     if (supervisor_.state() != sv::State::FindCandidates) return;
     std::vector<symmetry::Line> lines;
     for (const symmetry_line_t& line : m.lines) lines.push_back(bus::from_message(line));
-    supervisor_.on_lines(left, lines, now_);
+    supervisor_.on_lines(left, lines, m.utime, now_);
   }
 
   // Decoding costs: a frame is decoded only when the loop would use it.

@@ -117,7 +117,11 @@ class Triangulation {
     if (!pair) return;
     ++pairs_;
     publish_axes(pair->utime, pair->left, pair->right);
-    if (finder_) gather(pair->utime, pair->left, pair->right);
+    if (finder_ && pair->utime < request_utime_) {
+      ++stale_pairs_;  // taken before the request: not the table as it is now
+    } else if (finder_) {
+      gather(pair->utime, pair->left, pair->right);
+    }
     service_.set_status("pairs " + std::to_string(pairs_) + ", unmatched " + std::to_string(pairer_.dropped()));
   }
 
@@ -139,6 +143,8 @@ class Triangulation {
     if (request.lines_per_image > 0) params.lines_per_image = request.lines_per_image;
     if (finder_) log::warn() << "a new candidates request replaces the one in progress";
     finder_.emplace(rig_, *table_, arm_base_, params, opt_.triangulation);
+    request_utime_ = request.utime;
+    stale_pairs_ = 0;
     log::info() << "candidates requested: gathering " << params.frames << " stereo pairs, " << params.lines_per_image
                 << " lines per image";
   }
@@ -158,7 +164,9 @@ class Triangulation {
     msg.num_candidates = static_cast<int32_t>(msg.position.size());
     service_.publish(bus::channel::CANDIDATES, msg);
     log::info() << "candidates: " << msg.num_candidates << " locations from " << msg.intersects << " intersects over "
-                << msg.frames_used << " stereo pairs";
+                << msg.frames_used << " stereo pairs"
+                << (stale_pairs_ ? " (skipped " + std::to_string(stale_pairs_) + " stereo pair(s) taken before the request)"
+                                 : std::string());
     finder_.reset();
   }
 
@@ -171,6 +179,8 @@ class Triangulation {
   geo::StereoPairer<Lines> pairer_;
   std::optional<geo::LocationFinder> finder_;
   int64_t pairs_ = 0;
+  int64_t request_utime_ = 0;  // the candidates request's: pairs taken before it are not gathered
+  int64_t stale_pairs_ = 0;    // such pairs since the request
 };
 
 void add_flags(Flags& f, Options& o) {

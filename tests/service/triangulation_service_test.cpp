@@ -174,11 +174,14 @@ int right_order(int frame, int k) { return (k + frame) % 3; }
 
 // The good frames; frame 7's left lines also carry a NaN line; frame 12's right image has the wrong
 // size (skipped, so its left partner goes unmatched); a lone left message at the end.
-void write_input_log(const Scene& scene, const std::string& path) {
+// The request comes first in the log, stamped `request_utime` (a later one: the lines of the
+// frames before it arrive late, as from a lagging pipeline).
+void write_input_log(const Scene& scene, const std::string& path, int64_t request_utime = kStart - 1,
+                     int request_frames = 20) {
   LogWriter log(path);
   nudge::candidates_request_t request;
-  request.utime = kStart - 1;
-  request.frames = 20;
+  request.utime = request_utime;
+  request.frames = request_frames;
   request.lines_per_image = 3;
   log.raw(request.utime, "CANDIDATES_REQUEST", encode(request));
   for (int f = 0; f < kFrames; ++f) {
@@ -314,6 +317,29 @@ TEST(TriangulationService, AxesRecoverTheTablePointsAndCandidatesTheRingObjects)
   const std::string cmd = service_cmd(scene, rig_path, in, out);
   ASSERT_EQ(run(cmd, &err), 0) << cmd << "\n" << err;
   expect_axes_and_candidates(scene, read_output(out), err);
+}
+
+// Candidates describe the table as it is when they are asked for: stereo pairs taken before the
+// request (the arm still moving away, delivered late by a pipeline that lags) are not gathered.
+TEST(TriangulationService, CandidatesGatherOnlyPairsTakenAfterTheRequest) {
+  const Scene scene;
+  const std::string dir = scratch_dir();
+  const std::string rig_path = dir + "/triangulation_rig_late.yaml", in = dir + "/triangulation_late_in.lcmlog",
+                    out = dir + "/triangulation_late_out.lcmlog";
+  geo::save_rig(scene.rig, rig_path);
+  const int64_t request_utime = kStart + 10 * kPeriod - 1;
+  write_input_log(scene, in, request_utime, 10);
+  std::remove(out.c_str());
+  std::string err;
+  const std::string cmd = service_cmd(scene, rig_path, in, out);
+  ASSERT_EQ(run(cmd, &err), 0) << cmd << "\n" << err;
+  const Output output = read_output(out);
+  EXPECT_EQ(output.axes.size(), static_cast<size_t>(kFrames - 1));  // AXES for every pair, old or new
+  ASSERT_EQ(output.candidates.size(), 1u) << err;
+  EXPECT_EQ(output.candidates[0].frames_used, 10);
+  // Frames 10..20 without frame 12 (its right image is refused): the tenth pair taken after it.
+  EXPECT_EQ(output.candidates[0].utime, kStart + 20 * kPeriod);
+  EXPECT_NE(err.find("10 stereo pair(s) taken before the request"), std::string::npos) << err;
 }
 
 TEST(TriangulationService, TableAndArmBaseCanComeFromTheCalibrationFile) {

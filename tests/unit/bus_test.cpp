@@ -208,6 +208,28 @@ TEST(Subscriptions, MalformedMessagesAreCountedAndSkippedNamingTheChannel) {
   EXPECT_NE(log.find("skipped a malformed message on HEARTBEAT_TEST"), std::string::npos) << log;
 }
 
+// Which subscriptions are streams (their queue is --queue, docs/reliability.md "Soak"): frames and
+// what is computed from them, and the simulated world's state; never commands, requests, states
+// or heartbeats. (LCM 1.3.1's memq:// ignores queue capacities, so what udpm:// drops is measured
+// by the soak, not here.)
+TEST(Subscriptions, StreamsAreFramesAndWhatComesOfThemNotCommandsOrHeartbeats) {
+  EXPECT_TRUE(bus::IsStream<image_t>::value);
+  EXPECT_TRUE(bus::IsStream<symmetry_lines_t>::value);
+  EXPECT_TRUE(bus::IsStream<track_t>::value);
+  EXPECT_TRUE(bus::IsStream<contours_t>::value);
+  EXPECT_TRUE(bus::IsStream<sim_state_t>::value);
+  EXPECT_FALSE(bus::IsStream<heartbeat_t>::value);
+  EXPECT_FALSE(bus::IsStream<arm_command_t>::value);
+  EXPECT_FALSE(bus::IsStream<candidates_t>::value);
+  lcm::LCM lcm("memq://");
+  ASSERT_TRUE(lcm.good());
+  bus::Counters counters;
+  bus::Subscriptions subscriptions(lcm, counters);
+  subscriptions.subscribe<image_t>("CAMERA_TEST", [](const image_t&, const std::string&) {});
+  EXPECT_NO_THROW(subscriptions.set_stream_queue_capacity(3));
+  EXPECT_THROW(subscriptions.set_stream_queue_capacity(-1), std::invalid_argument);
+}
+
 // ---- channel names ----------------------------------------------------------------------------
 
 TEST(Channels, CameraChannelsNameTheirResults) {

@@ -26,6 +26,9 @@ Service::Service(std::string name, std::string summary)
   flags_.add_string("lcm-out", &lcm_out_, "LCM URL to publish to (e.g. file://out.lcmlog?mode=w); default --lcm-url");
   flags_.add_string("instance", &instance_, "instance name in heartbeats");
   flags_.add_bool("verbose", &verbose_, "log every message");
+  flags_.add_int("queue", &queue_capacity_,
+                 "on a udpm:// input: messages of a stream (images, lines, tracks, SIM_STATE) held per subscription "
+                 "before new ones are dropped (0: no limit)");
 }
 
 Service::~Service() {
@@ -36,6 +39,7 @@ bool Service::parse(int argc, char** argv) {
   if (!flags_.parse(argc, argv)) return false;
   if (verbose_) log::set_level(log::Level::Debug);
   if (instance_.empty()) instance_ = name_;
+  if (queue_capacity_ < 0) throw FlagError("--queue must be >= 0 (0: no limit), not " + std::to_string(queue_capacity_));
   return true;
 }
 
@@ -58,6 +62,9 @@ void Service::start(const std::string& in_url, const std::string& requested_out_
     if (!owned_out_->good()) throw std::runtime_error("cannot open LCM output '" + out_url + "'");
   }
   attach(*owned_in_, owned_out_ ? *owned_out_ : *owned_in_);
+  // Only a live network input drops what a slow receiver cannot hold; a log (file://) or an
+  // in-process bus (memq://, tests that publish a burst and then pump) keeps LCM's default.
+  if (in_url.rfind("udpm://", 0) == 0) subscriptions_->set_stream_queue_capacity(queue_capacity_);
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   log::info() << "started: in " << in_url << ", out " << out_url;

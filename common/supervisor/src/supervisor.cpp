@@ -587,9 +587,10 @@ void Supervisor::on_right_still(const cv::Mat& still, int64_t utime, int64_t now
   }
 }
 
-void Supervisor::on_lines(bool left, const std::vector<symmetry::Line>& lines, int64_t now) {
+void Supervisor::on_lines(bool left, const std::vector<symmetry::Line>& lines, int64_t utime, int64_t now) {
   (void)now;
   if (state_ != State::FindCandidates) return;
+  if (utime < request_time_) return;  // a frame from before the survey, delivered late
   auto& kept = survey_lines_[left ? 0 : 1];
   kept.push_back(lines);
   if (kept.size() > 50) kept.erase(kept.begin());
@@ -614,9 +615,12 @@ double Supervisor::stereo_agreement(const Candidate& candidate) const {
   return agreement;
 }
 
-void Supervisor::on_axes(const std::vector<Axis>& axes, int64_t now) {
+void Supervisor::on_axes(const std::vector<Axis>& axes, int64_t utime, int64_t now) {
+  (void)now;
   if (state_ != State::Track) return;
-  if (static_cast<double>(now - arm_done_time_) < config_.axes_from_s * kMicro) return;  // still sliding
+  // Judged by when the frames were taken, not when their axes arrived: a pipeline that lags
+  // delivers, after the settling pause, axes of frames taken while the object still slid.
+  if (static_cast<double>(utime - arm_done_time_) < config_.axes_from_s * kMicro) return;
   settled_axes_.insert(settled_axes_.end(), axes.begin(), axes.end());
 }
 

@@ -98,6 +98,7 @@ class Service {
   Flags flags_;
   std::string lcm_url_ = kDefaultLcmUrl, lcm_in_, lcm_out_, instance_;
   bool verbose_ = false;
+  int queue_capacity_ = kDefaultQueueCapacity;  // --queue: on a network input only
   std::unique_ptr<lcm::LCM> owned_in_, owned_out_;  // when start() opened the URLs itself
   lcm::LCM* in_ = nullptr;
   lcm::LCM* out_ = nullptr;

@@ -11,12 +11,14 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <stdexcept>
 #include <string>
 #include <type_traits>
 #include <vector>
 
 #include "nudge/bus/decode.hpp"
 #include "nudge/log.hpp"
+#include "nudge/sim_state_t.hpp"
 
 namespace nudge::bus {
 
@@ -72,6 +74,19 @@ struct HasFrameId : std::false_type {};
 template <typename Msg>
 struct HasFrameId<Msg, std::void_t<decltype(std::declval<Msg>().frame_id)>> : std::true_type {};
 
+// Streams: periodic messages of which a newer one supersedes an older one (camera frames and what
+// is computed from them, the simulated world's state). A receiver that falls behind a stream is
+// better off skipping to the newest than working through a backlog of stale ones; commands,
+// requests, states and heartbeats are never skipped that way (they keep LCM's queue of 30).
+template <typename Msg>
+struct IsStream : HasFrameId<Msg> {};
+template <>
+struct IsStream<sim_state_t> : std::true_type {};
+
+// Messages LCM holds per stream subscription, received but not yet handled, before it drops new
+// ones (LCM's own default is 30). Chosen by measurement (docs/reliability.md, "Soak").
+constexpr int kDefaultQueueCapacity = 3;
+
 class Subscriptions {
  public:
   Subscriptions(lcm::LCM& lcm, Counters& counters) : lcm_(lcm), counters_(counters) {}
@@ -98,13 +113,25 @@ class Subscriptions {
                        std::function<void(const Msg&, const std::string& channel, int64_t receive_utime)> handler) {
     auto h = std::make_unique<Typed<Msg>>(std::move(handler), counters_);
     h->subscription = lcm_.subscribe(channel, &Typed<Msg>::on_raw, h.get());
+    h->stream = IsStream<Msg>::value;
+    if (h->stream && stream_queue_capacity_ >= 0) h->subscription->setQueueCapacity(stream_queue_capacity_);
     handlers_.push_back(std::move(h));
+  }
+
+  // Messages held per stream subscription (IsStream) before LCM drops new ones (0: no limit), for
+  // the subscriptions made so far and those to come. Untouched, LCM's default (30) holds.
+  void set_stream_queue_capacity(int messages) {
+    if (messages < 0) throw std::invalid_argument("queue capacity must be >= 0, not " + std::to_string(messages));
+    stream_queue_capacity_ = messages;
+    for (auto& h : handlers_)
+      if (h->stream) h->subscription->setQueueCapacity(messages);
   }
 
  private:
   struct Base {
     virtual ~Base() = default;
     lcm::Subscription* subscription = nullptr;
+    bool stream = false;  // IsStream: its queue is stream_queue_capacity_
   };
   template <typename Msg>
   struct Typed : Base {
@@ -144,6 +171,7 @@ class Subscriptions {
   lcm::LCM& lcm_;
   Counters& counters_;
   std::vector<std::unique_ptr<Base>> handlers_;
+  int stream_queue_capacity_ = -1;  // -1: LCM's default
 };
 
 }  // namespace nudge::bus

@@ -223,10 +223,13 @@ class Supervisor {
   // while nudging, and either while its tracker runs.
   bool wants_frame(bool left) const;
   void on_right_still(const cv::Mat& still, int64_t utime, int64_t now);
-  void on_axes(const std::vector<Axis>& axes, int64_t now);
-  // One camera's symmetry lines (SYMMETRY_LEFT / SYMMETRY_RIGHT, 640x480) during a survey: they
-  // tell which candidates both cameras really see (Candidate::stereo_agreement).
-  void on_lines(bool left, const std::vector<symmetry::Line>& lines, int64_t now);
+  // 3D axes of the stereo pair captured at `utime` (the task clock): only axes of frames taken
+  // axes_from_s after the nudge ended count, however late a lagging pipeline delivers them.
+  void on_axes(const std::vector<Axis>& axes, int64_t utime, int64_t now);
+  // One camera's symmetry lines (SYMMETRY_LEFT / SYMMETRY_RIGHT, 640x480) of the frame captured at
+  // `utime`, during a survey: they tell which candidates both cameras really see
+  // (Candidate::stereo_agreement). Lines of frames taken before the survey began are ignored.
+  void on_lines(bool left, const std::vector<symmetry::Line>& lines, int64_t utime, int64_t now);
   // Learning: the left still (SNAPSHOT_LEFT), the learner's answers and whether it is alive.
   void on_left_still(const cv::Mat& still, int64_t utime, int64_t now);
   void on_recognition(int64_t seq, const std::string& label, const std::string& reason, int64_t now);
