@@ -61,6 +61,7 @@ void validate(const Workspace& w) {
 }
 
 Workspace load_workspace(const std::string& path) {
+  if (!std::ifstream(path).good()) throw std::runtime_error(path + ": cannot read the workspace file");
   const YAML::Node root = read_yaml_file(path, "workspace");
   if (!root.IsMap()) fail(path, "(top level)", "expected a map of workspace fields");
   const std::set<std::string> known(std::begin(kFields), std::end(kFields));
