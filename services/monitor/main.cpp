@@ -16,6 +16,7 @@
 #include "nudge/bus/image.hpp"
 #include "nudge/bus/service.hpp"
 #include "nudge/bus/symmetry_convert.hpp"
+#include "nudge/heartbeat_t.hpp"
 #include "nudge/log.hpp"
 #include "nudge/sim_state_t.hpp"
 #include "nudge/timing.hpp"
@@ -72,6 +73,18 @@ int main(int argc, char** argv) {
     if (!draw_dir.empty()) ::mkdir(draw_dir.c_str(), 0755);
     service.start();
     service.watch_heartbeats();  // every service: a killed one is named within 3 s
+    // Every service's state as it changes ("symmetry DEGRADED: CAMERA_LEFT silent for 3.1 s"): a
+    // service that degrades and recovers is seen here, not only in its own log.
+    std::map<std::string, int8_t> states_seen;
+    service.subscriptions().subscribe<heartbeat_t>(bus::channel::HEARTBEAT, [&](const heartbeat_t& hb, const std::string&) {
+      const std::string source = hb.instance.empty() || hb.instance == hb.service ? hb.service : hb.service + "/" + hb.instance;
+      const auto seen_state = states_seen.find(source);
+      if (seen_state != states_seen.end() && seen_state->second == hb.state) return;
+      states_seen[source] = hb.state;
+      const char* names[] = {"STARTING", "RUNNING", "DEGRADED", "STOPPING"};  // heartbeat_t::STATE_*
+      const std::string state = hb.state >= 0 && hb.state < 4 ? names[hb.state] : "state " + std::to_string(hb.state);
+      log::info() << "heartbeat: " << source << " " << state << ": " << hb.status;
+    });
 
     std::map<std::string, std::map<int64_t, cv::Mat>> frames;  // camera channel -> utime -> image
     std::map<std::string, std::set<int64_t>> seen;
