@@ -61,7 +61,7 @@ camera
 wait_for "SYMMETRY_LEFT frame" 20 "$work/monitor.log"
 wait_for "finished after" 30 "$work/camera.log"  # the file's end
 wait_for "no messages: CAMERA_LEFT silent" 10 "$work/symmetry.log"
-wait_for "heartbeat: symmetry DEGRADED: .*CAMERA_LEFT silent for" 5 "$work/monitor.log"
+wait_for "heartbeat: symmetry DEGRADED: .*CAMERA_LEFT silent for" 10 "$work/monitor.log"
 t_end=$(stamp_of "no messages: CAMERA_LEFT silent" "$work/symmetry.log")
 
 # 2. Frames again (a new camera, looping): the stream is back, and RUNNING after the hold.
@@ -74,7 +74,7 @@ wait_for "heartbeat: symmetry RUNNING: " 15 "$work/monitor.log" $((running + 1))
 kill -STOP $cam
 stalled=$(date +%s.%N)
 wait_for "no messages: CAMERA_LEFT silent" 10 "$work/symmetry.log" 2
-wait_for "heartbeat: symmetry DEGRADED: .*CAMERA_LEFT silent for" 5 "$work/monitor.log" 2
+wait_for "heartbeat: symmetry DEGRADED: .*CAMERA_LEFT silent for" 10 "$work/monitor.log" 2
 t_stall=$(awk -v a="$stalled" -v s="$started" -v b="$(stamp_of "no messages: CAMERA_LEFT silent" "$work/symmetry.log" 2)" \
   'BEGIN { printf "%.2f", b + s - a }')
 running=$(grep -c "heartbeat: symmetry RUNNING: " "$work/monitor.log" || true)

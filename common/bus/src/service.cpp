@@ -7,6 +7,7 @@
 #include <iostream>
 
 #include "nudge/bus/channels.hpp"
+#include "nudge/bus/log_file.hpp"
 #include "nudge/heartbeat_t.hpp"
 #include "nudge/log.hpp"
 #include "nudge/timing.hpp"
@@ -202,6 +203,7 @@ int Service::run(const std::function<int()>& tick, int wait_ms) {
       if (stop_requested()) break;  // a signal interrupted the wait
       if (from_log) {
         log::info() << "input log finished";
+        report_truncated_input();
       } else {
         log::error() << "LCM input failed";
         exit_code = 1;
@@ -221,6 +223,17 @@ int Service::run(const std::function<int()>& tick, int wait_ms) {
   log::info() << "stopping: " << counters_.messages_in << " in, " << counters_.messages_out << " out, "
               << counters_.errors << " errors";
   return exit_code;
+}
+
+void Service::report_truncated_input() const {
+  const std::string path = log_path_of_url(lcm_in_.empty() ? lcm_url_ : lcm_in_);
+  if (path.empty()) return;
+  try {
+    const std::string cut = describe_truncation(path, scan_log(path));
+    if (!cut.empty()) log::warn() << cut;
+  } catch (const std::runtime_error& e) {
+    log::warn() << "cannot check the input log's end: " << e.what();
+  }
 }
 
 int guarded_main(const std::string& name, const std::function<int()>& body) {

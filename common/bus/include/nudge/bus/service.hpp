@@ -102,6 +102,8 @@ class Service {
   void publish_heartbeat(int8_t state, int64_t now_utime);
   void attach(lcm::LCM& input, lcm::LCM& output);
   static int64_t wall_utime_now();
+  // At the end of an input log: warns when it ended in the middle of an event (LCM stops silently).
+  void report_truncated_input() const;
   std::string describe_status(const std::vector<HeartbeatWatch::Silent>& silent,
                               const std::vector<StreamWatch::Silent>& quiet) const;
 
