@@ -50,9 +50,9 @@ trap 'kill -CONT $cam 2>/dev/null; kill -INT $cam $sym $mon 2>/dev/null || true'
 sym=$!
 "$bin/nudge-monitor" --lcm-url "$url" 2>"$work/monitor.log" &
 mon=$!
-camera() {  # camera ARGS...: 5 Hz from the ten scenes
+camera() {  # camera ARGS...: 2 Hz from the ten scenes (a loaded machine keeps up: no missed frames)
   "$bin/nudge-camera" --lcm-url "$url" --left "images:$work/scenes/*.png" --right "images:$work/scenes/*.png" \
-    --rate 5 --format png "$@" 2>>"$work/camera.log" >/dev/null &
+    --rate 2 --format png "$@" 2>>"$work/camera.log" >/dev/null &
   cam=$!
 }
 
@@ -68,7 +68,7 @@ t_end=$(stamp_of "no messages: CAMERA_LEFT silent" "$work/symmetry.log")
 running=$(grep -c "heartbeat: symmetry RUNNING: " "$work/monitor.log" || true)
 camera --loop
 wait_for "every watched stream is flowing again" 10 "$work/symmetry.log"
-wait_for "heartbeat: symmetry RUNNING: " 15 "$work/monitor.log" $((running + 1))
+wait_for "heartbeat: symmetry RUNNING: " 20 "$work/monitor.log" $((running + 1))
 
 # 3. The stream stalls: the camera process stopped (no frames, no heartbeats), then resumed.
 kill -STOP $cam
@@ -80,7 +80,7 @@ t_stall=$(awk -v a="$stalled" -v s="$started" -v b="$(stamp_of "no messages: CAM
 running=$(grep -c "heartbeat: symmetry RUNNING: " "$work/monitor.log" || true)
 kill -CONT $cam
 wait_for "every watched stream is flowing again" 10 "$work/symmetry.log" 2
-wait_for "heartbeat: symmetry RUNNING: " 15 "$work/monitor.log" $((running + 1))
+wait_for "heartbeat: symmetry RUNNING: " 20 "$work/monitor.log" $((running + 1))
 
 kill -INT $cam $sym $mon
 wait $cam $sym $mon 2>/dev/null || true
