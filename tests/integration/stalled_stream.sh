@@ -24,7 +24,6 @@ bin=$1; work=$2
 ip link set lo up multicast on
 ip route add 224.0.0.0/4 dev lo
 url="udpm://239.255.76.67:7667?ttl=0&recv_buf_size=16777216"
-started=$(date +%s.%N)
 
 # Waits up to $2 seconds until the pattern $1 matches at least ${4:-1} lines of file $3.
 wait_for() {
@@ -36,16 +35,13 @@ wait_for() {
   tail -n 30 "$work"/*.log >&2
   return 1
 }
-# Seconds from the start to the log line's own stamp of the n-th ($3) match of $1 in $2.
+# The time (s since the epoch) of the n-th ($3) line matching $1 in $2, by the line's own stamp.
 stamp_of() {
-  local line
-  line=$(grep -- "$1" "$2" | sed -n "${3:-1}p" | cut -d' ' -f1)
-  awk -v a="$started" -v b="$(date -d "$line" +%s.%N)" 'BEGIN { printf "%.2f", b - a }'
+  date -d "$(grep -- "$1" "$2" | sed -n "${3:-1}p" | cut -d' ' -f1)" +%s.%N
 }
+count() { grep -c -- "$1" "$2" || true; }
+seconds() { awk -v a="$1" -v b="$2" 'BEGIN { printf "%.2f", b - a }'; }
 
-cam= sym= mon=
-# On failure too: no process left holding ctest's output open.
-trap 'kill -CONT $cam 2>/dev/null; kill -INT $cam $sym $mon 2>/dev/null || true' EXIT
 "$bin/nudge-symmetry" --lcm-url "$url" --inputs CAMERA_LEFT,CAMERA_RIGHT 2>"$work/symmetry.log" &
 sym=$!
 "$bin/nudge-monitor" --lcm-url "$url" 2>"$work/monitor.log" &
@@ -62,24 +58,28 @@ wait_for "SYMMETRY_LEFT frame" 20 "$work/monitor.log"
 wait_for "finished after" 30 "$work/camera.log"  # the file's end
 wait_for "no messages: CAMERA_LEFT silent" 10 "$work/symmetry.log"
 wait_for "heartbeat: symmetry DEGRADED: .*CAMERA_LEFT silent for" 10 "$work/monitor.log"
-t_end=$(stamp_of "no messages: CAMERA_LEFT silent" "$work/symmetry.log")
+t_end=$(seconds "$(stamp_of "finished after" "$work/camera.log")" "$(stamp_of "no messages: CAMERA_LEFT silent" "$work/symmetry.log")")
 
 # 2. Frames again (a new camera, looping): the stream is back, and RUNNING after the hold.
-running=$(grep -c "heartbeat: symmetry RUNNING: " "$work/monitor.log" || true)
+running=$(count "heartbeat: symmetry RUNNING: " "$work/monitor.log")
 camera --loop
 wait_for "every watched stream is flowing again" 10 "$work/symmetry.log"
 wait_for "heartbeat: symmetry RUNNING: " 20 "$work/monitor.log" $((running + 1))
 
 # 3. The stream stalls: the camera process stopped (no frames, no heartbeats), then resumed.
+quiet=$(count "no messages: " "$work/symmetry.log")
+degraded=$(count "heartbeat: symmetry DEGRADED: .*CAMERA_LEFT silent for" "$work/monitor.log")
+flowing=$(count "every watched stream is flowing again" "$work/symmetry.log")
 kill -STOP $cam
 stalled=$(date +%s.%N)
-wait_for "no messages: CAMERA_LEFT silent" 10 "$work/symmetry.log" 2
-wait_for "heartbeat: symmetry DEGRADED: .*CAMERA_LEFT silent for" 10 "$work/monitor.log" 2
-t_stall=$(awk -v a="$stalled" -v s="$started" -v b="$(stamp_of "no messages: CAMERA_LEFT silent" "$work/symmetry.log" 2)" \
-  'BEGIN { printf "%.2f", b + s - a }')
-running=$(grep -c "heartbeat: symmetry RUNNING: " "$work/monitor.log" || true)
+wait_for "no messages: " 10 "$work/symmetry.log" $((quiet + 1))
+grep -- "no messages: " "$work/symmetry.log" | sed -n "$((quiet + 1))p" | grep -q "CAMERA_LEFT silent" ||
+  { echo "FAILED: the stall was not named as CAMERA_LEFT's" >&2; exit 1; }
+wait_for "heartbeat: symmetry DEGRADED: .*CAMERA_LEFT silent for" 10 "$work/monitor.log" $((degraded + 1))
+t_stall=$(seconds "$stalled" "$(stamp_of "no messages: " "$work/symmetry.log" $((quiet + 1)))")
+running=$(count "heartbeat: symmetry RUNNING: " "$work/monitor.log")
 kill -CONT $cam
-wait_for "every watched stream is flowing again" 10 "$work/symmetry.log" 2
+wait_for "every watched stream is flowing again" 10 "$work/symmetry.log" $((flowing + 1))
 wait_for "heartbeat: symmetry RUNNING: " 20 "$work/monitor.log" $((running + 1))
 
 kill -INT $cam $sym $mon
@@ -87,5 +87,5 @@ wait $cam $sym $mon 2>/dev/null || true
 trap - EXIT
 grep -h "no messages\|flowing again" "$work/symmetry.log"
 grep -h "heartbeat: symmetry" "$work/monitor.log"
-echo "PASSED: the ended stream was named ${t_end} s after the start, the stalled one ${t_stall} s after SIGSTOP; RUNNING again both times"
+echo "PASSED: the ended stream was named ${t_end} s after the camera logged its end, the stalled one ${t_stall} s after SIGSTOP; RUNNING again both times"
 INNER
