@@ -15,6 +15,7 @@ NUDGE_PACKAGES=(
   iproute2 util-linux procps opencv-doc
   libcpp-httplib-dev nlohmann-json3-dev chromium
   clang-14 libfuzzer-14-dev
+  libyaml-cpp-dev
 )
 
 nudge_log() { printf '\033[1m[nudge]\033[0m %s\n' "$*" >&2; }

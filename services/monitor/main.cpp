@@ -5,6 +5,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -16,6 +17,7 @@
 #include "nudge/bus/image.hpp"
 #include "nudge/bus/service.hpp"
 #include "nudge/bus/symmetry_convert.hpp"
+#include "nudge/heartbeat_t.hpp"
 #include "nudge/log.hpp"
 #include "nudge/sim_state_t.hpp"
 #include "nudge/timing.hpp"
@@ -72,6 +74,21 @@ int main(int argc, char** argv) {
     if (!draw_dir.empty()) ::mkdir(draw_dir.c_str(), 0755);
     service.start();
     service.watch_heartbeats();  // every service: a killed one is named within 3 s
+    // Every service's state and what it reports as they change ("symmetry DEGRADED: CAMERA_LEFT
+    // silent for 3.1 s"; numbers ignored, so a counting status is not a change a second): a
+    // service that degrades and recovers is seen here, not only in its own log.
+    std::map<std::string, std::string> reported;
+    service.subscriptions().subscribe<heartbeat_t>(bus::channel::HEARTBEAT, [&](const heartbeat_t& hb, const std::string&) {
+      const std::string source = hb.instance.empty() || hb.instance == hb.service ? hb.service : hb.service + "/" + hb.instance;
+      std::string key = std::to_string(hb.state) + " ";
+      for (char c : hb.status)
+        if (!std::isdigit(static_cast<unsigned char>(c))) key += c;
+      if (reported[source] == key) return;
+      reported[source] = key;
+      const char* names[] = {"STARTING", "RUNNING", "DEGRADED", "STOPPING"};  // heartbeat_t::STATE_*
+      const std::string state = hb.state >= 0 && hb.state < 4 ? names[hb.state] : "state " + std::to_string(hb.state);
+      log::info() << "heartbeat: " << source << " " << state << ": " << hb.status;
+    });
 
     std::map<std::string, std::map<int64_t, cv::Mat>> frames;  // camera channel -> utime -> image
     std::map<std::string, std::set<int64_t>> seen;

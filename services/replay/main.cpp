@@ -11,6 +11,7 @@
 #include <set>
 
 #include "nudge/bus/channels.hpp"
+#include "nudge/bus/log_file.hpp"
 #include "nudge/bus/service.hpp"
 #include "nudge/log.hpp"
 #include "nudge/replay_command_t.hpp"
@@ -47,19 +48,16 @@ class LogReader {
   lcm::LogFile log_;
 };
 
+// One pass over the log for its first and last times and its length (the status reports them),
+// and whether it ends in the middle of an event.
 struct LogExtent {
   int64_t start = 0, end = 0, events = 0;
+  std::string truncation;  // bus::describe_truncation: "" for a whole log
 };
 
-// One pass over the log for its first and last times and its length (the status reports them).
 LogExtent scan(const std::string& path) {
-  LogReader reader(path);
-  LogExtent extent;
-  while (auto e = reader.next()) {
-    if (extent.events++ == 0) extent.start = e->timestamp;
-    extent.end = e->timestamp;
-  }
-  return extent;
+  const bus::LogScan log = bus::scan_log(path);
+  return {log.first_utime, log.last_utime, log.events, bus::describe_truncation(path, log)};
 }
 
 class Player {
@@ -130,6 +128,7 @@ class Player {
   }
 
   const LogExtent& extent() const { return extent_; }
+  int64_t played() const { return events_; }
 
  private:
   bus::Service& service_;
@@ -169,6 +168,7 @@ int main(int argc, char** argv) {
     Player player(service, f.positional()[0], pacer, std::set<std::string>(steps.begin(), steps.end()));
     log::info() << "playing " << f.positional()[0] << ": " << player.extent().events << " events, "
                 << (player.extent().end - player.extent().start) * 1e-6 << " s" << (paused ? " (paused)" : "");
+    if (!player.extent().truncation.empty()) log::warn() << player.extent().truncation;
 
     service.start();
     service.subscriptions().subscribe<replay_command_t>(
@@ -180,7 +180,8 @@ int main(int argc, char** argv) {
         throw std::runtime_error("LCM input failed");
       wait_ms = player.play_due();
       if (wait_ms < 0) {
-        log::info() << "log finished";
+        log::info() << "log finished: " << player.played() << " events played";
+        if (!player.extent().truncation.empty()) log::warn() << player.extent().truncation;
         break;
       }
     }

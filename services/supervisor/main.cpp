@@ -218,6 +218,12 @@ class Shell {
       service_.request_stop();
       return;
     }
+    if (m.utime + 1000000 < newest_beat_) {
+      // The replayed log went back (restarted, or the next of two logs): every service counts as
+      // heard now, not as silent until the stamps catch up with the old ones.
+      for (auto& [name, beat] : last_beat_) beat = std::min(beat, m.utime);
+      newest_beat_ = m.utime;
+    }
     last_beat_[m.service] = m.utime;
     newest_beat_ = std::max(newest_beat_, m.utime);
     check_services(service_.input_is_log() ? newest_beat_ : wall_utime());
@@ -292,6 +298,15 @@ class Shell {
 
   // ---- time and health ----
   void advance(int64_t now) {
+    // A stamp a little behind is another sender's clock or a late message: the clock stays. Far
+    // behind, the world or the log restarted: the clock follows and the timeouts restart.
+    constexpr int64_t kClockRestartUs = 1000000;
+    if (started_ && now + kClockRestartUs < now_) {
+      log::warn() << "the task clock went back " << (now_ - now) * 1e-6
+                  << " s (a restarted world or log): the current step's timeout counts from now";
+      now_ = now;
+      supervisor_.on_clock_restart(now);
+    }
     now_ = std::max(now_, now);
     // Live, listen for another supervisor's heartbeat (1 Hz) before taking the arm.
     if (!started_ && !service_.input_is_log() && wall_utime() < listen_until_) return;

@@ -59,6 +59,7 @@ int main(int argc, char** argv) {
     options.inputs = split_list(inputs);
     service.start();
     service.watch_heartbeats({"camera"});  // its input: say so when the camera goes quiet
+    service.watch_streams(options.inputs);  // and when its frames stop while it lives (a stall, a file's end)
     const symmetry_service::Handlers handlers(service, options);
     return service.run();
   });

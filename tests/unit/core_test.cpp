@@ -9,6 +9,7 @@
 #include "nudge/flags.hpp"
 #include "nudge/image_header.hpp"
 #include "nudge/json.hpp"
+#include "nudge/yaml_file.hpp"
 
 using namespace nudge;
 
@@ -247,4 +248,100 @@ TEST(ImageHeader, RefusesTruncatedAndForeignData) {
   const std::vector<uint8_t> text = {'h', 'e', 'l', 'l', 'o'};
   EXPECT_NE(check_compressed_image(text.data(), text.size()).find("not a PNG or JPEG"), std::string::npos);
   EXPECT_NE(check_compressed_image(nullptr, 0), "");
+}
+
+// ---------------------------------------------------------------------------------------------
+// YAML configuration files (yaml-cpp, not cv::FileStorage, which loops for ever on some inputs)
+
+namespace {
+// The error parse_yaml gives for `text`, or "" when it parses.
+std::string yaml_error(const std::string& text) {
+  try {
+    parse_yaml(text, "bad.yaml", "test");
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  return "";
+}
+}  // namespace
+
+TEST(YamlFile, ReadsOpenCVsHeaderTagsAndNumbers) {
+  // As cv::FileStorage writes a matrix: the `%YAML:1.0` directive, a tag, `0.` and `1.`.
+  const YAML::Node root = parse_yaml(
+      "%YAML:1.0\n---\nK: !!opencv-matrix\n   rows: 1\n   cols: 3\n   dt: d\n"
+      "   data: [ 5.7941125496954282e+02, 0., 1. ]\nname: \"3\"\nempty:\ntilde: ~\n",
+      "rig.yaml", "test");
+  const auto K = yaml_field(root, "K");
+  ASSERT_TRUE(K.has_value());
+  EXPECT_EQ(yaml_int(*yaml_field(*K, "rows")), 1);
+  EXPECT_EQ(yaml_text(*yaml_field(*K, "dt")), "d");
+  std::vector<double> data;
+  const YAML::Node items = *yaml_field(*K, "data");
+  for (const YAML::Node& item : items) data.push_back(yaml_number(item).value_or(-1));
+  EXPECT_EQ(data, (std::vector<double>{579.41125496954282, 0, 1}));
+  EXPECT_EQ(yaml_text(*yaml_field(root, "name")), "3") << "a quoted number is text";
+  EXPECT_FALSE(yaml_int(*yaml_field(root, "name")).has_value());
+  EXPECT_FALSE(yaml_field(root, "empty").has_value()) << "a null value counts as missing, as in OpenCV";
+  EXPECT_FALSE(yaml_field(root, "tilde").has_value());
+  EXPECT_FALSE(yaml_field(root, "absent").has_value());
+  EXPECT_FALSE(yaml_field(*yaml_field(*K, "rows"), "x").has_value()) << "a scalar has no fields";
+  EXPECT_EQ(yaml_keys(root), (std::vector<std::string>{"K", "name", "empty", "tilde"}));
+}
+
+TEST(YamlFile, TypesScalarsAsOpenCVDoes) {
+  const auto scalar = [](const std::string& text) { return YAML::Load("v: " + text)["v"]; };
+  EXPECT_EQ(yaml_int(scalar("-42")), -42);
+  EXPECT_EQ(yaml_int(scalar("+7")), 7);
+  EXPECT_FALSE(yaml_int(scalar("4.0")).has_value());
+  EXPECT_FALSE(yaml_int(scalar("99999999999")).has_value()) << "beyond an int";
+  EXPECT_EQ(yaml_number(scalar("1.")), 1.0);
+  EXPECT_EQ(yaml_number(scalar(".5")), 0.5);
+  EXPECT_EQ(yaml_number(scalar("+2.5e-1")), 0.25);
+  EXPECT_EQ(yaml_number(scalar("-3")), -3.0);
+  EXPECT_TRUE(std::isinf(*yaml_number(scalar(".Inf"))));
+  EXPECT_LT(*yaml_number(scalar("-.inf")), 0);
+  EXPECT_TRUE(std::isnan(*yaml_number(scalar(".Nan"))));
+  for (const char* text : {"abc", "1.2.3", "0x10", "inf", "nan", "1e999", "+-1", "+", "'1.5'", "12abc"}) {
+    EXPECT_FALSE(yaml_number(scalar(text)).has_value()) << text;
+    EXPECT_TRUE(yaml_text(scalar(text)).has_value()) << text;
+  }
+  EXPECT_FALSE(yaml_text(scalar("[1, 2]")).has_value());
+  EXPECT_FALSE(yaml_number(scalar("{a: 1}")).has_value());
+}
+
+TEST(YamlFile, MalformedTextIsAnErrorNamingTheSourceAndLine) {
+  // cv::FileStorage loops for ever on the first (found by fuzz_workspace).
+  const std::string hang = "%YAML:1.0\n---a%YAML:1.0\n-#e \n --\nr flagstool_l#en The a";
+  for (const std::string& text : {std::string("%YAML:1.0\nobjects: [1, 2\n"), std::string("a: b: c\n"),
+                                  std::string("a: [1, 2]]\n"), std::string("a:\n\tb: 1\n"),
+                                  std::string("a: *nowhere\n"), std::string(64000, '[')}) {
+    const std::string error = yaml_error(text);
+    EXPECT_EQ(error.rfind("bad.yaml: not a valid test file", 0), 0u) << text.substr(0, 40) << " -> " << error;
+  }
+  // The hang input is YAML to yaml-cpp (a plain scalar): it returns, and the readers refuse it
+  // for its missing fields (geometry_test, robot_workspace_tests, sim_test).
+  EXPECT_TRUE(parse_yaml(hang, "hang.yaml", "test").IsScalar());
+  // An alias may point back into its own node: the readers look fields up by name, never walk.
+  EXPECT_TRUE(parse_yaml("&a [*a]", "cycle.yaml", "test").IsSequence());
+}
+
+TEST(YamlFile, FilesAreReadWholeOrRefusedNamingThem) {
+  const std::string dir = ::testing::TempDir();
+  const std::string path = dir + "/yaml_file_test.yaml";
+  std::ofstream(path) << "%YAML:1.0\n---\na: 1\n";
+  EXPECT_EQ(yaml_int(*yaml_field(read_yaml_file(path, "test"), "a")), 1);
+  try {
+    read_yaml_file(dir + "/no_such.yaml", "workspace");
+    FAIL() << "a missing file read";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), dir + "/no_such.yaml: cannot open workspace file");
+  }
+  std::ofstream(path) << std::string(kMaxYamlFileBytes + 1, '#');
+  try {
+    read_yaml_file(path, "scene");
+    FAIL() << "a file beyond the limit read";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(path + ": larger than a scene file can be"), std::string::npos) << e.what();
+  }
+  std::remove(path.c_str());
 }

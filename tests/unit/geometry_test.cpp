@@ -549,6 +549,66 @@ TEST(GeometryRig, MissingOrBadFieldNamesFieldAndFile) {
   std::filesystem::remove(path);
 }
 
+// The rig files are OpenCV's: what save_rig writes reads back in cv::FileStorage, and a file
+// OpenCV writes (the shipped calibration) reads the same through load_rig's yaml-cpp.
+TEST(GeometryRig, FilesStayOpenCVs) {
+  const StereoRig rig = verged_rig();
+  const std::string path = temp_path("opencv.yaml");
+  save_rig(rig, path);
+  cv::FileStorage fs(path, cv::FileStorage::READ);
+  cv::Mat K;
+  fs["left"]["camera_matrix"] >> K;
+  Eigen::Matrix3d k;
+  cv::cv2eigen(K, k);
+  EXPECT_LT((k - rig.left.K).norm(), 1e-12);
+  EXPECT_EQ(static_cast<int>(fs["right"]["image_width"]), 640);
+  fs.release();
+  std::filesystem::remove(path);
+
+  const std::string shipped = std::string(NUDGE_SOURCE_DIR) + "/config/calibration_sim.yaml";
+  const StereoRig loaded = load_rig(shipped);
+  cv::FileStorage opencv(shipped, cv::FileStorage::READ);
+  cv::Mat R;
+  opencv["R"] >> R;
+  Eigen::Matrix3d r;
+  cv::cv2eigen(R, r);
+  EXPECT_EQ((loaded.R - r).norm(), 0.0);
+}
+
+TEST(GeometryRig, MalformedFilesAreRefusedNamingFileAndField) {
+  const std::string path = temp_path("malformed.yaml");
+  const auto error = [&](const std::string& text) {
+    std::ofstream(path) << text;
+    try {
+      load_rig(path);
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string("(loaded)");
+  };
+  // cv::FileStorage, which read rigs before, looped for ever on this one (found by fuzz_workspace).
+  std::string what = error("%YAML:1.0\n---a%YAML:1.0\n-#e \n --\nr flagstool_l#en The a");
+  EXPECT_EQ(what, path + ": field 'left.image_width' is missing");
+  save_rig(verged_rig(), path);
+  std::stringstream text;
+  text << std::ifstream(path).rdbuf();
+  const std::string full = text.str();
+  const auto with = [&](const std::string& from, const std::string& to) {
+    std::string changed = full;
+    changed.replace(changed.find(from), from.size(), to);
+    return changed;
+  };
+  what = error(with("rows: 3", "rows: 100000"));
+  EXPECT_NE(what.find("'left.camera_matrix' declares 100000x3"), std::string::npos) << what;
+  what = error(with("dt: d", "dt: 3d"));
+  EXPECT_NE(what.find("'left.camera_matrix.dt'"), std::string::npos) << what;
+  what = error(with("data: [", "data: [ 1.,"));
+  EXPECT_NE(what.find("'left.camera_matrix.data' must be a list of 9 numbers"), std::string::npos) << what;
+  what = error(with("image_width: 640", "image_width: [640"));
+  EXPECT_EQ(what.rfind(path + ": not a valid stereo rig file: line", 0), 0u) << what;
+  std::filesystem::remove(path);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Stereo consistency of CANDIDATES (issue 14)
 

@@ -148,6 +148,23 @@ TEST(WorkspaceFile, UnreadableFileIsNamed) {
   EXPECT_TRUE(contains(error, "garbage_")) << error;
 }
 
+// OpenCV's cv::FileStorage, which read this file before, looped for ever on the first (found by
+// fuzz_workspace): a service given it hung at start-up. Every malformed file is now refused.
+TEST(WorkspaceFile, MalformedYamlIsRefusedNamingTheFileNotLoopedOn) {
+  std::string error = load_error("hang", "%YAML:1.0\n---a%YAML:1.0\n-#e \n --\nr flagstool_l#en The a");
+  EXPECT_TRUE(contains(error, "hang_")) << error;
+  EXPECT_TRUE(contains(error, "(top level): expected a map of workspace fields")) << error;
+  error = load_error("flow", replace(kGoodWorkspace, "tool_length: 0.12", "tool_length: [0.12]]"));
+  EXPECT_TRUE(contains(error, "flow_")) << error;
+  EXPECT_TRUE(contains(error, "not a valid workspace file: line")) << error;
+  error = load_error("quoted", replace(kGoodWorkspace, "tool_length: 0.12", "tool_length: '0.12'"));
+  EXPECT_TRUE(contains(error, "tool_length: expected a number")) << error;
+  error = load_error("empty", "");
+  EXPECT_TRUE(contains(error, "(top level): expected a map")) << error;
+  error = load_error("alias", std::string(kGoodWorkspace) + "loop: &a [*a]\n");
+  EXPECT_TRUE(contains(error, "loop: unknown field")) << error;
+}
+
 TEST(WorkspaceFile, SavedFileLoadsTheSame) {
   Workspace w;
   w.base_yaw = 0.3;

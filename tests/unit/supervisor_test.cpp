@@ -446,6 +446,25 @@ TEST_F(SupervisorTest, ASnapshotThatNeverComesEndsTheAttemptAfterItsTimeout) {
   EXPECT_THROW(s.on_right_still(cv::Mat(480, 640, CV_8UC3), now_, now_), std::invalid_argument);  // wrong size: named
 }
 
+// A clock that goes back an hour (the world or the log restarted) would leave the run waiting an
+// hour for a snapshot; restarted, the timeout counts from the new time and the attempt ends.
+TEST_F(SupervisorTest, AClockThatGoesBackRestartsTheTimeoutsInsteadOfWaitingForItToCatchUp) {
+  sv::Supervisor s = make();
+  start_with(s, {Eigen::Vector3d(0.28, -0.05, 0)});
+  s.on_time(now_ += 5 * kSecond);
+  ASSERT_EQ(s.state(), sv::State::SnapshotBefore);
+  const int64_t back = now_ - 3600 * kSecond;
+  s.on_time(back + 11 * kSecond);
+  EXPECT_EQ(s.state(), sv::State::SnapshotBefore) << "a negative interval is no timeout";
+  s.on_clock_restart(back);
+  s.on_time(back + 5 * kSecond);
+  EXPECT_EQ(s.state(), sv::State::SnapshotBefore);
+  s.on_time(back + 11 * kSecond);
+  const auto ended = outputs_of<sv::AttemptEnded>(s.take_outputs());
+  ASSERT_EQ(ended.size(), 1u);
+  EXPECT_EQ(ended[0].attempt->outcome, sv::Outcome::SnapshotLost);
+}
+
 TEST_F(SupervisorTest, AServiceDyingMidNudgeStopsTheArmPausesAndResumesWithASurvey) {
   sv::Supervisor s = make();
   const Eigen::Vector3d object(0.28, -0.05, 0);

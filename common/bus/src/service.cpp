@@ -7,6 +7,7 @@
 #include <iostream>
 
 #include "nudge/bus/channels.hpp"
+#include "nudge/bus/log_file.hpp"
 #include "nudge/heartbeat_t.hpp"
 #include "nudge/log.hpp"
 #include "nudge/timing.hpp"
@@ -126,10 +127,36 @@ std::vector<HeartbeatWatch::Silent> Service::check_heartbeats(int64_t now_utime)
   return silent;
 }
 
-std::string Service::describe_status(const std::vector<HeartbeatWatch::Silent>& silent) const {
+void Service::watch_streams(const std::vector<std::string>& channels) {
+  if (!subscriptions_) throw std::logic_error("service " + name_ + ": watch_streams() before start()");
+  if (input_is_log()) return;
+  if (!streams_) streams_ = std::make_unique<StreamWatch>();
+  for (const std::string& channel : channels)
+    subscriptions_->on_receive(channel, [this](const std::string& ch, int64_t receive_utime) {
+      streams_->on_message(ch, receive_utime);
+    });
+}
+
+std::vector<StreamWatch::Silent> Service::check_streams(int64_t now_utime) {
+  if (!streams_ || input_is_log()) return {};
+  auto quiet = streams_->silent(now_utime);
+  std::string names;
+  for (const auto& q : quiet) names += q.channel + " ";
+  if (names != reported_quiet_) {  // log changes only, not every tick
+    if (!quiet.empty()) log::warn() << "no messages: " << describe(quiet) << " (stream stalled or ended?)";
+    else log::info() << "every watched stream is flowing again";
+    reported_quiet_ = names;
+  }
+  if (!quiet.empty()) last_problem_utime_ = now_utime;
+  return quiet;
+}
+
+std::string Service::describe_status(const std::vector<HeartbeatWatch::Silent>& silent,
+                                     const std::vector<StreamWatch::Silent>& quiet) const {
   std::string text = status_;
   const auto add = [&text](const std::string& part) { text += (text.empty() ? "" : "; ") + part; };
   if (!silent.empty()) add(describe(silent));
+  if (!quiet.empty()) add(describe(quiet));
   for (const auto& [channel, g] : counters_.gaps())
     if (g.missed > 0)
       add(channel + " missed " + std::to_string(g.missed) + " of " + std::to_string(g.missed + g.received));
@@ -142,12 +169,15 @@ std::string Service::describe_status(const std::vector<HeartbeatWatch::Silent>& 
 }
 
 void Service::publish_heartbeat_at(int64_t now_utime) {
-  const std::vector<HeartbeatWatch::Silent> silent = check_heartbeats(now_utime);
+  check_heartbeats(now_utime);
+  check_streams(now_utime);
   const int64_t problems = counters_.errors + counters_.missed;
   if (problems != problems_seen_) {
     problems_seen_ = problems;
     last_problem_utime_ = now_utime;
   }
+  // A clock that went back would hold DEGRADED until it caught up again: the hold restarts.
+  if (last_problem_utime_ > now_utime) last_problem_utime_ = now_utime;
   const bool degraded = last_problem_utime_ >= 0 && now_utime - last_problem_utime_ < kDegradedHoldUs;
   publish_heartbeat(degraded ? heartbeat_t::STATE_DEGRADED : heartbeat_t::STATE_RUNNING, now_utime);
 }
@@ -162,7 +192,9 @@ void Service::publish_heartbeat(int8_t state, int64_t now_utime) {
   hb.messages_in = counters_.messages_in;
   hb.messages_out = counters_.messages_out;
   hb.errors = counters_.errors;
-  hb.status = describe_status(watch_ && !input_is_log() ? watch_->silent(now_utime) : std::vector<HeartbeatWatch::Silent>{});
+  const bool live = !input_is_log();
+  hb.status = describe_status(watch_ && live ? watch_->silent(now_utime) : std::vector<HeartbeatWatch::Silent>{},
+                              streams_ && live ? streams_->silent(now_utime) : std::vector<StreamWatch::Silent>{});
   output().publish(channel::HEARTBEAT, &hb);
 }
 
@@ -178,6 +210,7 @@ int Service::run(const std::function<int()>& tick, int wait_ms) {
       if (stop_requested()) break;  // a signal interrupted the wait
       if (from_log) {
         log::info() << "input log finished";
+        report_truncated_input();
       } else {
         log::error() << "LCM input failed";
         exit_code = 1;
@@ -186,7 +219,8 @@ int Service::run(const std::function<int()>& tick, int wait_ms) {
     }
     wait = tick ? std::min(wait_ms, tick()) : wait_ms;
     const int64_t now = wall_utime();
-    check_heartbeats(now);  // a silent peer is logged when noticed, not at the next heartbeat
+    check_heartbeats(now);  // a silent peer or stream is logged when noticed, not at the next heartbeat
+    check_streams(now);
     if (now >= next_heartbeat) {
       publish_heartbeat_at(now);
       next_heartbeat = now + 1000000;
@@ -196,6 +230,17 @@ int Service::run(const std::function<int()>& tick, int wait_ms) {
   log::info() << "stopping: " << counters_.messages_in << " in, " << counters_.messages_out << " out, "
               << counters_.errors << " errors";
   return exit_code;
+}
+
+void Service::report_truncated_input() const {
+  const std::string path = log_path_of_url(lcm_in_.empty() ? lcm_url_ : lcm_in_);
+  if (path.empty()) return;
+  try {
+    const std::string cut = describe_truncation(path, scan_log(path));
+    if (!cut.empty()) log::warn() << cut;
+  } catch (const std::runtime_error& e) {
+    log::warn() << "cannot check the input log's end: " << e.what();
+  }
 }
 
 int guarded_main(const std::string& name, const std::function<int()>& body) {

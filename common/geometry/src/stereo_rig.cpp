@@ -6,10 +6,11 @@
 #include <opencv2/core/eigen.hpp>  // after Eigen/Core, as OpenCV requires
 
 #include <cmath>
-#include <fstream>
+#include <optional>
 #include <stdexcept>
 
 #include "nudge/atomic_file.hpp"
+#include "nudge/yaml_file.hpp"
 
 namespace nudge::geometry {
 
@@ -94,44 +95,63 @@ void validate(const StereoRig& rig) {
 namespace {
 
 struct Reader {
-  const cv::FileStorage& fs;
+  const YAML::Node& root;
   const std::string& path;
 
   [[noreturn]] void fail(const std::string& field, const std::string& what) const {
     throw std::runtime_error(path + ": field '" + field + "' " + what);
   }
-  cv::FileNode node(const std::string& field) const {
+  YAML::Node node(const std::string& field) const {
     const auto dot = field.find('.');
-    const cv::FileNode n = dot == std::string::npos ? fs[field] : fs[field.substr(0, dot)][field.substr(dot + 1)];
-    if (n.empty() || n.isNone()) fail(field, "is missing");
-    return n;
+    std::optional<YAML::Node> n;
+    if (dot == std::string::npos) {
+      n = yaml_field(root, field);
+    } else if (const auto parent = yaml_field(root, field.substr(0, dot))) {
+      n = yaml_field(*parent, field.substr(dot + 1));
+    }
+    if (!n) fail(field, "is missing");
+    return *n;
   }
   int integer(const std::string& field) const {
-    const cv::FileNode n = node(field);
-    if (!n.isInt()) fail(field, "must be an integer");
-    return static_cast<int>(n);
+    const auto value = yaml_int(node(field));
+    if (!value) fail(field, "must be an integer");
+    return *value;
   }
-  cv::Mat matrix(const std::string& field) const {
-    const cv::FileNode n = node(field);
-    // OpenCV allocates rows x cols before reading the data: a file declaring 100000 columns
-    // would cost gigabytes (found by fuzz_calibration). A rig's matrices are at most 3x3 or 1x5.
+  std::pair<int, int> matrix_size(const std::string& field, const YAML::Node& n) const {
+    const auto rows_node = yaml_field(n, "rows"), cols_node = yaml_field(n, "cols");
+    const auto rows = rows_node ? yaml_int(*rows_node) : std::nullopt;
+    const auto cols = cols_node ? yaml_int(*cols_node) : std::nullopt;
+    if (!rows || !cols) fail(field, "is not an OpenCV matrix (rows, cols, dt, data)");
+    // A rig's matrices are at most 3x3 or 1x5; a bound keeps a file declaring 100000 columns
+    // (found by fuzz_calibration when OpenCV read these files) from costing gigabytes.
     constexpr int kMaxSide = 16;
-    const cv::FileNode rows = n["rows"], cols = n["cols"];
-    if (!n.isMap() || !rows.isInt() || !cols.isInt()) fail(field, "is not an OpenCV matrix");
-    if (static_cast<int>(rows) < 1 || static_cast<int>(rows) > kMaxSide || static_cast<int>(cols) < 1 ||
-        static_cast<int>(cols) > kMaxSide)
-      fail(field, "declares " + std::to_string(static_cast<int>(rows)) + "x" + std::to_string(static_cast<int>(cols)) +
-                      " elements (at most " + std::to_string(kMaxSide) + " a side)");
-    cv::Mat m;
-    try {
-      n >> m;
-    } catch (const cv::Exception&) {
-      fail(field, "is not an OpenCV matrix");
+    const int r = *rows, c = *cols;
+    if (r < 1 || r > kMaxSide || c < 1 || c > kMaxSide)
+      fail(field, "declares " + std::to_string(r) + "x" + std::to_string(c) + " elements (at most " +
+                      std::to_string(kMaxSide) + " a side)");
+    return {r, c};
+  }
+  // An OpenCV matrix (`!!opencv-matrix` rows, cols, dt, data) of one channel, as doubles.
+  cv::Mat matrix(const std::string& field) const {
+    const YAML::Node n = node(field);
+    const auto [rows, cols] = matrix_size(field, n);
+    const auto type = yaml_field(n, "dt");
+    const auto type_name = type ? yaml_text(*type) : std::nullopt;
+    if (!type_name || type_name->size() != 1 || std::string("ucwsifd").find(*type_name) == std::string::npos)
+      fail(field + ".dt", "must be one of OpenCV's one-channel types u, c, w, s, i, f, d");
+    const auto data = yaml_field(n, "data");
+    const int count = rows * cols;
+    const std::string expected = "must be a list of " + std::to_string(count) + " numbers (rows x cols)";
+    if (!data || !data->IsSequence() || data->size() != static_cast<size_t>(count)) fail(field + ".data", expected);
+    cv::Mat m(rows, cols, CV_64F);
+    int i = 0;
+    for (const YAML::Node& item : *data) {
+      const auto value = yaml_number(item);
+      if (!value) fail(field + ".data", expected);
+      m.at<double>(i / cols, i % cols) = *value;
+      ++i;
     }
-    if (m.empty()) fail(field, "is not an OpenCV matrix");
-    cv::Mat d;
-    m.convertTo(d, CV_64F);
-    return d;
+    return m;
   }
 };
 
@@ -162,15 +182,8 @@ void write_camera(cv::FileStorage& fs, const Camera& c, const std::string& side)
 }  // namespace
 
 StereoRig load_rig(const std::string& path) {
-  // Checked first: OpenCV would also log its own error line for a missing file.
-  if (!std::ifstream(path)) throw std::runtime_error(path + ": cannot open stereo rig file");
-  cv::FileStorage fs;
-  try {
-    if (!fs.open(path, cv::FileStorage::READ)) throw std::runtime_error(path + ": cannot open stereo rig file");
-  } catch (const cv::Exception& e) {
-    throw std::runtime_error(path + ": not a readable OpenCV YAML file (" + e.msg + ")");
-  }
-  const Reader in{fs, path};
+  const YAML::Node root = read_yaml_file(path, "stereo rig");
+  const Reader in{root, path};
   StereoRig rig;
   rig.left = read_camera(in, "left");
   rig.right = read_camera(in, "right");

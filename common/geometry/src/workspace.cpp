@@ -3,7 +3,6 @@
 #include <unistd.h>
 
 #include <Eigen/Geometry>  // homogeneous()
-#include <opencv2/core.hpp>
 
 #include <cmath>
 #include <cstdio>
@@ -12,6 +11,7 @@
 #include <stdexcept>
 
 #include "nudge/atomic_file.hpp"
+#include "nudge/yaml_file.hpp"
 
 namespace nudge::geometry {
 
@@ -33,16 +33,17 @@ Plane plane_from_coefficients(const Eigen::Vector4d& c) {
 namespace {
 
 // A top-level sequence of `size` finite numbers, or nothing if the field is absent.
-std::optional<std::vector<double>> read_numbers(const cv::FileStorage& fs, const std::string& path,
+std::optional<std::vector<double>> read_numbers(const YAML::Node& root, const std::string& path,
                                                 const std::string& field, size_t size) {
-  const cv::FileNode node = fs[field];
-  if (node.empty() || node.isNone()) return std::nullopt;
+  const auto node = yaml_field(root, field);
+  if (!node) return std::nullopt;
   const std::string expected = "must be a list of " + std::to_string(size) + " numbers";
-  if (!node.isSeq() || node.size() != size) throw std::runtime_error(path + ": field '" + field + "' " + expected);
+  if (!node->IsSequence() || node->size() != size) throw std::runtime_error(path + ": field '" + field + "' " + expected);
   std::vector<double> values;
-  for (const cv::FileNode& item : node) {
-    if (!item.isReal() && !item.isInt()) throw std::runtime_error(path + ": field '" + field + "' " + expected);
-    values.push_back(static_cast<double>(item));
+  for (const YAML::Node& item : *node) {
+    const auto value = yaml_number(item);
+    if (!value) throw std::runtime_error(path + ": field '" + field + "' " + expected);
+    values.push_back(*value);
     if (!std::isfinite(values.back())) throw std::runtime_error(path + ": field '" + field + "' must be finite");
   }
   return values;
@@ -62,7 +63,7 @@ std::string numbers(std::initializer_list<double> values) {
 }
 
 // The camera-arm calibration: both fields or neither; the rotation must be one.
-std::optional<RigidTransform> read_arm_to_right(const cv::FileStorage& fs, const std::string& path) {
+std::optional<RigidTransform> read_arm_to_right(const YAML::Node& fs, const std::string& path) {
   const auto rotation = read_numbers(fs, path, "arm_to_right_rotation", 9);
   const auto translation = read_numbers(fs, path, "arm_to_right_translation", 3);
   if (!rotation && !translation) return std::nullopt;
@@ -80,13 +81,7 @@ std::optional<RigidTransform> read_arm_to_right(const cv::FileStorage& fs, const
 }  // namespace
 
 Workspace load_workspace(const std::string& path) {
-  if (!std::ifstream(path)) throw std::runtime_error(path + ": cannot open stereo rig file");
-  cv::FileStorage fs;
-  try {
-    if (!fs.open(path, cv::FileStorage::READ)) throw std::runtime_error(path + ": cannot open stereo rig file");
-  } catch (const cv::Exception& e) {
-    throw std::runtime_error(path + ": not a readable OpenCV YAML file (" + e.msg + ")");
-  }
+  const YAML::Node fs = read_yaml_file(path, "stereo rig");
   Workspace workspace;
   if (const auto plane = read_numbers(fs, path, "table_plane", 4)) {
     try {

@@ -1,7 +1,5 @@
 #include "nudge/robot/workspace.hpp"
 
-#include <opencv2/core.hpp>
-
 #include <cmath>
 #include <fstream>
 #include <set>
@@ -9,6 +7,7 @@
 #include <stdexcept>
 
 #include "nudge/atomic_file.hpp"
+#include "nudge/yaml_file.hpp"
 #include "nudge/robot/puma260.hpp"
 #include "nudge/robot/safety.hpp"
 #include "nudge/robot/types.hpp"
@@ -29,13 +28,13 @@ void require(bool ok, const std::string& message) {
   throw std::runtime_error(path + ": " + field + ": " + what);
 }
 
-double required_number(const cv::FileNode& root, const std::string& path, const std::string& key) {
-  const cv::FileNode node = root[key];
-  if (node.empty() || node.isNone()) fail(path, key, "missing (every workspace field is required)");
-  if (!node.isReal() && !node.isInt()) fail(path, key, "expected a number");
-  const double value = static_cast<double>(node);
-  if (!std::isfinite(value)) fail(path, key, "must be finite");
-  return value;
+double required_number(const YAML::Node& root, const std::string& path, const std::string& key) {
+  const auto node = yaml_field(root, key);
+  if (!node) fail(path, key, "missing (every workspace field is required)");
+  const auto value = yaml_number(*node);
+  if (!value) fail(path, key, "expected a number");
+  if (!std::isfinite(*value)) fail(path, key, "must be finite");
+  return *value;
 }
 
 // The file field a validate() message is about (its messages start with the struct's field name).
@@ -62,18 +61,11 @@ void validate(const Workspace& w) {
 }
 
 Workspace load_workspace(const std::string& path) {
-  // Checked first: OpenCV would log its own error for a missing file.
   if (!std::ifstream(path).good()) throw std::runtime_error(path + ": cannot read the workspace file");
-  cv::FileStorage fs;
-  try {
-    if (!fs.open(path, cv::FileStorage::READ)) throw std::runtime_error(path + ": cannot read the workspace file");
-  } catch (const cv::Exception& e) {
-    throw std::runtime_error(path + ": not a workspace file (OpenCV YAML): " + e.what());
-  }
-  const cv::FileNode root = fs.root();
-  if (!root.isMap()) fail(path, "(top level)", "expected a map of workspace fields");
+  const YAML::Node root = read_yaml_file(path, "workspace");
+  if (!root.IsMap()) fail(path, "(top level)", "expected a map of workspace fields");
   const std::set<std::string> known(std::begin(kFields), std::end(kFields));
-  for (const std::string& key : root.keys()) {
+  for (const std::string& key : yaml_keys(root)) {
     if (!known.count(key)) fail(path, key, "unknown field (known: base_yaw_deg, shoulder_height, tool_length, ring_inner, ring_outer, table_margin)");
   }
   Workspace w;

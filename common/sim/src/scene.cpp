@@ -7,7 +7,7 @@
 #include "nudge/sim/objects.hpp"
 #include "nudge/sim/textures.hpp"
 
-#include <opencv2/core.hpp>
+#include "nudge/yaml_file.hpp"
 
 #include <cctype>
 #include <cmath>
@@ -34,67 +34,65 @@ std::string join(const std::string& ctx, const std::string& key) {
 // reported instead of silently ignored.
 class MapReader {
  public:
-  MapReader(const cv::FileNode& node, std::string source, std::string ctx)
+  MapReader(const YAML::Node& node, std::string source, std::string ctx)
       : node_(node), source_(std::move(source)), ctx_(std::move(ctx)) {
-    if (!node_.isMap()) fail(source_, ctx_.empty() ? "(top level)" : ctx_, "expected a map");
+    if (!node_.IsMap()) fail(source_, ctx_.empty() ? "(top level)" : ctx_, "expected a map");
   }
 
   bool has(const std::string& key) {
     used_.insert(key);
-    return !node_[key].empty() && !node_[key].isNone();
+    return yaml_field(node_, key).has_value();
   }
 
   double number(const std::string& key, double def) {
     if (!has(key)) return def;
-    const cv::FileNode n = node_[key];
-    if (!n.isReal() && !n.isInt()) fail(source_, join(ctx_, key), "expected a number");
-    const double v = static_cast<double>(n);
-    if (!std::isfinite(v)) fail(source_, join(ctx_, key), "must be finite");
-    return v;
+    const auto v = yaml_number(*yaml_field(node_, key));
+    if (!v) fail(source_, join(ctx_, key), "expected a number");
+    if (!std::isfinite(*v)) fail(source_, join(ctx_, key), "must be finite");
+    return *v;
   }
 
   int integer(const std::string& key, int def) {
     if (!has(key)) return def;
-    const cv::FileNode n = node_[key];
-    if (!n.isInt()) fail(source_, join(ctx_, key), "expected an integer");
-    return static_cast<int>(n);
+    const auto v = yaml_int(*yaml_field(node_, key));
+    if (!v) fail(source_, join(ctx_, key), "expected an integer");
+    return *v;
   }
 
   bool boolean(const std::string& key, bool def) {
     if (!has(key)) return def;
-    const cv::FileNode n = node_[key];
-    if (n.isInt()) {
-      const int v = static_cast<int>(n);
-      if (v == 0 || v == 1) return v == 1;
-    } else if (n.isString()) {
-      const std::string s = static_cast<std::string>(n);
-      if (s == "true" || s == "yes" || s == "on") return true;
-      if (s == "false" || s == "no" || s == "off") return false;
+    const YAML::Node n = *yaml_field(node_, key);
+    if (const auto v = yaml_int(n)) {
+      if (*v == 0 || *v == 1) return *v == 1;
+    } else if (const auto s = yaml_text(n)) {
+      if (*s == "true" || *s == "yes" || *s == "on") return true;
+      if (*s == "false" || *s == "no" || *s == "off") return false;
     }
     fail(source_, join(ctx_, key), "expected a boolean (0/1, true/false)");
   }
 
   std::string string(const std::string& key, const std::string& def) {
     if (!has(key)) return def;
-    const cv::FileNode n = node_[key];
-    if (!n.isString()) fail(source_, join(ctx_, key), "expected a string");
-    return static_cast<std::string>(n);
+    const auto s = yaml_text(*yaml_field(node_, key));
+    if (!s) fail(source_, join(ctx_, key), "expected a string");
+    return *s;
   }
 
   std::vector<double> numbers(const std::string& key, size_t min_count, size_t max_count) {
-    const cv::FileNode n = node_[key];
+    used_.insert(key);
+    const auto n = yaml_field(node_, key);
     std::ostringstream expect;
     expect << "expected a sequence of " << min_count;
     if (max_count != min_count) expect << " to " << max_count;
     expect << " numbers";
-    if (!n.isSeq() || n.size() < min_count || n.size() > max_count)
+    if (!n || !n->IsSequence() || n->size() < min_count || n->size() > max_count)
       fail(source_, join(ctx_, key), expect.str());
     std::vector<double> out;
-    for (size_t i = 0; i < n.size(); ++i) {
-      const cv::FileNode e = n[static_cast<int>(i)];
-      if (!e.isReal() && !e.isInt()) fail(source_, join(ctx_, key), expect.str());
-      out.push_back(static_cast<double>(e));
-      if (!std::isfinite(out.back())) fail(source_, join(ctx_, key), "must be finite");
+    for (const YAML::Node& e : *n) {
+      const auto v = yaml_number(e);
+      if (!v) fail(source_, join(ctx_, key), expect.str());
+      if (!std::isfinite(*v)) fail(source_, join(ctx_, key), "must be finite");
+      out.push_back(*v);
     }
     return out;
   }
@@ -105,15 +103,15 @@ class MapReader {
     return Eigen::Vector3d(v[0], v[1], v[2]);
   }
 
-  cv::FileNode node(const std::string& key) {
+  // The value of a key has() found (a null node otherwise).
+  YAML::Node node(const std::string& key) {
     used_.insert(key);
-    return node_[key];
+    return yaml_field(node_, key).value_or(YAML::Node());
   }
 
   // Throws for keys that were never asked for.
   void finish() const {
-    for (auto it = node_.begin(); it != node_.end(); ++it) {
-      const std::string name = (*it).name();
+    for (const std::string& name : yaml_keys(node_)) {
       if (!used_.count(name)) fail(source_, join(ctx_, name), "unknown field");
     }
   }
@@ -121,7 +119,7 @@ class MapReader {
   const std::string& ctx() const { return ctx_; }
 
  private:
-  cv::FileNode node_;
+  YAML::Node node_;
   std::string source_, ctx_;
   std::set<std::string> used_;
 };
@@ -219,10 +217,10 @@ ObjectModel checked_model(const ObjectSpec& o, const std::string& src, const std
 // `label: picture.jpg`, or `label: { file: picture.jpg, bottom: 0.03, top: 0.12, specular: .., shininess: .. }`.
 void read_label(MapReader& r, LabelSpec& label, const std::string& source, const std::string& dir) {
   if (!r.has("label")) return;
-  const cv::FileNode node = r.node("label");
+  const YAML::Node node = r.node("label");
   const std::string ctx = join(r.ctx(), "label");
-  if (node.isString()) {
-    label.file = resolve(static_cast<std::string>(node), dir);
+  if (const auto file = yaml_text(node)) {
+    label.file = resolve(*file, dir);
     if (label.file.empty()) fail(source, ctx, "names no picture");
     return;
   }
@@ -288,22 +286,18 @@ Scene default_scene() {
 }
 
 Scene load_scene(const std::string& path) {
-  cv::FileStorage fs;
+  YAML::Node root;
   try {
-    if (!fs.open(path, cv::FileStorage::READ)) throw SceneError(path + ": cannot open scene file");
-  } catch (const cv::Exception& e) {
-    // OpenCV's parser puts "<file>(<line>): <what>" in the "function" part of its message.
-    std::string detail = e.msg;
-    const auto at = detail.find("in function '");
-    if (at != std::string::npos) detail = detail.substr(at + 13);
-    while (!detail.empty() && (detail.back() == '\n' || detail.back() == '\'' || detail.back() == ' '))
-      detail.pop_back();
-    throw SceneError(path + ": not a valid scene file: " + detail);
+    root = read_yaml_file(path, "scene");
+  } catch (const std::runtime_error& e) {
+    throw SceneError(e.what());
   }
+  // A file of comments only (or nothing) is the default scene.
+  if (root.IsNull()) root = YAML::Node(YAML::NodeType::Map);
   Scene scene = default_scene();
   scene.source = path;
   const std::string dir = directory_of(path);
-  MapReader top(fs.root(), path, "");
+  MapReader top(root, path, "");
 
   if (top.has("seed")) {
     const double seed = top.number("seed", 1);
@@ -375,11 +369,12 @@ Scene load_scene(const std::string& path) {
     r.finish();
   }
   if (top.has("objects")) {
-    const cv::FileNode objects = top.node("objects");
-    if (!objects.isSeq()) fail(path, "objects", "expected a sequence of object maps");
-    for (size_t i = 0; i < objects.size(); ++i) {
-      const std::string ctx = "objects[" + std::to_string(i) + "]";
-      MapReader r(objects[static_cast<int>(i)], path, ctx);
+    const YAML::Node objects = top.node("objects");
+    if (!objects.IsSequence()) fail(path, "objects", "expected a sequence of object maps");
+    size_t i = 0;
+    for (const YAML::Node& object : objects) {
+      const std::string ctx = "objects[" + std::to_string(i++) + "]";
+      MapReader r(object, path, ctx);
       ObjectSpec obj;
       if (!r.has("kind")) fail(path, join(ctx, "kind"), "missing (one of cup, mug, bottle, can, marker, mesh)");
       obj.kind = r.string("kind", "");

@@ -392,6 +392,12 @@ int64_t Supervisor::awaited_arm_seq() const {
 
 // ---- inputs ----
 
+void Supervisor::on_clock_restart(int64_t now) {
+  entered_ = now;
+  request_time_ = std::min(request_time_, now);
+  arm_done_time_ = std::min(arm_done_time_, now);
+}
+
 void Supervisor::on_time(int64_t now) {
   switch (state_) {
     case State::WaitServices:

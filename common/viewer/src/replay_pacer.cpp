@@ -25,6 +25,10 @@ int64_t ReplayPacer::wait_us(int64_t event_log_utime, int64_t now_wall) const {
 }
 
 void ReplayPacer::released(int64_t event_log_utime, bool is_step_event, int64_t now_wall) {
+  // The log's time went back (two logs back to back, a recording restarted): without a new
+  // anchor the second part would be due at once, all of it; with one it keeps its own spacing.
+  constexpr int64_t kBackJumpUs = 1000000;
+  if (anchored_ && event_log_utime + kBackJumpUs < position_) anchored_ = false;
   position_ = event_log_utime;
   if (paused_) {
     if (is_step_event) step_pending_ = false;

@@ -284,3 +284,76 @@ TEST(ServiceInProcess, AWatchedServiceThatFallsSilentIsNamedUntilItIsHeardAgain)
   service.handle_pending();
   EXPECT_TRUE(service.check_heartbeats(nudge::wall_utime() + 60000000).empty());
 }
+
+// A camera whose frames stop while its process lives (a hung driver, a video file at its end):
+// its heartbeats say nothing, so the receiving service watches the stream itself.
+TEST(ServiceInProcess, AStreamThatStopsIsNamedDegradedUntilItsFramesReturn) {
+  lcm::LCM bus("memq://");
+  Service service("symmetry", "test service");
+  service.start(bus);
+  service.watch_streams({"CAM"});
+  Probe probe(bus);
+  nudge::image_t frame{};
+  bus.publish("CAM", &frame);
+  service.handle_pending();
+  const int64_t heard = nudge::wall_utime();
+  EXPECT_TRUE(service.check_streams(heard).empty());
+  service.publish_heartbeat_at(heard);
+  service.handle_pending();
+  EXPECT_EQ(probe.heartbeats.get().state + 0, heartbeat_t::STATE_RUNNING + 0);
+
+  const auto quiet = service.check_streams(heard + nudge::bus::kStreamSilentAfterUs + 500000);
+  ASSERT_EQ(quiet.size(), 1u);
+  EXPECT_EQ(quiet[0].channel, "CAM");
+  service.publish_heartbeat_at(heard + 3000000);
+  service.handle_pending();
+  EXPECT_EQ(probe.heartbeats.get().state + 0, heartbeat_t::STATE_DEGRADED + 0);
+  EXPECT_NE(probe.heartbeats.get().status.find("CAM silent for 3."), std::string::npos) << probe.heartbeats.get().status;
+
+  bus.publish("CAM", &frame);  // the frames return
+  service.handle_pending();
+  const int64_t back = nudge::wall_utime();
+  EXPECT_TRUE(service.check_streams(back + 100000).empty());
+  service.publish_heartbeat_at(back + 100000);
+  service.handle_pending();
+  EXPECT_EQ(probe.heartbeats.get().status.find("CAM silent"), std::string::npos) << probe.heartbeats.get().status;
+  EXPECT_EQ(probe.heartbeats.get().state + 0, heartbeat_t::STATE_DEGRADED + 0)
+      << "DEGRADED for kDegradedHoldUs after the silence, RUNNING after (integration_stalled_stream)";
+}
+
+TEST(StreamWatch, ASlowStreamGetsFourOfItsIntervalsAndAClockThatGoesBackRestartsIt) {
+  nudge::bus::StreamWatch watch;
+  for (int i = 0; i < 5; ++i) watch.on_message("SLOW", i * 2000000);  // 0.5 Hz
+  EXPECT_TRUE(watch.silent(8000000 + 3000000).empty()) << "1.5 intervals late: not yet";
+  EXPECT_EQ(watch.silent(8000000 + 8500000).size(), 1u);
+  // The clock goes back (a replayed log restarted): not silence, and the next message restarts it.
+  EXPECT_TRUE(watch.silent(1000).empty());
+  watch.on_message("SLOW", 2000);
+  EXPECT_TRUE(watch.silent(2000 + 2000000).empty());
+  EXPECT_EQ(watch.silent(2000 + nudge::bus::kStreamSilentAfterUs + 1).size(), 1u);
+  EXPECT_EQ(nudge::bus::describe(watch.silent(2000 + 3100000)), "SLOW silent for 3.1 s");
+}
+
+// A wall clock stepped back (NTP, a restarted log's stamps) must not hold DEGRADED until it
+// catches up with the last problem: the hold restarts from now.
+TEST(ServiceInProcess, AClockThatGoesBackRestartsTheDegradedHold) {
+  lcm::LCM bus("memq://");
+  Service service("echo", "test service");
+  service.start(bus);
+  install_echo(service);
+  Probe probe(bus);
+  const heartbeat_t refused = heartbeat(1, "bad");
+  bus.publish("IN", &refused);
+  service.handle_pending();
+  const int64_t now = nudge::wall_utime();
+  service.publish_heartbeat_at(now);
+  service.handle_pending();
+  EXPECT_EQ(probe.heartbeats.get().state + 0, heartbeat_t::STATE_DEGRADED + 0);
+  const int64_t hour_back = now - 3600LL * 1000000;
+  service.publish_heartbeat_at(hour_back);
+  service.handle_pending();
+  EXPECT_EQ(probe.heartbeats.get().state + 0, heartbeat_t::STATE_DEGRADED + 0);
+  service.publish_heartbeat_at(hour_back + nudge::bus::kDegradedHoldUs + 1);
+  service.handle_pending();
+  EXPECT_EQ(probe.heartbeats.get().state + 0, heartbeat_t::STATE_RUNNING + 0);
+}

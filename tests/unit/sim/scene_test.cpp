@@ -85,6 +85,14 @@ TEST(SimScene, ErrorsNameTheFileAndTheField) {
   msg = load_error("%YAML:1.0\nobjects: [1, 2\n");  // not YAML
   EXPECT_NE(msg.find("not a valid scene file"), std::string::npos) << msg;
 
+  // OpenCV's cv::FileStorage, which read scenes before, looped for ever on this one.
+  msg = load_error("%YAML:1.0\n---a%YAML:1.0\n-#e \n --\nr flagstool_l#en The a", &path);
+  EXPECT_NE(msg.find(path + ": (top level): expected a map"), std::string::npos) << msg;
+  msg = load_error("%YAML:1.0\nobjects: &a [*a]\n");  // an alias into itself
+  EXPECT_NE(msg.find("objects[0]: expected a map"), std::string::npos) << msg;
+  msg = load_error("%YAML:1.0\ncameras: { width: '640' }\n");
+  EXPECT_NE(msg.find("cameras.width: expected an integer"), std::string::npos) << msg;
+
   msg = load_error("%YAML:1.0\ntable: { colour: [1.5, 0, 0] }\n");
   EXPECT_NE(msg.find("table.colour"), std::string::npos) << msg;
 

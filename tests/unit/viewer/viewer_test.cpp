@@ -120,6 +120,17 @@ TEST(ReplayPacer, KeepsTheLogsSpacingAtItsSpeed) {
   EXPECT_EQ(pacer.wait_us(log + 2 * kSecond, wall + kSecond), kSecond) << "re-anchored at the new speed";
 }
 
+TEST(ReplayPacer, ALogWhoseTimeGoesBackKeepsItsSpacingFromThere) {
+  ReplayPacer pacer(1.0);
+  const int64_t wall = 1000 * kSecond, log = 50 * kSecond;
+  pacer.released(log, false, wall);
+  pacer.released(log + 10 * kSecond, false, wall + 10 * kSecond);
+  // The second of two logs back to back starts 10 s earlier: due at once, then re-anchored.
+  EXPECT_EQ(pacer.wait_us(log, wall + 10 * kSecond), 0);
+  pacer.released(log, false, wall + 10 * kSecond);
+  EXPECT_EQ(pacer.wait_us(log + kSecond, wall + 10 * kSecond), kSecond) << "its own spacing, not a burst";
+}
+
 TEST(ReplayPacer, PausesStepsToTheNextStepEventAndResumesWhereItStopped) {
   ReplayPacer pacer(1.0, /*paused=*/true);
   const int64_t wall = 1000 * kSecond, log = 50 * kSecond;

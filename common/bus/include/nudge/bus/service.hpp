@@ -13,6 +13,7 @@
 #include <string>
 
 #include "nudge/bus/heartbeat_watch.hpp"
+#include "nudge/bus/stream_watch.hpp"
 #include "nudge/bus/subscribe.hpp"
 #include "nudge/flags.hpp"
 #include "nudge/heartbeat_t.hpp"
@@ -84,6 +85,15 @@ class Service {
   // What watch_heartbeats() finds silent at now_utime; logs sources that went silent or came back.
   std::vector<HeartbeatWatch::Silent> check_heartbeats(int64_t now_utime);
 
+  // Watches the receive times of these channels (a camera's frames), after start(): one that was
+  // heard and then stays quiet (StreamWatch: 2.5 s or 4 of its mean intervals) is logged, named
+  // in the status ("CAMERA_LEFT silent for 3.1 s") and makes this service DEGRADED until its
+  // messages come again. For streams that should be steady, not for requested stills. Does
+  // nothing when the input is a log (a log's pace is the player's).
+  void watch_streams(const std::vector<std::string>& channels);
+  // What watch_streams() finds silent at now_utime; logs channels that went silent or came back.
+  std::vector<StreamWatch::Silent> check_streams(int64_t now_utime);
+
   void request_stop() { stop_requested_ = true; }
   bool stop_requested() const;
   void set_status(const std::string& status) { status_ = status; }
@@ -92,7 +102,10 @@ class Service {
   void publish_heartbeat(int8_t state, int64_t now_utime);
   void attach(lcm::LCM& input, lcm::LCM& output);
   static int64_t wall_utime_now();
-  std::string describe_status(const std::vector<HeartbeatWatch::Silent>& silent) const;
+  // At the end of an input log: warns when it ended in the middle of an event (LCM stops silently).
+  void report_truncated_input() const;
+  std::string describe_status(const std::vector<HeartbeatWatch::Silent>& silent,
+                              const std::vector<StreamWatch::Silent>& quiet) const;
 
   std::string name_;
   Flags flags_;
@@ -108,6 +121,8 @@ class Service {
   bool stop_requested_ = false;
   std::unique_ptr<HeartbeatWatch> watch_;
   std::string reported_silent_;      // what check_heartbeats() last logged
+  std::unique_ptr<StreamWatch> streams_;
+  std::string reported_quiet_;       // what check_streams() last logged
   int64_t problems_seen_ = 0;        // errors + missed frames at the last heartbeat
   int64_t last_problem_utime_ = -1;  // when that count last grew, or a watched service was silent
 };

@@ -127,11 +127,24 @@ class Subscriptions {
       if (h->stream) h->subscription->setQueueCapacity(messages);
   }
 
+  // handler(channel, receive_utime) for every message on `channel`, undecoded and uncounted:
+  // for watching a stream's timing (StreamWatch) next to the subscription that reads it.
+  void on_receive(const std::string& channel, std::function<void(const std::string& channel, int64_t receive_utime)> handler) {
+    auto h = std::make_unique<Raw>();
+    h->fn = std::move(handler);
+    h->subscription = lcm_.subscribe(channel, &Raw::on_raw, h.get());
+    handlers_.push_back(std::move(h));
+  }
+
  private:
   struct Base {
     virtual ~Base() = default;
     lcm::Subscription* subscription = nullptr;
     bool stream = false;  // IsStream: its queue is stream_queue_capacity_
+  };
+  struct Raw : Base {
+    void on_raw(const lcm::ReceiveBuffer* rbuf, const std::string& channel) { fn(channel, rbuf->recv_utime); }
+    std::function<void(const std::string&, int64_t)> fn;
   };
   template <typename Msg>
   struct Typed : Base {

@@ -1,7 +1,7 @@
 #pragma once
 // Scene description of the simulated world: what stands on the table, what the table and the
 // backdrop look like, where the stereo cameras are, and how physics and rendering are set up.
-// A scene is plain data: build one in code, or load it from a cv::FileStorage YAML file
+// A scene is plain data: build one in code, or load it from a YAML file (OpenCV's style)
 // (format in docs/sim.md). Units: metres, radians in code, degrees in files (`*_deg` fields).
 //
 // World frame: origin on the PUMA's base axis at table-top height, z up (table top is z = 0),
@@ -148,7 +148,7 @@ ObjectModel model_of(const ObjectSpec& spec, int segments = 48);
 // Defaults for the table and backdrop: light wood-coloured table, plain off-white wall.
 Scene default_scene();
 
-// Loads a YAML (or XML/JSON) cv::FileStorage scene file. Missing fields take default_scene()'s
+// Loads a YAML (or JSON) scene file, parsed by yaml-cpp (nudge/yaml_file.hpp). Missing fields take default_scene()'s
 // values. Throws SceneError naming the file and the field ("scenes/x.yaml: objects[1].kind: ...").
 Scene load_scene(const std::string& path);
 

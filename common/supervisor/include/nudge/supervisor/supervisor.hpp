@@ -211,6 +211,11 @@ class Supervisor {
   // Every handler takes the task clock's time (us) at which the input arrived.
   void start(int64_t now, int64_t first_command_seq);
   void on_time(int64_t now);
+  // The task clock went back (a restarted world or log, two logs back to back): the state's
+  // timeout and the arm's settle time count again from `now`, and answers stamped from `now` on
+  // count as answers to the pending request. Without it the run would wait until the clock
+  // caught up with where it had been (an hour back: an hour's wait).
+  void on_clock_restart(int64_t now);
   // The required services not heard from within the watchdog's limit (empty: all alive).
   void on_services(const std::set<std::string>& silent, int64_t now);
   void on_candidates(const std::vector<Candidate>& candidates, int64_t utime, int64_t now);

@@ -1,0 +1,103 @@
+#!/usr/bin/env bash
+# Integration test (issue 12): a camera stream that ends (a file source at its end: the camera
+# says goodbye and stops) and one that stalls (the camera process stopped with SIGSTOP, as a hung
+# driver: no frames, no heartbeats) are named by the service that reads them: nudge-symmetry
+# logs "no messages: CAMERA_LEFT silent for ..." and its heartbeat turns DEGRADED naming the
+# channel (shown by nudge-monitor), then no longer names it once the frames are back (RUNNING
+# after kDegradedHoldUs, 5 s, unless frames are being dropped on a loaded machine). camera -> symmetry -> monitor over UDP multicast in a private network namespace.
+# usage: stalled_stream.sh BIN_DIR
+set -euo pipefail
+bin=${1:?usage: stalled_stream.sh BIN_DIR}
+
+if [ "$(id -u)" != 0 ] || ! unshare -n true 2>/dev/null; then
+  echo "SKIPPED: needs root and unshare -n for a private network namespace" >&2
+  exit 77
+fi
+
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+"$bin/nudge-synth-scenes" --out "$work/scenes" --count 10 --seed 7 >/dev/null
+
+unshare -n bash -s "$bin" "$work" <<'INNER'
+set -euo pipefail
+bin=$1; work=$2
+ip link set lo up multicast on
+ip route add 224.0.0.0/4 dev lo
+url="udpm://239.255.76.67:7667?ttl=0&recv_buf_size=16777216"
+
+# Waits up to $2 seconds until the pattern $1 matches at least ${4:-1} lines of file $3.
+wait_for() {
+  for _ in $(seq 1 $(( $2 * 20 ))); do
+    [ "$(grep -c -- "$1" "$3" || true)" -ge "${4:-1}" ] && return 0
+    sleep 0.05
+  done
+  echo "FAILED: fewer than ${4:-1} '$1' in $3 within $2 s" >&2
+  tail -n 30 "$work"/*.log >&2
+  return 1
+}
+# The time (s since the epoch) of the n-th ($3) line matching $1 in $2, by the line's own stamp.
+stamp_of() {
+  date -d "$(grep -- "$1" "$2" | sed -n "${3:-1}p" | cut -d' ' -f1)" +%s.%N
+}
+count() { grep -c -- "$1" "$2" || true; }
+# Symmetry's heartbeats, as the monitor logs their changes, that name no silent stream: RUNNING,
+# or DEGRADED for another reason (frames dropped on a loaded machine keep it DEGRADED for 5 s).
+recovered() { grep "heartbeat: symmetry " "$work/monitor.log" | grep -vc "silent" || true; }
+wait_recovered() {  # wait_recovered BEFORE: up to 20 s for a new such heartbeat
+  for _ in $(seq 1 400); do
+    [ "$(recovered)" -gt "$1" ] && return 0
+    sleep 0.05
+  done
+  echo "FAILED: symmetry's heartbeat still names a silent stream 20 s after the frames returned" >&2
+  tail -n 30 "$work"/*.log >&2
+  return 1
+}
+seconds() { awk -v a="$1" -v b="$2" 'BEGIN { printf "%.2f", b - a }'; }
+
+"$bin/nudge-symmetry" --lcm-url "$url" --inputs CAMERA_LEFT,CAMERA_RIGHT 2>"$work/symmetry.log" &
+sym=$!
+"$bin/nudge-monitor" --lcm-url "$url" 2>"$work/monitor.log" &
+mon=$!
+camera() {  # camera ARGS...: 2 Hz from the ten scenes (a loaded machine keeps up: no missed frames)
+  "$bin/nudge-camera" --lcm-url "$url" --left "images:$work/scenes/*.png" --right "images:$work/scenes/*.png" \
+    --rate 2 --format png "$@" 2>>"$work/camera.log" >/dev/null &
+  cam=$!
+}
+
+# 1. The stream ends: ten frames, then the camera says goodbye (STOPPING) and exits.
+camera
+wait_for "SYMMETRY_LEFT frame" 20 "$work/monitor.log"
+wait_for "finished after" 30 "$work/camera.log"  # the file's end
+wait_for "no messages: CAMERA_LEFT silent" 10 "$work/symmetry.log"
+wait_for "heartbeat: symmetry DEGRADED: .*CAMERA_LEFT silent for" 10 "$work/monitor.log"
+t_end=$(seconds "$(stamp_of "finished after" "$work/camera.log")" "$(stamp_of "no messages: CAMERA_LEFT silent" "$work/symmetry.log")")
+
+# 2. Frames again (a new camera, looping): the stream is back, and RUNNING after the hold.
+before=$(recovered)
+camera --loop
+wait_for "every watched stream is flowing again" 10 "$work/symmetry.log"
+wait_recovered "$before"
+
+# 3. The stream stalls: the camera process stopped (no frames, no heartbeats), then resumed.
+quiet=$(count "no messages: " "$work/symmetry.log")
+degraded=$(count "heartbeat: symmetry DEGRADED: .*CAMERA_LEFT silent for" "$work/monitor.log")
+flowing=$(count "every watched stream is flowing again" "$work/symmetry.log")
+kill -STOP $cam
+stalled=$(date +%s.%N)
+wait_for "no messages: " 10 "$work/symmetry.log" $((quiet + 1))
+grep -- "no messages: " "$work/symmetry.log" | sed -n "$((quiet + 1))p" | grep -q "CAMERA_LEFT silent" ||
+  { echo "FAILED: the stall was not named as CAMERA_LEFT's" >&2; exit 1; }
+wait_for "heartbeat: symmetry DEGRADED: .*CAMERA_LEFT silent for" 10 "$work/monitor.log" $((degraded + 1))
+t_stall=$(seconds "$stalled" "$(stamp_of "no messages: " "$work/symmetry.log" $((quiet + 1)))")
+before=$(recovered)
+kill -CONT $cam
+wait_for "every watched stream is flowing again" 10 "$work/symmetry.log" $((flowing + 1))
+wait_recovered "$before"
+
+kill -INT $cam $sym $mon
+wait $cam $sym $mon 2>/dev/null || true
+trap - EXIT
+grep -h "no messages\|flowing again" "$work/symmetry.log"
+grep -h "heartbeat: symmetry" "$work/monitor.log"
+echo "PASSED: the ended stream was named ${t_end} s after the camera logged its end, the stalled one ${t_stall} s after SIGSTOP; its heartbeat stopped naming it both times once frames returned"
+INNER
