@@ -20,6 +20,7 @@
 #include <sstream>
 
 #include "nudge/flags.hpp"
+#include "nudge/progress.hpp"
 #include "nudge/geometry/interesting_locations.hpp"
 #include "nudge/sim/world.hpp"
 #include "nudge/symmetry/detector.hpp"
@@ -406,20 +407,26 @@ int main(int argc, char** argv) {
   std::vector<Pipeline> pipelines = {before_issue14(), after_issue14(after_options)};
   if (skip_before) pipelines.erase(pipelines.begin());
   std::map<std::string, std::vector<SceneResult>> results;
+  nudge::Progress progress("nudge-exp-clutter", static_cast<int>(pipelines.size() * files.size()));
   for (const Pipeline& pipeline : pipelines) {
     for (const std::string& file : files) {
+      progress.step(pipeline.name + " " + fs::path(file).stem().string());
       results[pipeline.name].push_back(run_scene(file, pipeline, frames, pipeline.name == "after"));
       const SceneResult& r = results[pipeline.name].back();
       if (!pictures.empty() && !r.picture.empty()) cv::imwrite(pictures + "/" + r.name + ".png", r.picture);
-      std::cerr << pipeline.name << " " << r.name << ": " << r.objects << " objects; in lines L " << r.cameras[0].found
+      std::ostringstream detail;
+      detail << pipeline.name << " " << r.name << ": " << r.objects << " objects; in lines L " << r.cameras[0].found
                 << "/" << r.cameras[0].visible << " R " << r.cameras[1].found << "/" << r.cameras[1].visible
                 << "; phantom lines " << r.cameras[0].phantoms + r.cameras[1].phantoms << "/"
                 << r.cameras[0].lines + r.cameras[1].lines << "; candidates " << r.candidates << ": objects "
                 << r.object_candidates << ", duplicates " << r.duplicate_candidates << ", phantoms "
-                << r.phantom_candidates << ", objects without " << r.objects_without << "\n";
+                << r.phantom_candidates << ", objects without " << r.objects_without;
+      progress.note(detail.str());
     }
-    std::cerr << pipeline.name << ": " << summary_json(summarise(results[pipeline.name])) << "\n";
+    progress.note(pipeline.name + ": " + summary_json(summarise(results[pipeline.name])));
   }
+  progress.finish(std::to_string(files.size()) + " " + set + " scenes, " + std::to_string(pipelines.size()) +
+                  " pipeline(s)");
   if (no_write) return 0;
   // The report, written once per run on the evaluation family only.
   if (set != "eval") {

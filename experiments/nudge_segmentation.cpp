@@ -30,6 +30,7 @@
 #include "nudge/bus/image.hpp"
 #include "nudge/bus/sim_convert.hpp"
 #include "nudge/json.hpp"
+#include "nudge/progress.hpp"
 #include "nudge/segmentation/motion.hpp"
 #include "nudge/segmentation_t.hpp"
 #include "nudge/sim/world.hpp"
@@ -220,17 +221,19 @@ int main(int argc, char** argv) {
 
   std::vector<Run> runs;
   std::vector<fs::path> attempt_dirs;
+  nudge::Progress progress("nudge-exp-nudge-segmentation", static_cast<int>(names.size()));
   for (const std::string& name : names) {
+    progress.step(name);
     const fs::path run_dir = runs_dir / name / name;
     if (!fs::exists(run_dir / "summary.json")) {
-      std::cerr << name << ": no run in " << run_dir << " (skipped)\n";
+      progress.note(name + ": no run in " + run_dir.string() + " (skipped)");
       continue;
     }
-    std::cerr << "[" << runs.size() + 1 << "/" << names.size() << "] " << name << "\n";
     runs.push_back(evaluate(name, run_dir, scene_dir / (name + ".yaml")));
     for (const auto& entry : fs::directory_iterator(run_dir))
       if (entry.is_directory() && entry.path().filename().string().rfind("attempt_", 0) == 0) attempt_dirs.push_back(entry.path());
   }
+  progress.finish(std::to_string(runs.size()) + " runs read");
   std::sort(attempt_dirs.begin(), attempt_dirs.end());
 
   int single_runs = 0, successes = 0, effector = 0, phantoms = 0, multi_found = 0, multi_present = 0;

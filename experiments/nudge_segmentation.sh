@@ -17,8 +17,10 @@ if [ ${#names[@]} -eq 0 ]; then
 fi
 export -f nudge_run_loop
 i=0
+loop_start=$SECONDS
 for name in "${names[@]}"; do
   i=$((i + 1))
+  nudge_progress "$i" "${#names[@]}" "$loop_start" "$name"
   rm -rf "${runs_dir:?}/$name"
   mkdir -p "$runs_dir/$name"
   start=$(date +%s)
@@ -26,6 +28,8 @@ for name in "${names[@]}"; do
   nudge_in_private_network bash -c 'nudge_run_loop "$@"' loop "$NUDGE_BUILD_DIR/bin" "$scenes_dir/$name.yaml" \
     "$calibration" "$NUDGE_ROOT/config/workspace.yaml" "$runs_dir/$name" "$name" --first-seq 1000 2>"$runs_dir/$name/supervisor.log" || status=$?
   [ -d "$runs_dir/$name/$name" ] && echo $(($(date +%s) - start)) > "$runs_dir/$name/$name/wall_seconds.txt"
+  [ -t 2 ] && printf '\r\033[K' >&2
   nudge_log "[$i/${#names[@]}] $name: $(grep -h "ended:" "$runs_dir/$name/supervisor.log" | sed 's/^.*ended: //') (exit $status)"
 done
+nudge_log "${#names[@]} scenes run in $((SECONDS - loop_start)) s"
 "$NUDGE_BUILD_DIR/bin/nudge-exp-nudge-segmentation" "$runs_dir" "$scenes_dir" "${names[@]}"

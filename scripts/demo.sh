@@ -100,11 +100,12 @@ if [ $# -eq 0 ]; then
   export NUDGE_LOOP_LEARN=${NUDGE_DEMO_LEARN:-1}
   nudge_log "autonomous segmentation of $(basename "$scene"): world, camera, symmetry, triangulation, arm, learner and supervisor over LCM; run $run"
   status=0
+  loop_start=$SECONDS
   nudge_in_private_network bash -c 'nudge_run_loop "$@"' loop "$NUDGE_BUILD_DIR/bin" "$scene" \
     "$NUDGE_ROOT/config/calibration_sim.yaml" "$NUDGE_ROOT/config/workspace.yaml" "$out/runs" "$run" || status=$?
   dir="$out/runs/$run"
   if [ -f "$dir/summary.json" ]; then
-    nudge_log "run $run: $(grep -o '"segmented":[0-9]*' "$dir/summary.json" | head -1 | cut -d: -f2) objects segmented in $(grep -o '"attempts":[0-9]*' "$dir/summary.json" | head -1 | cut -d: -f2) nudges"
+    nudge_log "run $run: $(grep -o '"segmented":[0-9]*' "$dir/summary.json" | head -1 | cut -d: -f2) objects segmented in $(grep -o '"attempts":[0-9]*' "$dir/summary.json" | head -1 | cut -d: -f2) nudges in $((SECONDS - loop_start)) s"
     nudge_log "files: $dir/ (LCM log $run.lcmlog, summary.json, attempt_NN/ with before/after stills, mask, cutout, workspace.png, stages/, views/; objects/: what was learned)"
     "$NUDGE_BUILD_DIR/bin/nudge-report" "$dir" >/dev/null && nudge_log "report: $dir/report.html (opens in a browser, docs/operator.md)"
     nudge_log "replay the decisions: build/bin/nudge-supervisor --lcm-in 'file://$dir/$run.lcmlog?speed=0' --lcm-out 'file:///tmp/replay.lcmlog?mode=w' --calibration config/calibration_sim.yaml --first-seq $(grep -o '"first_command_seq":[0-9]*' "$dir/summary.json" | cut -d: -f2)"

@@ -40,16 +40,41 @@ nudge_build() {
     cmake -S "$NUDGE_ROOT" -B "$NUDGE_BUILD_DIR" -DCMAKE_BUILD_TYPE=Release >/dev/null
   fi
   nudge_log "building in $NUDGE_BUILD_DIR (the first build takes several minutes)"
-  local log
+  local log start=$SECONDS
   log=$(mktemp)
-  if ! cmake --build "$NUDGE_BUILD_DIR" -j "$NUDGE_JOBS" >"$log" 2>&1; then
+  if ! cmake --build "$NUDGE_BUILD_DIR" -j "$NUDGE_JOBS" 2>&1 | tee "$log" | nudge_build_progress "$start"; then
     grep -vE '^\[ *[0-9]+%\]' "$log" >&2
     rm -f "$log"
-    nudge_log "build failed"
+    nudge_log "build failed after $((SECONDS - start)) s"
     return 1
   fi
   grep -E 'warning:|error:' "$log" >&2 || true
   rm -f "$log"
+  nudge_log "built in $((SECONDS - start)) s"
+}
+
+# "[k/N] item … 34 s left" on stderr for step K of N of a loop started at START ($SECONDS), as
+# common/core's nudge::Progress writes it: rewritten in place on a terminal, a line each otherwise
+# (a script's steps are long and few: each is worth a line in a log).
+nudge_progress() {
+  local k=$1 n=$2 start=$3 item=$4 left=""
+  if [ "$k" -gt 1 ]; then left=" … $(((SECONDS - start) * (n - k + 1) / (k - 1))) s left"; fi
+  if [ -t 2 ]; then printf '\r\033[K[%d/%d] %s%s' "$k" "$n" "$item" "$left" >&2
+  else printf '[%d/%d] %s%s\n' "$k" "$n" "$item" "$left" >&2; fi
+}
+
+# Reads cmake --build's output; on a terminal shows its percentage and the time left as one line.
+nudge_build_progress() {
+  local start=$1 line pct
+  while IFS= read -r line; do
+    [ -t 2 ] || continue
+    [[ $line =~ ^\[\ *([0-9]+)%\] ]] || continue
+    pct=${BASH_REMATCH[1]}
+    if [ "$pct" -gt 0 ]; then
+      printf '\r\033[K[%3d%%] building … %d s left' "$pct" $(((SECONDS - start) * (100 - pct) / pct)) >&2
+    fi
+  done
+  if [ -t 2 ]; then printf '\r\033[K' >&2; fi
 }
 
 # LCM asks for recv_buf_size (the scripts: 16 MB) but the kernel caps every socket at

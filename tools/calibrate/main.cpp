@@ -20,6 +20,7 @@
 #include "nudge/geometry/stereo_rig.hpp"
 #include "nudge/geometry/workspace.hpp"
 #include "nudge/log.hpp"
+#include "nudge/progress.hpp"
 
 using namespace nudge;
 
@@ -91,12 +92,13 @@ cv::Size common_size(const std::vector<cv::Mat>& images) {
 std::string size_text(cv::Size size) { return std::to_string(size.width) + "x" + std::to_string(size.height); }
 
 Views collect_views(const std::vector<std::string>& left, const std::vector<std::string>& right,
-                    const BoardSize& board) {
+                    const BoardSize& board, Progress& progress) {
   if (left.size() != right.size())
     throw std::runtime_error("--left matches " + std::to_string(left.size()) + " files but --right matches " +
                              std::to_string(right.size()) + "; images pair up in sorted order");
   std::vector<cv::Mat> left_images, right_images;
   for (size_t i = 0; i < left.size(); ++i) {
+    progress.step("reading pair " + std::to_string(i + 1));
     left_images.push_back(read_grey(left[i]));
     right_images.push_back(read_grey(right[i]));
   }
@@ -104,11 +106,13 @@ Views collect_views(const std::vector<std::string>& left, const std::vector<std:
   views.left_size = common_size(left_images);
   views.right_size = common_size(right_images);
   for (size_t i = 0; i < left.size(); ++i) {
+    progress.step("board corners, pair " + std::to_string(i + 1));
     const cv::Mat &l = left_images[i], &r = right_images[i];
     const bool left_odd = l.size() != views.left_size, right_odd = r.size() != views.right_size;
     if (left_odd || right_odd) {
       const std::string& path = left_odd ? left[i] : right[i];
       const cv::Size size = left_odd ? l.size() : r.size(), usual = left_odd ? views.left_size : views.right_size;
+      progress.clear_status();
       log::warn() << path << ": image size " << size_text(size) << " differs from the " << size_text(usual) << " of most "
                   << (left_odd ? "left" : "right") << " images; pair " << i + 1 << " skipped";
       continue;
@@ -116,6 +120,7 @@ Views collect_views(const std::vector<std::string>& left, const std::vector<std:
     auto lc = find_corners(l, board), rc = find_corners(r, board);
     if (lc.empty() || rc.empty()) {
       const char* where = lc.empty() && rc.empty() ? "either image" : lc.empty() ? "the left image" : "the right image";
+      progress.clear_status();
       log::warn() << "pair " << i + 1 << " (" << left[i] << ", " << right[i] << "): no " << board.columns << "x"
                   << board.rows << " board found in " << where << "; pair skipped";
       continue;
@@ -228,8 +233,14 @@ int main(int argc, char** argv) {
     return 2;
   }
   try {
-    const Views views = collect_views(expand(opt.left_glob, "left"), expand(opt.right_glob, "right"), board);
+    const std::vector<std::string> left = expand(opt.left_glob, "left"), right = expand(opt.right_glob, "right");
+    // Steps: reading each pair, finding its corners, then the calibration itself.
+    Progress progress("nudge-calibrate", static_cast<int>(2 * left.size() + 1));
+    const Views views = collect_views(left, right, board, progress);
+    progress.step("stereo calibration of " + std::to_string(views.left.size()) + " pairs");
     const Calibration calibration = calibrate(views, board, opt.square);
+    progress.finish(std::to_string(views.left.size()) + " of " + std::to_string(left.size()) + " pairs used, rms " +
+                    std::to_string(calibration.rms) + " px");
     geometry::Workspace workspace;
     if (!opt.table_left.empty()) workspace.table = table_plane(calibration.rig, opt, board);
     geometry::save_rig(calibration.rig, workspace, opt.out);

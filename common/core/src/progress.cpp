@@ -44,7 +44,20 @@ void Progress::step(const std::string& item) {
   if (finished_) return;
   if (started_step_) ++done_;
   started_step_ = true;
+  item_ = item;
   if (interactive_) write_status(item);
+}
+
+void Progress::note(const std::string& line) {
+  if (interactive_) clear_status();
+  out_ << line << "\n";
+  if (interactive_ && started_step_ && !finished_) write_status(item_);
+  out_.flush();
+}
+
+void Progress::clear_status() {
+  if (status_width_ > 0) out_ << "\r" << std::string(status_width_, ' ') << "\r";
+  status_width_ = 0;
 }
 
 void Progress::write_status(const std::string& item) {
@@ -67,7 +80,7 @@ void Progress::finish(const std::string& summary) {
   if (finished_) return;
   finished_ = true;
   if (started_step_) ++done_;
-  if (interactive_ && status_width_ > 0) out_ << "\r" << std::string(status_width_, ' ') << "\r";
+  if (interactive_) clear_status();
   out_ << job_ << ": done ";
   if (total_ > 0) out_ << done_ << "/" << total_ << " ";
   out_ << "in " << format_duration(elapsed_s());

@@ -88,3 +88,20 @@ TEST(Progress, FormatsDurationsForPeople) {
   EXPECT_EQ(Progress::format_duration(2 * 3600 + 5 * 60), "2 h 05 m");
   EXPECT_EQ(Progress::format_duration(-1), "?");
 }
+
+TEST(Progress, NotesGoAboveTheStatusLine) {
+  std::ostringstream out;
+  FakeClock clock;
+  Progress p("exp", 2, out, true, clock.fn());
+  p.step("s01");
+  p.note("s01: 3 objects");
+  const std::string text = out.str();
+  // The status is blanked, the note written on its own line, then the status redrawn.
+  EXPECT_NE(text.find("\r[1/2] s01\r         \rs01: 3 objects\n\r[1/2] s01"), std::string::npos) << text;
+  std::ostringstream plain;
+  Progress q("exp", 2, plain, false, clock.fn());
+  q.step("s01");
+  q.note("s01: 3 objects");
+  EXPECT_EQ(plain.str(), "exp: 2 steps\ns01: 3 objects\n");
+  q.finish();
+}

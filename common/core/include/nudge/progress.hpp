@@ -26,6 +26,11 @@ class Progress {
 
   // Starts the next step, named `item` (e.g. "scene s03"): counts the previous one as done.
   void step(const std::string& item);
+  // A line of detail (e.g. a step's result) above the status line: the status is redrawn under it.
+  void note(const std::string& line);
+  // Blanks the status line on a terminal, before something else writes to stderr (a log line);
+  // the next step() draws it again.
+  void clear_status();
   // The one-line summary; counts the last step as done. Later calls do nothing.
   void finish(const std::string& summary = "");
 
@@ -50,6 +55,7 @@ class Progress {
   bool started_step_ = false;
   bool finished_ = false;
   size_t status_width_ = 0;  // the status line's length, to blank it when it shrinks
+  std::string item_;         // the current step's name, to redraw its status
 };
 
 }  // namespace nudge
