@@ -16,6 +16,7 @@ NUDGE_PACKAGES=(
   libcpp-httplib-dev nlohmann-json3-dev chromium
   clang-14 libfuzzer-14-dev
   libyaml-cpp-dev
+  xvfb x11-apps netpbm
 )
 
 nudge_log() { printf '\033[1m[nudge]\033[0m %s\n' "$*" >&2; }

@@ -1,0 +1,85 @@
+#!/usr/bin/env bash
+# lcm-spy, as scripts/spy.sh starts it, decodes the nudge types on a replayed log: under Xvfb and
+# inside a private network namespace, nudge-replay plays a short camera log and nudge-symmetry
+# answers it live; lcm-spy (in SpyTable.java's JVM) watches the bus. The check reads lcm-spy's
+# channel table from its Swing model (what its window shows, without OCR): every channel is
+# listed with its nudge type and none is undecodable. A screenshot of the screen is saved.
+# usage: spy_screen.sh BUILD_DIR SOURCE_DIR [SCREENSHOT.png]
+set -uo pipefail
+build=${1:?usage: spy_screen.sh BUILD_DIR SOURCE_DIR [SCREENSHOT.png]}
+src=${2:?usage: spy_screen.sh BUILD_DIR SOURCE_DIR [SCREENSHOT.png]}
+shot=${3:-$build/test_output/lcm_spy.png}
+jar="$build/share/nudge_lcmtypes.jar"
+
+skip() { echo "SKIPPED: $*" >&2; exit 77; }
+[ "$(id -u)" = 0 ] && unshare -n true 2>/dev/null || skip "needs root and unshare -n for a private network namespace"
+for tool in Xvfb xwd xwdtopnm pnmtopng java javac; do
+  command -v "$tool" >/dev/null || skip "$tool is not installed (Debian: xvfb, x11-apps, netpbm, default-jdk-headless)"
+done
+[ -f "$jar" ] || { echo "FAILED: $jar was not built" >&2; exit 1; }
+
+work=$(mktemp -d)
+[ -n "${NUDGE_KEEP:-}" ] || trap 'rm -rf "$work"' EXIT
+# The log: 20 stereo frames at 10 Hz, written by the camera straight to a file.
+"$build/bin/nudge-synth-scenes" --out "$work/scenes" --count 20 --seed 7 >/dev/null || exit 1
+"$build/bin/nudge-camera" --lcm-url "file://$work/camera.lcmlog?mode=w" --left "images:$work/scenes/*.png" \
+  --right "images:$work/scenes/*.png" --rate 10 --format jpeg 2>"$work/camera.log" || { cat "$work/camera.log" >&2; exit 1; }
+classpath="$jar:/usr/share/java/lcm.jar:/usr/share/java/jchart2d.jar"
+javac -cp "$classpath" -d "$work" "$src/tests/integration/SpyTable.java" || exit 1
+mkdir -p "$(dirname "$shot")"
+
+unshare -n bash -s "$build" "$work" "$classpath" "$shot" <<'INNER'
+set -uo pipefail
+build=$1; work=$2; classpath=$3; shot=$4
+ip link set lo up multicast on
+ip route add 224.0.0.0/4 dev lo
+url="udpm://239.255.76.67:7667?ttl=0"
+pids=()
+cleanup() { for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done; wait 2>/dev/null; }
+trap cleanup EXIT
+
+# Xvfb picks a free display itself (-displayfd): other X servers on this machine are left alone.
+Xvfb -displayfd 5 -screen 0 1024x640x24 -nolisten tcp 5>"$work/display" 2>"$work/xvfb.log" &
+pids+=($!)
+for _ in $(seq 50); do [ -s "$work/display" ] && break; sleep 0.1; done
+[ -s "$work/display" ] || { echo "FAILED: Xvfb did not start" >&2; cat "$work/xvfb.log" >&2; exit 1; }
+export DISPLAY=":$(head -1 "$work/display")"
+
+# lcm-spy as scripts/spy.sh runs it (the Spy class with the nudge jar on the CLASSPATH).
+expected="CAMERA_LEFT=image_t CAMERA_RIGHT=image_t SYMMETRY_LEFT=symmetry_lines_t SYMMETRY_RIGHT=symmetry_lines_t"
+expected+=" HEARTBEAT=heartbeat_t REPLAY_STATUS=replay_status_t"
+channels=$(for e in $expected; do printf '%s,' "${e%%=*}"; done)
+CLASSPATH="$work:$classpath" java -Djava.net.preferIPv4Stack=true -ea SpyTable 60 "${channels%,}" --lcm-url "$url" \
+  >"$work/spy.out" 2>"$work/spy.err" &
+pids+=($!)
+for _ in $(seq 600); do grep -qE '^(READY|NO_TABLE)' "$work/spy.out" && break; sleep 0.1; done
+grep -q '^READY' "$work/spy.out" || { echo "FAILED: lcm-spy's window did not open" >&2; cat "$work/spy.out" "$work/spy.err" >&2; exit 1; }
+"$build/bin/nudge-symmetry" --lcm-url "$url" --inputs CAMERA_LEFT,CAMERA_RIGHT 2>"$work/symmetry.log" &
+pids+=($!)
+sleep 1  # symmetry subscribes before the log plays
+"$build/bin/nudge-replay" "$work/camera.lcmlog" --lcm-url "$url" 2>"$work/replay.log" || { cat "$work/replay.log" >&2; exit 1; }
+for _ in $(seq 600); do grep -q '^COLUMNS' "$work/spy.out" && break; sleep 0.1; done
+sleep 1  # the window repaints its table
+xwd -root -silent | xwdtopnm 2>/dev/null | pnmtopng >"$shot" 2>/dev/null
+cat "$work/spy.out"
+grep -q '^COLUMNS' "$work/spy.out" || { echo "FAILED: lcm-spy's table was not read" >&2; cat "$work/spy.err" >&2; exit 1; }
+[ "$(head -c 8 "$shot" | od -An -tx1 | tr -d ' \n')" = 89504e470d0a1a0a ] || { echo "FAILED: no PNG screenshot" >&2; exit 1; }
+# Every channel listed with its nudge type (an unknown fingerprint shows as "?? HEX"), seen and
+# all decoded. LCM's own LCM_SELF_TEST (not a nudge type) is ignored.
+failed=0
+for e in $expected; do
+  channel=${e%%=*} type=${e#*=}
+  row=$(awk -F'\t' -v c="$channel" '$1 == "ROW" && $2 == c' "$work/spy.out")
+  if [ -z "$row" ]; then echo "FAILED: lcm-spy does not list $channel" >&2; failed=1; continue; fi
+  IFS=$'\t' read -r _ name shown count _ _ _ _ undecodable <<<"$row"
+  if [ "$shown" != "$type" ] || [ "$count" -lt 1 ] || [ "$undecodable" != 0 ]; then
+    echo "FAILED: $channel shown as '$shown' ($count messages, $undecodable undecodable), expected $type" >&2
+    failed=1
+  fi
+done
+[ $failed -eq 0 ] || exit 1
+echo "PASSED: lcm-spy decodes $(echo $expected | wc -w) channels of 4 nudge types on the replayed log"
+INNER
+status=$?
+[ $status -eq 0 ] || exit $status
+echo "screenshot: $shot"
