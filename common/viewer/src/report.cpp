@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
+#include <map>
 #include <sstream>
 #include <stdexcept>
 
@@ -105,7 +106,41 @@ std::string millimetres(const json& j, const std::string& key) {
   return "(" + fixed(j[key][0].get<double>() * 1000, 0) + ", " + fixed(j[key][1].get<double>() * 1000, 0) + ") mm";
 }
 
-std::string attempt_section(const fs::path& run_dir, const json& attempt) {
+const SimulationScore* score_of(const std::vector<SimulationScore>& scores, int attempt) {
+  for (const SimulationScore& s : scores)
+    if (s.attempt == attempt) return &s;
+  return nullptr;
+}
+
+std::string object_label(const SimulationScore& s) {
+  if (s.object < 0) return "no object";
+  return escape(s.object_name.empty() ? "object " + std::to_string(s.object) : s.object_name) + " (object " +
+         std::to_string(s.object) + ")";
+}
+
+// Per object of the scene that some mask covered: the attempts that segmented it with their IoU,
+// and the best. An object no mask covered is not listed (the scene's file is not read here).
+std::string iou_table(const std::vector<SimulationScore>& scores) {
+  std::map<int, std::vector<const SimulationScore*>> by_object;
+  for (const SimulationScore& s : scores) by_object[s.object].push_back(&s);
+  std::ostringstream out;
+  out << "<h2>IoU in simulation, per object</h2><table id=\"iou\"><tr><th>object</th><th>attempts (IoU)</th>"
+      << "<th>best IoU</th></tr>";
+  for (const auto& [object, list] : by_object) {
+    double best = 0;
+    std::string attempts;
+    for (const SimulationScore* s : list) {
+      best = std::max(best, s->iou);
+      attempts += (attempts.empty() ? "" : ", ") + std::to_string(s->attempt) + " (" + fixed(s->iou, 3) + ")";
+    }
+    out << "<tr><td>" << object_label(*list.front()) << "</td><td>" << attempts << "</td><td class=\"best\">"
+        << (object < 0 ? "–" : fixed(best, 3)) << "</td></tr>";
+  }
+  out << "</table>";
+  return out.str();
+}
+
+std::string attempt_section(const fs::path& run_dir, const json& attempt, const SimulationScore* score) {
   const int n = attempt.value("attempt", 0);
   std::ostringstream dir_name;
   dir_name << "attempt_" << std::setw(2) << std::setfill('0') << n;
@@ -115,7 +150,9 @@ std::string attempt_section(const fs::path& run_dir, const json& attempt) {
   out << "<section class=\"attempt\"><h2>attempt " << n << ": " << text_of(attempt, "outcome") << "</h2><p>"
       << text_of(attempt, "reason") << " · target " << millimetres(attempt, "target") << ", at rest " << millimetres(attempt, "rest") << " · " << fixed(ended - started, 1)
       << " s (from " << fixed(started, 1) << " s) · mask " << number(attempt, "mask_pixels") << " px · motion frames "
-      << number(attempt, "motion_frames") << "</p><div class=\"row\">";
+      << number(attempt, "motion_frames");
+  if (score) out << " · IoU (simulation) " << fixed(score->iou, 3) << " with " << object_label(*score);
+  out << "</p><div class=\"row\">";
   out << picture(run_dir, dir + "/before.png", "before") << picture(run_dir, dir + "/after.png", "after")
       << picture(run_dir, dir + "/mask.png", "mask") << picture(run_dir, dir + "/cutout.png", "cut-out")
       << picture(run_dir, dir + "/workspace.png", "the push seen from above (fig. 6.6)") << "</div>";
@@ -154,7 +191,8 @@ std::string attempt_section(const fs::path& run_dir, const json& attempt) {
 
 }  // namespace
 
-std::string render_run_report(const std::string& run_dir_name, const std::vector<StateEntry>& states) {
+std::string render_run_report(const std::string& run_dir_name, const std::vector<StateEntry>& states,
+                              const std::vector<SimulationScore>& scores) {
   const fs::path run_dir(run_dir_name);
   const json summary = read_json(run_dir / "summary.json");
   std::ostringstream out;
@@ -171,6 +209,7 @@ std::string render_run_report(const std::string& run_dir_name, const std::vector
       << "</td></tr><tr><th>outcomes</th><td>" << text_of(summary, "outcomes") << "</td></tr>";
   if (summary.contains("iou")) out << "<tr><th>IoU (simulation)</th><td>" << text_of(summary, "iou") << "</td></tr>";
   out << "</table>";
+  if (!scores.empty()) out << iou_table(scores);
   out << "<h2>timeline</h2><table id=\"timeline\"><tr><th>t (s)</th><th>state</th><th>attempt</th><th>reason</th></tr>";
   for (const StateEntry& s : states)
     out << "<tr><td>" << fixed((s.utime - states.front().utime) * 1e-6, 1) << "</td><td>" << escape(s.state) << "</td><td>"
@@ -178,7 +217,8 @@ std::string render_run_report(const std::string& run_dir_name, const std::vector
   if (states.empty()) out << "<tr><td colspan=\"4\">no SUPERVISOR_STATE in the run's log</td></tr>";
   out << "</table>";
   if (summary.contains("attempt_list") && summary["attempt_list"].is_array())
-    for (const auto& attempt : summary["attempt_list"]) out << attempt_section(run_dir, attempt);
+    for (const auto& attempt : summary["attempt_list"])
+      out << attempt_section(run_dir, attempt, score_of(scores, attempt.value("attempt", 0)));
   out << "</body></html>\n";
   return out.str();
 }

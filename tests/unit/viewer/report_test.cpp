@@ -74,6 +74,25 @@ TEST(RunReport, ShowsFiguresTimelineAndEachAttemptsPicturesByRelativePath) {
   EXPECT_EQ(html.find(dir), std::string::npos) << "no absolute paths: the folder can move";
 }
 
+TEST(RunReport, ShowsTheIoUInSimulationPerObjectAndPerAttempt) {
+  const std::string dir = make_run("report_iou");
+  std::vector<nudge::viewer::SimulationScore> scores(3);
+  scores[0] = {1, 2, "mug", 0.8734};
+  scores[1] = {2, 2, "mug", 0.61};   // the same object segmented again, less well
+  scores[2] = {3, 0, "cup", 0.42};   // an attempt the summary does not list still counts for its object
+  const std::string html = render_run_report(dir, states(), scores);
+  ASSERT_NE(html.find("<table id=\"iou\">"), std::string::npos);
+  EXPECT_NE(html.find("<tr><td>mug (object 2)</td><td>1 (0.873), 2 (0.610)</td><td class=\"best\">0.873</td></tr>"),
+            std::string::npos) << html;
+  EXPECT_NE(html.find("<tr><td>cup (object 0)</td><td>3 (0.420)</td><td class=\"best\">0.420</td></tr>"),
+            std::string::npos);
+  EXPECT_LT(html.find("cup (object 0)"), html.find("mug (object 2)")) << "objects in the scene's order";
+  EXPECT_NE(html.find("IoU (simulation) 0.873 with mug (object 2)"), std::string::npos) << "in attempt 1's section";
+  EXPECT_NE(html.find("IoU (simulation) 0.610 with mug (object 2)"), std::string::npos) << "in attempt 2's section";
+  // Without scores (a run on the robot) there is no IoU at all.
+  EXPECT_EQ(render_run_report(dir, states()).find("IoU"), std::string::npos);
+}
+
 TEST(RunReport, AMissingSummaryIsNamed) {
   try {
     render_run_report("/nonexistent/run", {});

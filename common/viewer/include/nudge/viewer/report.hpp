@@ -12,9 +12,19 @@
 
 namespace nudge::viewer {
 
+// One attempt's mask scored against the simulator's true masks (nudge-report --scene).
+struct SimulationScore {
+  int attempt = 0;
+  int object = -1;          // the scene's index of the object the mask covers most; -1: none
+  std::string object_name;  // its name in the scene file
+  double iou = 0;           // the mask's intersection over union with that object's true mask
+};
+
 // Reads RUN_DIR (summary.json, attempt_NN/) and renders the report; `states` are the supervisor's
-// transitions (from the run's log). Throws std::runtime_error naming the file when summary.json
-// is missing or not JSON.
-std::string render_run_report(const std::string& run_dir, const std::vector<StateEntry>& states);
+// transitions (from the run's log); `scores`, in simulation, give the IoU per object (a table of
+// the scene's objects with the best IoU each got) and per attempt. Throws std::runtime_error
+// naming the file when summary.json is missing or not JSON.
+std::string render_run_report(const std::string& run_dir, const std::vector<StateEntry>& states,
+                              const std::vector<SimulationScore>& scores = {});
 
 }  // namespace nudge::viewer
