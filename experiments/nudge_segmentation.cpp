@@ -33,6 +33,7 @@
 #include "nudge/progress.hpp"
 #include "nudge/segmentation/motion.hpp"
 #include "nudge/segmentation_t.hpp"
+#include "nudge/sim/mask_score.hpp"
 #include "nudge/sim/world.hpp"
 #include "nudge/sim_state_t.hpp"
 #include "report.hpp"
@@ -105,17 +106,10 @@ Truth render_truth(sim::World& world, const sim_state_t& state) {
 
 Segmented score(const cv::Mat& mask, const Truth& truth, int objects) {
   Segmented s;
-  s.mask_pixels = cv::countNonZero(mask);
-  int best_overlap = 0;
-  for (int i = 0; i < objects; ++i) {
-    const cv::Mat object = truth.labels == i + 1;
-    const int overlap = cv::countNonZero(object & mask);
-    if (overlap > best_overlap) {
-      best_overlap = overlap;
-      s.object = i;
-      s.iou = static_cast<double>(overlap) / std::max(1, cv::countNonZero(object | mask));
-    }
-  }
+  const sim::MaskScore m = sim::score_mask(mask, truth.labels, objects);
+  s.mask_pixels = m.mask_pixels;
+  s.object = m.object;
+  s.iou = m.iou;
   s.effector_pixels = cv::countNonZero(truth.effector & mask);
   return s;
 }

@@ -23,6 +23,7 @@
 #include "nudge/bus/channels.hpp"
 #include "nudge/bus/image.hpp"
 #include "nudge/bus/service.hpp"
+#include "nudge/bus/viewer_convert.hpp"
 #include "nudge/candidates_t.hpp"
 #include "nudge/heartbeat_t.hpp"
 #include "nudge/image_t.hpp"
@@ -189,17 +190,7 @@ void subscribe_robot(bus::Service& service, viewer::ViewModel& model) {
   });
   subs.subscribe<supervisor_state_t>(
       channel::SUPERVISOR_STATE, [&model](const supervisor_state_t& msg, const std::string&) {
-        viewer::StateEntry entry;
-        entry.utime = msg.utime;
-        entry.run_id = msg.run_id;
-        entry.state = msg.state_name;
-        entry.attempt = msg.attempt;
-        entry.reason = msg.reason;
-        entry.segmented = msg.segmented;
-        entry.failed_attempts = msg.failed_attempts;
-        entry.has_target = msg.attempt > 0;
-        std::copy(msg.target, msg.target + 3, entry.target);
-        model.observe_state(entry);
+        model.observe_state(bus::state_entry_of(msg));
       });
   subs.subscribe<segmentation_t>(channel::SEGMENTATION, [&model](const segmentation_t& msg, const std::string&) {
     viewer::Segmentation seg;
