@@ -107,7 +107,7 @@ if [ $# -eq 0 ]; then
   if [ -f "$dir/summary.json" ]; then
     nudge_log "run $run: $(grep -o '"segmented":[0-9]*' "$dir/summary.json" | head -1 | cut -d: -f2) objects segmented in $(grep -o '"attempts":[0-9]*' "$dir/summary.json" | head -1 | cut -d: -f2) nudges in $((SECONDS - loop_start)) s"
     nudge_log "files: $dir/ (LCM log $run.lcmlog, summary.json, attempt_NN/ with before/after stills, mask, cutout, workspace.png, stages/, views/; objects/: what was learned)"
-    "$NUDGE_BUILD_DIR/bin/nudge-report" "$dir" >/dev/null && nudge_log "report: $dir/report.html (opens in a browser, docs/operator.md)"
+    "$NUDGE_BUILD_DIR/bin/nudge-report" "$dir" --scene "$scene" >/dev/null && nudge_log "report: $dir/report.html (opens in a browser, docs/operator.md)"
     nudge_log "replay the decisions: build/bin/nudge-supervisor --lcm-in 'file://$dir/$run.lcmlog?speed=0' --lcm-out 'file:///tmp/replay.lcmlog?mode=w' --calibration config/calibration_sim.yaml --first-seq $(grep -o '"first_command_seq":[0-9]*' "$dir/summary.json" | cut -d: -f2)"
   fi
   exit $status
