@@ -1,31 +1,50 @@
+// nudge::log on spdlog: the same line format as before spdlog (scripts and people read it),
+//   2026-11-22T11:30:00.123Z I symmetry: message
+// with spdlog's thread-safe stderr sink doing the writing and the UTC time stamps.
 #include "nudge/log.hpp"
 
-#include <sys/time.h>
+#include <spdlog/pattern_formatter.h>
+#include <spdlog/sinks/stdout_sinks.h>
+#include <spdlog/spdlog.h>
 
 #include <atomic>
-#include <cstdio>
-#include <ctime>
+#include <memory>
 #include <mutex>
 
 namespace nudge::log {
 namespace {
-std::mutex g_mutex;
+std::mutex g_component_mutex;
 std::string g_component = "nudge";
 std::atomic<int> g_level{static_cast<int>(Level::Info)};
 
-char level_letter(Level level) {
+spdlog::level::level_enum spdlog_level(Level level) {
   switch (level) {
-    case Level::Debug: return 'D';
-    case Level::Info: return 'I';
-    case Level::Warn: return 'W';
-    case Level::Error: return 'E';
+    case Level::Debug: return spdlog::level::debug;
+    case Level::Info: return spdlog::level::info;
+    case Level::Warn: return spdlog::level::warn;
+    case Level::Error: return spdlog::level::err;
   }
-  return '?';
+  return spdlog::level::info;
+}
+
+// One logger for the process, made on first use (no static-initialisation order to worry about).
+// Unregistered: spdlog's global registry is left to whoever else links spdlog.
+spdlog::logger& logger() {
+  static const std::shared_ptr<spdlog::logger> instance = [] {
+    auto made = std::make_shared<spdlog::logger>("nudge", std::make_shared<spdlog::sinks::stderr_sink_mt>());
+    // %L: spdlog's one-letter level (D, I, W, E); the component goes in with the message.
+    made->set_formatter(std::make_unique<spdlog::pattern_formatter>("%Y-%m-%dT%H:%M:%S.%eZ %L %v",
+                                                                    spdlog::pattern_time_type::utc));
+    made->set_level(spdlog::level::trace);  // nudge::log filters by g_level
+    made->flush_on(spdlog::level::trace);   // every line at once: services are watched live
+    return made;
+  }();
+  return *instance;
 }
 }  // namespace
 
 void set_component(const std::string& name) {
-  std::lock_guard<std::mutex> lock(g_mutex);
+  std::lock_guard<std::mutex> lock(g_component_mutex);
   g_component = name;
 }
 
@@ -34,16 +53,12 @@ Level level() { return static_cast<Level>(g_level.load()); }
 
 void write(Level lvl, const std::string& message) {
   if (static_cast<int>(lvl) < g_level.load()) return;
-  timeval tv{};
-  gettimeofday(&tv, nullptr);
-  std::tm utc{};
-  gmtime_r(&tv.tv_sec, &utc);
-  char stamp[32];
-  std::strftime(stamp, sizeof stamp, "%Y-%m-%dT%H:%M:%S", &utc);
-  std::lock_guard<std::mutex> lock(g_mutex);
-  std::fprintf(stderr, "%s.%03dZ %c %s: %s\n", stamp, static_cast<int>(tv.tv_usec / 1000),
-               level_letter(lvl), g_component.c_str(), message.c_str());
-  std::fflush(stderr);
+  std::string component;
+  {
+    std::lock_guard<std::mutex> lock(g_component_mutex);
+    component = g_component;
+  }
+  logger().log(spdlog_level(lvl), "{}: {}", component, message);
 }
 
 }  // namespace nudge::log
