@@ -16,7 +16,7 @@ NUDGE_PACKAGES=(
   libcpp-httplib-dev nlohmann-json3-dev chromium
   clang-14 libfuzzer-14-dev
   libyaml-cpp-dev
-  xvfb x11-apps netpbm libspdlog-dev
+  xvfb x11-apps netpbm libspdlog-dev libcli11-dev
 )
 
 nudge_log() { printf '\033[1m[nudge]\033[0m %s\n' "$*" >&2; }

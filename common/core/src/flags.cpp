@@ -1,5 +1,7 @@
 #include "nudge/flags.hpp"
 
+#include <CLI/CLI.hpp>
+
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -81,37 +83,68 @@ void Flags::set_positional(const std::string& name, const std::string& help) {
   positional_help_ = help;
 }
 
+// Parsing is CLI11's (Debian's libcli11-dev): it matches --name value, --name=value, switches,
+// N-valued flags and positionals anywhere. What users see stays ours: the help text (help(), from
+// our table, printed for --help/-h wherever it stands), the error messages naming the flag, the
+// last value winning when a flag is repeated, and values converted by our strict parsers.
 bool Flags::parse(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
-    std::string arg = argv[i];
+    const std::string arg = argv[i];
+    if (arg == "--") break;
     if (arg == "--help" || arg == "-h") {
       std::cout << help();
       return false;
     }
-    if (arg.size() < 3 || arg.compare(0, 2, "--") != 0) {
-      positional_.push_back(arg);
-      continue;
+    // A switch given a value: CLI11 would read "--on=1" as "on"; ours takes none.
+    const auto eq = arg.find('=');
+    if (arg.compare(0, 2, "--") == 0 && eq != std::string::npos) {
+      const auto it = specs_.find(arg.substr(2, eq - 2));
+      if (it != specs_.end() && it->second.arity == 0) throw FlagError(arg.substr(0, eq) + " takes no value");
     }
-    std::string name = arg.substr(2);
-    std::vector<std::string> values;
-    const auto eq = name.find('=');
-    if (eq != std::string::npos) {
-      values.push_back(name.substr(eq + 1));
-      name = name.substr(0, eq);
+  }
+  CLI::App app(summary_, program_);
+  app.set_help_flag();   // ours: help() above
+  app.allow_extras();    // unknown flags are named below, in our words
+  std::map<std::string, std::vector<std::string>> values;
+  std::map<std::string, CLI::Option*> options;
+  for (const auto& name : order_) {
+    const Spec& spec = specs_.at(name);
+    if (spec.arity == 0) {
+      options[name] = app.add_flag("--" + name);
+    } else {
+      options[name] = app.add_option("--" + name, values[name])
+                          ->expected(spec.arity)
+                          ->allow_extra_args(false)
+                          ->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
     }
-    const auto it = specs_.find(name);
-    if (it == specs_.end()) throw FlagError("unknown flag --" + name + " (see --help)");
-    const Spec& spec = it->second;
-    if (spec.arity == 0 && !values.empty()) throw FlagError("--" + name + " takes no value");
-    while (static_cast<int>(values.size()) < spec.arity) {
-      if (i + 1 >= argc) {
-        throw FlagError("--" + name + " needs " + std::to_string(spec.arity) + " value(s)");
-      }
-      values.push_back(argv[++i]);
-    }
-    spec.assign(values);
+  }
+  std::vector<std::string> positional;
+  app.add_option("positional", positional);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ArgumentMismatch& e) {
+    const std::string what = e.what();  // "--name: 2 required TEXT missing"
+    const std::string flag = what.substr(0, what.find(':'));
+    const auto it = specs_.find(flag.size() > 2 ? flag.substr(2) : flag);
+    if (it == specs_.end()) throw FlagError(what);
+    throw FlagError(flag + " needs " + std::to_string(it->second.arity) + " value(s)");
+  } catch (const CLI::ParseError& e) {
+    throw FlagError(e.what());
+  }
+  for (const std::string& extra : app.remaining()) {
+    if (extra.compare(0, 2, "--") == 0 && extra.size() > 2)
+      throw FlagError("unknown flag " + extra.substr(0, extra.find('=')) + " (see --help)");
+    positional.push_back(extra);  // "-x": a positional argument, as it always was
+  }
+  for (const auto& name : order_) {
+    if (options[name]->count() == 0) continue;
+    const Spec& spec = specs_.at(name);
+    if (spec.arity > 0 && static_cast<int>(values[name].size()) != spec.arity)
+      throw FlagError("--" + name + " needs " + std::to_string(spec.arity) + " value(s)");
+    spec.assign(values[name]);
     given_[name] = true;
   }
+  positional_.insert(positional_.end(), positional.begin(), positional.end());
   return true;
 }
 
