@@ -25,6 +25,7 @@
 
 #include "nudge/flags.hpp"
 #include "nudge/json.hpp"
+#include "nudge/progress.hpp"
 #include "nudge/symmetry/corner_cutting.hpp"
 #include "nudge/symmetry/detector.hpp"
 #include "report.hpp"
@@ -158,15 +159,19 @@ int main(int argc, char** argv) try {
   if (!(tolerance > 0 && tolerance <= 90)) throw std::invalid_argument("--tolerance must be in (0, 90] degrees");
 
   std::vector<FrameResult> rows;
+  nudge::Progress progress("nudge-exp-mirror-voting", static_cast<int>(kFrames.size()));
   for (const std::string& name : kFrames) {
+    progress.step(name + ", " + std::to_string(repeats) + " repeats of 5 detectors");
     const cv::Mat image = read_frame(images, name);
     if (image.empty()) throw std::runtime_error("cannot read " + images + "/" + name + " (or .gz): install opencv-doc");
     rows.push_back(measure(name, image, tolerance, repeats));
     const FrameResult& r = rows.back();
+    progress.clear_status();  // the frame's line goes to stdout, on the same terminal
     std::cout << name << ": " << r.edges << " edges, before " << r.ms.at("before") << " ms, after " << r.ms.at("after")
               << " ms, portable before " << r.ms.at("portable_before") << " ms, portable after "
               << r.ms.at("portable_after") << " ms, author's loop " << r.author_loop_ms << " ms" << std::endl;
   }
+  progress.finish(std::to_string(rows.size()) + " frames measured");
 
   auto mean_of = [&](auto value) {
     std::vector<double> v;
