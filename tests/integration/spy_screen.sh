@@ -4,7 +4,7 @@
 # answers it live; lcm-spy (in SpyTable.java's JVM) watches the bus. The check reads lcm-spy's
 # channel table from its Swing model (what its window shows, without OCR): every channel is
 # listed with its nudge type and none is undecodable. A screenshot of the screen is saved.
-# usage: spy_screen.sh BUILD_DIR SOURCE_DIR [SCREENSHOT.png]
+# usage: spy_screen.sh BUILD_DIR SOURCE_DIR [SCREENSHOT.png]   (NUDGE_KEEP=1: keep the work folder)
 set -uo pipefail
 build=${1:?usage: spy_screen.sh BUILD_DIR SOURCE_DIR [SCREENSHOT.png]}
 src=${2:?usage: spy_screen.sh BUILD_DIR SOURCE_DIR [SCREENSHOT.png]}
