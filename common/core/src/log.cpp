@@ -27,11 +27,12 @@ spdlog::level::level_enum spdlog_level(Level level) {
   return spdlog::level::info;
 }
 
-// One logger for the process, made on first use (no static-initialisation order to worry about).
-// Unregistered: spdlog's global registry is left to whoever else links spdlog.
+// One logger for the process, made on first use (no static-initialisation order to worry about)
+// and never destroyed, so that a thread or a static destructor logging while the process exits
+// still finds it. Unregistered: spdlog's global registry is left to whoever else links spdlog.
 spdlog::logger& logger() {
-  static const std::shared_ptr<spdlog::logger> instance = [] {
-    auto made = std::make_shared<spdlog::logger>("nudge", std::make_shared<spdlog::sinks::stderr_sink_mt>());
+  static spdlog::logger* const instance = [] {
+    auto* made = new spdlog::logger("nudge", std::make_shared<spdlog::sinks::stderr_sink_mt>());
     // %L: spdlog's one-letter level (D, I, W, E); the component goes in with the message.
     made->set_formatter(std::make_unique<spdlog::pattern_formatter>("%Y-%m-%dT%H:%M:%S.%eZ %L %v",
                                                                     spdlog::pattern_time_type::utc));
