@@ -9,6 +9,7 @@ set -uo pipefail
 bin=${1:?usage: help_flags.sh BIN_DIR SOURCE_DIR LIST [--write]}
 src=${2:?usage: help_flags.sh BIN_DIR SOURCE_DIR LIST [--write]}
 list=${3:?usage: help_flags.sh BIN_DIR SOURCE_DIR LIST [--write]}
+src=$(cd "$src" && pwd)  # absolute, as the binaries were built with it
 
 # "--flag<TAB>default" for each flag of a --help text on stdin. A flag whose name fills the
 # column has its help (and default) on the next line.
@@ -28,13 +29,15 @@ flags_of() {
 }
 
 help_of() { timeout 10 "$bin/$1" --help </dev/null 2>/dev/null; }
+# The source tree's path (a literal, not a pattern) written as <src>: the list is machine-independent.
+without_src() { local text; text=$(cat); printf '%s\n' "${text//"$src"/<src>}"; }
 
 if [ "${4:-}" = --write ]; then
   for b in "$bin"/nudge-*; do
     name=$(basename "$b")
     text=$(help_of "$name") || continue
     [[ $text == usage:* ]] || continue
-    printf '%s\n' "$text" | flags_of | sed "s|$src|<src>|g" | sed "s|^|$name\t|"
+    printf '%s\n' "$text" | flags_of | without_src | sed "s|^|$name\t|"
   done >"$list"
   echo "wrote $(wc -l <"$list") flags of $(cut -f1 "$list" | sort -u | wc -l) binaries to $list"
   exit 0
@@ -43,7 +46,7 @@ fi
 failed=0 checked=0 skipped=()
 for name in $(cut -f1 "$list" | sort -u); do
   if [ ! -x "$bin/$name" ]; then skipped+=("$name"); continue; fi
-  now=$(help_of "$name" | flags_of | sed "s|$src|<src>|g")
+  now=$(help_of "$name" | flags_of | without_src)
   while IFS=$'\t' read -r binary flag default; do
     [ "$binary" = "$name" ] || continue
     checked=$((checked + 1))
