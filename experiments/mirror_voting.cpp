@@ -161,7 +161,7 @@ int main(int argc, char** argv) try {
   std::vector<FrameResult> rows;
   nudge::Progress progress("nudge-exp-mirror-voting", static_cast<int>(kFrames.size()));
   for (const std::string& name : kFrames) {
-    progress.step(name + ", " + std::to_string(repeats) + " repeats of 5 detectors");
+    progress.step(name + ", " + std::to_string(repeats) + " repeats");
     const cv::Mat image = read_frame(images, name);
     if (image.empty()) throw std::runtime_error("cannot read " + images + "/" + name + " (or .gz): install opencv-doc");
     rows.push_back(measure(name, image, tolerance, repeats));
