@@ -486,7 +486,7 @@ class Shell {
 
   void publish_segmentation(const sv::Attempt& a) {
     segmentation_t m{};
-    m.utime = now_;
+    m.utime = a.after_utime;  // the still the mask is cut from (published later, after any learning)
     m.run_id = opt_.run_id;
     m.attempt = a.number;
     copy3(a.target.position, m.position_before);
@@ -494,7 +494,7 @@ class Shell {
     m.line_before = bus::to_message(*a.before_line);
     m.line_after = bus::to_message(*a.after_line);
     m.mask_pixels = cv::countNonZero(a.segmentation.mask);
-    m.mask = bus::to_message(a.segmentation.mask, image_t::FORMAT_PNG, now_, a.number, "right");
+    m.mask = bus::to_message(a.segmentation.mask, image_t::FORMAT_PNG, a.after_utime, a.number, "right");
     publish(bus::channel::SEGMENTATION, m);
   }
 

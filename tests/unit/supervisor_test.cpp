@@ -260,12 +260,14 @@ TEST_F(SupervisorTest, SegmentsTheObjectThenFindsNothingLeftToNudge) {
   s.on_arm_state(arm(sv::ArmStatus::Motion::Done, homes[0].seq), now_ += kSecond);
   ASSERT_EQ(s.state(), sv::State::SnapshotAfter) << s.report().reason;
   now_ += kSecond / 5;
-  s.on_right_still(draw_scene(scene_, {1280, 960}, {rest}), now_, now_);
+  const int64_t after_taken = now_ - kSecond / 10;  // taken after the request, heard later
+  s.on_right_still(draw_scene(scene_, {1280, 960}, {rest}), after_taken, now_);
   out = s.take_outputs();
   const auto ended = outputs_of<sv::AttemptEnded>(out);
   ASSERT_EQ(ended.size(), 1u);
   const sv::Attempt& a = *ended[0].attempt;
   EXPECT_EQ(a.outcome, sv::Outcome::Segmented) << a.reason;
+  EXPECT_EQ(a.after_utime, after_taken) << "segmentation_t.utime is the after still's time";
   EXPECT_GE(a.motion_frames, 2);
   ASSERT_TRUE(a.rest);
   EXPECT_LT((*a.rest - rest).norm(), 0.005);

@@ -32,10 +32,11 @@ std::vector<viewer::SimulationScore> simulation_scores(const std::string& log_pa
   if (!log.good()) throw std::runtime_error("cannot read the run's LCM log " + log_path);
   std::vector<viewer::SimulationScore> scores;
   // The world's states by simulated time. The supervisor publishes SEGMENTATION when the attempt
-  // ends, stamped with that time: with learning, after the object was grasped, turned and put back
-  // (or dropped). So the mask is scored against the world as it was when segmentation began (the
-  // supervisor's SEGMENT state, right after the after still, the arm parked and the object at
-  // rest), and against the segmentation's own stamp only when the log has no SEGMENT state.
+  // ends: with learning, after the object was grasped, turned and put back (or dropped). Its stamp
+  // is the after still's time now, but logs recorded before that fix carry the attempt's end. So
+  // the mask is scored against the world as it was when segmentation began (the supervisor's
+  // SEGMENT state, right after the after still, the arm parked and the object at rest), and
+  // against the segmentation's own stamp only when the log has no SEGMENT state.
   std::map<int64_t, sim::PoseSnapshot> states;
   std::map<int, int64_t> segment_started;  // attempt -> the supervisor's SEGMENT transition
   while (const lcm::LogEvent* e = log.readNextEvent()) {
