@@ -105,3 +105,42 @@ TEST(SimStateSync, InterpolatedPosesForMotionBlur) {
   b.objects[0].name = "mug";  // different objects: nothing to interpolate
   EXPECT_EQ(nudge::sim::interpolate_poses(a, b, 0.5).objects[0].name, "mug");
 }
+
+// The camera's rendering world shows the tool the world service uses (--tool auto switches from
+// the pad to the gripper at a grasp): the gripper with its fingers' opening, and the pad again.
+TEST(SimStateSync, TheRenderingWorldShowsTheSimulatedTool) {
+  sim::World physics(two_objects()), renderer(two_objects());
+  const sim::PoseSnapshot pad = sim::snapshot_poses(physics, 0.0);
+  EXPECT_FALSE(pad.gripper_opening) << "the pad is the tool at first";
+  physics.set_end_effector({0.25, 0.0, 0.12}, 0.3, 0.05);
+  physics.step_for(0.5);  // the fingers close from open to 5 cm
+  const sim::PoseSnapshot gripper = sim::snapshot_poses(physics, 0.3);
+  ASSERT_TRUE(gripper.gripper_opening);
+  EXPECT_NEAR(*gripper.gripper_opening, 0.05, 0.005);
+
+  sim::PoseSnapshot pad_there = gripper;  // the same tool point, the pad
+  pad_there.gripper_opening.reset();
+  sim::apply_poses(renderer, pad_there);
+  EXPECT_FALSE(renderer.gripper_in_use());
+  const cv::Mat with_pad = renderer.render(1);
+  sim::apply_poses(renderer, gripper);
+  EXPECT_TRUE(renderer.gripper_in_use());
+  EXPECT_NEAR(renderer.gripper_opening(), *gripper.gripper_opening, 1e-9) << "the fingers drawn where they are";
+  EXPECT_LT((renderer.pusher_position() - physics.pusher_position()).norm(), 1e-12);
+  const cv::Mat with_gripper = renderer.render(1);
+  EXPECT_GT(cv::norm(with_pad, with_gripper, cv::NORM_L1), 0.0) << "the gripper is drawn, not the pad";
+
+  sim::apply_poses(renderer, pad_there);
+  EXPECT_FALSE(renderer.gripper_in_use()) << "the pad again";
+
+  sim::PoseSnapshot back = gripper;
+  back.gripper_opening = std::nan("");
+  EXPECT_THROW(sim::apply_poses(renderer, back), std::invalid_argument);
+  EXPECT_FALSE(renderer.gripper_in_use()) << "a bad state changes nothing";
+
+  // Motion blur between two gripper states interpolates the opening; pad to gripper takes the later.
+  sim::PoseSnapshot wide = gripper;
+  wide.gripper_opening = 0.09;
+  EXPECT_NEAR(*sim::interpolate_poses(gripper, wide, 0.5).gripper_opening, 0.5 * (*gripper.gripper_opening + 0.09), 1e-12);
+  EXPECT_EQ(sim::interpolate_poses(pad, wide, 0.5).gripper_opening, wide.gripper_opening);
+}

@@ -613,6 +613,29 @@ TEST(Grasp, TheObjectTopIsTheLargestBlobsFirstPixelOnTheLine) {
   EXPECT_FALSE(sv::object_top(cv::Mat::zeros(200, 300, CV_8U), vertical));
 }
 
+// The fingers close 90 mm below the estimated top (below a bottle's shoulder, where its sides are
+// vertical), and no lower than half way up a short object.
+TEST(Grasp, TheFingersCloseBelowTheTopOnTheSidesNotOnTheCap) {
+  const sv::GraspTargetParams params;
+  EXPECT_NEAR(sv::grip_height(0.20, params), 0.11, 1e-12);   // a 200 mm bottle: below its shoulder
+  EXPECT_NEAR(sv::grip_height(0.35, params), 0.26, 1e-12);
+  EXPECT_NEAR(sv::grip_height(0.12, params), 0.06, 1e-12);   // a can: half way up, not 30 mm
+  EXPECT_NEAR(sv::grip_height(0.18, params), 0.09, 1e-12);   // where the two rules meet
+  sv::GraspTargetParams shallow = params;
+  shallow.grip_depth_m = 0.01;
+  EXPECT_NEAR(sv::grip_height(0.20, shallow), 0.19, 1e-12);
+  // Through grasp_target: a 250 mm top, seen by both cameras, is gripped 90 mm below its
+  // estimated (lowered) top.
+  const sv::SceneGeometry scene = make_scene();
+  const Eigen::Vector3d foot(0.28, -0.05, 0), top(0.28, -0.05, 0.25);
+  const cv::Size still(1280, 960);
+  const sv::GraspTarget g = sv::grasp_target(scene, *scene.project_left(top, still), *scene.project_right(top, still), still, foot);
+  ASSERT_TRUE(g.ok()) << g.reason;
+  EXPECT_NEAR(g.top_height_m, 0.25 - g.overestimate_m, 1e-6);
+  EXPECT_NEAR(g.grasp_height_m, g.top_height_m - 0.09, 1e-6);
+  EXPECT_LT(g.grasp_height_m, g.top_height_m);
+}
+
 TEST(Grasp, TheTriangulatedTopIsLoweredByRTanTheta) {
   const sv::SceneGeometry scene = make_scene();
   const Eigen::Vector3d foot(0.28, -0.05, 0), top(0.28, -0.05, 0.12);
@@ -624,7 +647,8 @@ TEST(Grasp, TheTriangulatedTopIsLoweredByRTanTheta) {
   const Eigen::Vector3d camera = scene.right_camera_in_world();
   const double theta = std::atan2(camera.z() - top.z(), (camera - top).head<2>().norm());
   EXPECT_NEAR(g.overestimate_m, 0.06 * std::tan(theta), 1e-9);
-  EXPECT_NEAR(g.grasp_height_m, 0.12 - g.overestimate_m, 1e-6);
+  EXPECT_NEAR(g.top_height_m, 0.12 - g.overestimate_m, 1e-6);
+  EXPECT_NEAR(g.grasp_height_m, sv::grip_height(g.top_height_m, {}), 1e-12);
   // A top that is the table itself cannot be grasped; the reason says so.
   const sv::GraspTarget flat = sv::grasp_target(scene, *scene.project_left(foot, still), *scene.project_right(foot, still), still, foot);
   EXPECT_FALSE(flat.ok());
@@ -700,11 +724,11 @@ TEST_F(LearningTest, GraspsTurnsTwelveTimesLearnsAndPutsTheObjectBack) {
   sv::Supervisor s = make_learning();
   const sv::GraspCommand grasp = to_grasp(s);
   EXPECT_EQ(s.awaited_arm_seq(), grasp.seq);
-  // Above the axis' foot where the object came to rest, the fingers at its lowered top (12 cm
-  // box, lowered by r tan(theta) ~ 3 cm).
+  // Above the axis' foot where the object came to rest, the fingers half way up this short object
+  // (12 cm box, its top lowered by r tan(theta) ~ 3 cm: grip_height).
   EXPECT_LT((grasp.position - rest_).head<2>().norm(), 0.006);
-  EXPECT_GT(grasp.height, 0.06);
-  EXPECT_LT(grasp.height, 0.12);
+  EXPECT_GT(grasp.height, 0.03);
+  EXPECT_LT(grasp.height, 0.06);
   done(s, grasp.seq);
   std::vector<sv::LearnView> views;
   std::vector<sv::LearnCommit> commits;

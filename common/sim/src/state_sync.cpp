@@ -29,6 +29,7 @@ PoseSnapshot snapshot_poses(const World& world, double pusher_yaw) {
   }
   out.pusher_position = world.pusher_position();
   out.pusher_yaw = pusher_yaw;
+  if (world.gripper_in_use()) out.gripper_opening = world.gripper_opening();
   if (world.has_arm()) out.arm_joints = world.arm_joints();
   return out;
 }
@@ -43,6 +44,8 @@ void apply_poses(World& world, const PoseSnapshot& poses) {
   }
   if (!poses.pusher_position.allFinite() || !std::isfinite(poses.pusher_yaw))
     throw std::invalid_argument("pusher: pose is not finite");
+  if (poses.gripper_opening && !std::isfinite(*poses.gripper_opening))
+    throw std::invalid_argument("gripper: opening is not finite");
   if (poses.arm_joints)
     for (double j : *poses.arm_joints)
       if (!std::isfinite(j)) throw std::invalid_argument("arm: joints are not finite");
@@ -55,7 +58,10 @@ void apply_poses(World& world, const PoseSnapshot& poses) {
   // The pusher first: set_object_pose() recomputes the derived positions of every body (the
   // mocap pusher included); with no objects, set_state() of the current state does it.
   if (poses.arm_joints && world.has_arm()) world.set_arm_joints(*poses.arm_joints);
-  world.set_pusher(poses.pusher_position, poses.pusher_yaw);
+  if (poses.gripper_opening)
+    world.place_gripper(poses.pusher_position, poses.pusher_yaw, *poses.gripper_opening);
+  else
+    world.set_pusher(poses.pusher_position, poses.pusher_yaw);
   for (size_t k = 0; k < index.size(); ++k)
     world.set_object_pose(index[k], poses.objects[k].position, poses.objects[k].orientation);
   if (index.empty()) world.set_state(world.state());
@@ -72,6 +78,8 @@ PoseSnapshot interpolate_poses(const PoseSnapshot& from, const PoseSnapshot& to,
   out.pusher_position = (1 - t) * from.pusher_position + t * to.pusher_position;
   const double turn = std::remainder(to.pusher_yaw - from.pusher_yaw, 2 * M_PI);
   out.pusher_yaw = from.pusher_yaw + t * turn;
+  if (from.gripper_opening && to.gripper_opening)
+    out.gripper_opening = (1 - t) * *from.gripper_opening + t * *to.gripper_opening;
   if (from.arm_joints && to.arm_joints)
     for (int j = 0; j < 6; ++j) (*out.arm_joints)[j] = (1 - t) * (*from.arm_joints)[j] + t * (*to.arm_joints)[j];
   return out;

@@ -471,6 +471,21 @@ void World::set_end_effector(const Eigen::Vector3d& position, double yaw, double
   for (int f = 0; f < 2; ++f) s.data->ctrl[s.finger_act[f]] = apex;
 }
 
+void World::place_gripper(const Eigen::Vector3d& position, double yaw, double opening) {
+  if (!position.allFinite() || !std::isfinite(yaw) || !std::isfinite(opening))
+    throw std::invalid_argument("World::place_gripper: position, yaw and opening must be finite");
+  Impl& s = *impl_;
+  use_gripper(true);
+  s.place_tool(position, yaw);
+  s.snap_hand();
+  const GripperGeometry& g = gripper_geometry();
+  const double apex = g.apex_for_opening(std::clamp(opening, 0.0, g.max_opening));
+  for (int f = 0; f < 2; ++f) {
+    s.data->ctrl[s.finger_act[f]] = apex;
+    s.data->qpos[s.finger_qpos[f]] = apex;
+  }
+}
+
 bool World::gripper_in_use() const { return impl_->gripper; }
 
 double World::gripper_opening() const {

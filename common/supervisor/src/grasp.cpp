@@ -52,6 +52,10 @@ std::optional<cv::Point2d> object_top(const cv::Mat& mask, const symmetry::Line&
   return std::nullopt;
 }
 
+double grip_height(double top_height, const GraspTargetParams& params) {
+  return std::max(top_height - params.grip_depth_m, params.min_grip_fraction * top_height);
+}
+
 GraspTarget grasp_target(const SceneGeometry& scene, const cv::Point2d& left_top, const cv::Point2d& right_top,
                          cv::Size still_size, const Eigen::Vector3d& foot, const GraspTargetParams& params) {
   GraspTarget target;
@@ -75,7 +79,8 @@ GraspTarget grasp_target(const SceneGeometry& scene, const cv::Point2d& left_top
   const Eigen::Vector3d camera = scene.right_camera_in_world();
   const double theta = std::atan2(camera.z() - height, (camera - target.top).head<2>().norm());
   target.overestimate_m = params.top_radius_m * std::tan(std::max(0.0, theta));
-  target.grasp_height_m = height - target.overestimate_m;
+  target.top_height_m = height - target.overestimate_m;
+  target.grasp_height_m = grip_height(target.top_height_m, params);
   if (target.grasp_height_m < params.min_grasp_height_m) {
     std::snprintf(text, sizeof text, "the object's top (%.0f mm, %.0f mm lowered) is too low to grasp", height * 1e3,
                   target.overestimate_m * 1e3);

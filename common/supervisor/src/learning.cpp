@@ -127,7 +127,8 @@ void Supervisor::plan_grasp(int64_t now) {
   learn_seq_ = next_seq_++;
   arm_away_ = true;
   enter(State::Grasp, now, "grasping the object at " + millimetres(a.grasp->foot) + ", fingers " + mm(a.grasp->grasp_height_m) +
-                               " above the table (top " + mm(a.grasp->top.z()) + ", lowered " + mm(a.grasp->overestimate_m) + ")");
+                               " above the table (top " + mm(a.grasp->top_height_m) + ": triangulated " + mm(a.grasp->top.z()) +
+                               ", lowered " + mm(a.grasp->overestimate_m) + ")");
   outputs_.push_back(GraspCommand{learn_seq_, a.grasp->foot, a.grasp->grasp_height_m});
 }
 
@@ -178,11 +179,11 @@ void Supervisor::take_view(const cv::Mat& still, int64_t utime, int64_t now) {
   view.image = still.clone();
   view.utime = utime;
   view.object_key = a.object_key();
-  // The held object hangs below the fingers, which closed at its (lowered) top: it spans the grasp
-  // height below the tool point, and the lowering's uncertainty above it.
+  // The held object spans the grasp height below the tool point, and up to its triangulated top
+  // (the estimated top plus the lowering's uncertainty) above it.
   const Eigen::Vector3d tool = arm_.base.world_from_base() * robot::forward_kinematics(arm_.model, joints_).translation();
   view.box = cylinder_box(scene_, tool, config_.targets.object_radius, tool.z() - a.grasp->grasp_height_m,
-                          tool.z() + a.grasp->overestimate_m, config_.still_size);
+                          tool.z() + a.grasp->top.z() - a.grasp->grasp_height_m, config_.still_size);
   a.views.push_back(view);
   outputs_.push_back(view);
   if (static_cast<int>(a.views.size()) >= config_.views) return commit_views(now);
@@ -196,7 +197,7 @@ void Supervisor::commit_views(int64_t now) {
   if (a.views.empty()) return place(now, "not learned", "no view was taken");
   learn_seq_ = next_seq_++;
   enter(State::Learn, now, "learning from " + std::to_string(a.views.size()) + " views");
-  const double height = a.grasp->top.z() - a.grasp->overestimate_m;
+  const double height = a.grasp->top_height_m;
   outputs_.push_back(LearnCommit{learn_seq_, a.object_key(), static_cast<int>(a.views.size()), height, config_.grasp.top_radius_m});
 }
 

@@ -28,6 +28,9 @@ struct PoseSnapshot {
   std::vector<ObjectPose> objects;
   Eigen::Vector3d pusher_position = Eigen::Vector3d::Zero();
   double pusher_yaw = 0;
+  // The tool at the pusher's pose: the gripper with its fingers at this opening (m), or the pad
+  // when empty (the world service switches tools: --tool auto).
+  std::optional<double> gripper_opening;
   std::optional<std::array<double, 6>> arm_joints;  // the PUMA 260's joints, rad (worlds with an arm)
 };
 
@@ -50,7 +53,8 @@ PoseSnapshot snapshot_poses(const World& world, double pusher_yaw);
 // carry the same names; otherwise `to` is returned unchanged.
 PoseSnapshot interpolate_poses(const PoseSnapshot& from, const PoseSnapshot& to, double t);
 
-// Teleports every object of `world` (matched by name), the pusher and, when both have one, the
+// Teleports every object of `world` (matched by name), the pusher (the pad, or the gripper with
+// its fingers at gripper_opening when that is set) and, when both have one, the
 // arm (joints clamped to their limits) to `poses` and updates the
 // derived positions, so that the next render shows them. Throws std::invalid_argument naming the
 // object when a name is unknown, a pose is not finite, or the object counts differ.

@@ -116,6 +116,9 @@ class World {
   // actuators drive them towards the opening and they stop on what they grip, which is then held
   // by contact and friction only. Moves the tool point instantly: the caller steps physics.
   void set_end_effector(const Eigen::Vector3d& position, double yaw, double opening);
+  // The gripper in use, its hand at `position` (yaw as above) and its fingers at `opening` (m,
+  // clamped) at once, at rest: a renderer's teleport to a published state (no physics needed).
+  void place_gripper(const Eigen::Vector3d& position, double yaw, double opening);
   bool gripper_in_use() const;
   double gripper_opening() const;           // the fingers' actual opening now, m
   double gripper_commanded_opening() const;  // m

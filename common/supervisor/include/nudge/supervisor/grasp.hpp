@@ -3,7 +3,9 @@
 // camera's segmentation (the post-nudge symmetry line meets the top of the mask's largest
 // 8-connected blob), triangulated; the triangulated top lies on the rear rim of the object, too
 // high by d = r tan(theta) (r: the top's radius, theta: the camera's angle of view over the table),
-// so the fingers close that much lower. Also the box a held object occupies in the right still
+// and the object's top is that much lower. The fingers close a fixed depth below that top, where
+// a bottle's sides are vertical (its shoulder, neck and cap slope, and a squeeze on a slope pushes
+// the object out of the fingers), never below half the object's height. Also the box a held object occupies in the right still
 // (the learner's background pruning, sec. 7.3).
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
@@ -20,6 +22,12 @@ struct GraspTargetParams {
   // r in d = r tan(theta). The thesis' objects have tops of 30-90 mm radius and it lowers by the
   // middle value (36 mm at 30 deg: +-18 mm tolerance, which its foam pads exceed).
   double top_radius_m = 0.06;
+  // The tool point (the middle of the fingers, which span +-19 mm) this far below the estimated
+  // top: a bottle's top 75 mm narrow to the neck and cap (sim bottle: vertical sides up to 125 of
+  // its 200 mm), and a grip there slips out (the gripper test measures it); the thesis' foam pads
+  // gripped whatever they met.
+  double grip_depth_m = 0.09;
+  double min_grip_fraction = 0.5;  // a short object is gripped no lower than this part of its height
   double min_grasp_height_m = 0.03;  // the fingers never close lower (the table)
   double max_object_height_m = 0.35; // a taller triangulated top is a mismatch, not an object
 };
@@ -34,13 +42,18 @@ struct GraspTarget {
   Eigen::Vector3d foot = Eigen::Vector3d::Zero();  // where the axis meets the table, world
   Eigen::Vector3d top = Eigen::Vector3d::Zero();   // the triangulated top, world
   double overestimate_m = 0;                       // d = r tan(theta)
+  double top_height_m = 0;                         // the estimated top above the table: top.z() - d
   double grasp_height_m = 0;                       // tool point above the table at the grasp
   bool ok() const { return reason.empty(); }
 };
 
 // The grasp from the object's top in both stills (pixels at `still_size`) and its foot on the
-// table (world, from the settled axes). Fails with a reason when the tops do not triangulate, the
+// table (world, from the settled axes); the grasp height by grip_height(). Fails with a reason when the tops do not triangulate, the
 // top is below the minimum grasp height or above any object.
+// The tool point's height for an object whose top is `top_height` above the table:
+// max(top_height - grip_depth_m, min_grip_fraction * top_height).
+double grip_height(double top_height, const GraspTargetParams& params);
+
 GraspTarget grasp_target(const SceneGeometry& scene, const cv::Point2d& left_top, const cv::Point2d& right_top,
                          cv::Size still_size, const Eigen::Vector3d& foot, const GraspTargetParams& params = {});
 
