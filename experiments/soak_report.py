@@ -90,6 +90,28 @@ def stage_cells(values):
     return " | ".join(f"{values[s]:.0f}" if s in values else "–" for s in STAGES)
 
 
+def latency_table(r):
+    """A run summary's p50 and p99 latency per stage, a column a stage."""
+    return [
+        "| stage | " + " | ".join(STAGES) + " |",
+        "|---|" + "---|" * len(STAGES),
+        "| p50 latency, ms | " + stage_cells(r["p50_ms"]) + " |",
+        "| p99 latency, ms | " + stage_cells(r["p99_ms"]) + " |",
+    ]
+
+
+def process_table(r, columns):
+    """A row per process of a run summary; columns: (header, summary key) pairs."""
+    lines = ["| process | " + " | ".join(header for header, _ in columns) + " |", "|---|" + "---|" * len(columns)]
+    for p in sorted(r[columns[0][1]]):
+        lines.append(f"| {p} | " + " | ".join(str(r[key][p]) for _, key in columns) + " |")
+    return lines
+
+
+def heartbeat_lines(r):
+    return [f"- {p}: {status}" for p, status in sorted(r["heartbeat_status"].items())]
+
+
 def markdown(soak, slowest, sweep, cpu):
     s, w = summary(soak), summary(slowest)
     lines = [
@@ -113,21 +135,14 @@ def markdown(soak, slowest, sweep, cpu):
         f"Camera frames: {s['camera_frames']} ({s['camera_hz']} Hz stereo of the 25 asked for: the world and the camera",
         "fall behind real time when the machine is loaded).",
         "",
-        "| stage | " + " | ".join(STAGES) + " |",
-        "|---|" + "---|" * len(STAGES),
-        "| p50 latency, ms | " + stage_cells(s["p50_ms"]) + " |",
-        "| p99 latency, ms | " + stage_cells(s["p99_ms"]) + " |",
-        "",
-        "| process | RSS at the end, MB | RSS growth after warm-up, MB | CPU, % of a core | socket drops |",
-        "|---|---|---|---|---|",
     ]
-    for p in sorted(s["rss_mb_last"]):
-        lines.append(f"| {p} | {s['rss_mb_last'][p]} | {s['rss_growth_mb'][p]} | {s['cpu_percent_mean'][p]} | {s['socket_drops'][p]} |")
+    lines += latency_table(s) + [""]
+    lines += process_table(s, [("RSS at the end, MB", "rss_mb_last"), ("RSS growth after warm-up, MB", "rss_growth_mb"),
+                               ("CPU, % of a core", "cpu_percent_mean"), ("socket drops", "socket_drops")])
     lines += ["", "Frames not answered (camera frames a stage never sent a result for):", ""]
     lines += drop_lines(s["drops"])
     lines += ["", "What each service's last heartbeat said:", ""]
-    for p, status in sorted(s["heartbeat_status"].items()):
-        lines.append(f"- {p}: {status}")
+    lines += heartbeat_lines(s)
     lines += ["", "![RSS](soak_rss.png)", ""]
     if sweep:
         lines += [
@@ -155,21 +170,14 @@ def markdown(soak, slowest, sweep, cpu):
         "camera that take pixel noise for motion (`--motion-threshold 1.05 --start-min-blocks 1`).",
         f"Load average {w['load_average_mean']}; camera frames {w['camera_frames']} ({w['camera_hz']} Hz).",
         "",
-        "| stage | " + " | ".join(STAGES) + " |",
-        "|---|" + "---|" * len(STAGES),
-        "| p50 latency, ms | " + stage_cells(w["p50_ms"]) + " |",
-        "| p99 latency, ms | " + stage_cells(w["p99_ms"]) + " |",
-        "",
-        "| process | CPU, % of a core | RSS at the end, MB | socket drops |",
-        "|---|---|---|---|",
     ]
-    for p in sorted(w["cpu_percent_mean"]):
-        lines.append(f"| {p} | {w['cpu_percent_mean'][p]} | {w['rss_mb_last'][p]} | {w['socket_drops'][p]} |")
+    lines += latency_table(w) + [""]
+    lines += process_table(w, [("CPU, % of a core", "cpu_percent_mean"), ("RSS at the end, MB", "rss_mb_last"),
+                               ("socket drops", "socket_drops")])
     lines += ["", "Frames not answered:", ""]
     lines += drop_lines(w["drops"])
     lines += ["", "Heartbeats:", ""]
-    for p, status in sorted(w["heartbeat_status"].items()):
-        lines.append(f"- {p}: {status}")
+    lines += heartbeat_lines(w)
     lines.append("")
     return "\n".join(lines)
 

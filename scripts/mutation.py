@@ -308,9 +308,14 @@ def cpu_model():
     return next((l.split(":", 1)[1].strip() for l in out.splitlines() if l.startswith("Model name")), "unknown")
 
 
-def write_results(outcomes, seconds):
+def score(outcomes):
+    """The outcomes that count (the mutant built and its tests ran: killed or survived), and the killed ones."""
     scored = [o for o in outcomes if o["status"] in ("killed", "survived")]
-    killed = [o for o in scored if o["status"] == "killed"]
+    return scored, [o for o in scored if o["status"] == "killed"]
+
+
+def write_results(outcomes, seconds):
+    scored, killed = score(outcomes)
     survivors = [o for o in scored if o["status"] == "survived"]
     summary = {
         "mutants": len(scored),
@@ -425,8 +430,8 @@ def main():
         rerun = {o["id"]: o for o in outcomes}
         outcomes = [rerun.get(x["id"], dict(previous.get(x["id"]), harmless=x["harmless"]))
                     for x in MUTANTS if x["id"] in rerun or x["id"] in previous]
-    scored = [o for o in outcomes if o["status"] in ("killed", "survived")]
-    killed = sum(o["status"] == "killed" for o in scored)
+    scored, killed = score(outcomes)
+    killed = len(killed)
     print(f"{killed}/{len(scored)} mutants killed in {seconds:.0f} s")
     unexplained = [o["id"] for o in scored if o["status"] == "survived" and not o["harmless"]]
     stale = [o["id"] for o in outcomes if o["status"] in ("stale", "build_failed")]
