@@ -4,25 +4,14 @@
 # checks that lines arrive for every stereo frame.
 # usage: camera_symmetry.sh BIN_DIR
 set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 bin=${1:?usage: camera_symmetry.sh BIN_DIR}
 frames=12
-
-if [ "$(id -u)" != 0 ] || ! unshare -n true 2>/dev/null; then
-  echo "SKIPPED: needs root and unshare -n for a private network namespace" >&2
-  exit 77
-fi
-
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+nudge_test_in_private_network "$@"
+nudge_test_work_dir
 "$bin/nudge-synth-scenes" --out "$work/scenes" --count "$frames" --seed 7 >/dev/null
-
-unshare -n bash -s "$bin" "$work" "$frames" <<'INNER'
-set -euo pipefail
-bin=$1; work=$2; frames=$3
-ip link set lo up multicast on
-ip route add 224.0.0.0/4 dev lo
 sysctl -qw net.core.rmem_max=16777216 net.core.rmem_default=16777216 2>/dev/null || true
-url="udpm://239.255.76.67:7667?ttl=0&recv_buf_size=16777216"
+url=$NUDGE_TEST_URL
 
 "$bin/nudge-symmetry" --lcm-url "$url" --inputs CAMERA_LEFT,CAMERA_RIGHT 2>"$work/symmetry.log" &
 sym=$!
@@ -43,4 +32,3 @@ fi
 grep -E "lines for" "$work/monitor.log"
 grep -q "0 errors" "$work/symmetry.log" || { echo "FAILED: symmetry reported errors" >&2; cat "$work/symmetry.log" >&2; exit 1; }
 echo "PASSED: camera -> symmetry over UDP multicast, lines for all $frames stereo frames"
-INNER

@@ -6,17 +6,14 @@
 # namespace (unshare -m, root), so nothing outside the test sees it.
 # usage: full_disk.sh BIN_DIR
 set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 bin=${1:?usage: full_disk.sh BIN_DIR}
 data=/usr/share/doc/opencv-doc/examples/data
 
-if [ "$(id -u)" != 0 ] || ! unshare -m true 2>/dev/null; then
-  echo "SKIPPED: needs root and unshare -m for a private mount namespace" >&2
-  exit 77
-fi
+nudge_test_require_namespace -m "a private mount namespace"
 [ -f "$data/left01.jpg" ] || { echo "FAILED: $data is missing: install opencv-doc (scripts/lib.sh does)" >&2; exit 1; }
 
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+nudge_test_work_dir
 mkdir "$work/disk"
 
 unshare -m bash -s "$bin" "$work" "$data" <<'INNER'

@@ -6,23 +6,12 @@
 # of both parts and ends cleanly. In a private network namespace (nudge-replay publishes on UDP).
 # usage: logs_back_to_back.sh BIN_DIR
 set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 bin=${1:?usage: logs_back_to_back.sh BIN_DIR}
-
-if [ "$(id -u)" != 0 ] || ! unshare -n true 2>/dev/null; then
-  echo "SKIPPED: needs root and unshare -n for a private network namespace" >&2
-  exit 77
-fi
-
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+nudge_test_in_private_network "$@"
+nudge_test_work_dir
 "$bin/nudge-synth-scenes" --out "$work/scenes" --count 3 --seed 7 >/dev/null
-
-unshare -n bash -s "$bin" "$work" <<'INNER'
-set -euo pipefail
-bin=$1; work=$2
-ip link set lo up multicast on
-ip route add 224.0.0.0/4 dev lo
-url="udpm://239.255.76.67:7667?ttl=0&recv_buf_size=16777216"
+url=$NUDGE_TEST_URL
 fail() { echo "FAILED: $*" >&2; cat "$work"/*.log >&2; exit 1; }
 # Events per channel of an LCM log (LCM's file format): "COUNT CHANNEL" lines.
 channels() {
@@ -55,4 +44,3 @@ timeout 120 "$bin/nudge-symmetry" --lcm-in "file://$work/twice.lcmlog?speed=0" -
 answered=$(channels "$work/symmetry.lcmlog" | awk '$2 == "SYMMETRY_LEFT" { print $1 }')
 [ "$answered" = $((2 * once_left)) ] || fail "nudge-symmetry answered ${answered:-0} left frames of $((2 * once_left))"
 echo "PASSED: $((2 * events_once)) events replayed across the jump back, $answered left frames answered"
-INNER

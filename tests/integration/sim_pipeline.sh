@@ -5,26 +5,16 @@
 # and compares them with the true axes in SIM_STATE.
 # usage: sim_pipeline.sh BIN_DIR SCENE
 set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 bin=${1:?usage: sim_pipeline.sh BIN_DIR SCENE}
 scene=${2:?usage: sim_pipeline.sh BIN_DIR SCENE}
 seconds=2 rate=10
 frames=$((seconds * rate + 1))  # the state at t = 0, then one per period
 
-if [ "$(id -u)" != 0 ] || ! unshare -n true 2>/dev/null; then
-  echo "SKIPPED: needs root and unshare -n for a private network namespace" >&2
-  exit 77
-fi
-
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-
-unshare -n bash -s "$bin" "$work" "$scene" "$seconds" "$rate" "$frames" <<'INNER'
-set -euo pipefail
-bin=$1; work=$2; scene=$3; seconds=$4; rate=$5; frames=$6
-ip link set lo up multicast on
-ip route add 224.0.0.0/4 dev lo
+nudge_test_in_private_network "$@"
+nudge_test_work_dir
 sysctl -qw net.core.rmem_max=16777216 net.core.rmem_default=16777216 2>/dev/null || true
-url="udpm://239.255.76.67:7667?ttl=0&recv_buf_size=16777216"
+url=$NUDGE_TEST_URL
 
 # Mirror-consistent pairs: the striped mug's texture must not take the cup's line.
 "$bin/nudge-symmetry" --lcm-url "$url" --lines 5 --theta-min -25 --theta-max 25 --once-per-row --mirror-tolerance 15 \
@@ -35,11 +25,8 @@ mon=$!
 "$bin/nudge-camera" --lcm-url "$url" --source sim --scene "$scene" 2>"$work/camera.log" &
 cam=$!
 # Every subscriber listens before the first state: wait until each has started (the camera
-# builds its World first), at most 30 s.
-for _ in $(seq 300); do
-  [ "$(grep -l "started:" "$work/symmetry.log" "$work/monitor.log" "$work/camera.log" 2>/dev/null | wc -l)" -eq 3 ] && break
-  sleep 0.1
-done
+# builds its World first), each within 30 s.
+for s in symmetry monitor camera; do wait_for 30 "$s started" log_has "started:" "$work/$s.log"; done
 sleep 0.2
 "$bin/nudge-world" --lcm-url "$url" --scene "$scene" --realtime-factor 1 --rate "$rate" --duration "$seconds" \
   2>"$work/world.log"
@@ -62,4 +49,3 @@ for s in symmetry camera world; do
   grep -q " 0 errors" "$work/$s.log" || { echo "FAILED: $s reported errors" >&2; cat "$work/$s.log" >&2; exit 1; }
 done
 echo "PASSED: world -> camera (sim) -> symmetry over UDP multicast, lines for all $frames stereo frames"
-INNER

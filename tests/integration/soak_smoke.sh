@@ -4,14 +4,11 @@
 # the recorder's run.json must hold latencies for every stage and RSS and CPU for every process.
 # usage: soak_smoke.sh SOURCE_DIR BIN_DIR
 set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 src=${1:?usage: soak_smoke.sh SOURCE_DIR BIN_DIR}
 bin=${2:?usage: soak_smoke.sh SOURCE_DIR BIN_DIR}
-if [ "$(id -u)" != 0 ] || ! unshare -n true 2>/dev/null; then
-  echo "SKIPPED: needs root and unshare -n for a private network namespace" >&2
-  exit 77
-fi
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+nudge_test_require_namespace -n "a private network namespace"
+nudge_test_work_dir
 status=0
 NUDGE_BIN=$bin "$src/experiments/soak.sh" --seconds 12 --warmup 2 --out "$work" || status=$?
 [ $status -eq 77 ] && exit 77

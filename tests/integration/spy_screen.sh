@@ -6,20 +6,19 @@
 # listed with its nudge type and none is undecodable. A screenshot of the screen is saved.
 # usage: spy_screen.sh BUILD_DIR SOURCE_DIR [SCREENSHOT.png]   (NUDGE_KEEP=1: keep the work folder)
 set -uo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 build=${1:?usage: spy_screen.sh BUILD_DIR SOURCE_DIR [SCREENSHOT.png]}
 src=${2:?usage: spy_screen.sh BUILD_DIR SOURCE_DIR [SCREENSHOT.png]}
 shot=${3:-$build/test_output/lcm_spy.png}
 jar="$build/share/nudge_lcmtypes.jar"
 
-skip() { echo "SKIPPED: $*" >&2; exit 77; }
-[ "$(id -u)" = 0 ] && unshare -n true 2>/dev/null || skip "needs root and unshare -n for a private network namespace"
+nudge_test_in_private_network "$@"
 for tool in Xvfb xwd xwdtopnm pnmtopng java javac; do
-  command -v "$tool" >/dev/null || skip "$tool is not installed (Debian: xvfb, x11-apps, netpbm, default-jdk-headless)"
+  command -v "$tool" >/dev/null || nudge_test_skip "$tool is not installed (Debian: xvfb, x11-apps, netpbm, default-jdk-headless)"
 done
 [ -f "$jar" ] || { echo "FAILED: $jar was not built" >&2; exit 1; }
 
-work=$(mktemp -d)
-[ -n "${NUDGE_KEEP:-}" ] || trap 'rm -rf "$work"' EXIT
+nudge_test_work_dir  # every process started below is stopped on exit, Xvfb too
 # The log: 20 stereo frames at 10 Hz, written by the camera straight to a file.
 "$build/bin/nudge-synth-scenes" --out "$work/scenes" --count 20 --seed 7 >/dev/null || exit 1
 "$build/bin/nudge-camera" --lcm-url "file://$work/camera.lcmlog?mode=w" --left "images:$work/scenes/*.png" \
@@ -27,22 +26,11 @@ work=$(mktemp -d)
 classpath="$jar:/usr/share/java/lcm.jar:/usr/share/java/jchart2d.jar"
 javac -cp "$classpath" -d "$work" "$src/tests/integration/SpyTable.java" || exit 1
 mkdir -p "$(dirname "$shot")"
-
-unshare -n bash -s "$build" "$work" "$classpath" "$shot" <<'INNER'
-set -uo pipefail
-build=$1; work=$2; classpath=$3; shot=$4
-ip link set lo up multicast on
-ip route add 224.0.0.0/4 dev lo
 url="udpm://239.255.76.67:7667?ttl=0"
-pids=()
-cleanup() { for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done; wait 2>/dev/null; }
-trap cleanup EXIT
 
 # Xvfb picks a free display itself (-displayfd): other X servers on this machine are left alone.
 Xvfb -displayfd 5 -screen 0 1024x640x24 -nolisten tcp 5>"$work/display" 2>"$work/xvfb.log" &
-pids+=($!)
-for _ in $(seq 50); do [ -s "$work/display" ] && break; sleep 0.1; done
-[ -s "$work/display" ] || { echo "FAILED: Xvfb did not start" >&2; cat "$work/xvfb.log" >&2; exit 1; }
+wait_for 5 "Xvfb started (its display number)" test -s "$work/display" || exit 1
 export DISPLAY=":$(head -1 "$work/display")"
 
 # lcm-spy as scripts/spy.sh runs it (the Spy class with the nudge jar on the CLASSPATH).
@@ -51,14 +39,12 @@ expected+=" HEARTBEAT=heartbeat_t REPLAY_STATUS=replay_status_t"
 channels=$(for e in $expected; do printf '%s,' "${e%%=*}"; done)
 CLASSPATH="$work:$classpath" java -Djava.net.preferIPv4Stack=true -ea SpyTable 60 "${channels%,}" --lcm-url "$url" \
   >"$work/spy.out" 2>"$work/spy.err" &
-pids+=($!)
-for _ in $(seq 600); do grep -qE '^(READY|NO_TABLE)' "$work/spy.out" && break; sleep 0.1; done
+wait_for 60 "lcm-spy's window (READY or NO_TABLE)" grep -qE '^(READY|NO_TABLE)' "$work/spy.out"
 grep -q '^READY' "$work/spy.out" || { echo "FAILED: lcm-spy's window did not open" >&2; cat "$work/spy.out" "$work/spy.err" >&2; exit 1; }
 "$build/bin/nudge-symmetry" --lcm-url "$url" --inputs CAMERA_LEFT,CAMERA_RIGHT 2>"$work/symmetry.log" &
-pids+=($!)
 sleep 1  # symmetry subscribes before the log plays
 "$build/bin/nudge-replay" "$work/camera.lcmlog" --lcm-url "$url" 2>"$work/replay.log" || { cat "$work/replay.log" >&2; exit 1; }
-for _ in $(seq 600); do grep -q '^COLUMNS' "$work/spy.out" && break; sleep 0.1; done
+wait_for 60 "lcm-spy's table (COLUMNS)" grep -q '^COLUMNS' "$work/spy.out"
 sleep 1  # the window repaints its table
 xwd -root -silent | xwdtopnm 2>/dev/null | pnmtopng >"$shot" 2>/dev/null
 cat "$work/spy.out"
@@ -79,7 +65,4 @@ for e in $expected; do
 done
 [ $failed -eq 0 ] || exit 1
 echo "PASSED: lcm-spy decodes $(echo $expected | wc -w) channels of 4 nudge types on the replayed log"
-INNER
-status=$?
-[ $status -eq 0 ] || exit $status
 echo "screenshot: $shot"

@@ -7,23 +7,12 @@
 # In a private network namespace (nudge-replay publishes on UDP multicast).
 # usage: truncated_log.sh BIN_DIR
 set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 bin=${1:?usage: truncated_log.sh BIN_DIR}
-
-if [ "$(id -u)" != 0 ] || ! unshare -n true 2>/dev/null; then
-  echo "SKIPPED: needs root and unshare -n for a private network namespace" >&2
-  exit 77
-fi
-
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+nudge_test_in_private_network "$@"
+nudge_test_work_dir
 "$bin/nudge-synth-scenes" --out "$work/scenes" --count 4 --seed 7 >/dev/null
-
-unshare -n bash -s "$bin" "$work" <<'INNER'
-set -euo pipefail
-bin=$1; work=$2
-ip link set lo up multicast on
-ip route add 224.0.0.0/4 dev lo
-url="udpm://239.255.76.67:7667?ttl=0&recv_buf_size=16777216"
+url=$NUDGE_TEST_URL
 
 # The events of an LCM log: "end_offset channel" per whole event (LCM's file format).
 events() {
@@ -69,4 +58,3 @@ answered=$(events "$work/symmetry.lcmlog" | grep -c " SYMMETRY_LEFT$" || true)
 grep -q "log finished: $whole_events events played" "$work/replay.log" || fail "nudge-replay did not play the $whole_events whole events"
 grep -h "ends in the middle" "$work/symmetry.log" | head -n1
 echo "PASSED: $answered of $whole_left whole left frames answered by symmetry, $whole_events events replayed; the cut named by both"
-INNER

@@ -13,21 +13,11 @@
 #     monitor on the other (symmetry killed on the workstation, the camera on the robot).
 # usage: two_hosts.sh BIN_DIR SOURCE_DIR
 set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 bin=${1:?usage: two_hosts.sh BIN_DIR SOURCE_DIR}
 src=${2:?usage: two_hosts.sh BIN_DIR SOURCE_DIR}
-
-if [ "$(id -u)" != 0 ] || ! unshare -n true 2>/dev/null; then
-  echo "SKIPPED: needs root and unshare -n for private network namespaces" >&2
-  exit 77
-fi
-
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-
-unshare -n bash -s "$bin" "$src" "$work" <<'INNER'
-set -euo pipefail
-bin=$1; src=$2; work=$3
-trap 'kill $(jobs -p) 2>/dev/null || true; wait 2>/dev/null || true' EXIT
+nudge_test_in_private_network "$@"
+nudge_test_work_dir
 scene=$src/common/sim/scenes/single_cup.yaml
 calibration=$src/config/calibration_sim.yaml
 group=239.255.76.67
@@ -53,17 +43,6 @@ host_setup $workstation nudge-ws 10.76.67.2
 on_robot="nsenter -t $robot -n"
 on_workstation="nsenter -t $workstation -n"
 
-# Waits up to $2 seconds for the pattern $1 in file $3.
-wait_for() {
-  for _ in $(seq 1 $(( $2 * 10 ))); do
-    grep -q "$1" "$3" 2>/dev/null && return 0
-    sleep 0.1
-  done
-  echo "FAILED: no '$1' in $3 within $2 s" >&2
-  tail -n 20 "$work"/*.log >&2
-  return 1
-}
-
 # ttl=0: the camera's heartbeats stay on the robot.
 $on_workstation lcm-logger --lcm-url "$url" "$work/ttl0.lcmlog" 2>/dev/null & logger=$!
 sleep 0.5
@@ -82,7 +61,9 @@ $on_workstation "$bin/nudge-monitor" --lcm-url "$url" 2>"$work/monitor_workstati
 $on_robot "$bin/nudge-camera" --lcm-url "$url" --source sim --scene "$scene" --snapshots 2>"$work/camera.log" & camera=$!
 $on_robot "$bin/nudge-arm" --lcm-url "$url" --backend sim --clock sim 2>"$work/arm.log" &
 $on_robot "$bin/nudge-monitor" --lcm-url "$url" 2>"$work/monitor_robot.log" &
-for s in symmetry triangulation camera arm monitor_robot monitor_workstation; do wait_for "started:" 30 "$work/$s.log"; done
+for s in symmetry triangulation camera arm monitor_robot monitor_workstation; do
+  wait_for 30 "$s started" log_has "started:" "$work/$s.log"
+done
 $on_robot "$bin/nudge-world" --lcm-url "$url" --scene "$scene" --realtime-factor 1 --rate 10 2>"$work/world.log" &
 status=0
 $on_workstation timeout -s INT 200 "$bin/nudge-supervisor" --lcm-url "$url" --calibration "$calibration" \
@@ -97,9 +78,9 @@ grep -h "ended:" "$work/supervisor.log"
 
 # Heartbeats both ways: each monitor names the other host's killed service.
 kill -KILL $symmetry; wait $symmetry 2>/dev/null || true
-wait_for "no heartbeat: .*symmetry" 10 "$work/monitor_robot.log"
+wait_for 10 "the robot's monitor naming the killed symmetry" log_has "no heartbeat: .*symmetry" "$work/monitor_robot.log"
 kill -KILL $camera; wait $camera 2>/dev/null || true
-wait_for "no heartbeat: .*camera" 10 "$work/monitor_workstation.log"
+wait_for 10 "the workstation's monitor naming the killed camera" \
+  log_has "no heartbeat: .*camera" "$work/monitor_workstation.log"
 grep -h "no heartbeat" "$work/monitor_robot.log" "$work/monitor_workstation.log"
 echo "PASSED: ttl=0 stayed on its host; at ttl=1 the loop segmented the cup across two hosts; heartbeats seen both ways"
-INNER

@@ -4,23 +4,12 @@
 # other's pid) without sending any command, and the first must carry on. Private network namespace.
 # usage: two_supervisors.sh BIN_DIR SOURCE_DIR
 set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 bin=${1:?usage: two_supervisors.sh BIN_DIR SOURCE_DIR}
 src=${2:?usage: two_supervisors.sh BIN_DIR SOURCE_DIR}
-
-if [ "$(id -u)" != 0 ] || ! unshare -n true 2>/dev/null; then
-  echo "SKIPPED: needs root and unshare -n for a private network namespace" >&2
-  exit 77
-fi
-
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-
-unshare -n bash -s "$bin" "$src" "$work" <<'INNER'
-set -euo pipefail
-bin=$1; src=$2; work=$3
-ip link set lo up multicast on
-ip route add 224.0.0.0/4 dev lo
-url="udpm://239.255.76.67:7667?ttl=0&recv_buf_size=16777216"
+nudge_test_in_private_network "$@"
+nudge_test_work_dir
+url=$NUDGE_TEST_URL
 supervisor() {  # waits for services that never come: it stays in WAIT_SERVICES
   exec "$bin/nudge-supervisor" --lcm-url "$url" --clock wall --calibration "$src/config/calibration_sim.yaml" \
     --workspace "$src/config/workspace.yaml" --out "$work/runs" --run-id "$1" --require camera
@@ -44,4 +33,3 @@ kill -0 $first || { echo "FAILED: the first supervisor did not carry on" >&2; ca
 kill -INT $first
 wait $first || true
 echo "PASSED: the second supervisor refused to start; the first carried on"
-INNER
