@@ -6,7 +6,6 @@
 // (thesis fig. 6.3-6.4). Needs root for the namespace: skipped otherwise.
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
-#include <sched.h>
 #include <unistd.h>
 
 #include <Eigen/Geometry>
@@ -26,6 +25,7 @@
 #include "nudge/bus/channels.hpp"
 #include "nudge/bus/pose_convert.hpp"
 #include "nudge/sim_state_t.hpp"
+#include "nudge/test/private_network.hpp"
 #include "nudge/test/process.hpp"
 
 namespace channel = nudge::bus::channel;
@@ -33,7 +33,7 @@ namespace channel = nudge::bus::channel;
 namespace {
 
 const std::string kBin = NUDGE_BIN_DIR;
-const std::string kUrl = "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=16777216";
+const std::string kUrl = nudge::test::kPrivateLcmUrl;
 
 using nudge::test::Process;
 
@@ -52,10 +52,7 @@ double tilt_of(const nudge::pose_t& pose) {
 }  // namespace
 
 TEST(ArmWorld, TheArmServiceNudgesACupWithTheSimulatedPuma) {
-  if (geteuid() != 0 || unshare(CLONE_NEWNET) != 0) GTEST_SKIP() << "needs root to make a private network namespace";
-  ASSERT_EQ(std::system("ip link set lo up multicast on && ip route add 224.0.0.0/4 dev lo"), 0);
-  // Larger socket buffers where the kernel lets a namespace have them (not needed to pass).
-  (void)std::system("sysctl -qw net.core.rmem_max=16777216 net.core.rmem_default=16777216 2>/dev/null");
+  NUDGE_TEST_ENTER_PRIVATE_NETWORK();
   const std::string dir = testing::TempDir();
   const std::string scene = dir + "/arm_world.yaml";
   std::ofstream(scene) << "%YAML:1.0\n---\nseed: 1\n"

@@ -24,7 +24,6 @@
 // Needs root for the namespace: skipped otherwise.
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
-#include <sched.h>
 #include <signal.h>
 #include <unistd.h>
 
@@ -34,8 +33,6 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <map>
-#include <memory>
 #include <mutex>
 #include <optional>
 #include <regex>
@@ -48,17 +45,17 @@
 #include "nudge/bus/channels.hpp"
 #include "nudge/sim_state_t.hpp"
 #include "nudge/supervisor_state_t.hpp"
-#include "nudge/test/process.hpp"
+#include "nudge/test/loop_services.hpp"
 
+using nudge::test::LoopServices;
 using nudge::test::Process;
 using nudge::test::read_file;
 namespace channel = nudge::bus::channel;
 
 namespace {
 
-const std::string kBin = NUDGE_BIN_DIR;
 const std::string kSource = NUDGE_SOURCE_DIR;
-const std::string kUrl = "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=16777216";
+const std::string kUrl = nudge::test::kPrivateLcmUrl;
 const std::string kCalibration = kSource + "/config/calibration_sim.yaml";
 const std::string kScene = kSource + "/common/sim/scenes/single_cup.yaml";
 constexpr double kStillRad = 1e-4;  // joints that move less than this in a second stand still
@@ -145,22 +142,6 @@ double joint_travel(const std::vector<Heard<Msg>>& heard) {
   return travel;
 }
 
-// The command line of each service the supervisor needs (its --require set with --clock sim; the
-// learner when the run requires it, its object database in `dir`).
-std::vector<std::string> command_of(const std::string& service, const std::string& dir) {
-  if (service == "learner") return {kBin + "/nudge-learner", "--lcm-url", kUrl, "--db", dir + "/objects"};
-  if (service == "symmetry")
-    return {kBin + "/nudge-symmetry", "--lcm-url", kUrl, "--lines", "5", "--theta-min", "-25", "--theta-max", "25",
-            "--once-per-row", "--mirror-tolerance", "15"};
-  if (service == "camera")
-    return {kBin + "/nudge-camera", "--lcm-url", kUrl, "--source", "sim", "--scene", kScene, "--snapshots"};
-  if (service == "triangulation") return {kBin + "/nudge-triangulation", "--lcm-url", kUrl, "--calibration", kCalibration};
-  if (service == "arm") return {kBin + "/nudge-arm", "--lcm-url", kUrl, "--backend", "sim", "--clock", "sim"};
-  if (service == "world")
-    return {kBin + "/nudge-world", "--lcm-url", kUrl, "--scene", kScene, "--realtime-factor", "1", "--rate", "10"};
-  return {};
-}
-
 int json_int(const std::string& json, const std::string& key) {
   std::smatch m;
   if (!std::regex_search(json, m, std::regex("\"" + key + "\":(-?[0-9]+)"))) return -1;
@@ -180,31 +161,25 @@ class KilledMidNudge : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(KilledMidNudge, SupervisorPausesStopsTheArmAndResumesSafely) {
   const std::string victim = GetParam();
-  if (geteuid() != 0 || unshare(CLONE_NEWNET) != 0) GTEST_SKIP() << "needs root to make a private network namespace";
-  ASSERT_EQ(std::system("ip link set lo up multicast on && ip route add 224.0.0.0/4 dev lo"), 0);
+  NUDGE_TEST_ENTER_PRIVATE_NETWORK();
   const std::string dir = ::testing::TempDir() + "/killed_mid_nudge_" + victim + "_" + std::to_string(getpid());
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   BusRecorder bus;
   ASSERT_TRUE(bus.good());
 
-  std::map<std::string, std::unique_ptr<Process>> services;
-  const auto start = [&](const std::string& name) {
-    services[name] = std::make_unique<Process>(command_of(name, dir), dir + "/" + name + ".log");
-    return services[name]->started();
-  };
-  // The learner is needed only by a run that learns: it joins the run (and --require) when it is the one killed.
-  std::vector<std::string> fleet = {"symmetry", "camera", "triangulation", "arm"};
-  if (victim == "learner") fleet.push_back("learner");
-  for (const std::string& name : fleet) ASSERT_TRUE(start(name)) << name;
-  sleep(3);  // every subscriber listens before the world's first state (the camera builds its scene)
-  ASSERT_TRUE(start("world"));
+  // Every service the supervisor needs (its --require set with --clock sim). The learner is needed
+  // only by a run that learns: it joins the run (and --require) when it is the one killed.
+  const nudge::test::LoopSetup setup{dir, kScene, kCalibration};
+  LoopServices services(setup);
+  std::vector<std::string> extra;
+  if (victim == "learner") extra.push_back("learner");
+  ASSERT_EQ(services.start_all(extra), std::vector<std::string>{}) << "services that did not start";
   // --max-attempts 1: after the aborted attempt and the arm's parking the run ends by itself. The
   // required services are the default set (--clock sim), plus the learner when it is the victim.
-  std::vector<std::string> supervisor_argv = {kBin + "/nudge-supervisor", "--lcm-url", kUrl, "--calibration", kCalibration,
-                                              "--out", dir, "--run-id", "kill", "--first-seq", "1000", "--max-attempts", "1"};
-  if (victim == "learner") supervisor_argv.insert(supervisor_argv.end(), {"--require", "camera,symmetry,triangulation,arm,world,learner"});
-  Process supervisor(supervisor_argv, dir + "/supervisor.log");
+  std::vector<std::string> supervisor_flags = {"--max-attempts", "1"};
+  if (victim == "learner") supervisor_flags.insert(supervisor_flags.end(), {"--require", "camera,symmetry,triangulation,arm,world,learner"});
+  Process supervisor(nudge::test::loop_supervisor_command(setup, "kill", supervisor_flags), dir + "/supervisor.log");
   ASSERT_TRUE(supervisor.started());
   const auto logs = [&] {
     std::string text;
@@ -221,8 +196,8 @@ TEST_P(KilledMidNudge, SupervisorPausesStopsTheArmAndResumesSafely) {
   })) << "the arm never moved\n" << logs();
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   const int64_t killed = wall_us();
-  services[victim]->signal(SIGKILL);
-  services[victim]->wait_exit(5);
+  services[victim].signal(SIGKILL);
+  services[victim].wait_exit(5);
 
   // Noticed: PAUSED naming the service (10 s is a deadline for the test, not the promise).
   const auto paused = bus.wait_for<nudge::supervisor_state_t>(killed, 10, [&](const auto& m) {
@@ -264,7 +239,7 @@ TEST_P(KilledMidNudge, SupervisorPausesStopsTheArmAndResumesSafely) {
 
   // Back: the service restarted, the attempt ends aborted, the arm parks, the run ends by itself.
   const int64_t restarted = wall_us();
-  ASSERT_TRUE(start(victim));
+  ASSERT_TRUE(services.start(victim));
   const auto home = bus.wait_for<nudge::arm_command_t>(restarted, 60, [](const auto& m) {
     return m.command == nudge::arm_command_t::COMMAND_HOME;
   });
@@ -302,7 +277,7 @@ TEST_P(KilledMidNudge, SupervisorPausesStopsTheArmAndResumesSafely) {
         << (arm_stopped && stop ? "true" : "false") << ", \"resumed\": " << (home && code == 0 ? "true" : "false")
         << ", \"log_events\": " << events << ", \"passed\": " << (HasFailure() ? "false" : "true") << "}\n";
   }
-  for (auto& [name, process] : services) process->stop();
+  services.stop_all();
   if (!HasFailure()) std::filesystem::remove_all(dir);  // kept for a look when something failed
 }
 

@@ -7,7 +7,6 @@
 // before the nudge. Needs root for the namespace: skipped otherwise.
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
-#include <sched.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -31,17 +30,20 @@
 #include "nudge/recognize_request_t.hpp"
 #include "nudge/sim_state_t.hpp"
 #include "nudge/supervisor_state_t.hpp"
-#include "nudge/test/process.hpp"
+#include "nudge/test/loop_services.hpp"
 
+using nudge::test::loop_supervisor_command;
+using nudge::test::LoopServices;
+using nudge::test::LoopSetup;
+using nudge::test::replay_supervisor_command;
 using nudge::test::Process;
 using nudge::test::read_file;
 namespace channel = nudge::bus::channel;
 
 namespace {
 
-const std::string kBin = NUDGE_BIN_DIR;
 const std::string kSource = NUDGE_SOURCE_DIR;
-const std::string kUrl = "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=16777216";
+const std::string kUrl = nudge::test::kPrivateLcmUrl;
 const std::string kCalibration = kSource + "/config/calibration_sim.yaml";
 
 // The learner's part, played by the test; and where the cup went (SIM_STATE).
@@ -115,9 +117,7 @@ std::vector<std::string> decisions(const std::string& log_path) {
 }  // namespace
 
 TEST(SupervisorLearn, GraspsTurnsTwelveViewsAndPutsTheCupBack) {
-  if (geteuid() != 0 || unshare(CLONE_NEWNET) != 0) GTEST_SKIP() << "needs root to make a private network namespace";
-  ASSERT_EQ(std::system("ip link set lo up multicast on && ip route add 224.0.0.0/4 dev lo"), 0);
-  (void)std::system("sysctl -qw net.core.rmem_max=16777216 net.core.rmem_default=16777216 2>/dev/null");
+  NUDGE_TEST_ENTER_PRIVATE_NETWORK();
   const std::string dir = ::testing::TempDir() + "/supervisor_learn_" + std::to_string(getpid());
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
@@ -132,24 +132,15 @@ TEST(SupervisorLearn, GraspsTurnsTwelveViewsAndPutsTheCupBack) {
   lcm.subscribe(channel::LEARN_COMMIT, &Learner::on_commit, &learner);
   lcm.subscribe(channel::SIM_STATE, &Learner::on_sim, &learner);
 
-  Process symmetry({kBin + "/nudge-symmetry", "--lcm-url", kUrl, "--lines", "5", "--theta-min", "-25", "--theta-max", "25",
-                    "--once-per-row", "--mirror-tolerance", "15"}, dir + "/symmetry.log");
-  Process camera({kBin + "/nudge-camera", "--lcm-url", kUrl, "--source", "sim", "--scene", scene, "--snapshots"},
-                 dir + "/camera.log");
-  Process triangulation({kBin + "/nudge-triangulation", "--lcm-url", kUrl, "--calibration", kCalibration},
-                        dir + "/triangulation.log");
-  Process arm({kBin + "/nudge-arm", "--lcm-url", kUrl, "--backend", "sim", "--clock", "sim"}, dir + "/arm.log");
-  sleep(3);  // every subscriber listens before the world's first state (the camera builds its scene)
-  Process world({kBin + "/nudge-world", "--lcm-url", kUrl, "--scene", scene, "--realtime-factor", "1", "--rate", "10",
-                 "--tool", "auto"},
-                dir + "/world.log");
+  // The world's one hand: the pusher pad for a nudge, the gripper from a grasp command on.
+  const LoopSetup setup{dir, scene, kCalibration, kUrl, {"--tool", "auto"}};
+  LoopServices services(setup);
+  ASSERT_EQ(services.start_all(), std::vector<std::string>{}) << "services that did not start";
   // One attempt, with the held-object check on: the sim arm reports the world's measured finger
   // opening, which stops on the cup.
-  Process supervisor({kBin + "/nudge-supervisor", "--lcm-url", kUrl, "--calibration", kCalibration, "--out", dir,
-                      "--run-id", "learn", "--first-seq", "1000", "--learn", "on", "--max-attempts", "1"},
-                     dir + "/supervisor.log");
-  ASSERT_TRUE(symmetry.started() && camera.started() && triangulation.started() && arm.started() && world.started() &&
-              supervisor.started());
+  const std::vector<std::string> learn_once = {"--learn", "on", "--max-attempts", "1"};
+  Process supervisor(loop_supervisor_command(setup, "learn", learn_once), dir + "/supervisor.log");
+  ASSERT_TRUE(supervisor.started());
   int code = -1;
   const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(200);
   while ((code = supervisor.wait_exit(0.02)) == -1 && std::chrono::steady_clock::now() < end) lcm.handleTimeout(30);
@@ -179,9 +170,7 @@ TEST(SupervisorLearn, GraspsTurnsTwelveViewsAndPutsTheCupBack) {
   // Replay: the same states, commands and commit from the run's log alone (the learner's answers
   // are in it; the left camera's segmentation runs on its own thread and changes nothing).
   const std::string log = dir + "/learn/learn.lcmlog";
-  Process replay({kBin + "/nudge-supervisor", "--lcm-in", "file://" + log + "?speed=0", "--lcm-out",
-                  "file://" + dir + "/replay_out.lcmlog?mode=w", "--calibration", kCalibration, "--out", dir,
-                  "--run-id", "replay", "--first-seq", "1000", "--learn", "on", "--max-attempts", "1"},
+  Process replay(replay_supervisor_command(setup, log, dir + "/replay_out.lcmlog", "replay", learn_once),
                  dir + "/replay.log");
   ASSERT_EQ(replay.wait_exit(60), 0) << read_file(dir + "/replay.log");
   const std::vector<std::string> live = decisions(log), replayed = decisions(dir + "/replay_out.lcmlog");

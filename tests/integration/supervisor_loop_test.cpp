@@ -7,7 +7,6 @@
 // Needs root for the namespace: skipped otherwise.
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
-#include <sched.h>
 #include <unistd.h>
 
 #include <opencv2/imgcodecs.hpp>
@@ -25,17 +24,19 @@
 #include "nudge/sim_state_t.hpp"
 #include "nudge/supervisor/scene.hpp"
 #include "nudge/supervisor_state_t.hpp"
-#include "nudge/test/process.hpp"
+#include "nudge/test/loop_services.hpp"
 
+using nudge::test::loop_supervisor_command;
+using nudge::test::LoopServices;
+using nudge::test::LoopSetup;
+using nudge::test::replay_supervisor_command;
 using nudge::test::Process;
 using nudge::test::read_file;
 namespace channel = nudge::bus::channel;
 
 namespace {
 
-const std::string kBin = NUDGE_BIN_DIR;
 const std::string kSource = NUDGE_SOURCE_DIR;
-const std::string kUrl = "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=16777216";
 const std::string kCalibration = kSource + "/config/calibration_sim.yaml";
 
 int json_int(const std::string& json, const std::string& key) {
@@ -80,30 +81,18 @@ Decisions read_decisions(const std::string& log_path) {
 }  // namespace
 
 TEST(SupervisorLoop, FindsNudgesAndSegmentsACupThenReplaysItsRunIdentically) {
-  if (geteuid() != 0 || unshare(CLONE_NEWNET) != 0) GTEST_SKIP() << "needs root to make a private network namespace";
-  ASSERT_EQ(std::system("ip link set lo up multicast on && ip route add 224.0.0.0/4 dev lo"), 0);
-  (void)std::system("sysctl -qw net.core.rmem_max=16777216 net.core.rmem_default=16777216 2>/dev/null");
+  NUDGE_TEST_ENTER_PRIVATE_NETWORK();
   // Per process: two checkouts testing at once on one machine must not share it.
   const std::string dir = ::testing::TempDir() + "/supervisor_loop_" + std::to_string(getpid());
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   const std::string scene = kSource + "/common/sim/scenes/single_cup.yaml";
 
-  Process symmetry({kBin + "/nudge-symmetry", "--lcm-url", kUrl, "--lines", "5", "--theta-min", "-25", "--theta-max", "25",
-                    "--once-per-row", "--mirror-tolerance", "15"}, dir + "/symmetry.log");
-  Process camera({kBin + "/nudge-camera", "--lcm-url", kUrl, "--source", "sim", "--scene", scene, "--snapshots"},
-                 dir + "/camera.log");
-  Process triangulation({kBin + "/nudge-triangulation", "--lcm-url", kUrl, "--calibration", kCalibration},
-                        dir + "/triangulation.log");
-  Process arm({kBin + "/nudge-arm", "--lcm-url", kUrl, "--backend", "sim", "--clock", "sim"}, dir + "/arm.log");
-  sleep(3);  // every subscriber listens before the world's first state (the camera builds its scene)
-  Process world({kBin + "/nudge-world", "--lcm-url", kUrl, "--scene", scene, "--realtime-factor", "1", "--rate", "10"},
-                dir + "/world.log");
-  Process supervisor({kBin + "/nudge-supervisor", "--lcm-url", kUrl, "--calibration", kCalibration, "--out", dir,
-                      "--run-id", "loop", "--first-seq", "1000"},
-                     dir + "/supervisor.log");
-  ASSERT_TRUE(symmetry.started() && camera.started() && triangulation.started() && arm.started() && world.started() &&
-              supervisor.started());
+  const LoopSetup setup{dir, scene, kCalibration};
+  LoopServices services(setup);
+  ASSERT_EQ(services.start_all(), std::vector<std::string>{}) << "services that did not start";
+  Process supervisor(loop_supervisor_command(setup, "loop"), dir + "/supervisor.log");
+  ASSERT_TRUE(supervisor.started());
   const int code = supervisor.wait_exit(240);
   ASSERT_EQ(code, 0) << "the supervisor did not end its run by itself: " << read_file(dir + "/supervisor.log");
 
@@ -130,10 +119,7 @@ TEST(SupervisorLoop, FindsNudgesAndSegmentsACupThenReplaysItsRunIdentically) {
   EXPECT_LT(area, 60000);
 
   // Replay: the same decisions from the log alone.
-  Process replay({kBin + "/nudge-supervisor", "--lcm-in", "file://" + log + "?speed=0", "--lcm-out",
-                  "file://" + dir + "/replay_out.lcmlog?mode=w", "--calibration", kCalibration, "--out", dir,
-                  "--run-id", "replay", "--first-seq", "1000"},
-                 dir + "/replay.log");
+  Process replay(replay_supervisor_command(setup, log, dir + "/replay_out.lcmlog", "replay"), dir + "/replay.log");
   ASSERT_EQ(replay.wait_exit(60), 0) << read_file(dir + "/replay.log");
   const Decisions replayed = read_decisions(dir + "/replay_out.lcmlog");
   EXPECT_EQ(replayed.states, live.states);

@@ -6,7 +6,6 @@
 // namespace (needs root, like the other integration tests); skipped when Chromium is absent.
 #include <gtest/gtest.h>
 #include <httplib.h>
-#include <sched.h>
 #include <unistd.h>
 
 #include <nlohmann/json.hpp>
@@ -31,6 +30,7 @@
 #include "nudge/supervisor_state_t.hpp"
 #include "nudge/symmetry_lines_t.hpp"
 #include "nudge/test/lcm_log.hpp"
+#include "nudge/test/private_network.hpp"
 #include "nudge/test/process.hpp"
 #include "nudge/track_t.hpp"
 
@@ -220,8 +220,7 @@ int count(const std::string& text, const std::string& pattern) {
 
 TEST(ViewerPage, ShowsAReplayedRunAndPausesAndStepsIt) {
   if (access(kChromium.c_str(), X_OK) != 0) GTEST_SKIP() << "chromium is not installed (Debian package chromium)";
-  if (geteuid() != 0 || unshare(CLONE_NEWNET) != 0) GTEST_SKIP() << "needs root to make a private network namespace";
-  ASSERT_EQ(std::system("ip link set lo up multicast on && ip route add 224.0.0.0/4 dev lo"), 0);
+  NUDGE_TEST_ENTER_PRIVATE_NETWORK();
   const std::string dir = testing::TempDir() + "viewer_page_" + std::to_string(getpid());
   std::filesystem::create_directories(dir);
   const std::string log = dir + "/run.lcmlog";

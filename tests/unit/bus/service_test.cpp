@@ -49,14 +49,37 @@ struct Probe {
   Latest<heartbeat_t> out, heartbeats;
 };
 
+// The echo service started on an in-process bus of its own, and the test's probe on that bus.
+struct EchoOnMemq {
+  EchoOnMemq() : started((service.start(bus), install_echo(service), true)), probe(bus) {}
+  lcm::LCM bus{"memq://"};
+  Service service{"echo", "test service"};
+  bool started;
+  Probe probe;
+};
+
+// The heartbeat `service` publishes as if its clock read `utime`, as `probe` hears it.
+heartbeat_t heartbeat_at(Service& service, Probe& probe, int64_t utime) {
+  service.publish_heartbeat_at(utime);
+  service.handle_pending();
+  return probe.heartbeats.get();
+}
+
+// An echo that refused a message (now: the wall clock then): DEGRADED, naming the refusal.
+void expect_degraded_by_a_refused_message(EchoOnMemq& echo, int64_t now) {
+  const heartbeat_t refused = heartbeat(1, "bad");
+  echo.bus.publish("IN", &refused);
+  echo.service.handle_pending();
+  const heartbeat_t hb = heartbeat_at(echo.service, echo.probe, now);
+  EXPECT_EQ(hb.state + 0, heartbeat_t::STATE_DEGRADED + 0);
+  EXPECT_NE(hb.status.find("status 'bad' refused"), std::string::npos) << hb.status;
+}
+
 }  // namespace
 
 TEST(ServiceInProcess, HandlersRunOnAMemqBusPumpedByHandlePending) {
-  lcm::LCM bus("memq://");
-  Service service("echo", "test service");
-  service.start(bus);
-  install_echo(service);
-  Probe probe(bus);
+  EchoOnMemq echo;
+  auto& [bus, service, started, probe] = echo;
 
   const heartbeat_t first = heartbeat(10, "one"), second = heartbeat(20, "two");
   bus.publish("IN", &first);
@@ -72,11 +95,8 @@ TEST(ServiceInProcess, HandlersRunOnAMemqBusPumpedByHandlePending) {
 }
 
 TEST(ServiceInProcess, BadInputsAreCountedAndTheServiceKeepsHandling) {
-  lcm::LCM bus("memq://");
-  Service service("echo", "test service");
-  service.start(bus);
-  install_echo(service);
-  Probe probe(bus);
+  EchoOnMemq echo;
+  auto& [bus, service, started, probe] = echo;
 
   const std::vector<uint8_t> garbage = {1, 2, 3};
   bus.publish("IN", garbage.data(), static_cast<unsigned>(garbage.size()));  // does not decode
@@ -222,30 +242,19 @@ TEST(ServiceInProcess, FrameIdGapsAreCountedPerChannelAndShownInTheHeartbeat) {
 }
 
 TEST(ServiceInProcess, ADegradedHeartbeatRecoversWhenInputsAreGoodAgain) {
-  lcm::LCM bus("memq://");
-  Service service("echo", "test service");
-  service.start(bus);
-  install_echo(service);
-  Probe probe(bus);
-  const heartbeat_t refused = heartbeat(1, "bad");
-  bus.publish("IN", &refused);
-  service.handle_pending();
+  EchoOnMemq echo;
+  auto& [bus, service, started, probe] = echo;
   const int64_t now = nudge::wall_utime();
-  service.publish_heartbeat_at(now);
-  service.handle_pending();
-  EXPECT_EQ(probe.heartbeats.get().state + 0, heartbeat_t::STATE_DEGRADED + 0);
-  EXPECT_NE(probe.heartbeats.get().status.find("status 'bad' refused"), std::string::npos);
+  expect_degraded_by_a_refused_message(echo, now);
 
   const heartbeat_t good = heartbeat(2, "good");
   bus.publish("IN", &good);
   service.handle_pending();
-  service.publish_heartbeat_at(now + nudge::bus::kDegradedHoldUs / 2);
-  service.handle_pending();
-  EXPECT_EQ(probe.heartbeats.get().state + 0, heartbeat_t::STATE_DEGRADED + 0) << "still within the hold";
-  service.publish_heartbeat_at(now + nudge::bus::kDegradedHoldUs + 1);
-  service.handle_pending();
-  EXPECT_EQ(probe.heartbeats.get().state + 0, heartbeat_t::STATE_RUNNING + 0);
-  EXPECT_EQ(probe.heartbeats.get().errors, 1) << "the count stays: it is a total";
+  EXPECT_EQ(heartbeat_at(service, probe, now + nudge::bus::kDegradedHoldUs / 2).state + 0, heartbeat_t::STATE_DEGRADED + 0)
+      << "still within the hold";
+  const heartbeat_t hb = heartbeat_at(service, probe, now + nudge::bus::kDegradedHoldUs + 1);
+  EXPECT_EQ(hb.state + 0, heartbeat_t::STATE_RUNNING + 0);
+  EXPECT_EQ(hb.errors, 1) << "the count stays: it is a total";
 }
 
 TEST(ServiceInProcess, AWatchedServiceThatFallsSilentIsNamedUntilItIsHeardAgain) {
@@ -337,23 +346,12 @@ TEST(StreamWatch, ASlowStreamGetsFourOfItsIntervalsAndAClockThatGoesBackRestarts
 // A wall clock stepped back (NTP, a restarted log's stamps) must not hold DEGRADED until it
 // catches up with the last problem: the hold restarts from now.
 TEST(ServiceInProcess, AClockThatGoesBackRestartsTheDegradedHold) {
-  lcm::LCM bus("memq://");
-  Service service("echo", "test service");
-  service.start(bus);
-  install_echo(service);
-  Probe probe(bus);
-  const heartbeat_t refused = heartbeat(1, "bad");
-  bus.publish("IN", &refused);
-  service.handle_pending();
+  EchoOnMemq echo;
+  auto& [bus, service, started, probe] = echo;
   const int64_t now = nudge::wall_utime();
-  service.publish_heartbeat_at(now);
-  service.handle_pending();
-  EXPECT_EQ(probe.heartbeats.get().state + 0, heartbeat_t::STATE_DEGRADED + 0);
+  expect_degraded_by_a_refused_message(echo, now);
   const int64_t hour_back = now - 3600LL * 1000000;
-  service.publish_heartbeat_at(hour_back);
-  service.handle_pending();
-  EXPECT_EQ(probe.heartbeats.get().state + 0, heartbeat_t::STATE_DEGRADED + 0);
-  service.publish_heartbeat_at(hour_back + nudge::bus::kDegradedHoldUs + 1);
-  service.handle_pending();
-  EXPECT_EQ(probe.heartbeats.get().state + 0, heartbeat_t::STATE_RUNNING + 0);
+  EXPECT_EQ(heartbeat_at(service, probe, hour_back).state + 0, heartbeat_t::STATE_DEGRADED + 0);
+  EXPECT_EQ(heartbeat_at(service, probe, hour_back + nudge::bus::kDegradedHoldUs + 1).state + 0,
+            heartbeat_t::STATE_RUNNING + 0);
 }
