@@ -4,6 +4,7 @@
 // of the set on PROCESS_STATUS (process_status_t) once a second and at every change, so that the
 // viewer (or lcm-spy) shows it. docs/operator.md says why it is not supervisord.
 #include "nudge/bus/channels.hpp"
+#include "nudge/bus/process_status_convert.hpp"
 #include "nudge/bus/service.hpp"
 #include "nudge/launcher/config.hpp"
 #include "nudge/launcher/process_group.hpp"
@@ -15,35 +16,9 @@ using namespace nudge;
 
 namespace {
 
-int8_t state_code(launcher::ProcessState state) {
-  switch (state) {
-    case launcher::ProcessState::kRunning: return process_info_t::STATE_RUNNING;
-    case launcher::ProcessState::kBackoff: return process_info_t::STATE_BACKOFF;
-    case launcher::ProcessState::kExited: return process_info_t::STATE_EXITED;
-    case launcher::ProcessState::kStopping: return process_info_t::STATE_STOPPING;
-    case launcher::ProcessState::kStopped: return process_info_t::STATE_STOPPED;
-  }
-  return process_info_t::STATE_STOPPED;
-}
-
 process_status_t status_message(const launcher::ProcessGroup& group, const std::string& config_path) {
-  process_status_t msg{};
-  msg.utime = wall_utime();
-  msg.config = config_path;
-  for (const launcher::ProcessInfo& p : group.status(msg.utime)) {
-    process_info_t info{};
-    info.name = p.name;
-    info.pid = p.pid;
-    info.state = state_code(p.state);
-    info.restarts = p.restarts;
-    info.last_exit_code = p.last_exit_code;
-    info.uptime_s = p.uptime_s;
-    info.restart_in_s = p.restart_in_s;
-    info.log = p.log;
-    msg.processes.push_back(info);
-  }
-  msg.num_processes = static_cast<int32_t>(msg.processes.size());
-  return msg;
+  const int64_t now = wall_utime();
+  return bus::to_message(group.status(now), now, config_path);
 }
 
 }  // namespace

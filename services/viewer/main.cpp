@@ -85,17 +85,6 @@ std::string heartbeat_state_name(int8_t state) {
   return "state " + std::to_string(state);
 }
 
-std::string process_state_name(int8_t state) {
-  switch (state) {
-    case process_info_t::STATE_RUNNING: return "running";
-    case process_info_t::STATE_BACKOFF: return "restarting";
-    case process_info_t::STATE_EXITED: return "exited";
-    case process_info_t::STATE_STOPPING: return "stopping";
-    case process_info_t::STATE_STOPPED: return "stopped";
-  }
-  return "state " + std::to_string(state);
-}
-
 std::string replay_state_name(int8_t state) {
   switch (state) {
     case replay_status_t::STATE_PLAYING: return "playing";
@@ -237,20 +226,7 @@ void subscribe_health(bus::Service& service, viewer::ViewModel& model) {
     model.set_replay(status);
   });
   subs.subscribe<process_status_t>(channel::PROCESS_STATUS, [&model](const process_status_t& msg, const std::string&) {
-    std::vector<viewer::ProcessRow> rows;
-    for (const process_info_t& p : msg.processes) {
-      viewer::ProcessRow row;
-      row.name = p.name;
-      row.state = process_state_name(p.state);
-      row.log = p.log;
-      row.pid = p.pid;
-      row.restarts = p.restarts;
-      row.last_exit_code = p.last_exit_code;
-      row.uptime_s = p.uptime_s;
-      row.restart_in_s = p.restart_in_s;
-      rows.push_back(row);
-    }
-    model.set_processes(std::move(rows));
+    model.set_processes(bus::process_rows_of(msg));
   });
 }
 

@@ -70,3 +70,36 @@ TEST(BusViewer, AnUnreadableLogIsNamed) {
     EXPECT_NE(std::string(e.what()).find("/nonexistent/run.lcmlog"), std::string::npos);
   }
 }
+
+TEST(BusViewer, ProcessRowsCarryEveryFieldAndNameTheStateAsThePageDoes) {
+  process_status_t msg{};
+  const int8_t codes[] = {process_info_t::STATE_RUNNING, process_info_t::STATE_BACKOFF, process_info_t::STATE_EXITED,
+                          process_info_t::STATE_STOPPING, process_info_t::STATE_STOPPED, 99};
+  for (int8_t code : codes) {
+    process_info_t p{};
+    p.name = "p" + std::to_string(code);
+    p.state = code;
+    p.log = "logs/" + p.name + ".log";
+    p.pid = 100 + code;
+    p.restarts = code;
+    p.last_exit_code = -code;
+    p.uptime_s = 0.5 * code;
+    p.restart_in_s = 0.25 * code;
+    msg.processes.push_back(p);
+  }
+  msg.num_processes = static_cast<int32_t>(msg.processes.size());
+  const std::vector<viewer::ProcessRow> rows = bus::process_rows_of(msg);
+  ASSERT_EQ(rows.size(), 6u);
+  const std::vector<std::string> names = {"running", "restarting", "exited", "stopping", "stopped", "state 99"};
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const int code = codes[i];
+    EXPECT_EQ(rows[i].state, names[i]);
+    EXPECT_EQ(rows[i].name, "p" + std::to_string(code));
+    EXPECT_EQ(rows[i].log, "logs/p" + std::to_string(code) + ".log");
+    EXPECT_EQ(rows[i].pid, 100 + code);
+    EXPECT_EQ(rows[i].restarts, code);
+    EXPECT_EQ(rows[i].last_exit_code, -code);
+    EXPECT_DOUBLE_EQ(rows[i].uptime_s, 0.5 * code);
+    EXPECT_DOUBLE_EQ(rows[i].restart_in_s, 0.25 * code);
+  }
+}
