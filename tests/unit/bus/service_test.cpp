@@ -227,18 +227,15 @@ TEST(ServiceInProcess, FrameIdGapsAreCountedPerChannelAndShownInTheHeartbeat) {
   EXPECT_EQ(gaps.at("CAM").restarts, 1);
 
   const int64_t now = nudge::wall_utime();
-  service.publish_heartbeat_at(now);
-  service.handle_pending();
+  const heartbeat_t lossy = heartbeat_at(service, probe, now);
   ASSERT_TRUE(probe.heartbeats.has());
-  EXPECT_EQ(probe.heartbeats.get().state + 0, heartbeat_t::STATE_DEGRADED + 0);
-  EXPECT_NE(probe.heartbeats.get().status.find("CAM missed 5 of 11"), std::string::npos)
-      << probe.heartbeats.get().status;
+  EXPECT_EQ(lossy.state + 0, heartbeat_t::STATE_DEGRADED + 0);
+  EXPECT_NE(lossy.status.find("CAM missed 5 of 11"), std::string::npos) << lossy.status;
 
   // No new loss for longer than the hold: RUNNING again, the totals still in the status.
-  service.publish_heartbeat_at(now + nudge::bus::kDegradedHoldUs + 1);
-  service.handle_pending();
-  EXPECT_EQ(probe.heartbeats.get().state + 0, heartbeat_t::STATE_RUNNING + 0);
-  EXPECT_NE(probe.heartbeats.get().status.find("CAM missed 5 of 11"), std::string::npos);
+  const heartbeat_t held = heartbeat_at(service, probe, now + nudge::bus::kDegradedHoldUs + 1);
+  EXPECT_EQ(held.state + 0, heartbeat_t::STATE_RUNNING + 0);
+  EXPECT_NE(held.status.find("CAM missed 5 of 11"), std::string::npos);
 }
 
 TEST(ServiceInProcess, ADegradedHeartbeatRecoversWhenInputsAreGoodAgain) {
@@ -279,11 +276,9 @@ TEST(ServiceInProcess, AWatchedServiceThatFallsSilentIsNamedUntilItIsHeardAgain)
   EXPECT_EQ(silent[0].source, "camera");
   EXPECT_GT(silent[0].seconds, 2.5);
   EXPECT_LT(silent[0].seconds, 3.5);
-  service.publish_heartbeat_at(heard + 3000000);
-  service.handle_pending();
-  EXPECT_EQ(probe.heartbeats.get().state + 0, heartbeat_t::STATE_DEGRADED + 0);
-  EXPECT_NE(probe.heartbeats.get().status.find("camera silent for"), std::string::npos)
-      << probe.heartbeats.get().status;
+  const heartbeat_t hb = heartbeat_at(service, probe, heard + 3000000);
+  EXPECT_EQ(hb.state + 0, heartbeat_t::STATE_DEGRADED + 0);
+  EXPECT_NE(hb.status.find("camera silent for"), std::string::npos) << hb.status;
 
   bus.publish(nudge::bus::channel::HEARTBEAT, &camera);  // heard again
   service.handle_pending();
@@ -307,26 +302,22 @@ TEST(ServiceInProcess, AStreamThatStopsIsNamedDegradedUntilItsFramesReturn) {
   service.handle_pending();
   const int64_t heard = nudge::wall_utime();
   EXPECT_TRUE(service.check_streams(heard).empty());
-  service.publish_heartbeat_at(heard);
-  service.handle_pending();
-  EXPECT_EQ(probe.heartbeats.get().state + 0, heartbeat_t::STATE_RUNNING + 0);
+  EXPECT_EQ(heartbeat_at(service, probe, heard).state + 0, heartbeat_t::STATE_RUNNING + 0);
 
   const auto quiet = service.check_streams(heard + nudge::bus::kStreamSilentAfterUs + 500000);
   ASSERT_EQ(quiet.size(), 1u);
   EXPECT_EQ(quiet[0].channel, "CAM");
-  service.publish_heartbeat_at(heard + 3000000);
-  service.handle_pending();
-  EXPECT_EQ(probe.heartbeats.get().state + 0, heartbeat_t::STATE_DEGRADED + 0);
-  EXPECT_NE(probe.heartbeats.get().status.find("CAM silent for 3."), std::string::npos) << probe.heartbeats.get().status;
+  const heartbeat_t silent = heartbeat_at(service, probe, heard + 3000000);
+  EXPECT_EQ(silent.state + 0, heartbeat_t::STATE_DEGRADED + 0);
+  EXPECT_NE(silent.status.find("CAM silent for 3."), std::string::npos) << silent.status;
 
   bus.publish("CAM", &frame);  // the frames return
   service.handle_pending();
   const int64_t back = nudge::wall_utime();
   EXPECT_TRUE(service.check_streams(back + 100000).empty());
-  service.publish_heartbeat_at(back + 100000);
-  service.handle_pending();
-  EXPECT_EQ(probe.heartbeats.get().status.find("CAM silent"), std::string::npos) << probe.heartbeats.get().status;
-  EXPECT_EQ(probe.heartbeats.get().state + 0, heartbeat_t::STATE_DEGRADED + 0)
+  const heartbeat_t back_again = heartbeat_at(service, probe, back + 100000);
+  EXPECT_EQ(back_again.status.find("CAM silent"), std::string::npos) << back_again.status;
+  EXPECT_EQ(back_again.state + 0, heartbeat_t::STATE_DEGRADED + 0)
       << "DEGRADED for kDegradedHoldUs after the silence, RUNNING after (integration_stalled_stream)";
 }
 
