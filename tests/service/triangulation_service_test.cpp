@@ -231,16 +231,37 @@ Output read_output(const std::string& path) {
   return out;
 }
 
-std::string service_cmd(const Scene& scene, const std::string& rig_path, const std::string& in,
-                        const std::string& out) {
+// The flags that give the service the scene's table plane and arm base.
+std::string table_flags(const Scene& scene) {
   const auto plane = table_plane_in_right(scene.rig);
-  char extra[256];
-  std::snprintf(extra, sizeof extra, " --table-plane %.12f %.12f %.12f %.12f --arm-base %.12f %.12f %.12f", plane[0],
+  char flags[256];
+  std::snprintf(flags, sizeof flags, " --table-plane %.12f %.12f %.12f %.12f --arm-base %.12f %.12f %.12f", plane[0],
                 plane[1], plane[2], plane[3], scene.arm_base_right.x(), scene.arm_base_right.y(),
                 scene.arm_base_right.z());
-  return bin("nudge-triangulation") + " --calibration " + rig_path + extra + " --lcm-in 'file://" + in +
-         "?speed=0' --lcm-out 'file://" + out + "?mode=w'";
+  return flags;
 }
+
+// One run of nudge-triangulation from a log to a log, its files (the rig, the input and the
+// output log) named by `tag` in this process's scratch folder.
+struct ServiceRun {
+  explicit ServiceRun(const std::string& tag)
+      : rig(scratch_dir() + "/triangulation_" + tag + "_rig.yaml"),
+        in(scratch_dir() + "/triangulation_" + tag + "_in.lcmlog"),
+        out(scratch_dir() + "/triangulation_" + tag + "_out.lcmlog") {}
+
+  // The service's command line on these files, `flags` added.
+  std::string command(const std::string& flags = "") const {
+    return bin("nudge-triangulation") + " --calibration " + rig + flags + " --lcm-in 'file://" + in +
+           "?speed=0' --lcm-out 'file://" + out + "?mode=w'";
+  }
+  // Runs command(flags) on a fresh output log; its standard error in `err`. The exit code.
+  int operator()(const std::string& flags = "") {
+    std::remove(out.c_str());
+    return run(command(flags), &err);
+  }
+
+  std::string rig, in, out, err;
+};
 
 Eigen::Vector3d vec(const double v[3]) { return {v[0], v[1], v[2]}; }
 
@@ -307,33 +328,24 @@ void expect_axes_and_candidates(const Scene& scene, const Output& result, const 
 
 TEST(TriangulationService, AxesRecoverTheTablePointsAndCandidatesTheRingObjects) {
   const Scene scene;
-  const std::string dir = scratch_dir();
-  const std::string rig_path = dir + "/triangulation_rig.yaml", in = dir + "/triangulation_in.lcmlog",
-                    out = dir + "/triangulation_out.lcmlog";
-  geo::save_rig(scene.rig, rig_path);
-  write_input_log(scene, in);
-  std::remove(out.c_str());
-  std::string err;
-  const std::string cmd = service_cmd(scene, rig_path, in, out);
-  ASSERT_EQ(run(cmd, &err), 0) << cmd << "\n" << err;
-  expect_axes_and_candidates(scene, read_output(out), err);
+  ServiceRun service("table");
+  geo::save_rig(scene.rig, service.rig);
+  write_input_log(scene, service.in);
+  ASSERT_EQ(service(table_flags(scene)), 0) << service.command(table_flags(scene)) << "\n" << service.err;
+  expect_axes_and_candidates(scene, read_output(service.out), service.err);
 }
 
 // Candidates describe the table as it is when they are asked for: stereo pairs taken before the
 // request (the arm still moving away, delivered late by a pipeline that lags) are not gathered.
 TEST(TriangulationService, CandidatesGatherOnlyPairsTakenAfterTheRequest) {
   const Scene scene;
-  const std::string dir = scratch_dir();
-  const std::string rig_path = dir + "/triangulation_rig_late.yaml", in = dir + "/triangulation_late_in.lcmlog",
-                    out = dir + "/triangulation_late_out.lcmlog";
-  geo::save_rig(scene.rig, rig_path);
+  ServiceRun service("late");
+  geo::save_rig(scene.rig, service.rig);
   const int64_t request_utime = kStart + 10 * kPeriod - 1;
-  write_input_log(scene, in, request_utime, 10);
-  std::remove(out.c_str());
-  std::string err;
-  const std::string cmd = service_cmd(scene, rig_path, in, out);
-  ASSERT_EQ(run(cmd, &err), 0) << cmd << "\n" << err;
-  const Output output = read_output(out);
+  write_input_log(scene, service.in, request_utime, 10);
+  ASSERT_EQ(service(table_flags(scene)), 0) << service.command(table_flags(scene)) << "\n" << service.err;
+  const Output output = read_output(service.out);
+  const std::string& err = service.err;
   EXPECT_EQ(output.axes.size(), static_cast<size_t>(kFrames - 1));  // AXES for every pair, old or new
   ASSERT_EQ(output.candidates.size(), 1u) << err;
   EXPECT_EQ(output.candidates[0].frames_used, 10);
@@ -344,41 +356,30 @@ TEST(TriangulationService, CandidatesGatherOnlyPairsTakenAfterTheRequest) {
 
 TEST(TriangulationService, TableAndArmBaseCanComeFromTheCalibrationFile) {
   const Scene scene;
-  const std::string dir = scratch_dir();
-  const std::string rig_path = dir + "/triangulation_rig_ws.yaml", in = dir + "/triangulation_in_ws.lcmlog",
-                    out = dir + "/triangulation_out_ws.lcmlog";
+  ServiceRun service("workspace");
   const auto p = table_plane_in_right(scene.rig);
   geo::Workspace workspace;
   workspace.table = geo::plane_from_coefficients(Eigen::Vector4d(p[0], p[1], p[2], p[3]));
   workspace.arm_base = scene.arm_base_right;
-  geo::save_rig(scene.rig, workspace, rig_path);
-  const geo::Workspace loaded = geo::load_workspace(rig_path);
+  geo::save_rig(scene.rig, workspace, service.rig);
+  const geo::Workspace loaded = geo::load_workspace(service.rig);
   ASSERT_TRUE(loaded.table && loaded.arm_base);
   EXPECT_LT((loaded.table->normal - workspace.table->normal).norm(), 1e-12);
   EXPECT_LT((*loaded.arm_base - scene.arm_base_right).norm(), 1e-12);
 
-  write_input_log(scene, in);
-  std::remove(out.c_str());
-  std::string err;
-  const std::string cmd = bin("nudge-triangulation") + " --calibration " + rig_path + " --lcm-in 'file://" + in +
-                          "?speed=0' --lcm-out 'file://" + out + "?mode=w'";
-  ASSERT_EQ(run(cmd, &err), 0) << cmd << "\n" << err;
-  expect_axes_and_candidates(scene, read_output(out), err);
+  write_input_log(scene, service.in);
+  ASSERT_EQ(service(), 0) << service.command() << "\n" << service.err;
+  expect_axes_and_candidates(scene, read_output(service.out), service.err);
 }
 
 TEST(TriangulationService, WithoutATablePlaneAxesStayInTheCameraFrame) {
   const Scene scene;
-  const std::string dir = scratch_dir();
-  const std::string rig_path = dir + "/triangulation_rig2.yaml", in = dir + "/triangulation_in2.lcmlog",
-                    out = dir + "/triangulation_out2.lcmlog";
-  geo::save_rig(scene.rig, rig_path);
-  write_input_log(scene, in);
-  std::remove(out.c_str());
-  std::string err;
-  const std::string cmd = bin("nudge-triangulation") + " --calibration " + rig_path + " --lcm-in 'file://" + in +
-                          "?speed=0' --lcm-out 'file://" + out + "?mode=w'";
-  ASSERT_EQ(run(cmd, &err), 0) << cmd << "\n" << err;
-  const Output result = read_output(out);
+  ServiceRun service("no_table");
+  geo::save_rig(scene.rig, service.rig);
+  write_input_log(scene, service.in);
+  ASSERT_EQ(service(), 0) << service.command() << "\n" << service.err;
+  const Output result = read_output(service.out);
+  const std::string& err = service.err;
   ASSERT_FALSE(result.axes.empty());
   const auto& msg = result.axes.begin()->second;
   const Object& obj = scene.objects[0];
