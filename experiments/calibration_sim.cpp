@@ -28,6 +28,7 @@
 #include "nudge/geometry/stereo_rig.hpp"
 #include "nudge/geometry/workspace.hpp"
 #include "nudge/json.hpp"
+#include "nudge/progress.hpp"
 #include "nudge/sim/world.hpp"
 #include "report.hpp"
 
@@ -166,7 +167,9 @@ int main(int argc, char** argv) {
     geo::StereoRig rig;
     sim::CameraModel truth_right;
     Result result;
+    nudge::Progress progress("nudge-exp-calibration-sim", static_cast<int>(centres.size()) + 1);
     for (size_t k = 0; k < centres.size(); ++k) {
+      progress.step("board " + std::to_string(k + 1) + " of " + std::to_string(centres.size()));
       const std::string png = dir + "/board" + std::to_string(k) + ".png";
       const Board board = draw_board(centres[k], png);
       sim::Scene scene;
@@ -206,6 +209,7 @@ int main(int argc, char** argv) {
     result.corners = static_cast<int>(arm_points.size());
 
     // Arm (world) frame -> right camera frame, and the truth it should match.
+    progress.step("absolute orientation and table plane");
     const auto fit = geo::absolute_orientation(arm_points, camera_points);
     if (!fit) throw std::runtime_error(fit.reason());
     const geo::RigidTransform& arm_to_right = fit->transform;
@@ -240,7 +244,8 @@ int main(int argc, char** argv) {
     text += "arm_to_right_rotation: " + numbers(arm_to_right.R) + "\n";
     text += "arm_to_right_translation: " + numbers(arm_to_right.t.transpose()) + "\n";
     write_file_atomically(rig_file, text);
-    std::cerr << "wrote " << rig_file << "\n";
+    progress.note("wrote " + rig_file);
+    progress.clear_status();  // the result files' "wrote" lines follow on stderr
 
     JsonWriter j(6);
     j.begin_object();
@@ -276,9 +281,11 @@ int main(int argc, char** argv) {
        << "| table normal error | " << result.plane_angle_error_deg << " deg |\n"
        << "| table offset error | " << result.plane_offset_error_mm << " mm |\n";
     write_result("calibration_sim.md", md.str());
-    std::cerr << "translation error " << result.translation_error_mm << " mm, rotation error "
-              << result.rotation_error_deg << " deg, table normal " << result.plane_angle_error_deg << " deg, offset "
-              << result.plane_offset_error_mm << " mm\n";
+    std::ostringstream summary;
+    summary << result.corners << " corners; translation error " << result.translation_error_mm
+            << " mm, rotation error " << result.rotation_error_deg << " deg, table normal "
+            << result.plane_angle_error_deg << " deg, offset " << result.plane_offset_error_mm << " mm";
+    progress.finish(summary.str());
     if ((max_translation_mm > 0 && !(result.translation_error_mm <= max_translation_mm)) ||
         (max_rotation_deg > 0 && !(result.rotation_error_deg <= max_rotation_deg))) {
       std::cerr << "nudge-exp-calibration-sim: above the limits (" << max_translation_mm << " mm, " << max_rotation_deg

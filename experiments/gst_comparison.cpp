@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "nudge/json.hpp"
+#include "nudge/progress.hpp"
 #include "nudge/symmetry/detector.hpp"
 #include "nudge/symmetry/gst.hpp"
 #include "nudge/timing.hpp"
@@ -97,7 +98,9 @@ int main() {
     double gst_ms_total = 0, fast_ms_total = 0;
     int gst_runs = 0, fast_runs = 0;
     j.key("images").begin_object();
+    nudge::Progress progress("nudge-exp-gst", static_cast<int>(images.size()));
     for (const auto& [name, img] : images) {
+      progress.step(name + ": fast symmetry, GST at two scales");
       j.key(name).begin_object();
       sym::Params p;
       p.dmin = 10;
@@ -119,6 +122,7 @@ int main() {
          << (fh ? "found" : "missed") << " |\n";
       cv::Mat drawn;
       cv::resize(sym::draw_lines(img, result.lines), drawn, {}, 3, 3, cv::INTER_NEAREST);
+      progress.clear_status();  // write_png says so on stderr
       write_png("gst_" + name + "_fast.png", drawn);
       for (double sigma : {2.0, 200.0}) {
         const sym::GstResult g = sym::generalized_symmetry(img, sym::GstParams{sigma, 1e-6});
@@ -132,12 +136,16 @@ int main() {
         md << "| " << name << " | GST σ = " << sigma << " (" << g.pairs << " pairs) | " << g.ms << " | "
            << (cv_ >= 2 ? "found" : "missed") << " (" << cv_ << ") | " << (ch >= 2 ? "found" : "missed") << " (" << ch
            << ") |\n";
+        progress.clear_status();
         write_png("gst_" + name + "_sigma" + std::to_string(static_cast<int>(sigma)) + ".png", to_picture(g.magnitude));
-        std::cout << name << " sigma " << sigma << ": " << g.ms << " ms, contrast " << cv_ << " / " << ch << "\n";
+        std::ostringstream line;
+        line << name << " sigma " << sigma << ": " << g.ms << " ms, contrast " << cv_ << " / " << ch;
+        progress.note(line.str());
       }
       j.end_object();
     }
     j.end_object();
+    progress.clear_status();  // the result files' "wrote" lines follow on stderr
     const double gst_ms = gst_ms_total / gst_runs, fast_ms = fast_ms_total / fast_runs;
     j.field("gst_ms", gst_ms).field("fast_ms", fast_ms).field("ratio", gst_ms / fast_ms);
     j.field("thesis_gst_ms", 24000).field("thesis_fast_ms", 3);
@@ -155,6 +163,9 @@ int main() {
          << "_sigma200.png) |\n";
     }
     write_result("gst_comparison.md", md.str());
+    std::ostringstream summary;
+    summary << "GST " << gst_ms << " ms, fast symmetry " << fast_ms << " ms (" << gst_ms / fast_ms << "x)";
+    progress.finish(summary.str());
   } catch (const std::exception& e) {
     std::cerr << "nudge-exp-gst: " << e.what() << "\n";
     return 1;

@@ -35,6 +35,7 @@
 #include "nudge/bus/sim_convert.hpp"
 #include "nudge/flags.hpp"
 #include "nudge/json.hpp"
+#include "nudge/progress.hpp"
 #include "nudge/learning/database.hpp"
 #include "nudge/learning/match_truth.hpp"
 #include "nudge/learning/recognizer.hpp"
@@ -491,12 +492,15 @@ int run(const Options& o) {
 
   const std::vector<TestImage> images = read_test_images(o.test_images, "eval");
   std::vector<Judged> judged;
+  nudge::Progress progress("nudge-exp-learning", static_cast<int>(images.size()));
   for (const TestImage& t : images) {
+    progress.step(t.name);
     judged.push_back(recognise_and_judge(recognizer, t, bottle_of, training, o.tolerance_mm / 1e3));
     const Judged& x = judged.back();
-    std::cerr << x.image << ": " << (x.label.empty() ? "nothing (" + x.recognition.reason + ")" : x.bottle) << ", " << x.good
-              << " good / " << x.bad << " bad\n";
+    progress.note(x.image + ": " + (x.label.empty() ? "nothing (" + x.recognition.reason + ")" : x.bottle) + ", " +
+                  std::to_string(x.good) + " good / " + std::to_string(x.bad) + " bad");
   }
+  progress.clear_status();
   const Totals totals = add_up(runs, judged);
 
   std::vector<std::shared_ptr<const learning::ObjectModel>> padded = loaded.models;
@@ -528,6 +532,9 @@ int run(const Options& o) {
   write_result(o.name + ".json", json_report(o, runs, judged, totals, timing, descriptors));
   write_result(o.name + ".md", markdown_report(o, runs, judged, totals, timing, static_cast<int>(padded.size()), sheet_of,
                                                pictures, training));
+  progress.finish(std::to_string(totals.objects_learned) + " objects learned, " + std::to_string(totals.correct) + " of " +
+                  std::to_string(totals.test_images) + " test images recognised, " +
+                  std::to_string(totals.false_recognitions) + " false recognitions");
   return 0;
 }
 

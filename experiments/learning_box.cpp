@@ -11,6 +11,7 @@
 
 #include "nudge/flags.hpp"
 #include "nudge/json.hpp"
+#include "nudge/progress.hpp"
 #include "nudge/learning/recognizer.hpp"
 #include "nudge/learning/synthetic.hpp"
 #include "nudge/timing.hpp"
@@ -45,6 +46,9 @@ int main(int argc, char** argv) {
   try {
     if (!flags.parse(argc, argv)) return 0;
     const cv::Mat box = read_image(data + "/box.png"), scene = read_image(data + "/box_in_scene.png");
+    // The box learned and found, each negative photograph, the database, the three matchers timed.
+    nudge::Progress progress("nudge-exp-learning-box", static_cast<int>(kNegatives.size()) + 5);
+    progress.step("learning box.png, finding it in box_in_scene.png");
 
     learning::ObjectInfo info;
     info.name = "box";
@@ -55,12 +59,14 @@ int main(int argc, char** argv) {
     recognizer.add(model);
     const learning::Recognition found = recognizer.recognize(scene);
     const learning::ObjectScore& score = found.scores[0];
+    progress.clear_status();  // write_png says so on stderr
     write_png(name + ".png", learning::draw_match_picture(scene, box, model->views[0].features, found));
 
     int false_recognitions = 0;
     JsonWriter negatives;
     negatives.begin_array();
     for (const std::string& file : kNegatives) {
+      progress.step("negative " + file);
       const learning::Recognition r = recognizer.recognize(read_image(data + "/" + file));
       false_recognitions += r.recognised();
       negatives.begin_object().field("image", file).field("verified_matches", r.scores[0].verified_matches)
@@ -68,13 +74,18 @@ int main(int argc, char** argv) {
     }
     negatives.end_array();
 
+    progress.step("a database of 100 objects");
     std::vector<std::shared_ptr<const learning::ObjectModel>> objects = {model};
     for (auto& stand_in : learning::synthetic::object_models("synthetic_", 99, 2000)) objects.push_back(stand_in);
     int descriptors = 0;
     for (const auto& o : objects) descriptors += o->descriptor_count();
+    progress.step("recognition at 100 objects: FLANN per object");
     const RecognitionTiming flann = time_recognition(objects, scene, learning::MatcherKind::Flann, kTimingRuns);
+    progress.step("recognition at 100 objects: brute force");
     const RecognitionTiming bf = time_recognition(objects, scene, learning::MatcherKind::BruteForce, kTimingRuns);
+    progress.step("recognition at 100 objects: shared FLANN");
     const RecognitionTiming shared = time_recognition(objects, scene, learning::MatcherKind::SharedFlann, kTimingRuns);
+    progress.clear_status();  // the result files' "wrote" lines follow on stderr
     const learning::RecognizeParams defaults;
     const RecognitionTiming& chosen = defaults.matcher == learning::MatcherKind::Flann        ? flann
                                       : defaults.matcher == learning::MatcherKind::SharedFlann ? shared
@@ -131,6 +142,11 @@ int main(int argc, char** argv) {
        << "`recognition_ms_at_100_objects` in the JSON is the default matcher's (" << chosen.matcher << ").\n\n"
        << machine_description() << ", " << today() << ".\n";
     write_result(name + ".md", md.str());
+    std::ostringstream summary;
+    summary << "box " << (found.recognised() ? "recognised" : "NOT recognised") << ", " << false_recognitions
+            << " false recognitions of " << kNegatives.size() << ", " << chosen.median_ms << " ms at 100 objects ("
+            << chosen.matcher << ")";
+    progress.finish(summary.str());
     return found.recognised() && false_recognitions == 0 ? 0 : 1;
   } catch (const FlagError& e) {
     std::cerr << e.what() << "\n";

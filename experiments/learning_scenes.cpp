@@ -293,7 +293,8 @@ const char* variant_name(TestVariant v) {
   return "?";
 }
 
-std::vector<TestImage> make_test_images(const std::string& source_dir, const std::string& set) {
+std::vector<TestImage> make_test_images(const std::string& source_dir, const std::string& set,
+                                        const std::function<void(const std::string& name)>& before_image) {
   if (set != "eval" && set != "dev") throw std::invalid_argument("test image set must be eval or dev, not '" + set + "'");
   // Image i's seed at its attempt k: base + 1000 k + i (eval base 7100000, dev base 9100000).
   const uint64_t first_seed = set == "eval" ? 7100000 : 9100000;
@@ -311,6 +312,7 @@ std::vector<TestImage> make_test_images(const std::string& source_dir, const std
     name << (known ? 't' : 'u') << std::setw(2) << std::setfill('0') << (known ? i + 1 : i + 1 - 28) << '_'
          << object.name;
     if (known) name << '_' << variant_name(variant);
+    if (before_image) before_image(name.str());
     bool done = false;
     for (int attempt = 0; attempt < kTries && !done; ++attempt) {
       TestImage t;

@@ -10,6 +10,7 @@
 #include <opencv2/core.hpp>
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -54,7 +55,9 @@ struct TestImage {
 // tune on.
 // Renders each with the simulator (right camera). Throws std::runtime_error if a scene cannot be
 // drawn within its retries.
-std::vector<TestImage> make_test_images(const std::string& source_dir, const std::string& set);
+// `before_image(name)`, when given, is called before each image is drawn (for progress output).
+std::vector<TestImage> make_test_images(const std::string& source_dir, const std::string& set,
+                                        const std::function<void(const std::string& name)>& before_image = {});
 
 // The images nudge-exp-learning-scenes --out DIR wrote, read back from DIR/manifest.json: name,
 // target, variant, seed, visible fraction, colour, mask and surface (not the scene). `set` is

@@ -11,6 +11,7 @@
 #include "nudge/atomic_file.hpp"
 #include "nudge/flags.hpp"
 #include "nudge/json.hpp"
+#include "nudge/progress.hpp"
 #include "nudge/sim/truth_images.hpp"
 #include "report.hpp"
 
@@ -114,7 +115,10 @@ int main(int argc, char** argv) {
     if (out.empty()) return 0;
     std::filesystem::create_directories(out);
     const auto start = std::chrono::steady_clock::now();
-    const std::vector<TestImage> images = make_test_images(NUDGE_SOURCE_DIR, set);
+    nudge::Progress progress("nudge-exp-learning-scenes",
+                             static_cast<int>(4 * learning_bottles().size() + unknown_objects(NUDGE_SOURCE_DIR).size()));
+    const std::vector<TestImage> images =
+        make_test_images(NUDGE_SOURCE_DIR, set, [&](const std::string& name) { progress.step(name); });
     for (const auto& t : images) {
       write_image(out + "/" + t.name + ".png", t.colour);
       write_image(out + "/" + t.name + "_mask.png", t.mask);
@@ -122,8 +126,9 @@ int main(int argc, char** argv) {
     }
     write_file_atomically(out + "/manifest.json", manifest(images, set));
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    std::cerr << "wrote " << images.size() << " images to " << out << " in " << seconds << " s\n";
+    progress.clear_status();  // the report's "wrote" lines follow on stderr
     if (report) write_report(images, seconds, set);
+    progress.finish("wrote " + std::to_string(images.size()) + " " + set + " images and manifest.json to " + out);
   } catch (const FlagError& e) {
     std::cerr << "nudge-exp-learning-scenes: " << e.what() << "\n" << flags.help();
     return 2;

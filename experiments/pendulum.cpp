@@ -32,6 +32,7 @@
 
 #include "nudge/flags.hpp"
 #include "nudge/json.hpp"
+#include "nudge/progress.hpp"
 #include "nudge/sim/world.hpp"
 #include "nudge/symmetry/detector.hpp"
 #include "nudge/symmetry/line.hpp"
@@ -301,7 +302,7 @@ std::vector<double> absolute(std::vector<double> v) {
   return v;
 }
 
-BackgroundResult run_background(const std::string& name, int frames) {
+BackgroundResult run_background(const std::string& name, int frames, nudge::Progress& progress) {
   BackgroundResult res;
   res.name = name;
   res.frames = frames;
@@ -497,11 +498,12 @@ BackgroundResult run_background(const std::string& name, int frames) {
                           name + ": theta", "frame", "deg", {720, 360});
   cv::hconcat(pr, pt, res.plot_image);
 
-  std::cout << name << ": GT fit residuals " << res.gt_res_r << " px / " << res.gt_res_theta << " rad ("
-            << res.fit.summary << "), detection |R| " << res.r_mean << " px |theta| " << res.t_mean
-            << " rad over " << res.detected << "/" << res.scored << " scored frames, colour centroid "
-            << res.colour_mean << " px (" << res.colour_found << "), render " << res.ms_render
-            << " ms/frame, detect " << res.ms_detect << " ms/frame\n";
+  std::ostringstream line;
+  line << name << ": GT fit residuals " << res.gt_res_r << " px / " << res.gt_res_theta << " rad (" << res.fit.summary
+       << "), detection |R| " << res.r_mean << " px |theta| " << res.t_mean << " rad over " << res.detected << "/"
+       << res.scored << " scored frames, colour centroid " << res.colour_mean << " px (" << res.colour_found
+       << "), render " << res.ms_render << " ms/frame, detect " << res.ms_detect << " ms/frame";
+  progress.note(line.str());
   return res;
 }
 
@@ -632,12 +634,19 @@ int main(int argc, char** argv) {
     if (!(g_half_width_deg >= 0 && g_half_width_deg < 90)) throw FlagError("--half-width: in [0, 90)");
     if (!(g_steady_fraction >= 0 && g_steady_fraction <= 1)) throw FlagError("--steady: in [0, 1]");
     std::vector<BackgroundResult> results;
-    for (const std::string name : {"white", "red", "edge", "mixed"}) {
+    const std::vector<std::string> backgrounds = {"white", "red", "edge", "mixed"};
+    if (!only.empty() && std::find(backgrounds.begin(), backgrounds.end(), only) == backgrounds.end())
+      throw FlagError("--only: one of white, red, edge, mixed");
+    nudge::Progress progress("nudge-exp-pendulum", only.empty() ? static_cast<int>(backgrounds.size()) : 1);
+    for (const std::string& name : backgrounds) {
       if (!only.empty() && name != only) continue;
-      results.push_back(run_background(name, frames));
+      progress.step(name + " background, " + std::to_string(frames) + " frames");
+      results.push_back(run_background(name, frames, progress));
     }
-    if (results.empty()) throw FlagError("--only: one of white, red, edge, mixed");
+    progress.clear_status();  // the result files' "wrote" lines follow on stderr
     if (only.empty()) write_results(results, frames);
+    progress.finish(std::to_string(results.size()) + " background(s) of " + std::to_string(frames) + " frames" +
+                    (only.empty() ? "" : " (--only: nothing written)"));
   } catch (const std::exception& e) {
     std::cerr << "nudge-exp-pendulum: " << e.what() << "\n";
     return 1;

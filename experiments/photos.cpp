@@ -14,6 +14,7 @@
 
 #include "nudge/flags.hpp"
 #include "nudge/json.hpp"
+#include "nudge/progress.hpp"
 #include "nudge/symmetry/loy_eklundh.hpp"
 #include "nudge/symmetry/photo.hpp"
 #include "nudge/timing.hpp"
@@ -137,10 +138,12 @@ int main(int argc, char** argv) {
     Method le{"loy_eklundh", "Loy & Eklundh", {}, {}, {}, {}};
     std::vector<int> sweep_hits(sweep.size(), 0), polarity_hits(sweep.size(), 0);  // polarity: Params::mirror_polarity
     std::vector<std::string> files;
+    nudge::Progress progress("nudge-exp-photos", static_cast<int>(rows.size()));
     for (const auto& row : rows) {
+      progress.step(row.path.substr(row.path.rfind('/') + 1));
       const cv::Mat image = cv::imread(row.path, cv::IMREAD_COLOR);
       if (image.empty()) {
-        std::cerr << "skipped " << row.path << ": cannot read it\n";
+        progress.note("skipped " + row.path + ": cannot read it");
         continue;
       }
       files.push_back(row.path.substr(row.path.rfind('/') + 1));
@@ -158,9 +161,10 @@ int main(int argc, char** argv) {
         const auto polar = sym::detect_photo(image, options_with_mirror(sweep[t], true)).in_image.lines;
         polarity_hits[t] += !polar.empty() && sym::competition_match(polar[0], row.a, row.b);
       }
-      std::cout << files.back() << ": fast " << (fast.hits.back() ? "hit" : "miss") << ", locations only "
-                << (plain.hits.back() ? "hit" : "miss") << ", Loy-Eklundh " << (le.hits.back() ? "hit" : "miss") << "\n";
+      progress.note(files.back() + ": fast " + (fast.hits.back() ? "hit" : "miss") + ", locations only " +
+                    (plain.hits.back() ? "hit" : "miss") + ", Loy-Eklundh " + (le.hits.back() ? "hit" : "miss"));
     }
+    progress.clear_status();  // the result files' "wrote" lines follow on stderr
     const int images = static_cast<int>(files.size());
     if (images == 0) throw std::runtime_error("no readable images in " + annotations);
     JsonWriter j;
@@ -222,6 +226,9 @@ int main(int argc, char** argv) {
              << (m->line_hits[i] ? " (its support segment is too short or off-centre)" : "") << ".";
     md << "\n";
     write_result(name + ".md", md.str());
+    progress.finish(std::to_string(images) + " images: top line correct, fast " + std::to_string(fast.hit_count()) +
+                    ", locations only " + std::to_string(plain.hit_count()) + ", Loy-Eklundh " +
+                    std::to_string(le.hit_count()));
   } catch (const std::exception& e) {
     std::cerr << "nudge-exp-photos: " << e.what() << "\n";
     return 1;

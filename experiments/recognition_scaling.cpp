@@ -15,6 +15,7 @@
 
 #include "nudge/flags.hpp"
 #include "nudge/json.hpp"
+#include "nudge/progress.hpp"
 #include "nudge/learning/recognizer.hpp"
 #include "nudge/learning/synthetic.hpp"
 #include "report.hpp"
@@ -159,15 +160,20 @@ int main(int argc, char** argv) {
     const Query unknown = make_query(unknown_object, 3, 12, 1.0, scene_seed, "");
 
     std::vector<Row> rows;
+    nudge::Progress progress("nudge-exp-recognition-scaling", static_cast<int>(kSizes.size() * kMatchers.size()));
     for (int n : kSizes) {
       const auto queries = queries_for(n, known, known_index, unknown);
       for (learning::MatcherKind kind : kMatchers) {
+        progress.step(std::string(learning::matcher_name(kind)) + " at " + std::to_string(n) + " objects");
         rows.push_back(measure(kind, objects, n, queries, runs));
         const Row& r = rows.back();
-        std::cerr << learning::matcher_name(kind) << " at " << n << " objects: " << r.median_cpu_ms << " ms CPU, "
-                  << r.correct << "/" << r.queries << " right\n";
+        std::ostringstream line;
+        line << learning::matcher_name(kind) << " at " << n << " objects: " << r.median_cpu_ms << " ms CPU, "
+             << r.correct << "/" << r.queries << " right";
+        progress.note(line.str());
       }
     }
+    progress.clear_status();  // the result files' "wrote" lines follow on stderr
 
     const learning::RecognizeParams defaults;
     auto row_of = [&](learning::MatcherKind kind, int n) -> const Row& {
@@ -236,6 +242,11 @@ int main(int argc, char** argv) {
        << "\n\nCPU time, not wall time: the machine is shared (load average " << load_average()
        << " when it finished). " << machine_description() << ", " << today() << ".\n";
     write_result(name + ".md", md.str());
+    std::ostringstream summary;
+    summary << rows.size() << " matcher/size pairs, " << (all_right ? "every answer right" : "NOT every answer right")
+            << ", " << learning::matcher_name(defaults.matcher) << " at " << largest << " objects "
+            << fixed(chosen.median_cpu_ms) << " ms CPU";
+    progress.finish(summary.str());
     return all_right ? 0 : 1;
   } catch (const FlagError& e) {
     std::cerr << e.what() << "\n";

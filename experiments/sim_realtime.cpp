@@ -10,6 +10,7 @@
 
 #include "nudge/flags.hpp"
 #include "nudge/json.hpp"
+#include "nudge/progress.hpp"
 #include "nudge/sim/state_sync.hpp"
 #include "nudge/sim/world.hpp"
 #include "nudge/timing.hpp"
@@ -131,16 +132,26 @@ int main(int argc, char** argv) {
     if (!flags.parse(argc, argv)) return 0;
     if (!(seconds >= kFramePeriod)) throw FlagError("--seconds must be >= 0.04");
     std::vector<SceneTiming> results;
+    std::vector<std::string> paths;
     std::stringstream list(scenes);
-    for (std::string path; std::getline(list, path, ',');) {
-      if (path.empty()) continue;
+    for (std::string path; std::getline(list, path, ',');)
+      if (!path.empty()) paths.push_back(path);
+    nudge::Progress progress("nudge-exp-sim-realtime", static_cast<int>(paths.size()));
+    for (const std::string& path : paths) {
+      progress.step(path.substr(path.rfind('/') + 1));
       results.push_back(measure(path, seconds));
       const auto& t = results.back();
-      std::cerr << t.scene << ": physics " << t.physics_ms_per_frame << " ms, sync " << t.sync_ms_per_frame
-                << " ms, render " << t.render_ms_per_frame << " ms per image -> realtime factor "
-                << t.one_core_factor() << " (1 core), " << t.two_core_factor() << " (2 cores)\n";
+      std::ostringstream line;
+      line << t.scene << ": physics " << t.physics_ms_per_frame << " ms, sync " << t.sync_ms_per_frame
+           << " ms, render " << t.render_ms_per_frame << " ms per image -> realtime factor " << t.one_core_factor()
+           << " (1 core), " << t.two_core_factor() << " (2 cores)";
+      progress.note(line.str());
     }
+    progress.clear_status();  // the result files' "wrote" lines follow on stderr
     write_results(results, seconds);
+    std::ostringstream summary;
+    summary << results.size() << " scenes, " << seconds << " simulated s each";
+    progress.finish(summary.str());
   } catch (const FlagError& e) {
     std::cerr << "nudge-exp-sim-realtime: " << e.what() << "\n";
     return 2;

@@ -12,6 +12,7 @@
 // camera stamps simulated time; then the frame's capture is when this recorder first heard its
 // utime (on SIM_STATE, the world's state the camera renders, else on CAMERA_*).
 #include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -27,6 +28,7 @@
 #include "nudge/heartbeat_t.hpp"
 #include "nudge/image_t.hpp"
 #include "nudge/json.hpp"
+#include "nudge/progress.hpp"
 #include "nudge/atomic_file.hpp"
 #include "nudge/sim_state_t.hpp"
 #include "nudge/symmetry_lines_t.hpp"
@@ -295,10 +297,18 @@ int record(int argc, char** argv) {
 
   const int64_t end = start + static_cast<int64_t>(seconds * 1e6);
   int64_t next_sample = start;
+  constexpr double kProgressStep_s = 10;  // a status line every 10 s of the recording
+  nudge::Progress progress("nudge-exp-soak record", static_cast<int>(std::ceil(seconds / kProgressStep_s)));
+  int64_t next_step = start;
   std::vector<double> load;
   while (!service.stop_requested()) {
     const int64_t now = wall_utime();
     if (now >= end) break;
+    if (now >= next_step) {
+      progress.step("recording, " + std::to_string((now - start) / 1000000) + " s of " +
+                    std::to_string(static_cast<int>(seconds)));
+      next_step += static_cast<int64_t>(kProgressStep_s * 1e6);
+    }
     if (now >= next_sample) {
       rec.sample_processes(processes, now);
       load.push_back(load_average());
@@ -310,7 +320,10 @@ int record(int argc, char** argv) {
   rec.sample_processes(processes, stopped);
   write_file_atomically(out, rec.json(processes, stopped, label, load) + "\n");
   if (!csv.empty()) write_file_atomically(csv, rss_csv(processes));
+  progress.clear_status();
   log::info() << "wrote " << out << (csv.empty() ? "" : " and " + csv);
+  progress.finish(std::to_string((stopped - start) / 1000000) + " s recorded" +
+                  (service.stop_requested() ? " (stopped early by a signal)" : "") + " into " + out);
   return 0;
 }
 

@@ -11,6 +11,7 @@
 
 #include "nudge/flags.hpp"
 #include "nudge/json.hpp"
+#include "nudge/progress.hpp"
 #include "nudge/symmetry/corner_cutting.hpp"
 #include "nudge/symmetry/detector.hpp"
 #include "nudge/symmetry/synthetic.hpp"
@@ -93,15 +94,19 @@ FrameTiming time_frame(const cv::Mat& frame, int repeats) {
   return t;
 }
 
-void table3_1(const std::vector<cv::Mat>& frames, int repeats) {
+void table3_1(const std::vector<cv::Mat>& frames, int repeats, nudge::Progress& progress) {
   std::vector<FrameTiming> rows;
   for (size_t i = 0; i < frames.size(); ++i) {
+    progress.step("Table 3.1, frame " + std::to_string(i + 1));
     rows.push_back(time_frame(frames[i], repeats));
     const auto& r = rows.back();
-    std::cout << "frame " << i + 1 << ": " << r.edges << " edges, canny " << r.canny << " ms, vote " << r.vote
+    std::ostringstream line;
+    line << "frame " << i + 1 << ": " << r.edges << " edges, canny " << r.canny << " ms, vote " << r.vote
               << " ms, peaks " << r.peaks << " ms, plain vote " << r.plain_vote << " ms, corner-cutting vote "
-              << r.corner_cutting_vote << " ms (" << 100 * r.corner_cutting_votes_fraction << " % of the votes)\n";
+              << r.corner_cutting_vote << " ms (" << 100 * r.corner_cutting_votes_fraction << " % of the votes)";
+    progress.note(line.str());
   }
+  progress.clear_status();  // the result files' "wrote" lines follow on stderr
   std::vector<double> total, vote, peaks, canny, edges, with_canny, cc_fraction;
   double plain_sum = 0, fast_sum = 0, one_sum = 0, two_sum = 0, cc_sum = 0;
   for (const auto& r : rows) {
@@ -168,11 +173,12 @@ void table3_1(const std::vector<cv::Mat>& frames, int repeats) {
   write_result("table3_1.md", md.str());
 }
 
-void fig3_11(const std::vector<cv::Mat>& frames, int repeats) {
+void fig3_11(const std::vector<cv::Mat>& frames, int repeats, nudge::Progress& progress) {
   std::vector<sym::EdgeSet> edge_sets;
   for (const auto& f : frames) edge_sets.push_back(sym::detect_edges(f, sym::EdgeParams{1.0, 30, 90, false}));
   std::vector<double> ranges, times;
   for (int range = 10; range <= 180; range += 10) {
+    progress.step("fig. 3.11, range " + std::to_string(range) + " deg");
     sym::Params p = table_params();
     p.theta_min_deg = -range / 2.0 + (range == 180 ? 0.5 : 0);
     p.theta_max_deg = range / 2.0;
@@ -188,8 +194,11 @@ void fig3_11(const std::vector<cv::Mat>& frames, int repeats) {
     }
     ranges.push_back(static_cast<double>(sym::theta_bins_in_range(p.theta_min_deg, p.theta_max_deg).size()));
     times.push_back(mean(per_frame));
-    std::cout << "range " << ranges.back() << " deg: " << times.back() << " ms\n";
+    std::ostringstream line;
+    line << "range " << ranges.back() << " deg: " << times.back() << " ms";
+    progress.note(line.str());
   }
+  progress.clear_status();  // the result files' "wrote" lines follow on stderr
   const LinearFit fit = fit_line(ranges, times);
   JsonWriter j;
   j.begin_object();
@@ -231,8 +240,11 @@ int main(int argc, char** argv) {
     if (!flags.parse(argc, argv)) return 0;
     std::vector<cv::Mat> images;
     for (int i = 0; i < frames; ++i) images.push_back(sym::synthetic::indoor_scene(1 + i, 640, 480, clutter));
-    table3_1(images, repeats);
-    fig3_11(images, std::max(1, repeats / 2));
+    // One step per frame timed, then one per angle range of fig. 3.11 (10..180 deg by 10).
+    nudge::Progress progress("nudge-exp-table3_1", frames + 18);
+    table3_1(images, repeats, progress);
+    fig3_11(images, std::max(1, repeats / 2), progress);
+    progress.finish(std::to_string(frames) + " frames, 18 angle ranges timed");
   } catch (const std::exception& e) {
     std::cerr << "nudge-exp-table3_1: " << e.what() << "\n";
     return 1;

@@ -9,6 +9,7 @@
 
 #include "nudge/flags.hpp"
 #include "nudge/json.hpp"
+#include "nudge/progress.hpp"
 #include "nudge/segmentation/segment.hpp"
 #include "nudge/symmetry/detector.hpp"
 #include "nudge/symmetry/synthetic.hpp"
@@ -60,18 +61,21 @@ LineTiming time_line(const seg::Segmenter& segmenter, const sym::EdgeSet& edges,
 }
 
 void run_setting(Setting* setting, const std::vector<sym::EdgeSet>& edges,
-                 const std::vector<std::vector<sym::Line>>& lines, int repeats) {
+                 const std::vector<std::vector<sym::Line>>& lines, int repeats, nudge::Progress& progress) {
   seg::SegmentParams params;
   params.max_width = setting->max_width;
   const seg::Segmenter segmenter(params);
   for (size_t f = 0; f < edges.size(); ++f) {
+    progress.step("MAXw " + std::to_string(setting->max_width) + ", frame " + std::to_string(f + 1));
     for (size_t l = 0; l < lines[f].size(); ++l) {
       LineTiming t = time_line(segmenter, edges[f], lines[f][l], repeats);
       t.frame = static_cast<int>(f + 1);
       t.line = static_cast<int>(l + 1);
       setting->lines.push_back(t);
-      std::cout << "MAXw " << setting->max_width << ", frame " << t.frame << " line " << t.line << ": "
-                << t.edge_pairs << " edge pairs, " << t.ms << " ms\n";
+      std::ostringstream line;
+      line << "MAXw " << setting->max_width << ", frame " << t.frame << " line " << t.line << ": " << t.edge_pairs
+           << " edge pairs, " << t.ms << " ms";
+      progress.note(line.str());
     }
   }
 }
@@ -136,10 +140,13 @@ int main(int argc, char** argv) {
       lines.push_back(detector.detect(edges.back()).lines);
     }
     Setting wide{640, {}}, usual{250, {}};
-    run_setting(&wide, edges, lines, repeats);
-    run_setting(&usual, edges, lines, repeats);
+    nudge::Progress progress("nudge-exp-table4_1", 2 * frames);  // each frame at both widths
+    run_setting(&wide, edges, lines, repeats, progress);
+    run_setting(&usual, edges, lines, repeats, progress);
     if (wide.lines.empty()) throw std::runtime_error("the detector found no lines to segment");
+    progress.clear_status();  // the result files' "wrote" lines follow on stderr
     write_results(wide, usual, frames, repeats);
+    progress.finish(std::to_string(wide.lines.size()) + " lines segmented at MAXw 640 and 250");
   } catch (const std::exception& e) {
     std::cerr << "nudge-exp-table4_1: " << e.what() << "\n";
     return 1;

@@ -17,6 +17,7 @@
 #include "nudge/flags.hpp"
 #include "nudge/geometry/interesting_locations.hpp"
 #include "nudge/json.hpp"
+#include "nudge/progress.hpp"
 #include "nudge/sim/world.hpp"
 #include "nudge/symmetry/detector.hpp"
 #include "nudge/timing.hpp"
@@ -207,15 +208,19 @@ int main(int argc, char** argv) {
   try {
     if (!flags.parse(argc, argv)) return 0;
     std::vector<Trial> trials;
+    nudge::Progress progress("nudge-exp-table4_2", static_cast<int>(thesis_objects().size() * kLocations.size()));
     for (const auto& object : thesis_objects()) {
       for (int loc = 0; loc < static_cast<int>(kLocations.size()); ++loc) {
+        progress.step(object.label + " @" + std::to_string(loc + 1));
         trials.push_back(run_trial(object, loc, std::max(1, repeats)));
         const Trial& t = trials.back();
-        std::cout << t.object << " @" << loc + 1 << ": "
-                  << (t.failed ? "FAILED" : std::to_string(t.error_mm) + " mm") << ", " << t.valid_axes
-                  << " valid axes, " << t.ms << " ms\n";
+        std::ostringstream line;
+        line << t.object << " @" << loc + 1 << ": " << (t.failed ? "FAILED" : std::to_string(t.error_mm) + " mm")
+             << ", " << t.valid_axes << " valid axes, " << t.ms << " ms";
+        progress.note(line.str());
       }
     }
+    progress.clear_status();  // the result files' "wrote" lines follow on stderr
     std::vector<double> errors, valid, times;
     int failures = 0;
     for (const auto& t : trials) {
@@ -290,6 +295,10 @@ int main(int argc, char** argv) {
     write_png("table4_2_3d.png", plot_axes_3d(trials));
     write_png("table4_2_topview.png", plot({frame, origin, offsets}, "Table 4.2: intersections around the truth, top view",
                                            "y error (mm)", "x error (mm)", {560, 560}));
+    std::ostringstream summary;
+    summary << trials.size() - failures << " of " << trials.size() << " axes triangulated, mean error "
+            << mean(errors) << " mm";
+    progress.finish(summary.str());
   } catch (const std::exception& e) {
     std::cerr << "nudge-exp-table4_2: " << e.what() << "\n";
     return 1;

@@ -22,6 +22,7 @@
 #include "nudge/bus/image.hpp"
 #include "nudge/flags.hpp"
 #include "nudge/json.hpp"
+#include "nudge/progress.hpp"
 #include "nudge/symmetry/synthetic.hpp"
 #include "nudge/timing.hpp"
 #include "nudge/track_t.hpp"
@@ -128,11 +129,16 @@ int main(int argc, char** argv) {
   try {
     if (!flags.parse(argc, argv)) return 0;
     if (frames < 20) throw FlagError("--frames must be >= 20");
+    nudge::Progress progress("nudge-exp-table5_1", 3);  // the video, the tracker's time, the latency over LCM
+    progress.step("drawing " + std::to_string(frames) + " frames");
     const auto video = swinging_bottle(frames);
+    progress.step("tracker time per frame");
     const std::vector<double> ms = tracker_times(video);
     const double median_ms = median(ms);
     std::string why;
+    progress.step("latency over LCM (" + std::to_string(frames / 25) + " s at 25 Hz)");
     const std::vector<double> latency = lcm_latencies(video, &why);
+    progress.clear_status();  // the result files' "wrote" lines follow on stderr
     JsonWriter j;
     j.begin_object();
     j.field("machine", machine_description()).field("date", today()).field("frames", frames);
@@ -156,6 +162,10 @@ int main(int argc, char** argv) {
        << "| median latency camera → TRACK over LCM (ms) | "
        << (latency.empty() ? "unavailable: " + why : std::to_string(median(latency))) << " | – |\n";
     write_result("table5_1.md", md.str());
+    std::ostringstream summary;
+    summary << median_ms << " ms per frame, latency "
+            << (latency.empty() ? "unavailable" : std::to_string(median(latency)) + " ms");
+    progress.finish(summary.str());
   } catch (const std::exception& e) {
     std::cerr << "nudge-exp-table5_1: " << e.what() << "\n";
     return 1;

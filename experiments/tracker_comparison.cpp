@@ -32,6 +32,7 @@
 
 #include "nudge/flags.hpp"
 #include "nudge/json.hpp"
+#include "nudge/progress.hpp"
 #include "nudge/timing.hpp"
 #include "nudge/tracking/scoring.hpp"
 #include "nudge/tracking/tracker.hpp"
@@ -304,7 +305,8 @@ void write_preview(const std::string& directory, const std::string& name, const 
   if (!cv::imwrite(path, tile(tiles, 2))) throw std::runtime_error("--preview: cannot write " + path);
 }
 
-Run run_scenario(const Scenario& sc, int camera, int max_frames, const std::string& preview) {
+Run run_scenario(const Scenario& sc, int camera, int max_frames, const std::string& preview, nudge::Progress& progress) {
+  progress.step(sc.name);
   const std::array<Video, 2> videos = render_stereo_video(sc, max_frames);
   if (!preview.empty()) write_preview(preview, sc.name, videos);
   Run run;
@@ -313,13 +315,14 @@ Run run_scenario(const Scenario& sc, int camera, int max_frames, const std::stri
   for (int c = 0; c < 2; ++c) {
     if (camera >= 0 && c != camera) continue;
     run.cameras[c] = score_video(sc, videos[c]);
-    std::cout << sc.name << " camera " << c << ":";
+    std::ostringstream line;
+    line << sc.name << " camera " << c << ":";
     for (const std::string& name : all_scored()) {
       const Score& s = run.cameras[c].by_tracker.at(name);
-      std::cout << " " << name << " " << s.mean_error() << " px " << s.losses << "/" << s.scored << " iou "
+      line << " " << name << " " << s.mean_error() << " px " << s.losses << "/" << s.scored << " iou "
                 << s.mean_iou() << ";";
     }
-    std::cout << std::endl;
+    progress.note(line.str());
   }
   return run;
 }
@@ -551,22 +554,26 @@ int main(int argc, char** argv) {
     std::vector<int> held_seeds;
     for (int i = 0; i < seeds; ++i) held_seeds.push_back(first_seed + i);
     std::vector<Run> dev, heldout;
+    nudge::Progress progress("nudge-exp-tracker-comparison",
+                             only.empty() ? static_cast<int>(tracking_scenarios().size() + held_seeds.size()) : 1);
     for (const Scenario& sc : tracking_scenarios())
-      if (only.empty() || sc.name == only) dev.push_back(run_scenario(sc, camera, frames, preview));
+      if (only.empty() || sc.name == only) dev.push_back(run_scenario(sc, camera, frames, preview, progress));
     std::vector<std::string> unusable;  // a drawn scenario the simulator refuses, or with the target unseen in frame 0
     for (int seed : held_seeds) {
       if (!only.empty() && only != "seed_" + std::to_string(seed)) continue;
       try {
-        heldout.push_back(run_scenario(generated_scenario(static_cast<uint64_t>(seed), pictures), camera, frames, preview));
+        heldout.push_back(run_scenario(generated_scenario(static_cast<uint64_t>(seed), pictures), camera, frames, preview, progress));
       } catch (const std::runtime_error& e) {
-        std::cerr << "seed " << seed << " not scored: " << e.what() << "\n";
+        progress.note("seed " + std::to_string(seed) + " not scored: " + e.what());
         unusable.push_back("seed_" + std::to_string(seed) + ": " + e.what());
       }
     }
     if (!unusable.empty() && heldout.empty()) throw std::runtime_error("no held-out scenario could be rendered");
     if (dev.empty() && heldout.empty()) throw FlagError("--only: no video named '" + only + "'");
     const std::vector<int> cameras = camera < 0 ? std::vector<int>{0, 1} : std::vector<int>{camera};
+    progress.clear_status();
     if (only.empty()) write_results(dev, heldout, held_seeds, cameras, unusable);
+    progress.finish(std::to_string(dev.size()) + " development and " + std::to_string(heldout.size()) + " held-out videos");
   } catch (const std::exception& e) {
     std::cerr << "nudge-exp-tracker-comparison: " << e.what() << "\n";
     return 1;

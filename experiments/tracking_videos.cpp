@@ -18,6 +18,7 @@
 
 #include "nudge/flags.hpp"
 #include "nudge/json.hpp"
+#include "nudge/progress.hpp"
 #include "nudge/symmetry/line.hpp"
 #include "nudge/timing.hpp"
 #include "nudge/tracking/tracker.hpp"
@@ -55,7 +56,8 @@ void draw_line(cv::Mat& img, double r, double theta, const cv::Scalar& colour, i
   cv::line(img, p - 2000 * d, p + 2000 * d, colour, thickness, cv::LINE_AA);
 }
 
-VideoResult run_video(const Scenario& sc, int camera, int max_frames, const std::string& preview) {
+VideoResult run_video(const Scenario& sc, int camera, int max_frames, const std::string& preview,
+                      nudge::Progress& progress) {
   const Video video = render_video(sc, camera, max_frames);
   VideoResult res;
   res.name = sc.name;
@@ -153,11 +155,13 @@ VideoResult run_video(const Scenario& sc, int camera, int max_frames, const std:
   }
   res.convergent = res.start_frame >= 0 && res.start_frame - res.motion_start <= kMaxStartDelay &&
                    res.diverged_frames == 0 && res.lost_while_moving == 0;
-  std::cout << sc.name << ": " << (res.convergent ? "convergent" : "NOT convergent") << ", start frame "
+  std::ostringstream line;
+  line << sc.name << ": " << (res.convergent ? "convergent" : "NOT convergent") << ", start frame "
             << res.start_frame << " (motion " << res.motion_start << "), tracked " << res.tracked << "/"
             << res.frames << ", |R| mean " << res.r_mean << " max " << res.r_max << " px, |theta| mean "
             << res.t_mean << " max " << res.t_max << " deg, lost frames " << res.frames_lost << ", "
-            << res.ms_per_frame << " ms/frame (render " << res.render_ms / res.frames << " ms/frame)\n";
+            << res.ms_per_frame << " ms/frame (render " << res.render_ms / res.frames << " ms/frame)";
+  progress.note(line.str());
   return res;
 }
 
@@ -273,12 +277,16 @@ int main(int argc, char** argv) {
     if (camera < 0 || camera > 1) throw FlagError("--camera: must be 0 or 1");
     if (frames < 0) throw FlagError("--frames: must be >= 0");
     std::vector<VideoResult> results;
+    nudge::Progress progress("nudge-exp-tracking-videos", only.empty() ? static_cast<int>(tracking_scenarios().size()) : 1);
     for (const Scenario& sc : tracking_scenarios()) {
       if (!only.empty() && sc.name != only) continue;
-      results.push_back(run_video(sc, camera, frames, preview));
+      progress.step(sc.name);
+      results.push_back(run_video(sc, camera, frames, preview, progress));
     }
+    progress.clear_status();
     if (results.empty()) throw FlagError("--only: no video named '" + only + "'");
     if (only.empty() && !ablation) write_results(results, camera);
+    progress.finish(std::to_string(results.size()) + " video(s) tracked");
   } catch (const std::exception& e) {
     std::cerr << "nudge-exp-tracking-videos: " << e.what() << "\n";
     return 1;
