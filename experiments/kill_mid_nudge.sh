@@ -17,7 +17,8 @@ cmake --build "$NUDGE_BUILD_DIR" -j"$NUDGE_JOBS" --target killed_mid_nudge_test 
 lines=$(mktemp)
 trap 'rm -f "$lines"' EXIT
 for run in $(seq 1 "$repeats"); do
-  nudge_log "run $run of $repeats"
+  nudge_progress "$run" "$repeats" 0 "run $run of $repeats"
+  [ -t 2 ] && echo >&2  # the test's lines follow under the status
   NUDGE_KILL_RESULTS=$lines nice "$NUDGE_BUILD_DIR/bin/killed_mid_nudge_test" --gtest_also_run_disabled_tests \
     | grep -E "killed:|^\[ *(OK|FAILED) " >&2 || true
 done
@@ -83,3 +84,4 @@ open(rel_path, "a").write("\n")
 print(f"kill_detect_s_max {result['kill_detect_s_max']}, arm_stopped_all {result['arm_stopped_all']}, "
       f"{result['cases_passed']}/{len(cases)} cases passed")
 PY
+nudge_summary kill_mid_nudge.sh 0 "$repeats run(s) of every case; docs/results/kill_mid_nudge.{json,md} written"

@@ -43,9 +43,10 @@ if [ $runs = 1 ]; then
   # watchdogs (supervisor --service-timeout, arm --supervisor-timeout) at 10 s instead of 3 and 1.5.
   export NUDGE_LOOP_LEARN=1 NUDGE_OBJECT_DB="$runs_dir/objects" NUDGE_LOOP_REALTIME=${NUDGE_LOOP_REALTIME:-0.5}
   export NUDGE_LOOP_ARM_WATCHDOG=${NUDGE_LOOP_ARM_WATCHDOG:-10}
-  i=0
+  i=0 loop_start=$SECONDS
   for name in "${names[@]}"; do
     i=$((i + 1))
+    nudge_progress "$i" "${#names[@]}" "$loop_start" "$name"
     mkdir -p "$runs_dir/$name"
     start=$(date +%s)
     status=0
@@ -55,6 +56,7 @@ if [ $runs = 1 ]; then
     [ -d "$runs_dir/$name/$name" ] && echo $(($(date +%s) - start)) > "$runs_dir/$name/$name/wall_seconds.txt"
     learned=$(grep -ho '"learned_name":"[^"]*"' "$runs_dir/$name/$name/summary.json" 2>/dev/null | grep -v '""' | head -1 |
               sed 's/^.*:"\(.*\)"$/learned as \1/' || true)
+    [ -t 2 ] && printf '\r\033[K' >&2
     nudge_log "[$i/${#names[@]}] $name: $(grep -h "ended:" "$runs_dir/$name/supervisor.log" | sed 's/^.*ended: //') ${learned:-nothing learned} ($(($(date +%s) - start)) s, exit $status)"
   done
 fi
@@ -67,3 +69,4 @@ if [ $score = 1 ]; then
   fi
   "$NUDGE_BUILD_DIR/bin/nudge-exp-learning" --runs "$runs_dir" --scenes "$scenes_dir" --test-images "$test_images"
 fi
+nudge_summary learning.sh 0 "$(ls -d "$runs_dir"/objects/*/ 2>/dev/null | wc -l) objects in $runs_dir/objects"

@@ -48,6 +48,7 @@ echo "soak: $label, $seconds s, files in $out" >&2
 unshare -n bash -s "$bin" "$here" "$out" "$seconds" "$slowest" "$queue" "$label" "$warmup" <<'INNER'
 set -euo pipefail
 bin=$1; here=$2; out=$3; seconds=$4; slowest=$5; queue=$6; label=$7; warmup=$8
+source "$here/scripts/lib.sh"  # nudge_progress
 ip link set lo up multicast on
 ip route add 224.0.0.0/4 dev lo
 url="udpm://239.255.76.67:7667?ttl=0&recv_buf_size=16777216"
@@ -89,6 +90,16 @@ start world "$bin/nudge-world" "${common[@]}" --scene "$scene" --realtime-factor
 sleep 1
 pid_list=$(IFS=,; echo "${names[*]}")
 "$bin/nudge-exp-soak" record --lcm-url "$url" --seconds "$seconds" --warmup "$warmup" --pids "$pid_list" --label "$label" \
-  --out "$out/run.json" --csv "$out/rss.csv" 2>"$out/recorder.log"
+  --out "$out/run.json" --csv "$out/rss.csv" 2>"$out/recorder.log" &
+recorder=$!
+# How far the recording is, every 30 s (its log is a file: the recorder draws no status there).
+steps=$(((seconds + 29) / 30)) step=0 recording_start=$SECONDS
+while kill -0 "$recorder" 2>/dev/null; do
+  step=$((step + 1))
+  [ "$step" -le "$steps" ] && nudge_progress "$step" "$steps" "$recording_start" "recording, $((SECONDS - recording_start)) s of $seconds"
+  timeout 30 tail --pid="$recorder" -f /dev/null || true
+done
+[ -t 2 ] && printf '\r\033[K' >&2
+wait "$recorder"
 INNER
-echo "soak: wrote $out/run.json" >&2
+echo "soak: done in $SECONDS s — $label, $(tail -1 "$out/recorder.log" | sed 's/^.* — //'); wrote $out/run.json" >&2

@@ -105,10 +105,17 @@ if [ $# -eq 0 ]; then
     "$NUDGE_ROOT/config/calibration_sim.yaml" "$NUDGE_ROOT/config/workspace.yaml" "$out/runs" "$run" || status=$?
   dir="$out/runs/$run"
   if [ -f "$dir/summary.json" ]; then
-    nudge_log "run $run: $(grep -o '"segmented":[0-9]*' "$dir/summary.json" | head -1 | cut -d: -f2) objects segmented in $(grep -o '"attempts":[0-9]*' "$dir/summary.json" | head -1 | cut -d: -f2) nudges in $((SECONDS - loop_start)) s"
     nudge_log "files: $dir/ (LCM log $run.lcmlog, summary.json, attempt_NN/ with before/after stills, mask, cutout, workspace.png, stages/, views/; objects/: what was learned)"
-    "$NUDGE_BUILD_DIR/bin/nudge-report" "$dir" --scene "$scene" >/dev/null && nudge_log "report: $dir/report.html (opens in a browser, docs/operator.md)"
-    nudge_log "replay the decisions: build/bin/nudge-supervisor --lcm-in 'file://$dir/$run.lcmlog?speed=0' --lcm-out 'file:///tmp/replay.lcmlog?mode=w' --calibration config/calibration_sim.yaml --first-seq $(grep -o '"first_command_seq":[0-9]*' "$dir/summary.json" | cut -d: -f2)"
+    report="(no report)"
+    "$NUDGE_BUILD_DIR/bin/nudge-report" "$dir" --scene "$scene" >/dev/null && report="report $dir/report.html"
+    nudge_log "replay the decisions: build/bin/nudge-supervisor --lcm-in 'file://$dir/$run.lcmlog?speed=0' --lcm-out 'file:///tmp/replay.lcmlog?mode=w' --calibration config/calibration_sim.yaml --first-seq $(nudge_summary_field "$dir/summary.json" first_command_seq)"
+    # The one-line summary, last: what the run did and where it is.
+    learned=
+    [ "$NUDGE_LOOP_LEARN" = 1 ] && learned=", $(nudge_summary_field "$dir/summary.json" learned 0) learned"
+    nudge_summary demo "$loop_start" "$(nudge_summary_field "$dir/summary.json" segmented 0) objects segmented$learned" \
+      "in $(nudge_summary_field "$dir/summary.json" attempts 0) nudges (exit $status); run folder $dir, $report"
+  else
+    nudge_summary demo "$loop_start" "no run summary (exit $status): the services' logs are in $dir/services/"
   fi
   exit $status
 fi
@@ -137,10 +144,11 @@ else
             "$NUDGE_ROOT/config/calibration_sim.yaml" "$NUDGE_ROOT/config/workspace.yaml")
   drawn="detections drawn in out/demo/ (true axes dashed white)"
 fi
+pipeline_start=$SECONDS
 if nudge_in_private_network bash -c '"$@"' demo "${pipeline[@]}"; then
-  nudge_log "done: $drawn, LCM log $log ($(du -h "$log" | cut -f1))"
   nudge_log "replay it with: scripts/replay.sh $log"
+  nudge_summary demo "$pipeline_start" "$drawn, LCM log $log ($(du -h "$log" | cut -f1))"
 else
-  nudge_log "the pipeline did not deliver lines for every frame (logs in out/demo/)"
+  nudge_summary demo "$pipeline_start" "the pipeline did not deliver lines for every frame (logs in out/demo/)"
   exit 1
 fi

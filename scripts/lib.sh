@@ -64,6 +64,22 @@ nudge_progress() {
   else printf '[%d/%d] %s%s\n' "$k" "$n" "$item" "$left" >&2; fi
 }
 
+# The one-line summary at the end of a job started at START ($SECONDS), on stderr, as
+# nudge::Progress ends its jobs: "JOB: done in 1 m 12 s — SUMMARY".
+nudge_summary() {
+  local job=$1 start=$2 took=$((SECONDS - $2))
+  shift 2
+  if [ $took -ge 60 ]; then took="$((took / 60)) m $(printf %02d $((took % 60))) s"; else took="$took s"; fi
+  printf '%s: done in %s — %s\n' "$job" "$took" "$*" >&2
+}
+
+# A field of a run's summary.json (a number at its top level, the first of that name), or $3.
+nudge_summary_field() {
+  local value
+  value=$(grep -o "\"$2\":[0-9]*" "$1" 2>/dev/null | head -1 | cut -d: -f2)
+  echo "${value:-$3}"
+}
+
 # Reads cmake --build's output; on a terminal shows its percentage and the time left as one line.
 nudge_build_progress() {
   local start=$1 line pct
