@@ -165,7 +165,9 @@ void write_run_log(const std::string& path) {
   seg.mask = nudge::bus::to_message(mask, nudge::image_t::FORMAT_PNG, seg.utime, 0, "right");
   seg.mask_pixels = cv::countNonZero(mask);
   log.write(kT0 + 2600000, channel::SEGMENTATION, seg);
-  log.write(kT0 + 3800000, channel::SUPERVISOR_STATE, supervisor(kT0 + 3800000, S::STATE_DONE, "DONE", 1, "nothing left to nudge"));
+  nudge::supervisor_state_t done = supervisor(kT0 + 3800000, S::STATE_DONE, "DONE", 1, "nothing left to nudge");
+  done.segmented = 1;  // the attempt's segmentation above
+  log.write(kT0 + 3800000, channel::SUPERVISOR_STATE, done);
   log.save(path);
 }
 
@@ -279,6 +281,9 @@ TEST(ViewerPage, ShowsAReplayedRunAndPausesAndStepsIt) {
   EXPECT_EQ(count(dom, "<tr class=\"dead\" data-service=\"tracker\">"), 1) << "silent since 1 s of a 3.9 s log";
   EXPECT_EQ(count(dom, "class=\"mask\""), 1);
   EXPECT_NE(dom.find("replay: finished"), std::string::npos);
+  EXPECT_NE(dom.find("segmented 1"), std::string::npos) << "the supervisor's counts under its state";
+  // The viewer's own heartbeat is live, judged on the wall clock (not at the log's position).
+  EXPECT_EQ(count(dom, "<tr class=\"alive\" data-service=\"viewer/viewer\">"), 1) << dom;
 
   const std::string screenshot = dir + "/viewer_replay.png";
   chromium_dom(url, dir, screenshot);
