@@ -155,7 +155,7 @@ nudge_run_loop() {
   [ -n "${NUDGE_LOOP_ARM_WATCHDOG:-}" ] && arm_watchdog=", \"--supervisor-timeout\", \"$NUDGE_LOOP_ARM_WATCHDOG\""
   local viewer=
   [ -n "${NUDGE_VIEWER:-}" ] && viewer=",
-    {\"name\": \"viewer\", \"command\": [\"$bin/nudge-viewer\", \"--port\", \"$NUDGE_VIEWER\"]}"
+    {\"name\": \"viewer\", \"command\": [\"$bin/nudge-viewer\", \"--port\", \"$NUDGE_VIEWER\", \"--calibration\", \"$calibration\"]}"
   cat >"$logs/launch.json" <<EOF
 {"lcm_url": "$url", "log_dir": "$logs", "backoff": {"initial_s": 1, "max_s": 10},
  "processes": [

@@ -11,11 +11,16 @@
 //       GET /api/mask/I       the I-th segmentation mask (PNG)
 // It also shows the processes nudge-launch runs (PROCESS_STATUS).
 //       POST /api/replay?command=play|pause|step|speed[&speed=X]
+// Eigen (through the supervisor's scene geometry) before httplib.h, whose macros break Eigen's
+// headers when they come after it.
+#include "nudge/supervisor/scene.hpp"
+
 #include <httplib.h>
 
 #include <algorithm>
 #include <cctype>
 #include <mutex>
+#include <optional>
 #include <thread>
 #include <vector>
 
@@ -157,15 +162,20 @@ void subscribe_camera(bus::Service& service, viewer::ViewModel& model, const std
                           });
 }
 
-void subscribe_robot(bus::Service& service, viewer::ViewModel& model) {
+// `scene` (--calibration): the candidates are drawn in the arm's world frame, as the supervisor
+// converts them, so that the planned push (world frame) goes through its target's dot.
+void subscribe_robot(bus::Service& service, viewer::ViewModel& model,
+                     const std::optional<supervisor::SceneGeometry>& scene) {
   auto& subs = service.subscriptions();
-  subs.subscribe<candidates_t>(channel::CANDIDATES, [&model](const candidates_t& msg, const std::string&) {
+  subs.subscribe<candidates_t>(channel::CANDIDATES, [&model, &scene](const candidates_t& msg, const std::string&) {
     std::vector<viewer::Candidate> candidates(msg.num_candidates);
     for (int i = 0; i < msg.num_candidates; ++i) {
-      std::copy_n(msg.position[i].begin(), 3, candidates[i].position);
+      Eigen::Vector3d p(msg.position[i][0], msg.position[i][1], msg.position[i][2]);
+      if (scene) p = scene->table_to_world(p);
+      std::copy_n(p.data(), 3, candidates[i].position);
       candidates[i].cluster_size = msg.cluster_size[i];
     }
-    model.set_candidates(std::move(candidates), msg.utime);
+    model.set_candidates(std::move(candidates), msg.utime, scene.has_value());
   });
   subs.subscribe<arm_command_t>(channel::ARM_COMMAND, [&model](const arm_command_t& msg, const std::string&) {
     if (msg.command != arm_command_t::COMMAND_NUDGE) return;
@@ -284,6 +294,7 @@ int main(int argc, char** argv) {
   return bus::guarded_main("viewer", [&] {
     bus::Service service("viewer", "What the robot sees and thinks, in a browser (docs/operator.md).");
     std::string cameras = std::string(channel::CAMERA_LEFT) + "," + channel::CAMERA_RIGHT, bind = "127.0.0.1";
+    std::string calibration;
     int port = 8088, jpeg_quality = 80;
     double dead_after_s = 2.5;
     auto& f = service.flags();
@@ -292,12 +303,19 @@ int main(int argc, char** argv) {
     f.add_string("bind", &bind, "address to serve on (127.0.0.1: this machine only)");
     f.add_int("jpeg-quality", &jpeg_quality, "JPEG quality of the frames sent to the page, 1-100");
     f.add_double("dead-after", &dead_after_s, "a service silent for longer than this many seconds is shown dead");
+    f.add_string("calibration", &calibration,
+                 "the supervisor's calibration file: candidates drawn in the arm's frame, as the push (default: "
+                 "the triangulation's table frame)");
     if (!service.parse(argc, argv)) return 0;
     if (port < 0 || port > 65535) throw FlagError("--port must be in 0..65535");
     if (jpeg_quality < 1 || jpeg_quality > 100) throw FlagError("--jpeg-quality must be in 1..100");
     if (!(dead_after_s > 0)) throw FlagError("--dead-after must be > 0 seconds");
     const std::vector<std::string> camera_channels = split_list(cameras);
     if (camera_channels.empty()) throw FlagError("--cameras names no channel");
+
+    // A file that cannot be read is named (SceneGeometry::load) before anything is served.
+    std::optional<supervisor::SceneGeometry> scene;
+    if (!calibration.empty()) scene = supervisor::SceneGeometry::load(calibration);
 
     viewer::ViewModel model(dead_after_s, jpeg_quality);
     CommandQueue commands;
@@ -310,7 +328,7 @@ int main(int argc, char** argv) {
 
     service.start();
     for (const auto& c : camera_channels) subscribe_camera(service, model, c);
-    subscribe_robot(service, model);
+    subscribe_robot(service, model, scene);
     subscribe_health(service, model);
     const int code = service.run([&] {
       for (const replay_command_t& command : commands.take()) service.publish(channel::REPLAY_COMMAND, command);

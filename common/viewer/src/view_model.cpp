@@ -96,10 +96,11 @@ void ViewModel::set_track(const std::string& name, const TrackOverlay& track) {
   cam.has_track = true;
 }
 
-void ViewModel::set_candidates(std::vector<Candidate> candidates, int64_t utime) {
+void ViewModel::set_candidates(std::vector<Candidate> candidates, int64_t utime, bool in_world_frame) {
   std::lock_guard<std::mutex> lock(mutex_);
   candidates_ = std::move(candidates);
   candidates_utime_ = utime;
+  candidates_in_world_ = in_world_frame;
 }
 
 void ViewModel::set_push(const PlannedPush& push) {
@@ -175,7 +176,10 @@ json ViewModel::to_json(int64_t now_wall) const {
   }
   out["cameras"] = cameras;
 
-  json table = {{"candidates", json::array()}, {"candidates_utime", candidates_utime_}, {"push", nullptr}};
+  json table = {{"candidates", json::array()},
+                {"candidates_utime", candidates_utime_},
+                {"candidates_frame", candidates_in_world_ ? "world" : "table"},
+                {"push", nullptr}};
   for (const Candidate& c : candidates_)
     table["candidates"].push_back({{"position", vec3(c.position)}, {"cluster_size", c.cluster_size}});
   if (has_push_)

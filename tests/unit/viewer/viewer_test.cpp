@@ -220,6 +220,7 @@ TEST(ViewModel, JsonCarriesOverlaysTableTimelineMasksAndHealth) {
   EXPECT_EQ(j["cameras"]["right"]["lines"][0]["x1"], 10);
   EXPECT_EQ(j["cameras"]["right"]["track"]["box"][2][1], 7);
   EXPECT_EQ(j["table"]["candidates"][0]["cluster_size"], 4);
+  EXPECT_EQ(j["table"]["candidates_frame"], "table") << "as the triangulation sends them";
   EXPECT_EQ(j["table"]["push"]["target"][1], 0.1);
   EXPECT_EQ(j["supervisor"]["current"]["state"], "NUDGE");
   EXPECT_EQ(j["segmentations"][0]["url"], "/api/mask/0");
@@ -231,6 +232,19 @@ TEST(ViewModel, JsonCarriesOverlaysTableTimelineMasksAndHealth) {
   EXPECT_TRUE(j["replay"].is_null());
   EXPECT_EQ(j["processes"][0]["state"], "restarting");
   EXPECT_EQ(j["processes"][0]["restarts"], 2);
+}
+
+TEST(ViewModel, SaysWhichFrameTheCandidatesAreIn) {
+  ViewModel model;
+  Candidate c;
+  c.position[1] = -0.02;
+  model.set_candidates({c}, 9, true);
+  auto j = model.to_json(kSecond);
+  EXPECT_EQ(j["table"]["candidates_frame"], "world");
+  EXPECT_EQ(j["table"]["candidates"][0]["position"][1], -0.02);
+  model.set_candidates({c}, 10);
+  j = model.to_json(kSecond);
+  EXPECT_EQ(j["table"]["candidates_frame"], "table");
 }
 
 TEST(ViewModel, OnAReplayTheLogsHeartbeatsGoByLogTimeAndLiveOnesByArrival) {

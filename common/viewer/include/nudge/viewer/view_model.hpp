@@ -35,7 +35,7 @@ struct TrackOverlay {
 };
 
 struct Candidate {
-  double position[3] = {0, 0, 0};  // metres, as the triangulation sends them (table frame)
+  double position[3] = {0, 0, 0};  // metres: the triangulation's table frame, or the arm's world frame
   int cluster_size = 0;
 };
 
@@ -91,7 +91,9 @@ class ViewModel {
 
   void set_lines(const std::string& camera, std::vector<ImageLine> lines, int64_t utime);
   void set_track(const std::string& camera, const TrackOverlay& track);
-  void set_candidates(std::vector<Candidate> candidates, int64_t utime);
+  // `in_world_frame`: converted to the arm's world frame (the planned push's), not the
+  // triangulation's table frame they are sent in.
+  void set_candidates(std::vector<Candidate> candidates, int64_t utime, bool in_world_frame = false);
   void set_push(const PlannedPush& push);
   void observe_state(const StateEntry& state);
   // sender_utime: the heartbeat's own stamp; receive_utime: when it arrived (wall clock). Live,
@@ -125,6 +127,7 @@ class ViewModel {
   std::map<std::string, Camera> cameras_;
   std::vector<Candidate> candidates_;
   int64_t candidates_utime_ = 0;
+  bool candidates_in_world_ = false;
   PlannedPush push_;
   bool has_push_ = false;
   StateTimeline timeline_;
