@@ -249,6 +249,8 @@ TEST_F(SupervisorTest, SegmentsTheObjectThenFindsNothingLeftToNudge) {
   const Eigen::Vector3d rest = object + 0.03 * nudges[0].direction;
   play_nudge(s, nudges[0].seq, object, rest);
   EXPECT_EQ(s.state(), sv::State::Track);
+  EXPECT_EQ(s.report().failed_attempts, 0) << "the attempt under way has not failed";
+  EXPECT_EQ(s.report().segmented, 0);
   settle_with_axes(s, {rest + Eigen::Vector3d(0.002, -0.001, 0)});
   // The arm parks (COMMAND_HOME) before the after still, so that it is where it was for the first.
   ASSERT_EQ(s.state(), sv::State::Home) << s.report().reason;
@@ -289,6 +291,8 @@ TEST_F(SupervisorTest, SegmentsTheObjectThenFindsNothingLeftToNudge) {
   EXPECT_EQ(s.state(), sv::State::Done);
   EXPECT_EQ(s.summary().segmented, 1);
   EXPECT_EQ(s.summary().attempts, 1);
+  EXPECT_EQ(s.report().segmented, 1);
+  EXPECT_EQ(s.report().failed_attempts, 0);
   ASSERT_EQ(outputs_of<sv::Finished>(out).size(), 1u);
   EXPECT_NE(s.summary().end_reason.find("no nudgeable candidate left"), std::string::npos) << s.summary().end_reason;
 }
@@ -366,6 +370,7 @@ TEST_F(SupervisorTest, ATippedObjectIsReportedNotSegmented) {
   ASSERT_EQ(ended.size(), 1u);
   EXPECT_EQ(ended[0].attempt->outcome, sv::Outcome::Tipped);
   EXPECT_TRUE(ended[0].attempt->after.empty());  // no still taken, nothing segmented
+  EXPECT_EQ(s.report().failed_attempts, 1) << "an ended attempt that segmented nothing";
   // Lying down it has no upright axis at all: also reported.
   answer_survey(s, {Eigen::Vector3d(0.30, 0.10, 0)});
   s.on_right_still(draw_scene(scene_, {1280, 960}, {Eigen::Vector3d(0.30, 0.10, 0)}), now_, now_);
@@ -375,6 +380,7 @@ TEST_F(SupervisorTest, ATippedObjectIsReportedNotSegmented) {
   ended = outputs_of<sv::AttemptEnded>(s.take_outputs());
   ASSERT_EQ(ended.size(), 1u);
   EXPECT_EQ(ended[0].attempt->outcome, sv::Outcome::Tipped);
+  EXPECT_EQ(s.report().failed_attempts, 2);
 }
 
 // A pipeline that lags (docs/reliability.md, "Soak": AXES about a second behind under load)

@@ -102,7 +102,8 @@ void Supervisor::enter(State state, int64_t now, const std::string& reason) {
   report_.state = state;
   report_.reason = reason;
   report_.segmented = summary_.segmented;
-  report_.failed_attempts = summary_.attempts - summary_.segmented;
+  // The attempt under way has not failed (yet): only ended ones count.
+  report_.failed_attempts = summary_.attempts - (attempt_ ? 1 : 0) - summary_.segmented;
   outputs_.push_back(report_);
 }
 
