@@ -140,6 +140,48 @@ std::string iou_table(const std::vector<SimulationScore>& scores) {
   return out.str();
 }
 
+// Seconds spent in each state over the run (from each transition to the next; the last state's
+// time is unknown), in the order the states first came, with how often each was entered.
+std::string state_times_table(const std::vector<StateEntry>& states) {
+  std::vector<std::string> order;
+  std::map<std::string, std::pair<double, int>> time_and_entries;
+  for (size_t i = 0; i < states.size(); ++i) {
+    auto [it, added] = time_and_entries.try_emplace(states[i].state, 0.0, 0);
+    if (added) order.push_back(states[i].state);
+    ++it->second.second;
+    if (i + 1 < states.size()) it->second.first += (states[i + 1].utime - states[i].utime) * 1e-6;
+  }
+  std::ostringstream out;
+  out << "<h2>time per state</h2><table id=\"state_times\"><tr><th>state</th><th>seconds</th><th>entered</th></tr>";
+  for (const std::string& state : order)
+    out << "<tr><td>" << escape(state) << "</td><td>" << fixed(time_and_entries[state].first, 1) << "</td><td>"
+        << time_and_entries[state].second << "</td></tr>";
+  out << "</table>";
+  return out.str();
+}
+
+// The supervisor's transitions; a run of one state within an attempt (the twelve views' ROTATE)
+// is one row: its first and last reasons and how many transitions it was.
+std::string timeline_table(const std::vector<StateEntry>& states) {
+  std::ostringstream out;
+  out << "<h2>timeline</h2><table id=\"timeline\"><tr><th>t (s)</th><th>state</th><th>attempt</th><th>reason</th></tr>";
+  for (size_t i = 0; i < states.size();) {
+    size_t last = i;
+    while (last + 1 < states.size() && states[last + 1].state == states[i].state &&
+           states[last + 1].attempt == states[i].attempt)
+      ++last;
+    const StateEntry& s = states[i];
+    out << "<tr><td>" << fixed((s.utime - states.front().utime) * 1e-6, 1) << "</td><td>" << escape(s.state)
+        << "</td><td>" << s.attempt << "</td><td>" << escape(s.reason);
+    if (last > i) out << " … " << escape(states[last].reason) << " (" << last - i + 1 << " transitions)";
+    out << "</td></tr>";
+    i = last + 1;
+  }
+  if (states.empty()) out << "<tr><td colspan=\"4\">no SUPERVISOR_STATE in the run's log</td></tr>";
+  out << "</table>";
+  return out.str();
+}
+
 std::string attempt_section(const fs::path& run_dir, const json& attempt, const SimulationScore* score) {
   const int n = attempt.value("attempt", 0);
   std::ostringstream dir_name;
@@ -178,9 +220,19 @@ std::string attempt_section(const fs::path& run_dir, const json& attempt, const 
       others.push_back(rel);
     }
   std::sort(others.begin(), others.end());
-  if (!others.empty()) {
+  // The views the learner was given (thesis ch. 7: twelve, a turn of the wrist apart) first.
+  const auto views_end = std::stable_partition(others.begin(), others.end(), [&](const std::string& rel) {
+    return rel.rfind(dir + "/views/", 0) == 0;
+  });
+  const std::vector<std::string> views(others.begin(), views_end), rest(views_end, others.end());
+  if (!views.empty()) {
+    out << "<h3>learned views (" << views.size() << ")</h3><div class=\"row\">";
+    for (const auto& v : views) out << picture(run_dir, v, v.substr(dir.size() + 1));
+    out << "</div>";
+  }
+  if (!rest.empty()) {
     out << "<h3>more pictures</h3><div class=\"row\">";
-    for (const auto& o : others) out << picture(run_dir, o, o.substr(dir.size() + 1));
+    for (const auto& o : rest) out << picture(run_dir, o, o.substr(dir.size() + 1));
     out << "</div>";
   }
   const std::string plot = tracking_plot(attempt);
@@ -210,12 +262,8 @@ std::string render_run_report(const std::string& run_dir_name, const std::vector
   if (summary.contains("iou")) out << "<tr><th>IoU (simulation)</th><td>" << text_of(summary, "iou") << "</td></tr>";
   out << "</table>";
   if (!scores.empty()) out << iou_table(scores);
-  out << "<h2>timeline</h2><table id=\"timeline\"><tr><th>t (s)</th><th>state</th><th>attempt</th><th>reason</th></tr>";
-  for (const StateEntry& s : states)
-    out << "<tr><td>" << fixed((s.utime - states.front().utime) * 1e-6, 1) << "</td><td>" << escape(s.state) << "</td><td>"
-        << s.attempt << "</td><td>" << escape(s.reason) << "</td></tr>";
-  if (states.empty()) out << "<tr><td colspan=\"4\">no SUPERVISOR_STATE in the run's log</td></tr>";
-  out << "</table>";
+  if (!states.empty()) out << state_times_table(states);
+  out << timeline_table(states);
   if (summary.contains("attempt_list") && summary["attempt_list"].is_array())
     for (const auto& attempt : summary["attempt_list"])
       out << attempt_section(run_dir, attempt, score_of(scores, attempt.value("attempt", 0)));

@@ -64,6 +64,10 @@ TEST(RunReport, ShowsFiguresTimelineAndEachAttemptsPicturesByRelativePath) {
   EXPECT_NE(html.find("no candidate &lt;left&gt;"), std::string::npos) << "text is escaped";
   EXPECT_EQ(count(html, "<tr><td>[0-9.]+</td><td>(FIND_CANDIDATES|NUDGE|DONE)</td>"), 3);
   EXPECT_NE(html.find("<td>2.5</td><td>NUDGE</td>"), std::string::npos) << "times from the first state";
+  EXPECT_NE(html.find("<tr><td>FIND_CANDIDATES</td><td>2.5</td><td>1</td></tr>"), std::string::npos)
+      << "time per state: until the next transition";
+  EXPECT_NE(html.find("<tr><td>NUDGE</td><td>56.5</td><td>1</td></tr>"), std::string::npos);
+  EXPECT_NE(html.find("<h3>learned views (1)</h3>"), std::string::npos);
   EXPECT_EQ(count(html, "<section class=\"attempt\">"), 2);
   EXPECT_NE(html.find("target (301, -20) mm, at rest (304, -44) mm"), std::string::npos);
   EXPECT_NE(html.find("<img src=\"attempt_01/stages/c_difference.png\""), std::string::npos);
@@ -72,6 +76,21 @@ TEST(RunReport, ShowsFiguresTimelineAndEachAttemptsPicturesByRelativePath) {
   EXPECT_EQ(count(html, "<img src=\"attempt_02/"), 1) << "only the pictures that exist";
   EXPECT_EQ(count(html, "<polyline"), 1) << "one tracker traced";
   EXPECT_EQ(html.find(dir), std::string::npos) << "no absolute paths: the folder can move";
+}
+
+TEST(RunReport, ARunOfOneStateIsOneTimelineRowAndItsTimeAddsUp) {
+  const std::string dir = make_run("report_rotate");
+  std::vector<StateEntry> s(5);
+  s[0].state = "GRASP", s[0].utime = 0, s[0].attempt = 1;
+  s[1].state = "ROTATE", s[1].utime = 1000000, s[1].attempt = 1, s[1].reason = "view 1 of 12";
+  s[2].state = "ROTATE", s[2].utime = 2000000, s[2].attempt = 1, s[2].reason = "turning the wrist 30 deg";
+  s[3].state = "ROTATE", s[3].utime = 3500000, s[3].attempt = 1, s[3].reason = "view 2 of 12";
+  s[4].state = "LEARN", s[4].utime = 4000000, s[4].attempt = 1;
+  const std::string html = render_run_report(dir, s);
+  EXPECT_EQ(count(html, "<td>ROTATE</td><td>1</td>"), 1) << html;
+  EXPECT_NE(html.find("view 1 of 12 … view 2 of 12 (3 transitions)"), std::string::npos);
+  EXPECT_NE(html.find("<tr><td>ROTATE</td><td>3.0</td><td>3</td></tr>"), std::string::npos);
+  EXPECT_NE(html.find("<tr><td>LEARN</td><td>0.0</td><td>1</td></tr>"), std::string::npos) << "the last: no time yet";
 }
 
 TEST(RunReport, ShowsTheIoUInSimulationPerObjectAndPerAttempt) {
