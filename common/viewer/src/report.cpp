@@ -140,6 +140,15 @@ std::string iou_table(const std::vector<SimulationScore>& scores) {
   return out.str();
 }
 
+// "segmented 2, tipped or lost 1" from summary.json's {"segmented": 2, "tipped or lost": 1}.
+std::string outcomes_text(const json& summary) {
+  if (!summary.contains("outcomes") || !summary["outcomes"].is_object()) return text_of(summary, "outcomes");
+  std::ostringstream out;
+  for (const auto& [outcome, count] : summary["outcomes"].items())
+    out << (out.tellp() > 0 ? ", " : "") << escape(outcome) << " " << (count.is_number() ? count.dump() : "?");
+  return out.str();
+}
+
 // Seconds spent in each state over the run (from each transition to the next; the last state's
 // time is unknown), in the order the states first came, with how often each was entered.
 std::string state_times_table(const std::vector<StateEntry>& states) {
@@ -189,7 +198,7 @@ std::string attempt_section(const fs::path& run_dir, const json& attempt, const 
   const std::string dir = dir_name.str();
   std::ostringstream out;
   const double started = attempt.value("started_s", 0.0), ended = attempt.value("ended_s", 0.0);
-  out << "<section class=\"attempt\"><h2>attempt " << n << ": " << text_of(attempt, "outcome") << "</h2><p>"
+  out << "<section class=\"attempt\" id=\"" << dir << "\"><h2>attempt " << n << ": " << text_of(attempt, "outcome") << "</h2><p>"
       << text_of(attempt, "reason") << " · target " << millimetres(attempt, "target") << ", at rest " << millimetres(attempt, "rest") << " · " << fixed(ended - started, 1)
       << " s (from " << fixed(started, 1) << " s) · mask " << number(attempt, "mask_pixels") << " px · motion frames "
       << number(attempt, "motion_frames");
@@ -258,7 +267,9 @@ std::string render_run_report(const std::string& run_dir_name, const std::vector
   out << "<table id=\"figures\"><tr><th>objects segmented</th><td>" << number(summary, "segmented")
       << "</td></tr><tr><th>nudges (attempts)</th><td>" << number(summary, "attempts") << "</td></tr><tr><th>surveys</th><td>"
       << number(summary, "surveys") << "</td></tr><tr><th>end</th><td>" << text_of(summary, "end_reason")
-      << "</td></tr><tr><th>outcomes</th><td>" << text_of(summary, "outcomes") << "</td></tr>";
+      << "</td></tr><tr><th>outcomes</th><td>" << outcomes_text(summary) << "</td></tr>";
+  if (summary.contains("learned"))
+    out << "<tr><th>objects learned</th><td>" << number(summary, "learned") << "</td></tr>";
   if (summary.contains("iou")) out << "<tr><th>IoU (simulation)</th><td>" << text_of(summary, "iou") << "</td></tr>";
   out << "</table>";
   if (!scores.empty()) out << iou_table(scores);

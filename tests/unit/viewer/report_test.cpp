@@ -68,7 +68,9 @@ TEST(RunReport, ShowsFiguresTimelineAndEachAttemptsPicturesByRelativePath) {
       << "time per state: until the next transition";
   EXPECT_NE(html.find("<tr><td>NUDGE</td><td>56.5</td><td>1</td></tr>"), std::string::npos);
   EXPECT_NE(html.find("<h3>learned views (1)</h3>"), std::string::npos);
-  EXPECT_EQ(count(html, "<section class=\"attempt\">"), 2);
+  EXPECT_EQ(count(html, "<section class=\"attempt\" id=\"attempt_0[12]\">"), 2) << "linkable: report.html#attempt_01";
+  EXPECT_NE(html.find("<td>segmented 1, tipped or lost 1</td>"), std::string::npos) << "the outcomes, readable";
+  EXPECT_EQ(html.find("objects learned"), std::string::npos) << "a run without learning has no such figure";
   EXPECT_NE(html.find("target (301, -20) mm, at rest (304, -44) mm"), std::string::npos);
   EXPECT_NE(html.find("<img src=\"attempt_01/stages/c_difference.png\""), std::string::npos);
   EXPECT_NE(html.find("<img src=\"attempt_01/views/view_00.png\""), std::string::npos) << "learned views shown";
@@ -91,6 +93,13 @@ TEST(RunReport, ARunOfOneStateIsOneTimelineRowAndItsTimeAddsUp) {
   EXPECT_NE(html.find("view 1 of 12 … view 2 of 12 (3 transitions)"), std::string::npos);
   EXPECT_NE(html.find("<tr><td>ROTATE</td><td>3.0</td><td>3</td></tr>"), std::string::npos);
   EXPECT_NE(html.find("<tr><td>LEARN</td><td>0.0</td><td>1</td></tr>"), std::string::npos) << "the last: no time yet";
+}
+
+TEST(RunReport, ARunThatLearnedSaysHowManyObjects) {
+  const std::string dir = make_run("report_learned");
+  std::ofstream(dir + "/summary.json") << R"({"run_id": "r2", "attempts": 1, "segmented": 1, "learned": 1,
+    "outcomes": {"segmented": 1}, "attempt_list": []})";
+  EXPECT_NE(render_run_report(dir, states()).find("<tr><th>objects learned</th><td>1</td></tr>"), std::string::npos);
 }
 
 TEST(RunReport, ShowsTheIoUInSimulationPerObjectAndPerAttempt) {
@@ -134,7 +143,7 @@ TEST(RunReport, OpensInHeadlessChromiumWithNoServer) {
   ASSERT_EQ(std::system((base + "--screenshot=" + shot + " file://" + dir + "/report.html > /dev/null 2>&1").c_str()), 0);
   std::ifstream in(dom);
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  EXPECT_EQ(count(text, "<section class=\"attempt\">"), 2);
+  EXPECT_EQ(count(text, "<section class=\"attempt\" id=\"attempt_0[12]\">"), 2);
   EXPECT_TRUE(fs::exists(shot) && fs::file_size(shot) > 5000);
   std::cout << "screenshot of the report: " << shot << "\n";
 }
