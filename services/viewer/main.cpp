@@ -277,7 +277,11 @@ void add_routes(httplib::Server& server, viewer::ViewModel& model, CommandQueue&
     }
     res.set_content(std::string(png.begin(), png.end()), "image/png");
   });
-  server.Post("/api/replay", [&commands](const httplib::Request& req, httplib::Response& res) {
+  // With a content reader: a POST with no body and no Content-Length (`curl -X POST URL`) is
+  // answered at once; httplib would otherwise wait for the client to close before calling us.
+  server.Post("/api/replay", [&commands](const httplib::Request& req, httplib::Response& res,
+                                         const httplib::ContentReader& content_reader) {
+    if (req.has_header("Content-Length")) content_reader([](const char*, size_t) { return true; });  // ignored
     try {
       commands.push(replay_command_from_request(req));
       res.set_content("ok\n", "text/plain");

@@ -122,6 +122,8 @@ void ViewModel::observe_heartbeat(Heartbeat heartbeat, int64_t sender_utime, int
   heartbeat.log_time = replaying() && sender_utime >= replay_.start_utime - kMargin &&
                        sender_utime <= replay_.end_utime + kMargin;
   heartbeat.seen_utime = heartbeat.log_time ? sender_utime : receive_utime;
+  // On a replay the log's services and the live ones (this viewer, say) may share a name: a row each.
+  if (replaying() && !heartbeat.log_time) heartbeat.instance += heartbeat.instance.empty() ? "(live)" : " (live)";
   health_.observe(heartbeat);
 }
 

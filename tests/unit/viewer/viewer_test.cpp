@@ -258,11 +258,15 @@ TEST(ViewModel, OnAReplayTheLogsHeartbeatsGoByLogTimeAndLiveOnesByArrival) {
   model.set_replay(replay);
   model.observe_heartbeat(beat("tracker", 0, 0), 140 * kSecond, 8999 * kSecond);  // from the log
   model.observe_heartbeat(beat("viewer", 0, 0), 9000 * kSecond, 9000 * kSecond);  // live
+  model.observe_heartbeat(beat("viewer", 0, 0), 149 * kSecond, 9000 * kSecond);   // the recorded run's viewer
   const auto j = model.to_json(9000 * kSecond);
   EXPECT_EQ(j["mode"], "replay");
-  ASSERT_EQ(j["health"].size(), 2u);
+  ASSERT_EQ(j["health"].size(), 3u) << j["health"].dump();
   EXPECT_EQ(j["health"][0]["name"], "tracker");
   EXPECT_FALSE(j["health"][0]["alive"]) << "10 s of log without a heartbeat";
+  EXPECT_EQ(j["health"][1]["name"], "viewer") << "the log's";
   EXPECT_TRUE(j["health"][1]["alive"]);
+  EXPECT_EQ(j["health"][2]["name"], "viewer/(live)") << "the live one: its own row, not mixed with the log's";
+  EXPECT_TRUE(j["health"][2]["alive"]);
   EXPECT_TRUE(j["replay"]["connected"]);
 }
