@@ -191,6 +191,24 @@ std::string timeline_table(const std::vector<StateEntry>& states) {
   return out.str();
 }
 
+// With learning (thesis ch. 7): what recognition answered before the nudge and what learning did.
+std::string learning_line(const json& attempt) {
+  if (!attempt.contains("learning") || !attempt["learning"].is_object()) return "";
+  const json& l = attempt["learning"];
+  const auto field = [&l](const char* key) {
+    return l.contains(key) && l[key].is_string() ? escape(l[key].get<std::string>()) : std::string();
+  };
+  std::ostringstream out;
+  out << "<p class=\"learning\">recognition: "
+      << (field("recognised").empty() ? "nothing known (" + field("recognition_reason") + ")"
+                                      : "recognised as " + field("recognised"))
+      << " · learning: " << text_of(l, "outcome");
+  if (!field("reason").empty()) out << " (" << field("reason") << ")";
+  if (l.contains("grasp_plan_ms")) out << " · grasp planned in " << number(l, "grasp_plan_ms") << " ms";
+  out << "</p>";
+  return out.str();
+}
+
 std::string attempt_section(const fs::path& run_dir, const json& attempt, const SimulationScore* score) {
   const int n = attempt.value("attempt", 0);
   std::ostringstream dir_name;
@@ -203,7 +221,7 @@ std::string attempt_section(const fs::path& run_dir, const json& attempt, const 
       << " s (from " << fixed(started, 1) << " s) · mask " << number(attempt, "mask_pixels") << " px · motion frames "
       << number(attempt, "motion_frames");
   if (score) out << " · IoU (simulation) " << fixed(score->iou, 3) << " with " << object_label(*score);
-  out << "</p><div class=\"row\">";
+  out << "</p>" << learning_line(attempt) << "<div class=\"row\">";
   out << picture(run_dir, dir + "/before.png", "before") << picture(run_dir, dir + "/after.png", "after")
       << picture(run_dir, dir + "/mask.png", "mask") << picture(run_dir, dir + "/cutout.png", "cut-out")
       << picture(run_dir, dir + "/workspace.png", "the push seen from above (fig. 6.6)") << "</div>";

@@ -95,11 +95,18 @@ TEST(RunReport, ARunOfOneStateIsOneTimelineRowAndItsTimeAddsUp) {
   EXPECT_NE(html.find("<tr><td>LEARN</td><td>0.0</td><td>1</td></tr>"), std::string::npos) << "the last: no time yet";
 }
 
-TEST(RunReport, ARunThatLearnedSaysHowManyObjects) {
+TEST(RunReport, ARunThatLearnedSaysHowManyObjectsAndWhatRecognitionAnswered) {
   const std::string dir = make_run("report_learned");
-  std::ofstream(dir + "/summary.json") << R"({"run_id": "r2", "attempts": 1, "segmented": 1, "learned": 1,
-    "outcomes": {"segmented": 1}, "attempt_list": []})";
-  EXPECT_NE(render_run_report(dir, states()).find("<tr><th>objects learned</th><td>1</td></tr>"), std::string::npos);
+  std::ofstream(dir + "/summary.json") << R"({"run_id": "r2", "attempts": 2, "segmented": 1, "learned": 1,
+    "outcomes": {"segmented": 1, "known": 1}, "attempt_list": [
+      {"attempt": 1, "outcome": "segmented", "learning": {"outcome": "learned", "reason": "learned as 'mug'",
+       "recognised": "", "recognition_reason": "empty database", "grasp_plan_ms": 61.7}},
+      {"attempt": 2, "outcome": "known", "learning": {"outcome": "known", "recognised": "mug"}}]})";
+  const std::string html = render_run_report(dir, states());
+  EXPECT_NE(html.find("<tr><th>objects learned</th><td>1</td></tr>"), std::string::npos);
+  EXPECT_NE(html.find("recognition: nothing known (empty database) · learning: learned (learned as 'mug') · "
+                      "grasp planned in 62 ms"), std::string::npos) << html;
+  EXPECT_NE(html.find("recognition: recognised as mug · learning: known</p>"), std::string::npos);
 }
 
 TEST(RunReport, ShowsTheIoUInSimulationPerObjectAndPerAttempt) {
