@@ -29,6 +29,7 @@
 #include "nudge/bus/image.hpp"
 #include "nudge/candidates_t.hpp"
 #include "nudge/heartbeat_t.hpp"
+#include "nudge/process_status_t.hpp"
 #include "nudge/segmentation_t.hpp"
 #include "nudge/supervisor_state_t.hpp"
 #include "nudge/symmetry_lines_t.hpp"
@@ -171,6 +172,23 @@ void write_run_log(const std::string& path) {
   nudge::supervisor_state_t done = supervisor(kT0 + 3800000, S::STATE_DONE, "DONE", 1, "nothing left to nudge");
   done.segmented = 1;  // the attempt's segmentation above
   log.write(kT0 + 3800000, channel::SUPERVISOR_STATE, done);
+  // nudge-launch's last word: symmetry running, the tracker (silent since 1 s) waiting to restart.
+  nudge::process_status_t processes{};
+  processes.utime = kT0 + 3000000;
+  processes.config = "launch.json";
+  processes.num_processes = 2;
+  processes.processes.resize(2);
+  processes.processes[0].name = "symmetry";
+  processes.processes[0].pid = 1234;
+  processes.processes[0].state = nudge::process_info_t::STATE_RUNNING;
+  processes.processes[0].uptime_s = 3;
+  processes.processes[0].last_exit_code = -1;
+  processes.processes[1].name = "tracker";
+  processes.processes[1].state = nudge::process_info_t::STATE_BACKOFF;
+  processes.processes[1].restarts = 1;
+  processes.processes[1].last_exit_code = 139;
+  processes.processes[1].restart_in_s = 2;
+  log.write(kT0 + 3000000, channel::PROCESS_STATUS, processes);
   log.save(path);
 }
 
@@ -308,6 +326,9 @@ TEST(ViewerPage, ShowsAReplayedRunAndPausesAndStepsIt) {
   EXPECT_EQ(count(dom, "<tr class=\"dead\" data-service=\"tracker\">"), 1) << "silent since 1 s of a 3.9 s log";
   EXPECT_EQ(count(dom, "class=\"mask\""), 1);
   EXPECT_NE(dom.find("replay: finished"), std::string::npos);
+  // nudge-launch's status over LCM, as the viewer shows it.
+  EXPECT_EQ(count(dom, "<tr class=\"alive\" data-process=\"symmetry\">"), 1) << dom;
+  EXPECT_EQ(count(dom, "<tr class=\"dead\" data-process=\"tracker\"><td>tracker</td><td>restarting in 2.0 s</td>"), 1);
   EXPECT_NE(dom.find("segmented 1"), std::string::npos) << "the supervisor's counts under its state";
   // The viewer's own heartbeat is live, judged on the wall clock (not at the log's position).
   EXPECT_EQ(count(dom, "<tr class=\"alive\" data-service=\"viewer/viewer \\(live\\)\">"), 1) << dom;
