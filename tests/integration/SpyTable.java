@@ -3,10 +3,14 @@
 // row per line: the columns' values separated by tabs, after a header line. What lcm-spy draws is
 // read from its Swing table model, not from pixels (no OCR), so the check is what a person sees
 // in the table: each channel and the type lcm-spy decoded it as.
-//   java SpyTable SECONDS CHANNEL,CHANNEL,... [lcm-spy arguments...]
+// With -Dspy.open=CHANNEL it then double-clicks that channel's row, as a person does to see its
+// fields, and prints "VIEWER <title>" for every window then open (lcm-spy opens one per channel).
+//   java [-Dspy.open=CHANNEL] SpyTable SECONDS CHANNEL,CHANNEL,... [lcm-spy arguments...]
 import java.awt.Component;
 import java.awt.Container;
 import java.awt.Frame;
+import java.awt.Rectangle;
+import java.awt.event.MouseEvent;
 import javax.swing.JTable;
 import javax.swing.SwingUtilities;
 import javax.swing.table.TableModel;
@@ -42,7 +46,36 @@ public class SpyTable {
       }
     });
     System.out.flush();
+    final String open = System.getProperty("spy.open");
+    if (open != null) {
+      SwingUtilities.invokeAndWait(() -> doubleClick(found, open));
+      Thread.sleep(1500);  // the viewer window opens and draws the next message's fields
+      SwingUtilities.invokeAndWait(() -> {
+        for (Frame frame : Frame.getFrames()) {
+          if (!frame.isShowing()) continue;
+          // The field view beside the channel table (it opens over it), so that the picture has both.
+          if (frame.getTitle().contains(open)) frame.setLocation(420, 190);
+          System.out.println("VIEWER " + frame.getTitle());
+        }
+      });
+      Thread.sleep(500);
+      System.out.flush();
+    }
     // Leave the window up for the screenshot; the test ends this JVM.
+  }
+
+  // The mouse events of a double click on the row showing `channel` (lcm-spy opens its viewer).
+  static void doubleClick(JTable table, String channel) {
+    for (int row = 0; row < table.getRowCount(); ++row) {
+      if (!channel.equals(String.valueOf(table.getValueAt(row, 0)))) continue;
+      Rectangle cell = table.getCellRect(row, 0, true);
+      int x = cell.x + cell.width / 2, y = cell.y + cell.height / 2;
+      long now = System.currentTimeMillis();
+      for (int id : new int[] {MouseEvent.MOUSE_PRESSED, MouseEvent.MOUSE_RELEASED, MouseEvent.MOUSE_CLICKED})
+        table.dispatchEvent(new MouseEvent(table, id, now, 0, x, y, 2, false, MouseEvent.BUTTON1));
+      return;
+    }
+    System.out.println("NO_ROW " + channel);
   }
 
   static <T> T onSwingThread(java.util.function.Supplier<T> supplier) throws Exception {

@@ -29,7 +29,7 @@ mkdir -p "$(dirname "$shot")"
 url="udpm://239.255.76.67:7667?ttl=0"
 
 # Xvfb picks a free display itself (-displayfd): other X servers on this machine are left alone.
-Xvfb -displayfd 5 -screen 0 1024x640x24 -nolisten tcp 5>"$work/display" 2>"$work/xvfb.log" &
+Xvfb -displayfd 5 -screen 0 1100x800x24 -nolisten tcp 5>"$work/display" 2>"$work/xvfb.log" &
 wait_for 5 "Xvfb started (its display number)" test -s "$work/display" || exit 1
 export DISPLAY=":$(head -1 "$work/display")"
 
@@ -37,18 +37,22 @@ export DISPLAY=":$(head -1 "$work/display")"
 expected="CAMERA_LEFT=image_t CAMERA_RIGHT=image_t SYMMETRY_LEFT=symmetry_lines_t SYMMETRY_RIGHT=symmetry_lines_t"
 expected+=" HEARTBEAT=heartbeat_t REPLAY_STATUS=replay_status_t"
 channels=$(for e in $expected; do printf '%s,' "${e%%=*}"; done)
-CLASSPATH="$work:$classpath" java -Djava.net.preferIPv4Stack=true -ea SpyTable 60 "${channels%,}" --lcm-url "$url" \
+CLASSPATH="$work:$classpath" java -Djava.net.preferIPv4Stack=true -Dspy.open=SYMMETRY_LEFT -ea SpyTable 60 "${channels%,}" --lcm-url "$url" \
   >"$work/spy.out" 2>"$work/spy.err" &
 wait_for 60 "lcm-spy's window (READY or NO_TABLE)" grep -qE '^(READY|NO_TABLE)' "$work/spy.out"
 grep -q '^READY' "$work/spy.out" || { echo "FAILED: lcm-spy's window did not open" >&2; cat "$work/spy.out" "$work/spy.err" >&2; exit 1; }
 "$build/bin/nudge-symmetry" --lcm-url "$url" --inputs CAMERA_LEFT,CAMERA_RIGHT 2>"$work/symmetry.log" &
 sleep 1  # symmetry subscribes before the log plays
-"$build/bin/nudge-replay" "$work/camera.lcmlog" --lcm-url "$url" 2>"$work/replay.log" || { cat "$work/replay.log" >&2; exit 1; }
+"$build/bin/nudge-replay" "$work/camera.lcmlog" --lcm-url "$url" --speed 0.5 2>"$work/replay.log" &
 wait_for 60 "lcm-spy's table (COLUMNS)" grep -q '^COLUMNS' "$work/spy.out"
-sleep 1  # the window repaints its table
+# SpyTable double-clicks SYMMETRY_LEFT while the log still plays: its viewer shows a live message.
+wait_for 20 "lcm-spy's field view of SYMMETRY_LEFT (VIEWER)" grep -q '^VIEWER .*SYMMETRY_LEFT' "$work/spy.out"
+sleep 1  # the windows repaint
 xwd -root -silent | xwdtopnm 2>/dev/null | pnmtopng >"$shot" 2>/dev/null
 cat "$work/spy.out"
 grep -q '^COLUMNS' "$work/spy.out" || { echo "FAILED: lcm-spy's table was not read" >&2; cat "$work/spy.err" >&2; exit 1; }
+grep -q '^VIEWER .*SYMMETRY_LEFT' "$work/spy.out" ||
+  { echo "FAILED: a double click on SYMMETRY_LEFT opened no field view" >&2; cat "$work/spy.err" >&2; exit 1; }
 [ "$(head -c 8 "$shot" | od -An -tx1 | tr -d ' \n')" = 89504e470d0a1a0a ] || { echo "FAILED: no PNG screenshot" >&2; exit 1; }
 # Every channel listed with its nudge type (an unknown fingerprint shows as "?? HEX"), seen and
 # all decoded. LCM's own LCM_SELF_TEST (not a nudge type) is ignored.
