@@ -19,8 +19,11 @@ targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
   for program in "$build"/bin/fuzz_*; do targets+=("${program##*/fuzz_}"); done
 fi
-failed=0
+failed=0 k=0 loop_start=$SECONDS
 for target in "${targets[@]}"; do
+  k=$((k + 1))
+  nudge_progress "$k" "${#targets[@]}" "$loop_start" "fuzz_$target, $seconds s"
+  [ -t 2 ] && printf '\r\033[K' >&2  # the target's result line follows
   corpus=$(mktemp -d)  # new inputs stay out of the committed seeds
   crashes="$NUDGE_ROOT/tests/fuzz/crashes/$target"
   mkdir -p "$crashes"
@@ -37,4 +40,5 @@ for target in "${targets[@]}"; do
   fi
   rm -rf "$corpus"
 done
+nudge_summary fuzz.sh 0 "${#targets[@]} target(s) for $seconds s each, $([ $failed = 0 ] && echo "no crash" || echo "CRASHES found (see above)")"
 exit $failed

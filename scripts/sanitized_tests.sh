@@ -22,7 +22,10 @@ export ASAN_OPTIONS=detect_leaks=1:abort_on_error=0 UBSAN_OPTIONS=halt_on_error=
 # SymmetryDetect.MirrorRuleRaisesTheAxisAboveClutter asserts a ratio of votes (> 1.5x) that clang's
 # floating point reaches only 1.44x of (gcc: above); no sanitizer reports it. Left out here only.
 declare -A skip=([symmetry_test]="-SymmetryDetect.MirrorRuleRaisesTheAxisAboveClutter")
+k=0
 for t in "${tests[@]}"; do
-  nudge_log "$t"
+  k=$((k + 1))
+  nudge_log "[$k/${#tests[@]}] $t"
   "./bin/$t" --gtest_brief=1 ${skip[$t]:+--gtest_filter=${skip[$t]}} "$@"
 done
+nudge_summary sanitized_tests.sh 0 "${#tests[@]} test programs clean under ASan + UBSan"
