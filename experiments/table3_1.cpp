@@ -244,7 +244,7 @@ int main(int argc, char** argv) {
     nudge::Progress progress("nudge-exp-table3_1", frames + 18);
     table3_1(images, repeats, progress);
     fig3_11(images, std::max(1, repeats / 2), progress);
-    progress.finish(std::to_string(frames) + " frames, 18 angle ranges timed");
+    progress.finish(std::to_string(frames) + " frame(s), 18 angle ranges timed");
   } catch (const std::exception& e) {
     std::cerr << "nudge-exp-table3_1: " << e.what() << "\n";
     return 1;

@@ -146,7 +146,7 @@ int main(int argc, char** argv) {
     if (wide.lines.empty()) throw std::runtime_error("the detector found no lines to segment");
     progress.clear_status();  // the result files' "wrote" lines follow on stderr
     write_results(wide, usual, frames, repeats);
-    progress.finish(std::to_string(wide.lines.size()) + " lines segmented at MAXw 640 and 250");
+    progress.finish(std::to_string(wide.lines.size()) + " line(s) segmented at MAXw 640 and 250");
   } catch (const std::exception& e) {
     std::cerr << "nudge-exp-table4_1: " << e.what() << "\n";
     return 1;

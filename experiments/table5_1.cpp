@@ -163,8 +163,9 @@ int main(int argc, char** argv) {
        << (latency.empty() ? "unavailable: " + why : std::to_string(median(latency))) << " | – |\n";
     write_result("table5_1.md", md.str());
     std::ostringstream summary;
-    summary << median_ms << " ms per frame, latency "
-            << (latency.empty() ? "unavailable" : std::to_string(median(latency)) + " ms");
+    summary << median_ms << " ms per frame, latency ";
+    if (latency.empty()) summary << "unavailable";
+    else summary << median(latency) << " ms";
     progress.finish(summary.str());
   } catch (const std::exception& e) {
     std::cerr << "nudge-exp-table5_1: " << e.what() << "\n";
