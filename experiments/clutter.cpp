@@ -22,6 +22,7 @@
 #include "nudge/flags.hpp"
 #include "nudge/progress.hpp"
 #include "nudge/geometry/interesting_locations.hpp"
+#include "nudge/geometry/upright.hpp"
 #include "nudge/sim/world.hpp"
 #include "nudge/symmetry/detector.hpp"
 #include "nudge/symmetry/verify.hpp"
@@ -47,6 +48,8 @@ struct Pipeline {
   sym::EdgeParams edge;
   sym::VerifyParams verify;
   bool verify_lines = false;
+  double upright_max_deg = 0;  // > 0: only peaks that can be upright axes are verified
+  bool upright_snap = false;    // the verified lines turned into images of upright axes
   geo::LocationParams locations;
 };
 
@@ -75,6 +78,10 @@ struct AfterOptions {
   int candidate_lines = 8;
   bool stereo_check = true, colour_edges = true;
   double min_overlap = 0.3, max_foot = 0.08;
+  bool refine = false;
+  double refine_max = 4;
+  double upright = 0;
+  bool snap = false;
   double min_fraction = 0.03;
 };
 
@@ -98,6 +105,10 @@ Pipeline after_issue14(const AfterOptions& o) {
   p.verify.colour_tolerance = o.colour_tolerance;
   p.verify.band_gap_px = o.band_gap;
   p.verify.suppress_px = o.verify_suppress;
+  p.verify.refine = o.refine;
+  p.upright_max_deg = o.upright;
+  p.upright_snap = o.snap;
+  p.verify.refine_max_deg = o.refine_max;
   p.locations.lines_per_image = o.candidate_lines;
   p.locations.stereo_check = o.stereo_check;
   p.locations.min_height_overlap = o.min_overlap;
@@ -110,10 +121,25 @@ struct CameraCount {
   int visible = 0, found = 0, lines = 0, phantoms = 0, images = 0;
 };
 
+// Where each object that is not in a camera's lines was lost (--diagnose; object-frames, both
+// cameras): its axis among the verified lines (found), among the accumulator's peaks but dropped by
+// the verification, a peak of the accumulator (suppression 1) ranked within the peaks taken but
+// removed by the coarser suppression, ranked lower, or no peak of the accumulator at all.
+struct LineLoss {
+  int found = 0, verification = 0, suppressed = 0, rank_low = 0, below_ratio = 0, no_peak = 0;
+};
+// Per object: never in both cameras' lines in one frame; in both but no table intersect near it
+// (stereo pairing, the stereo check, the upright / workspace filter); intersects but no cluster.
+struct CandidateLoss {
+  int candidate = 0, never_both = 0, no_intersect = 0, not_clustered = 0;
+};
+
 struct SceneResult {
   std::string name;
   int objects = 0;
   std::array<CameraCount, 2> cameras;
+  LineLoss line_loss;
+  CandidateLoss candidate_loss;
   int candidates = 0, object_candidates = 0, duplicate_candidates = 0, objects_without = 0, phantom_candidates = 0;
   cv::Mat picture;
 };
@@ -144,13 +170,142 @@ geo::Plane table_in_right_camera(const sim::World& world) {
   return p;
 }
 
-std::vector<sym::Line> detect(sym::Detector& detector, const Pipeline& pipeline, const cv::Mat& image) {
-  if (!pipeline.verify_lines) return detector.detect(image).lines;
+// The stages of one image's detection, kept for the diagnosis.
+struct Detection {
+  std::vector<sym::Line> peaks;  // the accumulator's peaks (before verification)
+  std::vector<sym::Line> lines;  // what the pipeline returns
+};
+
+// Where an image was taken, for the upright check.
+struct View {
+  const geo::StereoRig* rig = nullptr;
+  const geo::Plane* table = nullptr;
+  geo::Side side = geo::Side::Left;
+};
+
+Detection detect(sym::Detector& detector, const Pipeline& pipeline, const cv::Mat& image, const View& view) {
+  if (!pipeline.verify_lines) {
+    std::vector<sym::Line> lines = detector.detect(image).lines;
+    return {lines, lines};
+  }
   sym::EdgeParams edge = pipeline.edge;
   edge.gradients = true;  // as Detector::detect with the mirror rule on
   const sym::EdgeSet edges = sym::detect_edges(image, edge);
   const sym::Result result = detector.detect(edges);
-  return sym::verify_lines(detector, edges, image, result.lines, pipeline.verify);
+  std::vector<sym::Line> peaks = result.lines;
+  if (pipeline.upright_max_deg > 0)
+    peaks = geo::upright_lines(*view.rig, view.side, *view.table, peaks, pipeline.upright_max_deg);
+  std::vector<sym::Line> lines = sym::verify_lines(detector, edges, image, peaks, pipeline.verify);
+  if (pipeline.upright_snap) lines = geo::upright_lines(*view.rig, view.side, *view.table, lines, 90, true);
+  return {result.lines, lines};
+}
+
+bool matches(const sym::Line& line, const sim::ImageLine& truth, int width, int height) {
+  const auto [d, a] = line_error(line, truth, width, height);
+  return d <= kLineDistancePx && a <= kLineAngleDeg;
+}
+
+bool any_matches(const std::vector<sym::Line>& lines, const sim::ImageLine& truth, int width, int height) {
+  for (const auto& l : lines)
+    if (matches(l, truth, width, height)) return true;
+  return false;
+}
+
+// --dump: features of every accumulator peak, one CSV row each, with what it is (the object it
+// matches within 3 px / 2 deg, -1 near an object but not on it, -2 a phantom), to design scores.
+struct PeakDump {
+  std::ofstream* out = nullptr;
+  std::string scene;
+  int frame = 0, camera = 0;
+};
+
+// How far (deg) the plane through the camera centre and an image line is from containing the
+// table's normal: an upright axis' image has 0 (up to the axis' tilt).
+double upright_tilt_deg(const sim::CameraModel& camera, const sym::Line& line) {
+  const Eigen::Vector2d a = camera.undistort({line.end1.x, line.end1.y}), b = camera.undistort({line.end2.x, line.end2.y});
+  const Eigen::Vector3d m = Eigen::Vector3d(a.x(), a.y(), 1).cross(Eigen::Vector3d(b.x(), b.y(), 1)).normalized();
+  const Eigen::Vector3d up = camera.R * Eigen::Vector3d::UnitZ();
+  return std::asin(std::min(1.0, std::fabs(m.dot(up)))) * 180 / M_PI;
+}
+
+void dump_peaks(const sym::Detector& detector, const Pipeline& pipeline, const cv::Mat& image,
+                const std::vector<sim::ImageLine>& truth, const std::vector<bool>& visible, const PeakDump& d,
+                const sim::CameraModel& camera) {
+  sym::EdgeParams edge = pipeline.edge;
+  edge.gradients = true;
+  const sym::EdgeSet edges = sym::detect_edges(image, edge);
+  sym::Detector probe(detector.params(), pipeline.edge);
+  const sym::Result result = probe.detect(edges);
+  cv::Mat direction(image.size(), CV_16S, cv::Scalar(0));
+  for (size_t i = 0; i < edges.points.size(); ++i) direction.at<int16_t>(edges.points[i]) = edges.direction[i];
+  const cv::Point2d centre(0.5 * (image.cols - 1), 0.5 * (image.rows - 1));
+  for (size_t k = 0; k < result.lines.size(); ++k) {
+    const sym::Line& line = result.lines[k];
+    const sym::LineEvidence e = sym::line_evidence(probe, edges, image, line, pipeline.verify);
+    const auto pairs = probe.voting_pairs(edges, line);
+    const cv::Point2d normal(std::cos(line.theta), std::sin(line.theta)), dir(-normal.y, normal.x);
+    std::vector<std::pair<double, double>> along_width;
+    int polarity = 0;
+    for (const auto& p : pairs) {
+      const cv::Point2d a(p.a), b(p.b);
+      along_width.push_back({(0.5 * (a + b) - centre).dot(dir), cv::norm(b - a)});
+      // Mirrored directions: a + b = 2 theta + 180 deg (mod 360), in 360/65536 units.
+      const int16_t sum = static_cast<int16_t>(direction.at<int16_t>(p.a) + direction.at<int16_t>(p.b));
+      const int16_t want = sym::direction_units(2 * line.theta + M_PI);
+      polarity += std::abs(static_cast<int16_t>(sum - want)) <= 30 * 65536 / 360;
+    }
+    std::sort(along_width.begin(), along_width.end());
+    // Largest band, its length and rows; width smoothness inside it.
+    size_t best_start = 0, best_end = 0, start = 0;
+    for (size_t i = 1; i <= along_width.size(); ++i) {
+      if (i < along_width.size() && along_width[i].first - along_width[i - 1].first <= pipeline.verify.band_gap_px) continue;
+      if (i - start > best_end - best_start) best_start = start, best_end = i;
+      start = i;
+    }
+    double band_len = 0;
+    int rows = 0, smooth = 0;
+    if (best_end > best_start) {
+      band_len = along_width[best_end - 1].first - along_width[best_start].first;
+      double last_row = -1e9;
+      for (size_t i = best_start; i < best_end; ++i) {
+        if (along_width[i].first - last_row >= 0.9) ++rows, last_row = along_width[i].first;
+        bool near = false;
+        for (size_t j = i > best_start + 3 ? i - 3 : best_start; j < std::min(best_end, i + 4); ++j)
+          if (j != i && std::fabs(along_width[j].second - along_width[i].second) <= 3) near = true;
+        smooth += near;
+      }
+    }
+    int label = -2;
+    for (size_t i = 0; i < truth.size(); ++i) {
+      if (!truth[i].valid) continue;
+      const auto [dist, ang] = line_error(line, truth[i], image.cols, image.rows);
+      if (visible[i] && dist <= kLineDistancePx && ang <= kLineAngleDeg) { label = static_cast<int>(i); break; }
+      if (dist <= kPhantomDistancePx && ang <= kPhantomAngleDeg) label = -1;
+    }
+    *d.out << d.scene << "," << d.frame << "," << d.camera << "," << k << "," << line.votes << "," << e.pairs << ","
+           << e.band_share << "," << e.appearance << "," << band_len << "," << rows << "," << smooth << "," << polarity
+           << "," << line.r << "," << line.theta << "," << label << "," << upright_tilt_deg(camera, line) << "\n";
+  }
+}
+
+// Where a visible object missing from `detection.lines` was lost (LineLoss).
+void diagnose_line(const sym::Detector& detector, const Detection& detection, const sim::ImageLine& truth,
+                   int width, int height, LineLoss* loss) {
+  if (any_matches(detection.lines, truth, width, height)) return void(++loss->found);
+  if (any_matches(detection.peaks, truth, width, height)) return void(++loss->verification);
+  sym::Params fine = detector.params();
+  fine.num_lines = 300;
+  fine.suppress_r = fine.suppress_theta = 1;
+  fine.min_peak_ratio = 0;
+  const std::vector<sym::Line> all = sym::Detector(fine).find_peaks(detector.last_accumulator(), width, height);
+  const double highest = all.empty() ? 0 : all.front().votes;
+  for (size_t k = 0; k < all.size(); ++k) {
+    if (!matches(all[k], truth, width, height)) continue;
+    if (all[k].votes < detector.params().min_peak_ratio * highest) return void(++loss->below_ratio);
+    if (static_cast<int>(k) < detector.params().num_lines) return void(++loss->suppressed);
+    return void(++loss->rank_low);
+  }
+  ++loss->no_peak;
 }
 
 void draw_frame(const cv::Mat& image, const std::vector<sym::Line>& lines, const std::vector<sim::ImageLine>& truth,
@@ -168,7 +323,8 @@ void draw_frame(const cv::Mat& image, const std::vector<sym::Line>& lines, const
   *out = canvas;
 }
 
-SceneResult run_scene(const std::string& file, const Pipeline& pipeline, int frames, bool picture) {
+SceneResult run_scene(const std::string& file, const Pipeline& pipeline, int frames, bool picture, bool diagnose,
+                      std::ofstream* dump = nullptr) {
   SceneResult result;
   result.name = fs::path(file).stem().string();
   sim::World world(sim::load_scene(file));
@@ -185,9 +341,11 @@ SceneResult run_scene(const std::string& file, const Pipeline& pipeline, int fra
   std::array<std::vector<bool>, 2> visible;
   std::vector<sym::Line> first_left;
   cv::Mat first_image;
+  std::vector<int> frames_in_both(world.num_objects(), 0);
   for (int f = 0; f < frames; ++f) {
     const sim::StereoImages images = world.render_stereo(f == 0);
     std::array<std::vector<sym::Line>, 2> lines;
+    std::array<std::vector<bool>, 2> in_lines;
     for (int c = 0; c < 2; ++c) {
       if (f == 0) {
         for (int i = 0; i < world.num_objects(); ++i) {
@@ -196,7 +354,13 @@ SceneResult run_scene(const std::string& file, const Pipeline& pipeline, int fra
         }
       }
       const cv::Mat& image = images.colour[c];
-      lines[c] = detect(detector, pipeline, image);
+      const Detection detection = detect(detector, pipeline, image, {&rig, &table, c == 0 ? geo::Side::Left : geo::Side::Right});
+      lines[c] = detection.lines;
+      if (dump) dump_peaks(detector, pipeline, image, truth[c], visible[c], {dump, result.name, f, c}, world.camera(c));
+      in_lines[c].assign(world.num_objects(), false);
+      if (diagnose)
+        for (int i = 0; i < world.num_objects(); ++i)
+          if (visible[c][i]) diagnose_line(detector, detection, truth[c][i], image.cols, image.rows, &result.line_loss);
       CameraCount& count = result.cameras[c];
       ++count.images;
       count.lines += static_cast<int>(lines[c].size());
@@ -207,6 +371,7 @@ SceneResult run_scene(const std::string& file, const Pipeline& pipeline, int fra
           const auto [d, a] = line_error(l, truth[c][i], image.cols, image.rows);
           if (d <= kLineDistancePx && a <= kLineAngleDeg) {
             ++count.found;
+            in_lines[c][i] = true;
             break;
           }
         }
@@ -225,6 +390,7 @@ SceneResult run_scene(const std::string& file, const Pipeline& pipeline, int fra
       first_left = lines[0];
       first_image = images.colour[0];
     }
+    for (int i = 0; i < world.num_objects(); ++i) frames_in_both[i] += in_lines[0][i] && in_lines[1][i];
     finder.add_frame(lines[0], lines[1]);
   }
 
@@ -254,6 +420,18 @@ SceneResult run_scene(const std::string& file, const Pipeline& pipeline, int fra
     drawn_is_object.push_back(nearest >= 0);
   }
   for (bool has : has_candidate) result.objects_without += !has;
+  for (int i = 0; i < world.num_objects(); ++i) {
+    int near = 0;
+    for (const Eigen::Vector3d& hit : finder.intersect_points()) {
+      const Eigen::Vector3d p = right.R.transpose() * (hit - right.t);
+      near += (p.head<2>() - world.object(i).position.head<2>()).norm() <= kCandidateRadiusM;
+    }
+    CandidateLoss& loss = result.candidate_loss;
+    if (has_candidate[i]) ++loss.candidate;
+    else if (frames_in_both[i] == 0) ++loss.never_both;
+    else if (near == 0) ++loss.no_intersect;
+    else ++loss.not_clustered;
+  }
   if (picture) draw_frame(first_image, first_left, truth[0], drawn, drawn_is_object, &result.picture);
   return result;
 }
@@ -293,6 +471,30 @@ Summary summarise(const std::vector<SceneResult>& results) {
 std::string fixed(double v, int digits = 3) {
   std::ostringstream s;
   s << std::fixed << std::setprecision(digits) << v;
+  return s.str();
+}
+
+std::string losses_text(const std::vector<SceneResult>& results) {
+  LineLoss l;
+  CandidateLoss c;
+  for (const auto& r : results) {
+    l.found += r.line_loss.found;
+    l.verification += r.line_loss.verification;
+    l.suppressed += r.line_loss.suppressed;
+    l.rank_low += r.line_loss.rank_low;
+    l.below_ratio += r.line_loss.below_ratio;
+    l.no_peak += r.line_loss.no_peak;
+    c.candidate += r.candidate_loss.candidate;
+    c.never_both += r.candidate_loss.never_both;
+    c.no_intersect += r.candidate_loss.no_intersect;
+    c.not_clustered += r.candidate_loss.not_clustered;
+  }
+  std::ostringstream s;
+  s << "object-frames: in lines " << l.found << ", dropped by verification " << l.verification
+    << ", a peak removed by suppression " << l.suppressed << ", a peak ranked below the peaks taken " << l.rank_low
+    << ", a peak below min_peak_ratio " << l.below_ratio << ", no peak " << l.no_peak << "; objects: candidate "
+    << c.candidate << ", never in both cameras' lines " << c.never_both << ", no intersect near it "
+    << c.no_intersect << ", intersects but no cluster " << c.not_clustered;
   return s.str();
 }
 
@@ -350,8 +552,9 @@ std::string mirror_voting_fields() {
 int main(int argc, char** argv) {
   std::string set = "eval", scenes_dir = std::string(NUDGE_SOURCE_DIR) + "/common/sim/scenes/clutter";
   int frames = 25;
-  bool no_write = false, skip_before = false;
-  std::string pictures;
+  bool no_write = false, skip_before = false, diagnose = false;
+  int seed_min = 0, seed_max = 1 << 30;
+  std::string pictures, dump_file;
   AfterOptions after_options;
   std::vector<double> canny;
   nudge::Flags flags("nudge-exp-clutter", "Symmetry lines and candidates on busy tables (issue 14).");
@@ -360,9 +563,17 @@ int main(int argc, char** argv) {
   flags.add_int("frames", &frames, "stereo pairs per scene (a survey's)");
   flags.add_bool("no-write", &no_write, "print only; write no result files");
   flags.add_string("pictures", &pictures, "also write each scene's picture (after) to this directory");
+  flags.add_string("dump", &dump_file, "write every accumulator peak's features and truth to this CSV (tuning)");
+  flags.add_bool("diagnose", &diagnose, "print where each missed object was lost (stage by stage)");
+  flags.add_int("seed-min", &seed_min, "only scenes whose seed (file name's number) is at least this");
+  flags.add_int("seed-max", &seed_max, "only scenes whose seed is at most this");
   flags.add_bool("skip-before", &skip_before, "measure only the issue-14 pipeline (with --no-write, for tuning)");
   AfterOptions& a = after_options;
-  double verify_flag = 1, colour_flag = 1, stereo_flag = 1;
+  double verify_flag = 1, colour_flag = 1, stereo_flag = 1, refine_flag = a.refine, snap_flag = a.snap;
+  flags.add_double("snap", &snap_flag, "after: 1 = turn the verified lines into images of upright axes");
+  flags.add_double("refine", &refine_flag, "after: 1 = refit each verified line to its band's pair midpoints");
+  flags.add_double("upright", &a.upright, "after: > 0: verify only peaks within this many deg of an upright axis' image");
+  flags.add_double("refine-max", &a.refine_max, "after: largest refit move, deg");
   flags.add_double("dmin", &a.dmin, "after: minimum pairing distance, px");
   flags.add_double("dmax", &a.dmax, "after: maximum pairing distance, px");
   flags.add_double("blur", &a.blur, "after: Gaussian blur before Canny");
@@ -385,12 +596,14 @@ int main(int argc, char** argv) {
   flags.add_double("min-fraction", &a.min_fraction, "after: smallest QT cluster, share of all intersects");
   try {
     if (!flags.parse(argc, argv)) return 0;
-    if (set != "eval" && set != "dev") throw nudge::FlagError("--set must be eval or dev");
+    if (set != "eval" && set != "dev" && set != "held") throw nudge::FlagError("--set must be eval, held or dev");
     if (frames < 1) throw nudge::FlagError("--frames must be >= 1");
     if (skip_before && !no_write) throw nudge::FlagError("--skip-before needs --no-write");
     a.verify = verify_flag != 0;
     a.colour_edges = colour_flag != 0;
     a.stereo_check = stereo_flag != 0;
+    a.refine = refine_flag != 0;
+    a.snap = snap_flag != 0;
     if (!canny.empty()) {
       a.canny_low = canny[0];
       a.canny_high = canny[1];
@@ -399,7 +612,14 @@ int main(int argc, char** argv) {
     std::cerr << e.what() << "\n" << flags.help();
     return 2;
   }
-  const std::vector<std::string> files = scene_files(scenes_dir, set);
+  std::vector<std::string> files = scene_files(scenes_dir, set);
+  files.erase(std::remove_if(files.begin(), files.end(),
+                             [&](const std::string& f) {
+                               const std::string stem = fs::path(f).stem().string();
+                               const int seed = std::stoi(stem.substr(stem.rfind('_') + 1));
+                               return seed < seed_min || seed > seed_max;
+                             }),
+              files.end());
   if (files.empty()) {
     std::cerr << "nudge-exp-clutter: no " << set << "_*.yaml scenes in " << scenes_dir << "\n";
     return 1;
@@ -407,11 +627,17 @@ int main(int argc, char** argv) {
   std::vector<Pipeline> pipelines = {before_issue14(), after_issue14(after_options)};
   if (skip_before) pipelines.erase(pipelines.begin());
   std::map<std::string, std::vector<SceneResult>> results;
+  std::ofstream dump;
+  if (!dump_file.empty()) {
+    dump.open(dump_file);
+    dump << "scene,frame,camera,rank,votes,pairs,band_share,appearance,band_len,rows,smooth,polarity,r,theta,label,tilt\n";
+  }
   nudge::Progress progress("nudge-exp-clutter", static_cast<int>(pipelines.size() * files.size()));
   for (const Pipeline& pipeline : pipelines) {
     for (const std::string& file : files) {
       progress.step(pipeline.name + " " + fs::path(file).stem().string());
-      results[pipeline.name].push_back(run_scene(file, pipeline, frames, pipeline.name == "after"));
+      results[pipeline.name].push_back(run_scene(file, pipeline, frames, pipeline.name == "after", diagnose,
+                                                 dump.is_open() && pipeline.name == "after" ? &dump : nullptr));
       const SceneResult& r = results[pipeline.name].back();
       if (!pictures.empty() && !r.picture.empty()) cv::imwrite(pictures + "/" + r.name + ".png", r.picture);
       std::ostringstream detail;
@@ -424,6 +650,7 @@ int main(int argc, char** argv) {
       progress.note(detail.str());
     }
     progress.note(pipeline.name + ": " + summary_json(summarise(results[pipeline.name])));
+    if (diagnose) progress.note(pipeline.name + " losses: " + losses_text(results[pipeline.name]));
   }
   progress.finish(std::to_string(files.size()) + " " + set + " scenes, " + std::to_string(pipelines.size()) +
                   " pipeline(s)");

@@ -1,8 +1,11 @@
 #include "handlers.hpp"
 
+#include <stdexcept>
+
 #include "nudge/bus/image.hpp"
 #include "nudge/bus/symmetry_convert.hpp"
 #include "nudge/contours_t.hpp"
+#include "nudge/geometry/upright.hpp"
 #include "nudge/log.hpp"
 #include "nudge/timing.hpp"
 
@@ -62,13 +65,24 @@ Handlers::Handlers(bus::Service& service, const Options& options)
   for (const auto& channel : options_.inputs) {
     const std::string out = bus::channel::derived(channel, bus::channel::SYMMETRY);
     const std::string contours_out = bus::channel::derived(channel, bus::channel::CONTOURS);
-    service_.subscriptions().subscribe<image_t>(
-        channel, [this, out, contours_out](const image_t& msg, const std::string&) { on_image(msg, out, contours_out); });
+    const geometry::Side side = options_.upright ? side_of_channel(channel) : geometry::Side::Left;
+    service_.subscriptions().subscribe<image_t>(channel, [this, out, contours_out, side](const image_t& msg, const std::string&) {
+      on_image(msg, out, contours_out, side);
+    });
     log::info() << channel << " -> " << out;
   }
 }
 
-void Handlers::on_image(const image_t& msg, const std::string& out, const std::string& contours_out) {
+geometry::Side side_of_channel(const std::string& channel) {
+  auto ends_with = [&](const std::string& suffix) {
+    return channel.size() >= suffix.size() && channel.compare(channel.size() - suffix.size(), suffix.size(), suffix) == 0;
+  };
+  if (ends_with("LEFT")) return geometry::Side::Left;
+  if (ends_with("RIGHT")) return geometry::Side::Right;
+  throw std::invalid_argument("input channel " + channel + " names no camera (LEFT or RIGHT at its end): the upright check needs one");
+}
+
+void Handlers::on_image(const image_t& msg, const std::string& out, const std::string& contours_out, geometry::Side side) {
   const cv::Mat image = bus::to_mat(msg);  // throws ImageError naming the image: counted, skipped
   Stopwatch watch;
   const symmetry::EdgeSet edges = symmetry::detect_edges(image, options_.edge);
@@ -77,6 +91,14 @@ void Handlers::on_image(const image_t& msg, const std::string& out, const std::s
   result.ms.edges_ms = edges_ms;
   if (options_.verify) {  // part of finding the peaks
     Stopwatch verify_watch;
+    if (options_.upright) {
+      const Options::Upright& u = *options_.upright;
+      if (image.cols != (side == geometry::Side::Left ? u.rig.left : u.rig.right).width ||
+          image.rows != (side == geometry::Side::Left ? u.rig.left : u.rig.right).height)
+        throw std::runtime_error(out + " frame " + std::to_string(msg.frame_id) + ": image " + std::to_string(image.cols) +
+                                 "x" + std::to_string(image.rows) + " differs from the calibration's camera");
+      result.lines = geometry::upright_lines(u.rig, side, u.table, result.lines, u.max_tilt_deg);
+    }
     result.lines = symmetry::verify_lines(detector_, edges, image, result.lines, options_.verify_params);
     result.ms.peaks_ms += verify_watch.elapsed_ms();
   }

@@ -1,6 +1,7 @@
 #pragma once
 // The symmetry service's message handlers, apart from main() so that tests build them on an
 // in-process bus (docs/architecture.md, "Testing a service's handlers in one process").
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -9,6 +10,9 @@
 #include "nudge/image_t.hpp"
 #include "nudge/segmentation/segment.hpp"
 #include "nudge/symmetry/detector.hpp"
+#include "nudge/geometry/plane.hpp"
+#include "nudge/geometry/stereo_pairing.hpp"
+#include "nudge/geometry/stereo_rig.hpp"
 #include "nudge/symmetry/verify.hpp"
 
 namespace nudge::symmetry_service {
@@ -22,7 +26,20 @@ struct Options {
   // mirrored colour) and publish the best verify.keep of them; off unless `verify` is set.
   bool verify = false;
   symmetry::VerifyParams verify_params;
+  // With verify: only the peaks that can be the image of an axis standing upright on the table
+  // are verified (geometry/upright.hpp); needs the rig and the table, and input channels that
+  // name their camera (..._LEFT, ..._RIGHT).
+  struct Upright {
+    geometry::StereoRig rig;
+    geometry::Plane table;  // right camera frame
+    double max_tilt_deg = 2;
+  };
+  std::optional<Upright> upright;
 };
+
+// The camera of an input channel for the upright check: LEFT or RIGHT at the end of its name.
+// Throws std::invalid_argument naming a channel that says neither.
+geometry::Side side_of_channel(const std::string& channel);
 
 // Subscribes the started `service` to every input channel: each image's symmetry lines go out on
 // its SYMMETRY_* channel, with Options::contours > 0 also the contours on CONTOURS_*. A bad image
@@ -34,7 +51,7 @@ class Handlers {
   Handlers& operator=(const Handlers&) = delete;
 
  private:
-  void on_image(const image_t& msg, const std::string& out, const std::string& contours_out);
+  void on_image(const image_t& msg, const std::string& out, const std::string& contours_out, geometry::Side side);
 
   bus::Service& service_;
   Options options_;

@@ -5,6 +5,7 @@
 #include "nudge/bus/channels.hpp"
 #include "nudge/bus/service.hpp"
 #include "nudge/flags.hpp"
+#include "nudge/geometry/workspace.hpp"
 
 using namespace nudge;
 
@@ -40,6 +41,15 @@ int main(int argc, char** argv) {
     f.add_int("verify", &verify, "busy tables: verify the --lines peaks (local support, mirrored colour) and publish the best N; 0: off");
     f.add_double("appearance-tolerance", &options.verify_params.colour_tolerance,
                  "with --verify: L1 BGR difference under which mirrored colour samples agree");
+    std::string upright_calibration;
+    std::vector<double> upright_table;
+    double upright_tilt = 2;
+    f.add_string("upright-calibration", &upright_calibration,
+                 "with --verify: verify only peaks that can be upright axes on the table of this rig file (its table_plane "
+                 "unless --upright-table); input channels must end in LEFT / RIGHT");
+    f.add_doubles("upright-table", &upright_table, 4, "with --upright-calibration: table plane NX NY NZ D (right camera frame, m)");
+    f.add_double("upright-max-tilt", &upright_tilt, "with --upright-calibration: largest angle (deg) between the table normal "
+                 "and the plane through the camera and a line");
     f.add_bool("colour-edges", &edge.colour, "Canny on the colour image (the channel that changes most)");
     f.add_int("contours", &options.contours, "also segment the contours of the top N lines (CONTOURS_*); 0: off");
     if (!service.parse(argc, argv)) return 0;
@@ -57,6 +67,25 @@ int main(int argc, char** argv) {
     }
     if (options.contours < 0) throw FlagError("--contours must be >= 0");
     options.inputs = split_list(inputs);
+    if (!upright_calibration.empty()) {
+      if (!options.verify) throw FlagError("--upright-calibration needs --verify N");
+      if (!(upright_tilt >= 0 && upright_tilt <= 90)) throw FlagError("--upright-max-tilt must be in [0, 90]");
+      symmetry_service::Options::Upright upright;
+      try {
+        upright.rig = geometry::load_rig(upright_calibration);
+        std::optional<geometry::Plane> table = geometry::load_workspace(upright_calibration).table;
+        if (!upright_table.empty())
+          table = geometry::plane_from_coefficients(
+              Eigen::Vector4d(upright_table[0], upright_table[1], upright_table[2], upright_table[3]));
+        if (!table) throw std::invalid_argument(upright_calibration + " has no table_plane; give --upright-table");
+        upright.table = *table;
+        for (const auto& channel : options.inputs) symmetry_service::side_of_channel(channel);
+      } catch (const std::exception& e) {
+        throw FlagError(std::string("--upright-calibration: ") + e.what());
+      }
+      upright.max_tilt_deg = upright_tilt;
+      options.upright = upright;
+    }
     service.start();
     service.watch_heartbeats({"camera"});  // its input: say so when the camera goes quiet
     service.watch_streams(options.inputs);  // and when its frames stop while it lives (a stall, a file's end)

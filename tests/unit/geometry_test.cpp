@@ -16,6 +16,7 @@
 #include "nudge/geometry/qt_cluster.hpp"
 #include "nudge/geometry/stereo_rig.hpp"
 #include "nudge/geometry/triangulation.hpp"
+#include "nudge/geometry/upright.hpp"
 
 using namespace nudge::geometry;
 namespace sym = nudge::symmetry;
@@ -672,4 +673,58 @@ TEST(GeometryStereoCheck, LocationFinderUsesItOnlyWhenAsked) {
   EXPECT_GE(every, 2);
   params.min_height_overlap = 1.5;
   EXPECT_THROW(LocationFinder(rig, plane, std::nullopt, params), std::invalid_argument);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Lines that can be upright axes (issue 14)
+
+TEST(GeometryUpright, AnUprightAxisPassesATiltedOneAndATableLineDoNot) {
+  const StereoRig rig = verged_rig(Lens::Typical);
+  const Table table;
+  const Plane plane = table_plane_in_right(rig, table);
+  const StereoAxis upright = observe_axis(rig, table, 0.03, 0.55, 0.12);
+  for (const Side side : {Side::Left, Side::Right}) {
+    const auto tilt = upright_tilt_deg(rig, side, plane, side == Side::Left ? upright.left : upright.right);
+    ASSERT_TRUE(tilt.ok()) << tilt.reason();
+    EXPECT_LT(*tilt, 0.3);
+  }
+  // The same axis leaning 8 deg sideways (about the viewing direction), and a line on the table.
+  auto left_line_of = [&](const Eigen::Vector3d& base, const Eigen::Vector3d& top) {
+    std::vector<Eigen::Vector3d> along;
+    for (int i = 0; i <= 60; ++i) along.push_back(base + (top - base) * (i / 60.0));
+    return fit_line(project(along, rig.left, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero()), 640, 480);
+  };
+  const Eigen::Vector3d base = table.at(0.03, 0.55);
+  const Eigen::Vector3d leaning = base + 0.12 * (std::cos(8 * kDeg) * table.up() + std::sin(8 * kDeg) * Eigen::Vector3d::UnitX());
+  const sym::Line tilted = left_line_of(base, leaning);
+  const sym::Line on_table = left_line_of(table.at(0.0, 0.5), table.at(0.02, 0.62));
+  EXPECT_GT(*upright_tilt_deg(rig, Side::Left, plane, tilted), 5.0);
+  EXPECT_GT(*upright_tilt_deg(rig, Side::Left, plane, on_table), 5.0);
+  const std::vector<sym::Line> kept = upright_lines(rig, Side::Left, plane, {tilted, upright.left, on_table}, 2.0);
+  ASSERT_EQ(kept.size(), 1u);
+  EXPECT_EQ(kept[0].r, upright.left.r);
+  EXPECT_EQ(upright_lines(rig, Side::Left, plane, {tilted, upright.left, on_table}, 90.0).size(), 3u);
+  EXPECT_THROW(upright_lines(rig, Side::Left, plane, {upright.left}, -1), std::invalid_argument);
+}
+
+TEST(GeometryUpright, SnapsALineOntoTheImageOfAnUprightAxis) {
+  const StereoRig rig = verged_rig(Lens::Typical);
+  const Table table;
+  const Plane plane = table_plane_in_right(rig, table);
+  const StereoAxis axis = observe_axis(rig, table, -0.04, 0.6, 0.1);
+  // The right view's line turned 1.5 deg about its middle, as a coarse accumulator bin leaves it.
+  sym::Line turned = axis.right;
+  const cv::Point2d middle = 0.5 * (turned.seg1 + turned.seg2);
+  turned.theta += 1.5 * kDeg;
+  turned.r = (middle.x - 319.5) * std::cos(turned.theta) + (middle.y - 239.5) * std::sin(turned.theta);
+  EXPECT_GT(*upright_tilt_deg(rig, Side::Right, plane, turned), 0.5);
+  const auto snapped = snapped_upright(rig, Side::Right, plane, turned);
+  ASSERT_TRUE(snapped.ok()) << snapped.reason();
+  EXPECT_LT(*upright_tilt_deg(rig, Side::Right, plane, *snapped), 0.05);
+  EXPECT_NEAR(snapped->theta, axis.right.theta, 0.1 * kDeg);
+  EXPECT_NEAR(snapped->r, axis.right.r, 0.5);
+  // upright_lines with snap returns the snapped line.
+  const auto kept = upright_lines(rig, Side::Right, plane, {turned}, 5.0, true);
+  ASSERT_EQ(kept.size(), 1u);
+  EXPECT_NEAR(kept[0].theta, snapped->theta, 1e-12);
 }

@@ -27,20 +27,27 @@ int l1(const cv::Vec3b& a, const cv::Vec3b& b) {
 struct Band {
   double lo = 0, hi = 0;
   int pairs = 0;
+  std::vector<cv::Point2d> midpoints;  // of the band's pairs
 };
 
 // The largest run of pair midpoints along the line with no gap wider than `gap`.
-Band largest_band(std::vector<double> along, double gap) {
+Band largest_band(const std::vector<double>& along, const std::vector<cv::Point2d>& midpoints, double gap) {
   Band best;
   if (along.empty()) return best;
-  std::sort(along.begin(), along.end());
-  size_t start = 0;
-  for (size_t i = 1; i <= along.size(); ++i) {
-    if (i < along.size() && along[i] - along[i - 1] <= gap) continue;
+  std::vector<size_t> order(along.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return along[a] < along[b]; });
+  size_t start = 0, best_start = 0;
+  for (size_t i = 1; i <= order.size(); ++i) {
+    if (i < order.size() && along[order[i]] - along[order[i - 1]] <= gap) continue;
     const int count = static_cast<int>(i - start);
-    if (count > best.pairs) best = {along[start], along[i - 1], count};
+    if (count > best.pairs) {
+      best = {along[order[start]], along[order[i - 1]], count, {}};
+      best_start = start;
+    }
     start = i;
   }
+  for (size_t i = best_start; i < best_start + static_cast<size_t>(best.pairs); ++i) best.midpoints.push_back(midpoints[order[i]]);
   return best;
 }
 
@@ -59,25 +66,68 @@ LineEvidence evidence_of(const std::vector<VotingPair>& pairs, const cv::Mat& bg
   const cv::Point2d centre(0.5 * (bgr.cols - 1), 0.5 * (bgr.rows - 1));
   const cv::Point2d normal(std::cos(line.theta), std::sin(line.theta)), dir(-normal.y, normal.x);
   std::vector<double> along;
+  std::vector<cv::Point2d> midpoints;
   along.reserve(pairs.size());
+  midpoints.reserve(pairs.size());
   int agree = 0, samples = 0;
   for (const VotingPair& p : pairs) {
     const cv::Point2d a(p.a), b(p.b), mid = 0.5 * (a + b), half = 0.5 * (b - a);
     along.push_back((mid - centre).dot(dir));
+    midpoints.push_back(mid);
     for (double t : kInside) {
       agree += l1(colour_at(bgr, mid - t * half), colour_at(bgr, mid + t * half)) <= params.colour_tolerance;
       ++samples;
     }
   }
-  const Band band = largest_band(along, params.band_gap_px);
+  Band band = largest_band(along, midpoints, params.band_gap_px);
   e.band_share = static_cast<double>(band.pairs) / e.pairs;
   e.appearance = static_cast<double>(agree) / samples;
   e.score = line.votes * std::pow(e.band_share, params.band_weight) * std::pow(e.appearance, params.appearance_weight);
-  if (band_out) *band_out = band;
+  if (band_out) *band_out = std::move(band);
   return e;
 }
 
+// The line refitted to its band's pair midpoints (VerifyParams::refine), or the line as it was.
+Line refined(const Line& line, const Band& band, const VerifyParams& params, int width, int height) {
+  if (!params.refine || band.pairs < params.refine_min_pairs) return line;
+  const std::optional<Line> fit = fit_line(band.midpoints, width, height);
+  if (!fit) return line;
+  const LineDifference d = line_difference(*fit, line);
+  if (std::fabs(d.theta) > params.refine_max_deg * M_PI / 180) return line;
+  Line out = line;
+  out.r = fit->r;
+  out.theta = fit->theta;
+  border_endpoints(out.r, out.theta, width, height, &out.end1, &out.end2);
+  return out;
+}
+
 }  // namespace
+
+std::optional<Line> fit_line(const std::vector<cv::Point2d>& points, int width, int height) {
+  if (points.size() < 2) return std::nullopt;
+  cv::Point2d mean(0, 0);
+  for (const auto& p : points) mean += p;
+  mean *= 1.0 / static_cast<double>(points.size());
+  double sxx = 0, sxy = 0, syy = 0;
+  for (const auto& p : points) {
+    const cv::Point2d q = p - mean;
+    sxx += q.x * q.x;
+    sxy += q.x * q.y;
+    syy += q.y * q.y;
+  }
+  if (sxx + syy <= 0) return std::nullopt;
+  // The normal is the direction of least spread: the scatter matrix's smaller eigenvector.
+  const double direction = 0.5 * std::atan2(2 * sxy, sxx - syy);
+  double theta = direction + M_PI / 2;
+  while (theta > M_PI / 2) theta -= M_PI;
+  while (theta <= -M_PI / 2) theta += M_PI;
+  const cv::Point2d centre(0.5 * (width - 1), 0.5 * (height - 1));
+  Line line;
+  line.theta = theta;
+  line.r = (mean - centre).dot(cv::Point2d(std::cos(theta), std::sin(theta)));
+  border_endpoints(line.r, line.theta, width, height, &line.end1, &line.end2);
+  return line;
+}
 
 void validate(const VerifyParams& p) {
   auto require = [](bool ok, const char* what) {
@@ -90,6 +140,8 @@ void validate(const VerifyParams& p) {
   require(p.appearance_weight >= 0 && p.appearance_weight <= 10, "verify parameter appearance_weight must be in [0, 10]");
   require(p.band_weight >= 0 && p.band_weight <= 10, "verify parameter band_weight must be in [0, 10]");
   require(p.suppress_px >= 0 && p.suppress_deg >= 0, "verify parameters suppress_px and suppress_deg must be >= 0");
+  require(p.refine_max_deg >= 0 && p.refine_max_deg < 90, "verify parameter refine_max_deg must be in [0, 90)");
+  require(p.refine_min_pairs >= 2, "verify parameter refine_min_pairs must be >= 2");
 }
 
 LineEvidence line_evidence(const Detector& detector, const EdgeSet& edges, const cv::Mat& image, const Line& line,
@@ -114,10 +166,16 @@ std::vector<Line> verify_lines(const Detector& detector, const EdgeSet& edges, c
     Band band;
     found[i] = evidence_of(detector.voting_pairs(edges, lines[i]), bgr, lines[i], params, &band);
     if (band.pairs > 0) {  // the support segment: the object's band, not stray pairs along the line
-      const cv::Point2d normal(std::cos(lines[i].theta), std::sin(lines[i].theta)), dir(-normal.y, normal.x);
-      const cv::Point2d pivot = centre + lines[i].r * normal;
-      scored[i].seg1 = pivot + band.lo * dir;
-      scored[i].seg2 = pivot + band.hi * dir;
+      scored[i] = refined(lines[i], band, params, bgr.cols, bgr.rows);
+      const cv::Point2d normal(std::cos(scored[i].theta), std::sin(scored[i].theta)), dir(-normal.y, normal.x);
+      const cv::Point2d pivot = centre + scored[i].r * normal;
+      double lo = 1e300, hi = -1e300;
+      for (const cv::Point2d& m : band.midpoints) {
+        lo = std::min(lo, (m - centre).dot(dir));
+        hi = std::max(hi, (m - centre).dot(dir));
+      }
+      scored[i].seg1 = pivot + lo * dir;
+      scored[i].seg2 = pivot + hi * dir;
     }
   }
   std::vector<size_t> order(lines.size());

@@ -108,3 +108,48 @@ TEST(SymmetryVerify, RefusesBadInput) {
   const cv::Mat smaller = image(cv::Rect(0, 0, 100, 100)).clone();
   EXPECT_THROW(sym::verify_lines(d.detector, d.edges, smaller, d.lines), std::invalid_argument);
 }
+
+// A peak two degrees beside the pale object's axis still collects chords of its two straight
+// sides, whose midpoints lie on the axis: the refit moves the line onto the axis, the line as
+// the accumulator gave it stays two degrees off.
+TEST(SymmetryVerify, RefitsABesidePeakOntoTheAxis) {
+  const cv::Mat image = busy_image();
+  Detection d = detect(image);
+  const sym::Line* object = line_at(d.lines, 69.5);
+  ASSERT_NE(object, nullptr);
+  sym::Line beside = *object;
+  beside.theta_bin = object->theta_bin + 2;
+  beside.theta = sym::theta_of_bin_deg(beside.theta_bin) * M_PI / 180;
+  // Through the axis at the object's mid-height (row 130).
+  beside.r = (69.5 - 0.5 * (kWidth - 1)) * std::cos(beside.theta) + (130 - 0.5 * (kHeight - 1)) * std::sin(beside.theta);
+  beside.r_bin = static_cast<int>(std::lround(beside.r)) + d.detector.last_accumulator().r_max;
+  sym::VerifyParams params;
+  params.keep = 1;
+  const std::vector<sym::Line> as_is = sym::verify_lines(d.detector, d.edges, image, {beside}, params);
+  ASSERT_EQ(as_is.size(), 1u);
+  EXPECT_NEAR(as_is[0].theta, 2 * M_PI / 180, 1e-9);
+  params.refine = true;
+  const std::vector<sym::Line> refit = sym::verify_lines(d.detector, d.edges, image, {beside}, params);
+  ASSERT_EQ(refit.size(), 1u);
+  EXPECT_LT(std::fabs(refit[0].theta), 0.3 * M_PI / 180);
+  EXPECT_NEAR(x_of(refit[0]), 69.5, 0.5);
+  // A refit that would move the line further than refine_max_deg is not taken.
+  params.refine_max_deg = 1;
+  EXPECT_NEAR(sym::verify_lines(d.detector, d.edges, image, {beside}, params)[0].theta, 2 * M_PI / 180, 1e-9);
+}
+
+TEST(SymmetryVerify, FitsALineThroughPoints) {
+  std::vector<cv::Point2d> points;
+  for (int i = 0; i < 20; ++i) points.emplace_back(100 + 0.1 * i, 20 + 5 * i);  // steep, leaning right
+  const auto line = sym::fit_line(points, kWidth, kHeight);
+  ASSERT_TRUE(line.has_value());
+  EXPECT_NEAR(line->theta, -std::atan(0.1 / 5), 1e-9);
+  for (const auto& p : points)
+    EXPECT_NEAR((p.x - 0.5 * (kWidth - 1)) * std::cos(line->theta) + (p.y - 0.5 * (kHeight - 1)) * std::sin(line->theta),
+                line->r, 1e-9);
+  EXPECT_FALSE(sym::fit_line({cv::Point2d(1, 1)}, kWidth, kHeight).has_value());
+  EXPECT_FALSE(sym::fit_line({cv::Point2d(1, 1), cv::Point2d(1, 1)}, kWidth, kHeight).has_value());
+  sym::VerifyParams bad;
+  bad.refine_min_pairs = 1;
+  EXPECT_THROW(sym::validate(bad), std::invalid_argument);
+}

@@ -109,6 +109,8 @@ class LocationFinder {
   bool complete() const { return frames_ >= params_.frames; }
   int frames() const { return frames_; }
   int intersects() const { return static_cast<int>(points_.size()); }
+  // The table intersects gathered so far (right camera frame), in the order they were added.
+  const std::vector<Eigen::Vector3d>& intersect_points() const { return points_; }
   // QT clusters of the intersects gathered so far, largest first.
   std::vector<Location> locations() const;
   void reset();

@@ -11,6 +11,7 @@
 // verify_lines() scores the detector's lines by both and keeps the best.
 #include <opencv2/core.hpp>
 
+#include <optional>
 #include <vector>
 
 #include "nudge/symmetry/detector.hpp"
@@ -28,6 +29,14 @@ struct VerifyParams {
   double appearance_weight = 1;
   // A line this close to a better one (both in R and in theta) is the same peak again: dropped.
   double suppress_px = 4, suppress_deg = 3;
+  // Refit each line to the midpoints of its largest band's pairs (a total-least-squares line),
+  // when the fit moves it by at most refine_max_deg: an accumulator peak a bin or two beside an
+  // object still collects pairs of that object's outline, and the midpoints of chords between
+  // two (near-)parallel sides lie on the true axis whatever the chords' angle. Off: the
+  // accumulator's (R, theta) as it is.
+  bool refine = false;
+  double refine_max_deg = 4;
+  int refine_min_pairs = 8;  // fewer pairs in the band: too few to fit, the line is kept as it is
 };
 
 // Throws std::invalid_argument naming the offending parameter.
@@ -45,8 +54,12 @@ struct LineEvidence {
 LineEvidence line_evidence(const Detector& detector, const EdgeSet& edges, const cv::Mat& image, const Line& line,
                            const VerifyParams& params = {});
 
+// The total-least-squares line through `points` (image pixels) as (R, theta) about the centre of a
+// width x height image, theta in (-90, 90] deg; nullopt for fewer than 2 points or no direction.
+std::optional<Line> fit_line(const std::vector<cv::Point2d>& points, int width, int height);
+
 // Scores every line and returns the best `params.keep`, best first; each line's support segment
-// becomes the extent of its largest band. Throws std::invalid_argument if image and edges differ in size.
+// becomes the extent of its largest band (with params.refine the line is first refitted to it). Throws std::invalid_argument if image and edges differ in size.
 std::vector<Line> verify_lines(const Detector& detector, const EdgeSet& edges, const cv::Mat& image,
                                const std::vector<Line>& lines, const VerifyParams& params = {},
                                std::vector<LineEvidence>* evidence = nullptr);
