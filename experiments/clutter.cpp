@@ -17,10 +17,12 @@
 #include <iomanip>
 #include <iostream>
 #include <map>
+#include <tuple>
 #include <sstream>
 
 #include "nudge/flags.hpp"
 #include "nudge/progress.hpp"
+#include "nudge/timing.hpp"
 #include "nudge/geometry/interesting_locations.hpp"
 #include "nudge/geometry/upright.hpp"
 #include "nudge/sim/world.hpp"
@@ -72,7 +74,7 @@ Pipeline before_issue14() {
 // Issue 14's pipeline (docs/clutter.md): every value below was chosen on the development family.
 struct AfterOptions {
   double dmin = 8, dmax = 90, blur = 2.0, canny_low = 30, canny_high = 90;
-  int candidates = 20, suppress = 4, keep = 8;
+  int candidates = 80, suppress = 4, keep = 12;  // first round: 20 peaks, 8 kept
   bool verify = true;
   double appearance_weight = 1, band_weight = 0.5, min_appearance = 0, colour_tolerance = 90, band_gap = 8, verify_suppress = 4;
   int candidate_lines = 8;
@@ -80,7 +82,7 @@ struct AfterOptions {
   double min_overlap = 0.3, max_foot = 0.08;
   bool refine = false;
   double refine_max = 4;
-  double upright = 0;
+  double upright = 2;  // second round: only peaks that can be upright axes are verified
   bool snap = false;
   double min_fraction = 0.03;
 };
@@ -140,6 +142,7 @@ struct SceneResult {
   std::array<CameraCount, 2> cameras;
   LineLoss line_loss;
   CandidateLoss candidate_loss;
+  double pair_ms = 0;  // both cameras' detection and the pair's candidate intersects, summed over frames
   int candidates = 0, object_candidates = 0, duplicate_candidates = 0, objects_without = 0, phantom_candidates = 0;
   cv::Mat picture;
 };
@@ -354,7 +357,9 @@ SceneResult run_scene(const std::string& file, const Pipeline& pipeline, int fra
         }
       }
       const cv::Mat& image = images.colour[c];
+      nudge::Stopwatch watch;
       const Detection detection = detect(detector, pipeline, image, {&rig, &table, c == 0 ? geo::Side::Left : geo::Side::Right});
+      result.pair_ms += watch.elapsed_ms();
       lines[c] = detection.lines;
       if (dump) dump_peaks(detector, pipeline, image, truth[c], visible[c], {dump, result.name, f, c}, world.camera(c));
       in_lines[c].assign(world.num_objects(), false);
@@ -391,7 +396,9 @@ SceneResult run_scene(const std::string& file, const Pipeline& pipeline, int fra
       first_image = images.colour[0];
     }
     for (int i = 0; i < world.num_objects(); ++i) frames_in_both[i] += in_lines[0][i] && in_lines[1][i];
+    nudge::Stopwatch watch;
     finder.add_frame(lines[0], lines[1]);
+    result.pair_ms += watch.elapsed_ms();
   }
 
   // Candidates against the objects' axes, on the table (world frame).
@@ -441,13 +448,16 @@ struct Summary {
   std::array<double, 2> in_lines{};  // per camera
   double phantom_lines_per_frame = 0, candidates_share = 0, phantom_candidates_per_scene = 0;
   double lines_per_frame = 0;
+  double ms_per_pair = 0;
 };
 
 Summary summarise(const std::vector<SceneResult>& results) {
   Summary s;
   std::array<int, 2> visible{}, found{};
   int phantoms = 0, lines = 0, images = 0, with_candidate = 0, phantom_candidates = 0;
+  double ms = 0;
   for (const auto& r : results) {
+    ms += r.pair_ms;
     ++s.scenes;
     s.objects += r.objects;
     for (int c = 0; c < 2; ++c) {
@@ -463,6 +473,7 @@ Summary summarise(const std::vector<SceneResult>& results) {
   for (int c = 0; c < 2; ++c) s.in_lines[c] = visible[c] ? static_cast<double>(found[c]) / visible[c] : 0;
   s.phantom_lines_per_frame = images ? static_cast<double>(phantoms) / images : 0;
   s.lines_per_frame = images ? static_cast<double>(lines) / images : 0;
+  s.ms_per_pair = images ? ms / (images / 2.0) : 0;
   s.candidates_share = s.objects ? static_cast<double>(with_candidate) / s.objects : 0;
   s.phantom_candidates_per_scene = s.scenes ? static_cast<double>(phantom_candidates) / s.scenes : 0;
   return s;
@@ -505,7 +516,8 @@ std::string summary_json(const Summary& s) {
     << fixed(0.5 * (s.in_lines[0] + s.in_lines[1])) << "}, \"lines_per_frame\": " << fixed(s.lines_per_frame, 2)
     << ", \"phantom_lines_per_frame\": " << fixed(s.phantom_lines_per_frame, 2)
     << ", \"objects_as_candidates_share\": " << fixed(s.candidates_share)
-    << ", \"phantom_candidates_per_scene\": " << fixed(s.phantom_candidates_per_scene, 2) << "}";
+    << ", \"phantom_candidates_per_scene\": " << fixed(s.phantom_candidates_per_scene, 2)
+    << ", \"ms_per_stereo_pair\": " << fixed(s.ms_per_pair, 1) << "}";
   return j.str();
 }
 
@@ -547,20 +559,165 @@ std::string mirror_voting_fields() {
   return "\"mirror_vote_ms\": " + field("mirror_vote_ms") + ", \"mirror_speedup\": " + field("mirror_speedup");
 }
 
+
+std::string summary_row(const std::string& label, const Summary& s) {
+  std::ostringstream md;
+  md << "| " << label << " | " << s.scenes << " | " << s.objects << " | " << fixed(100 * s.in_lines[0], 1) << " % | "
+     << fixed(100 * s.in_lines[1], 1) << " % | " << fixed(s.lines_per_frame, 1) << " | " << fixed(s.phantom_lines_per_frame, 2)
+     << " | " << fixed(100 * s.candidates_share, 1) << " % | " << fixed(s.phantom_candidates_per_scene, 2) << " | "
+     << fixed(s.ms_per_pair, 0) << " |\n";
+  return md.str();
+}
+
+std::string per_scene_json(const std::vector<SceneResult>& rs) {
+  std::ostringstream json;
+  json << "[\n";
+  for (size_t i = 0; i < rs.size(); ++i) {
+    const SceneResult& r = rs[i];
+    json << "    {\"scene\": \"" << r.name << "\", \"objects\": " << r.objects << ", \"in_lines\": [" << r.cameras[0].found << ", "
+         << r.cameras[1].found << "], \"visible\": [" << r.cameras[0].visible << ", " << r.cameras[1].visible
+         << "], \"phantom_lines\": " << r.cameras[0].phantoms + r.cameras[1].phantoms << ", \"candidates\": " << r.candidates
+         << ", \"object_candidates\": " << r.object_candidates << ", \"objects_without\": " << r.objects_without
+         << ", \"phantom_candidates\": " << r.phantom_candidates << "}" << (i + 1 < rs.size() ? "," : "") << "\n";
+  }
+  json << "  ]";
+  return json.str();
+}
+
+std::string per_scene_md(const std::vector<SceneResult>& rs) {
+  std::ostringstream md;
+  md << "| scene | objects | in left / right lines (object-frames) | phantom lines | candidates | objects | objects without | phantoms |\n"
+     << "|---|---|---|---|---|---|---|---|\n";
+  for (const SceneResult& r : rs)
+    md << "| " << r.name << " | " << r.objects << " | " << r.cameras[0].found << "/" << r.cameras[0].visible << ", "
+       << r.cameras[1].found << "/" << r.cameras[1].visible << " | " << r.cameras[0].phantoms + r.cameras[1].phantoms << " | "
+       << r.candidates << " | " << r.object_candidates << " | " << r.objects_without << " | " << r.phantom_candidates << " |\n";
+  return md.str();
+}
+
+LineLoss total_line_loss(const std::vector<SceneResult>& rs) {
+  LineLoss l;
+  for (const auto& r : rs) {
+    l.found += r.line_loss.found;
+    l.verification += r.line_loss.verification;
+    l.suppressed += r.line_loss.suppressed;
+    l.rank_low += r.line_loss.rank_low;
+    l.below_ratio += r.line_loss.below_ratio;
+    l.no_peak += r.line_loss.no_peak;
+  }
+  return l;
+}
+
+CandidateLoss total_candidate_loss(const std::vector<SceneResult>& rs) {
+  CandidateLoss c;
+  for (const auto& r : rs) {
+    c.candidate += r.candidate_loss.candidate;
+    c.never_both += r.candidate_loss.never_both;
+    c.no_intersect += r.candidate_loss.no_intersect;
+    c.not_clustered += r.candidate_loss.not_clustered;
+  }
+  return c;
+}
+
+using Results = std::map<std::string, std::map<std::string, std::vector<SceneResult>>>;
+
+void write_report(const Results& results, int frames, int dev_frames, const AfterOptions& o) {
+  const Summary before = summarise(results.at("eval").at("before")), after = summarise(results.at("eval").at("after"));
+  const Summary held_before = summarise(results.at("held").at("before")), held_after = summarise(results.at("held").at("after"));
+  std::ostringstream json;
+  json << "{\n  \"machine\": \"" << machine_description() << "\",\n  \"date\": \"" << today() << "\",\n  \"frames_per_scene\": "
+       << frames << ",\n  \"scenes\": " << after.scenes << ",\n  \"objects\": " << after.objects
+       << ",\n  \"objects_in_lines_share\": {\"left\": " << fixed(after.in_lines[0]) << ", \"right\": " << fixed(after.in_lines[1])
+       << ", \"mean\": " << fixed(0.5 * (after.in_lines[0] + after.in_lines[1])) << "},\n  \"phantom_lines_per_frame\": "
+       << fixed(after.phantom_lines_per_frame, 2) << ",\n  \"objects_as_candidates_share\": " << fixed(after.candidates_share)
+       << ",\n  \"phantom_candidates_per_scene\": " << fixed(after.phantom_candidates_per_scene, 2) << ",\n  "
+       << mirror_voting_fields() << ",\n  \"before\": " << summary_json(before) << ",\n  \"after\": " << summary_json(after)
+       << ",\n  \"first_round_after\": {\"objects_in_lines_share\": {\"left\": 0.542, \"right\": 0.528, \"mean\": 0.535}, "
+          "\"objects_as_candidates_share\": 0.391, \"phantom_candidates_per_scene\": 1.00, \"note\": \"reported 2026-11-24 "
+          "before the second round (docs/clutter.md)\"}"
+       << ",\n  \"per_scene\": " << per_scene_json(results.at("eval").at("after"))
+       << ",\n  \"held_out_2001_2012\": {\"before\": " << summary_json(held_before) << ", \"after\": " << summary_json(held_after)
+       << ",\n  \"per_scene\": " << per_scene_json(results.at("held").at("after")) << "}";
+  const LineLoss lb = total_line_loss(results.at("dev").at("before")), la = total_line_loss(results.at("dev").at("after"));
+  const CandidateLoss cb = total_candidate_loss(results.at("dev").at("before")), ca = total_candidate_loss(results.at("dev").at("after"));
+  auto loss_json = [](const LineLoss& l, const CandidateLoss& c) {
+    std::ostringstream j;
+    j << "{\"object_frames\": {\"in_lines\": " << l.found << ", \"dropped_by_verification\": " << l.verification
+      << ", \"removed_by_suppression\": " << l.suppressed << ", \"ranked_below_peaks_taken\": " << l.rank_low
+      << ", \"below_min_peak_ratio\": " << l.below_ratio << ", \"no_peak\": " << l.no_peak << "}, \"objects\": {\"candidate\": "
+      << c.candidate << ", \"never_in_both_cameras_lines\": " << c.never_both << ", \"no_intersect_near\": " << c.no_intersect
+      << ", \"intersects_not_clustered\": " << c.not_clustered << "}}";
+    return j.str();
+  };
+  json << ",\n  \"development_losses\": {\"frames_per_scene\": " << dev_frames << ", \"before\": " << loss_json(lb, cb)
+       << ", \"after\": " << loss_json(la, ca) << "}\n}\n";
+  write_result("clutter.json", json.str());
+
+  std::ostringstream md;
+  md << "# Busy tables: symmetry lines and candidates (issue 14)\n\n"
+     << "`nudge-exp-clutter --set both`, " << today() << ". " << machine_description() << ". Two held-out families: "
+     << "`eval_*` (seeds 1001-1010, fixed before the first round) and `held_*` (seeds 2001-2012, fixed before the "
+     << "second round changed anything; docs/clutter.md), " << frames
+     << " noisy stereo pairs per scene (a survey's), each run once. Objects \"in the lines\": the true axis within " << kLineDistancePx
+     << " px (at its middle) and " << kLineAngleDeg << " deg of one of the camera's lines, over the objects with at least "
+     << kMinVisiblePixels << " visible pixels; phantom lines: further than " << kPhantomDistancePx << " px or "
+     << kPhantomAngleDeg << " deg from every axis; a candidate is an object within " << kCandidateRadiusM * 1000
+     << " mm of its axis. ms / pair: both cameras' detection (edges, voting, peaks, verification) and the pair's "
+        "intersects, single-threaded, on this machine while others shared it.\n\n"
+     << "| pipeline | scenes | objects | in left lines | in right lines | lines / image | phantom lines / image | objects as candidates | phantom candidates / scene | ms / pair |\n"
+     << "|---|---|---|---|---|---|---|---|---|---|\n"
+     << summary_row("eval 1001-1010, before issue 14", before)
+     << "| eval 1001-1010, first round (reported before; docs/clutter.md) | 10 | 64 | 54.2 % | 52.8 % | 8.0 | 3.77 | 39.1 % | 1.00 | |\n"
+     << summary_row("eval 1001-1010, after", after) << summary_row("held 2001-2012, before issue 14", held_before)
+     << summary_row("held 2001-2012, after", held_after)
+     << "\nTargets (issue 14): >= 90 % of objects in each camera's lines, >= 95 % of objects a candidate, <= 1 phantom "
+        "candidate per scene.\n\n"
+     << "\"after\": " << o.candidates << " accumulator peaks (suppression " << o.suppress << "), only those within "
+     << o.upright << " deg of an upright axis' image verified, " << o.keep << " kept" << (o.snap ? ", snapped upright" : "")
+     << "; " << o.candidate_lines << " lines per image to CANDIDATES"
+     << (o.stereo_check ? ", stereo check (overlap " + fixed(o.min_overlap, 2) + ", foot " + fixed(o.max_foot, 2) + " m)" : ", no stereo check")
+     << ", QT min fraction " << fixed(o.min_fraction, 2) << " (docs/clutter.md).\n\n"
+     << "## Where objects are lost (development family, seeds 1-40, " << dev_frames << " stereo pairs per scene)\n\n"
+     << "Per visible object and camera frame: its axis among the lines; among the accumulator's peaks but dropped by the "
+        "verification (with the upright check: by it or by the verification); a peak of the accumulator (suppression 1, "
+        "no peak ratio) ranked within the peaks taken but removed by the coarser suppression; ranked below the peaks "
+        "taken; below the peak ratio; no peak at all (edges, voting, or a partly hidden outline). Per object: a "
+        "candidate; never in both cameras' lines in one frame; in both but no table intersect within 25 mm (stereo "
+        "pairing, the stereo check, the upright / workspace filter); intersects but no cluster.\n\n"
+     << "| pipeline | object-frames in lines | dropped by verification | removed by suppression | ranked below | below ratio | no peak | objects: candidate | never in both | no intersect | not clustered |\n"
+     << "|---|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const auto& [label, l, c] : {std::tuple<std::string, LineLoss, CandidateLoss>{"before issue 14", lb, cb}, {"after", la, ca}})
+    md << "| " << label << " | " << l.found << " | " << l.verification << " | " << l.suppressed << " | " << l.rank_low << " | "
+       << l.below_ratio << " | " << l.no_peak << " | " << c.candidate << " | " << c.never_both << " | " << c.no_intersect
+       << " | " << c.not_clustered << " |\n";
+  md << "\n## Per scene (eval, after)\n\n" << per_scene_md(results.at("eval").at("after"))
+     << "\n## Per scene (held, after)\n\n" << per_scene_md(results.at("held").at("after"))
+     << "\nOne left frame per scene (half size): true axes green, the frame's lines red (their support segments), "
+        "candidates projected from the table: cyan = an object, magenta = a phantom.\n\n";
+  for (const std::string family : {"eval", "held"})
+    for (const SceneResult& r : results.at(family).at("after")) {
+      cv::Mat half;
+      cv::resize(r.picture, half, cv::Size(), 0.5, 0.5, cv::INTER_AREA);
+      write_png("clutter_" + r.name + ".png", half);
+      md << "![" << r.name << "](clutter_" << r.name << ".png)\n";
+    }
+  write_result("clutter.md", md.str());
+}
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string set = "eval", scenes_dir = std::string(NUDGE_SOURCE_DIR) + "/common/sim/scenes/clutter";
-  int frames = 25;
+  std::string set = "both", scenes_dir = std::string(NUDGE_SOURCE_DIR) + "/common/sim/scenes/clutter";
+  int frames = 25, dev_frames = 2;
   bool no_write = false, skip_before = false, diagnose = false;
   int seed_min = 0, seed_max = 1 << 30;
   std::string pictures, dump_file;
   AfterOptions after_options;
   std::vector<double> canny;
   nudge::Flags flags("nudge-exp-clutter", "Symmetry lines and candidates on busy tables (issue 14).");
-  flags.add_string("set", &set, "scene family: eval (the report) or dev (for tuning)");
+  flags.add_string("set", &set, "scene families: both (the report: eval and held, and the losses on dev), or eval, held, dev alone");
   flags.add_string("scenes", &scenes_dir, "directory of the clutter scenes");
   flags.add_int("frames", &frames, "stereo pairs per scene (a survey's)");
+  flags.add_int("dev-frames", &dev_frames, "with --set both: stereo pairs per development scene for the loss breakdown");
   flags.add_bool("no-write", &no_write, "print only; write no result files");
   flags.add_string("pictures", &pictures, "also write each scene's picture (after) to this directory");
   flags.add_string("dump", &dump_file, "write every accumulator peak's features and truth to this CSV (tuning)");
@@ -596,7 +753,9 @@ int main(int argc, char** argv) {
   flags.add_double("min-fraction", &a.min_fraction, "after: smallest QT cluster, share of all intersects");
   try {
     if (!flags.parse(argc, argv)) return 0;
-    if (set != "eval" && set != "dev" && set != "held") throw nudge::FlagError("--set must be eval, held or dev");
+    if (set != "eval" && set != "dev" && set != "held" && set != "both")
+      throw nudge::FlagError("--set must be both (the report), eval, held or dev");
+    if (dev_frames < 1) throw nudge::FlagError("--dev-frames must be >= 1");
     if (frames < 1) throw nudge::FlagError("--frames must be >= 1");
     if (skip_before && !no_write) throw nudge::FlagError("--skip-before needs --no-write");
     a.verify = verify_flag != 0;
@@ -612,107 +771,66 @@ int main(int argc, char** argv) {
     std::cerr << e.what() << "\n" << flags.help();
     return 2;
   }
-  std::vector<std::string> files = scene_files(scenes_dir, set);
-  files.erase(std::remove_if(files.begin(), files.end(),
-                             [&](const std::string& f) {
-                               const std::string stem = fs::path(f).stem().string();
-                               const int seed = std::stoi(stem.substr(stem.rfind('_') + 1));
-                               return seed < seed_min || seed > seed_max;
-                             }),
-              files.end());
-  if (files.empty()) {
-    std::cerr << "nudge-exp-clutter: no " << set << "_*.yaml scenes in " << scenes_dir << "\n";
-    return 1;
-  }
+  // The families to run: --set both is the report (the two held-out families, and the loss
+  // breakdown on the development family); eval, held or dev alone are for looking.
+  std::vector<std::string> sets = set == "both" ? std::vector<std::string>{"eval", "held", "dev"} : std::vector<std::string>{set};
   std::vector<Pipeline> pipelines = {before_issue14(), after_issue14(after_options)};
   if (skip_before) pipelines.erase(pipelines.begin());
-  std::map<std::string, std::vector<SceneResult>> results;
+  std::map<std::string, std::map<std::string, std::vector<SceneResult>>> results;  // [set][pipeline]
   std::ofstream dump;
   if (!dump_file.empty()) {
     dump.open(dump_file);
     dump << "scene,frame,camera,rank,votes,pairs,band_share,appearance,band_len,rows,smooth,polarity,r,theta,label,tilt\n";
   }
-  nudge::Progress progress("nudge-exp-clutter", static_cast<int>(pipelines.size() * files.size()));
-  for (const Pipeline& pipeline : pipelines) {
-    for (const std::string& file : files) {
-      progress.step(pipeline.name + " " + fs::path(file).stem().string());
-      results[pipeline.name].push_back(run_scene(file, pipeline, frames, pipeline.name == "after", diagnose,
-                                                 dump.is_open() && pipeline.name == "after" ? &dump : nullptr));
-      const SceneResult& r = results[pipeline.name].back();
-      if (!pictures.empty() && !r.picture.empty()) cv::imwrite(pictures + "/" + r.name + ".png", r.picture);
-      std::ostringstream detail;
-      detail << pipeline.name << " " << r.name << ": " << r.objects << " objects; in lines L " << r.cameras[0].found
-                << "/" << r.cameras[0].visible << " R " << r.cameras[1].found << "/" << r.cameras[1].visible
-                << "; phantom lines " << r.cameras[0].phantoms + r.cameras[1].phantoms << "/"
-                << r.cameras[0].lines + r.cameras[1].lines << "; candidates " << r.candidates << ": objects "
-                << r.object_candidates << ", duplicates " << r.duplicate_candidates << ", phantoms "
-                << r.phantom_candidates << ", objects without " << r.objects_without;
-      progress.note(detail.str());
+  std::map<std::string, std::vector<std::string>> files_of;
+  int steps = 0;
+  for (const std::string& family : sets) {
+    std::vector<std::string> files = scene_files(scenes_dir, family);
+    files.erase(std::remove_if(files.begin(), files.end(),
+                               [&](const std::string& f) {
+                                 const std::string stem = fs::path(f).stem().string();
+                                 const int seed = std::stoi(stem.substr(stem.rfind('_') + 1));
+                                 return seed < seed_min || seed > seed_max;
+                               }),
+                files.end());
+    if (files.empty()) {
+      std::cerr << "nudge-exp-clutter: no " << family << "_*.yaml scenes in " << scenes_dir << "\n";
+      return 1;
     }
-    progress.note(pipeline.name + ": " + summary_json(summarise(results[pipeline.name])));
-    if (diagnose) progress.note(pipeline.name + " losses: " + losses_text(results[pipeline.name]));
+    steps += static_cast<int>(pipelines.size() * files.size());
+    files_of[family] = files;
   }
-  progress.finish(std::to_string(files.size()) + " " + set + " scenes, " + std::to_string(pipelines.size()) +
-                  " pipeline(s)");
+  nudge::Progress progress("nudge-exp-clutter", steps);
+  for (const std::string& family : sets) {
+    // In the report the development family only gives the loss breakdown, over fewer frames.
+    const bool breakdown_only = set == "both" && family == "dev";
+    for (const Pipeline& pipeline : pipelines) {
+      for (const std::string& file : files_of[family]) {
+        progress.step(pipeline.name + " " + fs::path(file).stem().string());
+        results[family][pipeline.name].push_back(
+            run_scene(file, pipeline, breakdown_only ? dev_frames : frames, pipeline.name == "after" && !breakdown_only,
+                      diagnose || breakdown_only, dump.is_open() && pipeline.name == "after" ? &dump : nullptr));
+        const SceneResult& r = results[family][pipeline.name].back();
+        if (!pictures.empty() && !r.picture.empty()) cv::imwrite(pictures + "/" + r.name + ".png", r.picture);
+        std::ostringstream detail;
+        detail << pipeline.name << " " << r.name << ": " << r.objects << " objects; in lines L " << r.cameras[0].found
+               << "/" << r.cameras[0].visible << " R " << r.cameras[1].found << "/" << r.cameras[1].visible
+               << "; phantom lines " << r.cameras[0].phantoms + r.cameras[1].phantoms << "/"
+               << r.cameras[0].lines + r.cameras[1].lines << "; candidates " << r.candidates << ": objects "
+               << r.object_candidates << ", duplicates " << r.duplicate_candidates << ", phantoms "
+               << r.phantom_candidates << ", objects without " << r.objects_without;
+        if (!breakdown_only || diagnose) progress.note(detail.str());
+      }
+      progress.note(family + " " + pipeline.name + ": " + summary_json(summarise(results[family][pipeline.name])));
+      if (diagnose || breakdown_only) progress.note(family + " " + pipeline.name + " losses: " + losses_text(results[family][pipeline.name]));
+    }
+  }
+  progress.finish(set + " scenes, " + std::to_string(pipelines.size()) + " pipeline(s)");
   if (no_write) return 0;
-  // The report, written once per run on the evaluation family only.
-  if (set != "eval") {
-    std::cerr << "(dev set: nothing written)\n";
+  if (set != "both") {
+    std::cerr << "(only --set both writes the report)\n";
     return 0;
   }
-  const Summary before = summarise(results["before"]), after = summarise(results["after"]);
-  std::ostringstream json;
-  json << "{\n  \"machine\": \"" << machine_description() << "\",\n  \"date\": \"" << today() << "\",\n  \"frames_per_scene\": "
-       << frames << ",\n  \"scenes\": " << after.scenes << ",\n  \"objects\": " << after.objects
-       << ",\n  \"objects_in_lines_share\": {\"left\": " << fixed(after.in_lines[0]) << ", \"right\": " << fixed(after.in_lines[1])
-       << ", \"mean\": " << fixed(0.5 * (after.in_lines[0] + after.in_lines[1])) << "},\n  \"phantom_lines_per_frame\": "
-       << fixed(after.phantom_lines_per_frame, 2) << ",\n  \"objects_as_candidates_share\": " << fixed(after.candidates_share)
-       << ",\n  \"phantom_candidates_per_scene\": " << fixed(after.phantom_candidates_per_scene, 2) << ",\n  "
-       << mirror_voting_fields() << ",\n  \"before\": " << summary_json(before) << ",\n  \"after\": " << summary_json(after)
-       << ",\n  \"per_scene\": [\n";
-  const auto& rs = results["after"];
-  for (size_t i = 0; i < rs.size(); ++i) {
-    const SceneResult& r = rs[i];
-    json << "    {\"scene\": \"" << r.name << "\", \"objects\": " << r.objects << ", \"in_lines\": [" << r.cameras[0].found << ", "
-         << r.cameras[1].found << "], \"visible\": [" << r.cameras[0].visible << ", " << r.cameras[1].visible
-         << "], \"phantom_lines\": " << r.cameras[0].phantoms + r.cameras[1].phantoms << ", \"candidates\": " << r.candidates
-         << ", \"object_candidates\": " << r.object_candidates << ", \"objects_without\": " << r.objects_without
-         << ", \"phantom_candidates\": " << r.phantom_candidates << "}" << (i + 1 < rs.size() ? "," : "") << "\n";
-  }
-  json << "  ]\n}\n";
-  write_result("clutter.json", json.str());
-
-  std::ostringstream md;
-  md << "# Busy tables: symmetry lines and candidates (issue 14)\n\n"
-     << "`nudge-exp-clutter`, " << today() << ". " << machine_description() << ". The evaluation family "
-     << "(`common/sim/scenes/clutter/eval_*.yaml`, seeds fixed before any result: docs/clutter.md), " << frames
-     << " noisy stereo pairs per scene (a survey's). Objects \"in the lines\": the true axis within " << kLineDistancePx
-     << " px (at its middle) and " << kLineAngleDeg << " deg of one of the camera's lines, over the objects with at least "
-     << kMinVisiblePixels << " visible pixels; phantom lines: further than " << kPhantomDistancePx << " px or "
-     << kPhantomAngleDeg << " deg from every axis; a candidate is an object within " << kCandidateRadiusM * 1000
-     << " mm of its axis.\n\n"
-     << "| pipeline | scenes | objects | in left lines | in right lines | lines / image | phantom lines / image | objects as candidates | phantom candidates / scene |\n"
-     << "|---|---|---|---|---|---|---|---|---|\n";
-  for (const auto& [label, s] : {std::pair<std::string, Summary>{"before issue 14", before}, {"after", after}})
-    md << "| " << label << " | " << s.scenes << " | " << s.objects << " | " << fixed(100 * s.in_lines[0], 1) << " % | "
-       << fixed(100 * s.in_lines[1], 1) << " % | " << fixed(s.lines_per_frame, 1) << " | " << fixed(s.phantom_lines_per_frame, 2)
-       << " | " << fixed(100 * s.candidates_share, 1) << " % | " << fixed(s.phantom_candidates_per_scene, 2) << " |\n";
-  md << "\nTargets (issue 14): >= 90 % of objects in each camera's lines, >= 95 % of objects a candidate, <= 1 phantom "
-        "candidate per scene.\n\n## Per scene (after)\n\n"
-     << "| scene | objects | in left / right lines (object-frames) | phantom lines | candidates | objects | objects without | phantoms |\n"
-     << "|---|---|---|---|---|---|---|---|\n";
-  for (const SceneResult& r : rs)
-    md << "| " << r.name << " | " << r.objects << " | " << r.cameras[0].found << "/" << r.cameras[0].visible << ", "
-       << r.cameras[1].found << "/" << r.cameras[1].visible << " | " << r.cameras[0].phantoms + r.cameras[1].phantoms << " | "
-       << r.candidates << " | " << r.object_candidates << " | " << r.objects_without << " | " << r.phantom_candidates << " |\n";
-  md << "\nOne left frame per scene (half size): true axes green, the frame's lines red (their support segments), "
-        "candidates projected from the table: cyan = an object, magenta = a phantom.\n\n";
-  for (const SceneResult& r : rs) {
-    cv::Mat half;
-    cv::resize(r.picture, half, cv::Size(), 0.5, 0.5, cv::INTER_AREA);
-    write_png("clutter_" + r.name + ".png", half);
-    md << "![" << r.name << "](clutter_" << r.name << ".png)\n";
-  }
-  write_result("clutter.md", md.str());
+  write_report(results, frames, dev_frames, after_options);
   return 0;
 }
