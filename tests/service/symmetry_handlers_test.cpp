@@ -119,3 +119,52 @@ TEST(SymmetryHandlers, ContoursOfTheTopLinesOnRequest) {
     for (const auto& p : *side)  // within the bottle's half-width (30 px) of the axis
       EXPECT_LE(std::fabs((p[0] - 159.5) * std::cos(theta) + (p[1] - 119.5) * std::sin(theta) - r), 33.0);
 }
+
+// With the upright check (issue 14) a camera looking level at the table (its normal is the
+// image's up) publishes vertical lines only: the bottle standing upright is found, the one
+// leaning 10 deg gets no line at its axis. A channel that names no camera is refused.
+TEST(SymmetryHandlers, UprightCheckKeepsOnlyLinesThatCanStandOnTheTable) {
+  nudge::symmetry_service::Options options = mono_options();
+  options.inputs = {"CAMERA_LEFT"};
+  options.params.num_lines = 10;
+  options.verify = true;
+  options.verify_params.keep = 3;
+  nudge::symmetry_service::Options::Upright upright;
+  for (nudge::geometry::Camera* camera : {&upright.rig.left, &upright.rig.right}) {
+    camera->width = 320;
+    camera->height = 240;
+    camera->K << 300, 0, 159.5, 0, 300, 119.5, 0, 0, 1;
+  }
+  upright.rig.T = Eigen::Vector3d(-0.1, 0, 0);
+  upright.table.normal = Eigen::Vector3d(0, -1, 0);
+  upright.table.offset = 0.3;
+  upright.max_tilt_deg = 2;
+  options.upright = upright;
+  InProcess run(options);
+  Latest<nudge::symmetry_lines_t> left_lines(run.probe, "SYMMETRY_LEFT");
+  auto publish = [&](double theta_deg, int64_t utime) {
+    nudge::image_t image = bottle_image(20, theta_deg * kDeg, utime);
+    run.bus.publish("CAMERA_LEFT", &image);
+    run.service.handle_pending();
+    return left_lines.get();
+  };
+  const nudge::symmetry_lines_t standing = publish(0, 1);
+  ASSERT_GE(standing.num_lines, 1);
+  EXPECT_NEAR(standing.lines[0].r, 20, 1.0);
+  EXPECT_NEAR(standing.lines[0].theta, 0, 1.0 * kDeg);
+  const nudge::symmetry_lines_t leaning = publish(10, 2);
+  EXPECT_EQ(leaning.utime, 2);
+  for (int i = 0; i < leaning.num_lines; ++i) EXPECT_GT(std::fabs(leaning.lines[i].theta - 10 * kDeg), 2 * kDeg);
+  EXPECT_EQ(run.service.counters().errors, 0);
+  // Without the check the leaning bottle's axis is published first.
+  options.upright.reset();
+  InProcess unchecked(options);
+  Latest<nudge::symmetry_lines_t> unchecked_lines(unchecked.probe, "SYMMETRY_LEFT");
+  nudge::image_t image = bottle_image(20, 10 * kDeg, 3);
+  unchecked.bus.publish("CAMERA_LEFT", &image);
+  unchecked.service.handle_pending();
+  ASSERT_GE(unchecked_lines.get().num_lines, 1);
+  EXPECT_NEAR(unchecked_lines.get().lines[0].theta, 10 * kDeg, 1.0 * kDeg);
+  EXPECT_EQ(nudge::symmetry_service::side_of_channel("CAMERA_RIGHT"), nudge::geometry::Side::Right);
+  EXPECT_THROW(nudge::symmetry_service::side_of_channel("CAMERA"), std::invalid_argument);
+}
