@@ -658,12 +658,12 @@ void write_report(const Results& results, int frames, int dev_frames, const Afte
      << "`nudge-exp-clutter --set both`, " << today() << ". " << machine_description() << ". Two held-out families: "
      << "`eval_*` (seeds 1001-1010, fixed before the first round) and `held_*` (seeds 2001-2012, fixed before the "
      << "second round changed anything; docs/clutter.md), " << frames
-     << " noisy stereo pairs per scene (a survey's), each run once. Objects \"in the lines\": the true axis within " << kLineDistancePx
+     << " noisy stereo pairs per scene (a survey takes 25; fewer here: 8 engineers shared the 2 cores), each run once. Objects \"in the lines\": the true axis within " << kLineDistancePx
      << " px (at its middle) and " << kLineAngleDeg << " deg of one of the camera's lines, over the objects with at least "
      << kMinVisiblePixels << " visible pixels; phantom lines: further than " << kPhantomDistancePx << " px or "
      << kPhantomAngleDeg << " deg from every axis; a candidate is an object within " << kCandidateRadiusM * 1000
      << " mm of its axis. ms / pair: both cameras' detection (edges, voting, peaks, verification) and the pair's "
-        "intersects, single-threaded, on this machine while others shared it.\n\n"
+        "intersects, single-threaded, on this machine while others shared it (load average about 10 on 2 cores: the figures vary by 4x between runs of the same pipeline, compare within a row pair only roughly).\n\n"
      << "| pipeline | scenes | objects | in left lines | in right lines | lines / image | phantom lines / image | objects as candidates | phantom candidates / scene | ms / pair |\n"
      << "|---|---|---|---|---|---|---|---|---|---|\n"
      << summary_row("eval 1001-1010, before issue 14", before)
