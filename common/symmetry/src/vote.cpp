@@ -137,19 +137,28 @@ constexpr bool kHaveNarrowPath = true;
 // and one 512-bit vector a row of up to 32, so most rows need a single compare per pixel. Only
 // valid when every coordinate, difference and histogram index fits in int16 (see narrow_fits).
 // With kMirror, a[0..n) are the row's orientations and pairs must also pass the mirror rule.
-template <bool kMirror>
+// With kFast (the mirror rule's fast path, Params::mirror_sorted_rows), two vector operations fewer
+// per step: the rule is tested as one unsigned compare, (a_i + a_j - 2 theta + tol) mod 2^16 <=
+// 2 tol, which is |a_i + a_j - 2 theta| <= tol without the absolute value; and out receives the
+// pair sums x_i + x_j + offset unshifted (the histogram shifts them, add_votes' shift = 2).
+template <bool kMirror, bool kFast = false>
 inline int row_pair_bins16(const int16_t* x, const int16_t* a, int n, const PairRule& rule,
                            const detail::MirrorRule& mirror, int16_t* out) {
+  static_assert(kMirror || !kFast, "the fast path is the mirror rule's");
   int count = 0;
   const int16_t dmin2 = static_cast<int16_t>(rule.dmin2);
   const int16_t span = static_cast<int16_t>(std::min<uint32_t>(rule.span, 0xFFFF));
   const int16_t offset = static_cast<int16_t>(rule.offset);
-  const __m512i vtol = _mm512_set1_epi16(mirror.tolerance);
+  // kFast: the pixel's side carries + tol, and the bound is 2 tol (<= 65534: tol <= 32767).
+  const int16_t bias = kFast ? mirror.tolerance : int16_t{0};
+  const __m512i vtol = _mm512_set1_epi16(kFast ? static_cast<int16_t>(2 * mirror.tolerance) : mirror.tolerance);
   // With kMirror: keeps the pairs whose |a_i + a_j - 2 theta| (int16 wraps modulo 180 deg) is
-  // within the tolerance.
+  // within the tolerance. ai_minus_target is a_i - 2 theta (+ tol with kFast).
   auto mirror_ok = [&](__mmask32 ok, __m512i aj, __m512i ai_minus_target) {
-    return _mm512_mask_cmple_epu16_mask(ok, _mm512_abs_epi16(_mm512_add_epi16(aj, ai_minus_target)), vtol);
+    const __m512i error = _mm512_add_epi16(aj, ai_minus_target);
+    return _mm512_mask_cmple_epu16_mask(ok, kFast ? error : _mm512_abs_epi16(error), vtol);
   };
+  auto bins_of = [](__m512i sums) { return kFast ? sums : _mm512_srai_epi16(sums, 2); };
   if (n <= 16) {
     // Two pixels per step: the row sits in both 256-bit halves of one 512-bit vector, the low
     // half compared with x[i] and the high half with x[i + 1].
@@ -171,11 +180,11 @@ inline int row_pair_bins16(const int16_t* x, const int16_t* a, int n, const Pair
       if constexpr (kMirror) {
         const int16_t a_next = i + 1 < n ? a[i + 1] : a[i];
         const __m512i ai = _mm512_inserti64x4(
-            _mm512_castsi256_si512(_mm256_set1_epi16(static_cast<int16_t>(a[i] - mirror.target))),
-            _mm256_set1_epi16(static_cast<int16_t>(a_next - mirror.target)), 1);
+            _mm512_castsi256_si512(_mm256_set1_epi16(static_cast<int16_t>(a[i] - mirror.target + bias))),
+            _mm256_set1_epi16(static_cast<int16_t>(a_next - mirror.target + bias)), 1);
         ok = mirror_ok(ok, as, ai);
       }
-      const __m512i bins = _mm512_srai_epi16(_mm512_add_epi16(xs, base), 2);
+      const __m512i bins = bins_of(_mm512_add_epi16(xs, base));
       _mm512_storeu_si512(out + count, _mm512_maskz_compress_epi16(ok, bins));
       count += __builtin_popcount(static_cast<unsigned>(ok));
     }
@@ -185,7 +194,7 @@ inline int row_pair_bins16(const int16_t* x, const int16_t* a, int n, const Pair
   for (int i = 0; i + 1 < n; ++i) {
     const __m512i xi = _mm512_set1_epi16(x[i]);
     const __m512i base = _mm512_set1_epi16(static_cast<int16_t>(x[i] + offset));
-    const __m512i ai = _mm512_set1_epi16(kMirror ? static_cast<int16_t>(a[i] - mirror.target) : int16_t{0});
+    const __m512i ai = _mm512_set1_epi16(kMirror ? static_cast<int16_t>(a[i] - mirror.target + bias) : int16_t{0});
     for (int j = i + 1; j < n; j += 32) {
       const int left = n - j;
       const __mmask32 lanes = left >= 32 ? ~__mmask32{0} : static_cast<__mmask32>((1ull << left) - 1);
@@ -193,7 +202,7 @@ inline int row_pair_bins16(const int16_t* x, const int16_t* a, int n, const Pair
       const __m512i d = _mm512_abs_epi16(_mm512_sub_epi16(xj, xi));
       __mmask32 ok = _mm512_mask_cmple_epu16_mask(lanes, _mm512_sub_epi16(d, vdmin), vspan);
       if constexpr (kMirror) ok = mirror_ok(ok, _mm512_maskz_loadu_epi16(lanes, a + j), ai);
-      const __m512i bins = _mm512_srai_epi16(_mm512_add_epi16(xj, base), 2);
+      const __m512i bins = bins_of(_mm512_add_epi16(xj, base));
       _mm512_storeu_si512(out + count, _mm512_maskz_compress_epi16(ok, bins));
       count += __builtin_popcount(static_cast<unsigned>(ok));
     }
@@ -202,7 +211,7 @@ inline int row_pair_bins16(const int16_t* x, const int16_t* a, int n, const Pair
 }
 #else
 constexpr bool kHaveNarrowPath = false;
-template <bool kMirror>
+template <bool kMirror, bool kFast = false>
 inline int row_pair_bins16(const int16_t*, const int16_t*, int, const PairRule&, const detail::MirrorRule&, int16_t*) {
   return 0;
 }
@@ -291,39 +300,104 @@ struct KernelChoice {
   int32_t offset;  // added to pair sums so that histogram indices are >= 0 for any skew
   bool narrow;
   bool windowed;
+  bool fast_mirror;  // the mirror rule on the 16-bit loops: ranked row sort, row_pair_bins16<true, true>
 };
 KernelChoice choose_kernels(const Layout& layout, const Params& p) {
   KernelChoice c;
   c.offset = 4 * (layout.r_max + 2) * (1 + skew_margin(p.skew_deg));
   c.narrow = kHaveNarrowPath && p.vector_kernels && 4 * layout.r_max + 2 * c.offset + 16 < 32767;
   c.windowed = !c.narrow && p.mirror_tolerance_deg > 0 && p.mirror_sorted_rows;
+  c.fast_mirror = c.narrow && p.mirror_tolerance_deg > 0 && p.mirror_sorted_rows;
   return c;
+}
+
+// Counting sort of the pixels into rows of Rot for the fast mirror path (KernelChoice::fast_mirror).
+// The plain scatter increments a row's counter for every pixel it places, and pixels along an edge
+// share rows, so each placement waits for the previous one's increment to reach memory. Here the
+// counting pass notes each pixel's rank among the earlier pixels of its row (in its counter lane),
+// so placing needs no counter update: slot = where the lane's part of the row starts + rank. x and
+// angle travel as one 32-bit word (one store per pixel), split into the 16-bit arrays afterwards.
+// Ranks fit in 16 bits: the 16-bit loops only run on images whose rows hold far fewer pixels.
+// Writes starts[0..num_rows] and x16, angle16 in row order.
+void sort_rows_ranked(const int32_t* xq, const int32_t* row, const int16_t* angle, size_t n, int num_rows,
+                      std::vector<int32_t>& counts, std::vector<uint16_t>& rank, std::vector<uint32_t>& packed,
+                      int32_t* starts, int16_t* x16, int16_t* angle16) {
+  constexpr int kLanes = 4;  // pixel i counts in lane i % 4: four independent chains of increments
+  counts.assign(kLanes * static_cast<size_t>(num_rows), 0);
+  rank.resize(n);
+  packed.resize(n);
+  int32_t* c = counts.data();
+  uint16_t* r = rank.data();
+  size_t i = 0;
+  for (; i + kLanes <= n; i += kLanes)
+    for (int l = 0; l < kLanes; ++l) r[i + l] = static_cast<uint16_t>(c[l * num_rows + row[i + l]]++);
+  for (; i < n; ++i) r[i] = static_cast<uint16_t>(c[row[i]]++);  // the tail counts in lane 0
+  int32_t running = 0;
+  for (int y = 0; y < num_rows; ++y) {
+    starts[y] = running;
+    for (int l = 0; l < kLanes; ++l) {
+      const int32_t lane_count = c[l * num_rows + y];
+      c[l * num_rows + y] = running;  // where lane l's pixels of row y start
+      running += lane_count;
+    }
+  }
+  starts[num_rows] = running;
+  uint32_t* out = packed.data();
+  auto word = [&](size_t p) {
+    return static_cast<uint32_t>(static_cast<uint16_t>(xq[p])) | static_cast<uint32_t>(static_cast<uint16_t>(angle[p])) << 16;
+  };
+  i = 0;
+  for (; i + kLanes <= n; i += kLanes)
+    for (int l = 0; l < kLanes; ++l) out[c[l * num_rows + row[i + l]] + r[i + l]] = word(i + l);
+  for (; i < n; ++i) out[c[row[i]] + r[i]] = word(i);
+  for (size_t k = 0; k < n; ++k) {  // vectorised by the compiler
+    x16[k] = static_cast<int16_t>(out[k] & 0xFFFF);
+    angle16[k] = static_cast<int16_t>(out[k] >> 16);
+  }
 }
 
 }  // namespace
 
-// Histograms pair bins into the four interleaved copies of the accumulator row.
-template <typename Bin>
-void Detector::add_votes(const Bin* bins, int votes, size_t hist_size, Scratch& s) const {
-  int32_t* h = s.hist.data();
+namespace {
+
+// The histogram index of a stored bin: the bin itself, or (kShift = 2) a non-negative pair sum >> 2.
+template <int kShift, typename Bin>
+inline auto histogram_index(Bin bin) {
+  if constexpr (kShift == 0) return bin;
+  else return static_cast<uint32_t>(static_cast<std::make_unsigned_t<Bin>>(bin)) >> kShift;
+}
+
+template <int kShift, typename Bin>
+void histogram4(const Bin* bins, int votes, size_t hist_size, int32_t* h) {
   int q = 0;
   for (; q + 4 <= votes; q += 4) {
-    ++h[bins[q]];
-    ++h[hist_size + bins[q + 1]];
-    ++h[2 * hist_size + bins[q + 2]];
-    ++h[3 * hist_size + bins[q + 3]];
+    ++h[histogram_index<kShift>(bins[q])];
+    ++h[hist_size + histogram_index<kShift>(bins[q + 1])];
+    ++h[2 * hist_size + histogram_index<kShift>(bins[q + 2])];
+    ++h[3 * hist_size + histogram_index<kShift>(bins[q + 3])];
   }
-  for (; q < votes; ++q) ++h[bins[q]];
+  for (; q < votes; ++q) ++h[histogram_index<kShift>(bins[q])];
+}
+
+}  // namespace
+
+// Histograms pair bins into the four interleaved copies of the accumulator row. Bins are
+// histogram indices, or with shift = 2 pair sums (non-negative) whose index is sum >> 2.
+template <typename Bin>
+void Detector::add_votes(const Bin* bins, int votes, size_t hist_size, Scratch& s, int shift) const {
+  if (shift == 2) histogram4<2>(bins, votes, hist_size, s.hist.data());
+  else histogram4<0>(bins, votes, hist_size, s.hist.data());
 }
 
 // One row's bins under the rule "a row of Rot increments a bin at most once" (sec. 3.2.3).
 template <typename Bin>
-void Detector::add_votes_once(const Bin* bins, int votes, int32_t row_id, Scratch& s) const {
+void Detector::add_votes_once(const Bin* bins, int votes, int32_t row_id, Scratch& s, int shift) const {
   int32_t* h = s.hist.data();
   for (int q = 0; q < votes; ++q) {
-    if (s.stamp[bins[q]] == row_id) continue;
-    s.stamp[bins[q]] = row_id;
-    ++h[bins[q]];
+    const uint32_t b = shift == 2 ? histogram_index<2>(bins[q]) : static_cast<uint32_t>(bins[q]);
+    if (s.stamp[b] == row_id) continue;
+    s.stamp[b] = row_id;
+    ++h[b];
   }
 }
 
@@ -410,6 +484,7 @@ void Detector::vote_thetas(const EdgeSet& edges, const std::vector<int>& thetas,
   if (narrow) s.sorted16.resize(n);
   const bool mirror = params_.mirror_tolerance_deg > 0;
   const bool sorted_rows = kernels.windowed;  // rows of Rot keep the pixels' orientation grouping
+  const int sum_shift = kernels.fast_mirror ? 2 : 0;  // the fast mirror loops store pair sums, not indices
   if (mirror) s.angle16.resize(n);
   s.bucket_start.resize(2 * kAngleBuckets + 1);
 
@@ -427,6 +502,10 @@ void Detector::vote_thetas(const EdgeSet& edges, const std::vector<int>& thetas,
       xq[i] = detail::rotated_xq(u[i], v[i], t);
       row[i] = detail::rotated_row(u[i], v[i], t) + layout.row_max;
     }
+    if (kernels.fast_mirror) {
+      sort_rows_ranked(xq, row, angle_.data(), n, num_rows, s.fill, s.rank, s.packed, s.starts.data(), s.sorted16.data(),
+                       s.angle16.data());
+    } else {
     constexpr int kLanes = 4;
     int32_t* counts = s.fill.data();  // kLanes x num_rows, lane-major
     int16_t* angle_out_sorted = s.angle16.data();
@@ -493,6 +572,7 @@ void Detector::vote_thetas(const EdgeSet& edges, const std::vector<int>& thetas,
     else if (narrow) scatter(s.sorted16.data(), std::false_type{});
     else if (mirror) scatter(s.sorted.data(), std::true_type{});
     else scatter(s.sorted.data(), std::false_type{});
+    }
     const detail::MirrorRule mirror_rule = detail::mirror_rule(k, params_.mirror_tolerance_deg, params_.mirror_polarity);
 
     // A grouped row taken twice over (see row_pair_bins_windowed).
@@ -519,14 +599,16 @@ void Detector::vote_thetas(const EdgeSet& edges, const std::vector<int>& thetas,
         // stores that wrote them would stall on store-to-load forwarding.
         if (narrow) {
           if (pending + need > s.pairs16.size()) {
-            add_votes(s.pairs16.data(), static_cast<int>(pending), hist_size, s);
+            add_votes(s.pairs16.data(), static_cast<int>(pending), hist_size, s, sum_shift);
             pending = 0;
             if (need > s.pairs16.size()) s.pairs16.resize(std::max(need, size_t{16384}));
           }
           const int16_t* x16 = s.sorted16.data() + s.starts[r];
           int16_t* out16 = s.pairs16.data() + pending;
-          pending += mirror ? row_pair_bins16<true>(x16, s.angle16.data() + s.starts[r], count, rule, mirror_rule, out16)
-                            : row_pair_bins16<false>(x16, nullptr, count, rule, mirror_rule, out16);
+          const int16_t* a16 = mirror ? s.angle16.data() + s.starts[r] : nullptr;
+          if (kernels.fast_mirror) pending += row_pair_bins16<true, true>(x16, a16, count, rule, mirror_rule, out16);
+          else if (mirror) pending += row_pair_bins16<true>(x16, a16, count, rule, mirror_rule, out16);
+          else pending += row_pair_bins16<false>(x16, nullptr, count, rule, mirror_rule, out16);
         } else {
           if (pending + need > s.pairs.size()) {
             add_votes(s.pairs.data(), static_cast<int>(pending), hist_size, s);
@@ -547,12 +629,12 @@ void Detector::vote_thetas(const EdgeSet& edges, const std::vector<int>& thetas,
                                               : row_pair_bins_scalar(x32, count, rule, out32);
         }
         if (params_.once_per_row) {  // the rule needs each row's bins on their own
-          if (narrow) add_votes_once(s.pairs16.data(), static_cast<int>(pending), (k * num_layers + layer) * num_rows + r, s);
+          if (narrow) add_votes_once(s.pairs16.data(), static_cast<int>(pending), (k * num_layers + layer) * num_rows + r, s, sum_shift);
           else add_votes_once(s.pairs.data(), static_cast<int>(pending), (k * num_layers + layer) * num_rows + r, s);
           pending = 0;
         }
       }
-      if (narrow) add_votes(s.pairs16.data(), static_cast<int>(pending), hist_size, s);
+      if (narrow) add_votes(s.pairs16.data(), static_cast<int>(pending), hist_size, s, sum_shift);
       else add_votes(s.pairs.data(), static_cast<int>(pending), hist_size, s);
       pending = 0;
       // Sum the copies into the accumulator row and clear them for the next theta.

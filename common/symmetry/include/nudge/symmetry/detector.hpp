@@ -153,11 +153,15 @@ class Detector {
     // orientation buckets start.
     std::vector<int16_t> doubled_angle;
     std::vector<int32_t> doubled_x, bucket_start;
+    // The mirror rule's ranked row sort (16-bit loops): each pixel's rank in its row, and the
+    // pixels' x and angle as one word in row order.
+    std::vector<uint16_t> rank;
+    std::vector<uint32_t> packed;
   };
   template <typename Bin>
-  void add_votes(const Bin* bins, int votes, size_t hist_size, Scratch& s) const;
+  void add_votes(const Bin* bins, int votes, size_t hist_size, Scratch& s, int shift = 0) const;
   template <typename Bin>
-  void add_votes_once(const Bin* bins, int votes, int32_t row_id, Scratch& s) const;
+  void add_votes_once(const Bin* bins, int votes, int32_t row_id, Scratch& s, int shift = 0) const;
   void vote_thetas(const EdgeSet& edges, const std::vector<int>& thetas, size_t first, size_t step,
                    Scratch& scratch);
   void add_support(const EdgeSet& edges, Line* line) const;
