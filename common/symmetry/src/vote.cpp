@@ -191,7 +191,13 @@ inline int row_pair_bins16(const int16_t* x, const int16_t* a, int n, const Pair
     return count;
   }
   const __m512i vdmin = _mm512_set1_epi16(dmin2), vspan = _mm512_set1_epi16(span);
-  for (int i = 0; i + 1 < n; ++i) {
+  // kFast: the last 16 pixels have at most 15 later partners each, a 32-lane step apiece; paired
+  // up as a row of their own they take two pixels a step. The pixels before them still check
+  // every later partner, the 16 included.
+  constexpr int kTail = 16;
+  const int wide_end = kFast ? n - kTail : n - 1;
+  if constexpr (kFast) count = row_pair_bins16<kMirror, kFast>(x + wide_end, a + wide_end, kTail, rule, mirror, out);
+  for (int i = 0; i < wide_end; ++i) {
     const __m512i xi = _mm512_set1_epi16(x[i]);
     const __m512i base = _mm512_set1_epi16(static_cast<int16_t>(x[i] + offset));
     const __m512i ai = _mm512_set1_epi16(kMirror ? static_cast<int16_t>(a[i] - mirror.target + bias) : int16_t{0});
