@@ -197,17 +197,23 @@ inline int row_pair_bins16(const int16_t* x, const int16_t* a, int n, const Pair
   constexpr int kTail = 16;
   const int wide_end = kFast ? n - kTail : n - 1;
   if constexpr (kFast) count = row_pair_bins16<kMirror, kFast>(x + wide_end, a + wide_end, kTail, rule, mirror, out);
+  const __m512i voffset = _mm512_set1_epi16(offset);
   for (int i = 0; i < wide_end; ++i) {
     const __m512i xi = _mm512_set1_epi16(x[i]);
-    const __m512i base = _mm512_set1_epi16(static_cast<int16_t>(x[i] + offset));
+    // kFast: one broadcast fewer (an add instead, which more ports take).
+    const __m512i base = kFast ? _mm512_add_epi16(xi, voffset) : _mm512_set1_epi16(static_cast<int16_t>(x[i] + offset));
     const __m512i ai = _mm512_set1_epi16(kMirror ? static_cast<int16_t>(a[i] - mirror.target + bias) : int16_t{0});
     for (int j = i + 1; j < n; j += 32) {
       const int left = n - j;
       const __mmask32 lanes = left >= 32 ? ~__mmask32{0} : static_cast<__mmask32>((1ull << left) - 1);
-      const __m512i xj = _mm512_maskz_loadu_epi16(lanes, x + j);
+      // kFast: plain loads (a masked load costs a vector operation besides the load); x and a have
+      // 32 readable entries past the row's end (sort_rows_ranked), and lanes past it are masked
+      // out of both compares and of the compress.
+      const __m512i xj = kFast ? _mm512_loadu_si512(x + j) : _mm512_maskz_loadu_epi16(lanes, x + j);
       const __m512i d = _mm512_abs_epi16(_mm512_sub_epi16(xj, xi));
       __mmask32 ok = _mm512_mask_cmple_epu16_mask(lanes, _mm512_sub_epi16(d, vdmin), vspan);
-      if constexpr (kMirror) ok = mirror_ok(ok, _mm512_maskz_loadu_epi16(lanes, a + j), ai);
+      if constexpr (kMirror)
+        ok = mirror_ok(ok, kFast ? _mm512_loadu_si512(a + j) : _mm512_maskz_loadu_epi16(lanes, a + j), ai);
       const __m512i bins = bins_of(_mm512_add_epi16(xj, base));
       _mm512_storeu_si512(out + count, _mm512_maskz_compress_epi16(ok, bins));
       count += __builtin_popcount(static_cast<unsigned>(ok));
@@ -487,11 +493,13 @@ void Detector::vote_thetas(const EdgeSet& edges, const std::vector<int>& thetas,
   for (double d : params_.skew_deg) tan_skew.push_back(std::tan(d * M_PI / 180.0));
   const PairRule base_rule{layout.dmin2, static_cast<uint32_t>(layout.dmax2 - layout.dmin2), offset + 2};
   const bool narrow = kernels.narrow;
-  if (narrow) s.sorted16.resize(n);
+  // The fast mirror loops read whole 32-lane vectors from a row's start: 32 entries of padding.
+  const size_t padding = kernels.fast_mirror ? 32 : 0;
+  if (narrow) s.sorted16.resize(n + padding);
   const bool mirror = params_.mirror_tolerance_deg > 0;
   const bool sorted_rows = kernels.windowed;  // rows of Rot keep the pixels' orientation grouping
   const int sum_shift = kernels.fast_mirror ? 2 : 0;  // the fast mirror loops store pair sums, not indices
-  if (mirror) s.angle16.resize(n);
+  if (mirror) s.angle16.resize(n + padding);
   s.bucket_start.resize(2 * kAngleBuckets + 1);
 
   for (size_t ti = first; ti < thetas.size(); ti += step) {
