@@ -19,7 +19,10 @@
 //    a stable counting sort keeps every row of Rot grouped, so the possible partners of a pixel
 //    are one run of the row taken twice over, found through a table of where each bucket starts;
 //    only those are checked (Params::mirror_sorted_rows). The 16-bit AVX-512 loops check up to 32
-//    partners a step, and there whole rows measured faster than windows.
+//    partners a step, and there whole rows measured faster than windows; with mirror_sorted_rows
+//    they take a faster way to the same votes instead (KernelChoice::fast_mirror): a ranked row
+//    sort (sort_rows_ranked: placing a pixel waits on no counter), the rule as one unsigned
+//    compare, pair sums shifted in the histogram, and the last 16 pixels of a long row two a step.
 // The accumulator is bit-identical to reference_vote() (tests compare them).
 #include <algorithm>
 #include <cstring>

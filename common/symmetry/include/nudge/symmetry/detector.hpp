@@ -58,8 +58,9 @@ struct Params {
   // against the partners whose orientations can mirror its own about the current angle (the other
   // pairs cannot vote). Applies to the 32-bit pair loops (no AVX-512, vector_kernels = false, or
   // images too large for 16-bit lanes); the 16-bit AVX-512 loops check whole rows, which measured
-  // faster (docs/results/mirror_voting.md). The accumulator is the same either way; false checks
-  // every pair of every row.
+  // faster, and here take their fast path: a row sort with no counter chain and fewer vector
+  // operations per pair step (docs/results/mirror_voting.md). The accumulator is the same either
+  // way; false is the plain mirror voting: every pair of every row, the plain row sort.
   bool mirror_sorted_rows = true;
   // false: the portable scalar pair loops even where AVX-512 is available (what builds without it
   // run; for tests and measurements). Same accumulator.
