@@ -157,7 +157,7 @@ class Detector {
     // The mirror rule's ranked row sort (16-bit loops): each pixel's rank in its row, and the
     // pixels' x and angle as one word in row order.
     std::vector<uint16_t> rank;
-    std::vector<uint32_t> packed;
+    std::vector<uint32_t> packed, uv;  // uv: the pixels' (u2, v2) as two int16 in one word
   };
   template <typename Bin>
   void add_votes(const Bin* bins, int votes, size_t hist_size, Scratch& s, int shift = 0) const;
