@@ -416,6 +416,59 @@ TEST(SymmetryVote, MirrorPolarityFastEqualsPlain) {
   expect_mirror_variants_equal_plain(edges, wrap);
 }
 
+TEST(SymmetryVote, MirrorFastPathEqualsPlainOnOddSizesLongRowsAndToleranceExtremes) {
+  // The mirror rule's fast path on the 16-bit AVX-512 loops (mirror_sorted_rows, vector_kernels:
+  // ranked row sort, the rule as one unsigned compare, pair sums shifted in the histogram) against
+  // the plain loop, with and without polarity: odd image sizes (pixel centres at half-integer
+  // doubled coordinates), rows of a thousand pixels (large ranks, many 32-lane steps per pixel, no
+  // distance limits), and tolerances at both ends (0 units: only exact mirrors; 90 deg: every
+  // pair but one angle error).
+  auto any_angle = [](std::mt19937& rng) {
+    return static_cast<int16_t>(std::uniform_int_distribution<int>(-32768, 32767)(rng));
+  };
+  auto with_directions = [&](EdgeSet edges, uint32_t seed) {
+    std::mt19937 rng(seed);
+    for (size_t i = 0; i < edges.points.size(); ++i) edges.direction.push_back(any_angle(rng));
+    return edges;
+  };
+  struct Case {
+    std::string name;
+    EdgeSet edges;
+    double dmin, dmax, tolerance;
+  };
+  std::vector<Case> cases;
+  cases.push_back({"161 x 97", with_directions(random_edges(161, 97, 2500, 31, any_angle), 32), 3, 120, 15});
+  cases.push_back({"33 x 17", with_directions(random_edges(33, 17, 300, 33, any_angle), 34), 1, 40, 20});
+  cases.push_back({"7 x 301", with_directions(random_edges(7, 301, 900, 35, any_angle), 36), 0, 0, 30});
+  cases.push_back({"161 x 97, tolerance 0 units", with_directions(random_edges(161, 97, 2500, 37, [](std::mt19937& rng) {
+                     return static_cast<int16_t>(std::uniform_int_distribution<int>(-3, 3)(rng) * 4096);
+                   }), 38), 2, 150, 0.001});
+  cases.push_back({"161 x 97, tolerance 90 deg", with_directions(random_edges(161, 97, 1500, 39, any_angle), 40), 2, 150, 90});
+  {
+    EdgeSet full;  // every pixel of a 1001 x 3 image: rows of Rot up to 1001 pixels long
+    full.width = 1001;
+    full.height = 3;
+    std::mt19937 rng(41);
+    for (int y = 0; y < full.height; ++y)
+      for (int x = 0; x < full.width; ++x) {
+        full.points.emplace_back(x, y);
+        full.orientation.push_back(any_angle(rng));
+      }
+    cases.push_back({"1001 x 3, every pixel", with_directions(full, 42), 0, 0, 10});
+  }
+  for (const Case& c : cases) {
+    for (const bool polarity : {false, true}) {
+      SCOPED_TRACE(c.name + ", polarity " + std::to_string(polarity));
+      Params p = synthetic_params();
+      p.dmin = c.dmin;
+      p.dmax = c.dmax;
+      p.mirror_tolerance_deg = c.tolerance;
+      p.mirror_polarity = polarity;
+      expect_mirror_variants_equal_plain(c.edges, p);
+    }
+  }
+}
+
 TEST(SymmetryBadInput, MirrorPolarityNeedsTheRuleAndDirections) {
   Params p;
   p.mirror_polarity = true;

@@ -19,7 +19,10 @@
 //    a stable counting sort keeps every row of Rot grouped, so the possible partners of a pixel
 //    are one run of the row taken twice over, found through a table of where each bucket starts;
 //    only those are checked (Params::mirror_sorted_rows). The 16-bit AVX-512 loops check up to 32
-//    partners a step, and there whole rows measured faster than windows.
+//    partners a step, and there whole rows measured faster than windows; with mirror_sorted_rows
+//    they take a faster way to the same votes instead (KernelChoice::fast_mirror): a ranked row
+//    sort (sort_rows_ranked: placing a pixel waits on no counter), the rule as one unsigned
+//    compare, pair sums shifted in the histogram, and the last 16 pixels of a long row two a step.
 // The accumulator is bit-identical to reference_vote() (tests compare them).
 #include <algorithm>
 #include <cstring>
@@ -137,19 +140,28 @@ constexpr bool kHaveNarrowPath = true;
 // and one 512-bit vector a row of up to 32, so most rows need a single compare per pixel. Only
 // valid when every coordinate, difference and histogram index fits in int16 (see narrow_fits).
 // With kMirror, a[0..n) are the row's orientations and pairs must also pass the mirror rule.
-template <bool kMirror>
+// With kFast (the mirror rule's fast path, Params::mirror_sorted_rows), two vector operations fewer
+// per step: the rule is tested as one unsigned compare, (a_i + a_j - 2 theta + tol) mod 2^16 <=
+// 2 tol, which is |a_i + a_j - 2 theta| <= tol without the absolute value; and out receives the
+// pair sums x_i + x_j + offset unshifted (the histogram shifts them, add_votes' shift = 2).
+template <bool kMirror, bool kFast = false>
 inline int row_pair_bins16(const int16_t* x, const int16_t* a, int n, const PairRule& rule,
                            const detail::MirrorRule& mirror, int16_t* out) {
+  static_assert(kMirror || !kFast, "the fast path is the mirror rule's");
   int count = 0;
   const int16_t dmin2 = static_cast<int16_t>(rule.dmin2);
   const int16_t span = static_cast<int16_t>(std::min<uint32_t>(rule.span, 0xFFFF));
   const int16_t offset = static_cast<int16_t>(rule.offset);
-  const __m512i vtol = _mm512_set1_epi16(mirror.tolerance);
+  // kFast: the pixel's side carries + tol, and the bound is 2 tol (<= 65534: tol <= 32767).
+  const int16_t bias = kFast ? mirror.tolerance : int16_t{0};
+  const __m512i vtol = _mm512_set1_epi16(kFast ? static_cast<int16_t>(2 * mirror.tolerance) : mirror.tolerance);
   // With kMirror: keeps the pairs whose |a_i + a_j - 2 theta| (int16 wraps modulo 180 deg) is
-  // within the tolerance.
+  // within the tolerance. ai_minus_target is a_i - 2 theta (+ tol with kFast).
   auto mirror_ok = [&](__mmask32 ok, __m512i aj, __m512i ai_minus_target) {
-    return _mm512_mask_cmple_epu16_mask(ok, _mm512_abs_epi16(_mm512_add_epi16(aj, ai_minus_target)), vtol);
+    const __m512i error = _mm512_add_epi16(aj, ai_minus_target);
+    return _mm512_mask_cmple_epu16_mask(ok, kFast ? error : _mm512_abs_epi16(error), vtol);
   };
+  auto bins_of = [](__m512i sums) { return kFast ? sums : _mm512_srai_epi16(sums, 2); };
   if (n <= 16) {
     // Two pixels per step: the row sits in both 256-bit halves of one 512-bit vector, the low
     // half compared with x[i] and the high half with x[i + 1].
@@ -171,29 +183,41 @@ inline int row_pair_bins16(const int16_t* x, const int16_t* a, int n, const Pair
       if constexpr (kMirror) {
         const int16_t a_next = i + 1 < n ? a[i + 1] : a[i];
         const __m512i ai = _mm512_inserti64x4(
-            _mm512_castsi256_si512(_mm256_set1_epi16(static_cast<int16_t>(a[i] - mirror.target))),
-            _mm256_set1_epi16(static_cast<int16_t>(a_next - mirror.target)), 1);
+            _mm512_castsi256_si512(_mm256_set1_epi16(static_cast<int16_t>(a[i] - mirror.target + bias))),
+            _mm256_set1_epi16(static_cast<int16_t>(a_next - mirror.target + bias)), 1);
         ok = mirror_ok(ok, as, ai);
       }
-      const __m512i bins = _mm512_srai_epi16(_mm512_add_epi16(xs, base), 2);
+      const __m512i bins = bins_of(_mm512_add_epi16(xs, base));
       _mm512_storeu_si512(out + count, _mm512_maskz_compress_epi16(ok, bins));
       count += __builtin_popcount(static_cast<unsigned>(ok));
     }
     return count;
   }
   const __m512i vdmin = _mm512_set1_epi16(dmin2), vspan = _mm512_set1_epi16(span);
-  for (int i = 0; i + 1 < n; ++i) {
+  // kFast: the last 16 pixels have at most 15 later partners each, a 32-lane step apiece; paired
+  // up as a row of their own they take two pixels a step. The pixels before them still check
+  // every later partner, the 16 included.
+  constexpr int kTail = 16;
+  const int wide_end = kFast ? n - kTail : n - 1;
+  if constexpr (kFast) count = row_pair_bins16<kMirror, kFast>(x + wide_end, a + wide_end, kTail, rule, mirror, out);
+  const __m512i voffset = _mm512_set1_epi16(offset);
+  for (int i = 0; i < wide_end; ++i) {
     const __m512i xi = _mm512_set1_epi16(x[i]);
-    const __m512i base = _mm512_set1_epi16(static_cast<int16_t>(x[i] + offset));
-    const __m512i ai = _mm512_set1_epi16(kMirror ? static_cast<int16_t>(a[i] - mirror.target) : int16_t{0});
+    // kFast: one broadcast fewer (an add instead, which more ports take).
+    const __m512i base = kFast ? _mm512_add_epi16(xi, voffset) : _mm512_set1_epi16(static_cast<int16_t>(x[i] + offset));
+    const __m512i ai = _mm512_set1_epi16(kMirror ? static_cast<int16_t>(a[i] - mirror.target + bias) : int16_t{0});
     for (int j = i + 1; j < n; j += 32) {
       const int left = n - j;
       const __mmask32 lanes = left >= 32 ? ~__mmask32{0} : static_cast<__mmask32>((1ull << left) - 1);
-      const __m512i xj = _mm512_maskz_loadu_epi16(lanes, x + j);
+      // kFast: plain loads (a masked load costs a vector operation besides the load); x and a have
+      // 32 readable entries past the row's end (sort_rows_ranked), and lanes past it are masked
+      // out of both compares and of the compress.
+      const __m512i xj = kFast ? _mm512_loadu_si512(x + j) : _mm512_maskz_loadu_epi16(lanes, x + j);
       const __m512i d = _mm512_abs_epi16(_mm512_sub_epi16(xj, xi));
       __mmask32 ok = _mm512_mask_cmple_epu16_mask(lanes, _mm512_sub_epi16(d, vdmin), vspan);
-      if constexpr (kMirror) ok = mirror_ok(ok, _mm512_maskz_loadu_epi16(lanes, a + j), ai);
-      const __m512i bins = _mm512_srai_epi16(_mm512_add_epi16(xj, base), 2);
+      if constexpr (kMirror)
+        ok = mirror_ok(ok, kFast ? _mm512_loadu_si512(a + j) : _mm512_maskz_loadu_epi16(lanes, a + j), ai);
+      const __m512i bins = bins_of(_mm512_add_epi16(xj, base));
       _mm512_storeu_si512(out + count, _mm512_maskz_compress_epi16(ok, bins));
       count += __builtin_popcount(static_cast<unsigned>(ok));
     }
@@ -202,7 +226,7 @@ inline int row_pair_bins16(const int16_t* x, const int16_t* a, int n, const Pair
 }
 #else
 constexpr bool kHaveNarrowPath = false;
-template <bool kMirror>
+template <bool kMirror, bool kFast = false>
 inline int row_pair_bins16(const int16_t*, const int16_t*, int, const PairRule&, const detail::MirrorRule&, int16_t*) {
   return 0;
 }
@@ -291,39 +315,131 @@ struct KernelChoice {
   int32_t offset;  // added to pair sums so that histogram indices are >= 0 for any skew
   bool narrow;
   bool windowed;
+  bool fast_mirror;  // the mirror rule on the 16-bit loops: ranked row sort, row_pair_bins16<true, true>
 };
 KernelChoice choose_kernels(const Layout& layout, const Params& p) {
   KernelChoice c;
   c.offset = 4 * (layout.r_max + 2) * (1 + skew_margin(p.skew_deg));
   c.narrow = kHaveNarrowPath && p.vector_kernels && 4 * layout.r_max + 2 * c.offset + 16 < 32767;
   c.windowed = !c.narrow && p.mirror_tolerance_deg > 0 && p.mirror_sorted_rows;
+  c.fast_mirror = c.narrow && p.mirror_tolerance_deg > 0 && p.mirror_sorted_rows;
   return c;
+}
+
+// The rotation of quantise.hpp for pixels given as (u2, v2) int16 pairs, 16 at a time with one
+// 16-bit multiply-add per coordinate (u2 C + v2 S and v2 C - u2 S, exact in int32) instead of two
+// 32-bit multiplies. Returns how many pixels it rotated (the rest are the caller's); 0 without
+// AVX-512 BW.
+size_t rotate_pairs16(const uint32_t* uv, size_t n, const ThetaTable& t, int row_max, int32_t* xq, int32_t* row) {
+  size_t i = 0;
+#if defined(__AVX512BW__)
+  auto pair = [](int32_t low, int32_t high) {
+    return _mm512_set1_epi32(static_cast<int32_t>(static_cast<uint32_t>(static_cast<uint16_t>(low)) |
+                                                  static_cast<uint32_t>(static_cast<uint16_t>(high)) << 16));
+  };
+  const __m512i cos_sin = pair(t.c, t.s), minus_sin_cos = pair(-t.s, t.c);
+  const __m512i half_x = _mm512_set1_epi32(1 << (detail::kFixedShift - 1));
+  const __m512i half_row = _mm512_set1_epi32(1 << detail::kFixedShift), first_row = _mm512_set1_epi32(row_max);
+  for (; i + 16 <= n; i += 16) {
+    const __m512i p = _mm512_loadu_si512(uv + i);
+    const __m512i x = _mm512_srai_epi32(_mm512_add_epi32(_mm512_madd_epi16(p, cos_sin), half_x), detail::kFixedShift);
+    const __m512i y = _mm512_srai_epi32(_mm512_add_epi32(_mm512_madd_epi16(p, minus_sin_cos), half_row), detail::kFixedShift + 1);
+    _mm512_storeu_si512(xq + i, x);
+    _mm512_storeu_si512(row + i, _mm512_add_epi32(y, first_row));
+  }
+#else
+  (void)uv, (void)n, (void)t, (void)row_max, (void)xq, (void)row;
+#endif
+  return i;
+}
+
+// Counting sort of the pixels into rows of Rot for the fast mirror path (KernelChoice::fast_mirror).
+// The plain scatter increments a row's counter for every pixel it places, and pixels along an edge
+// share rows, so each placement waits for the previous one's increment to reach memory. Here the
+// counting pass notes each pixel's rank among the earlier pixels of its row (in its counter lane),
+// so placing needs no counter update: slot = where the lane's part of the row starts + rank. x and
+// angle travel as one 32-bit word (one store per pixel), split into the 16-bit arrays afterwards.
+// Ranks fit in 16 bits: the 16-bit loops only run on images whose rows hold far fewer pixels.
+// Writes starts[0..num_rows] and x16, angle16 in row order.
+void sort_rows_ranked(const int32_t* xq, const int32_t* row, const int16_t* angle, size_t n, int num_rows,
+                      std::vector<int32_t>& counts, std::vector<uint16_t>& rank, std::vector<uint32_t>& packed,
+                      int32_t* starts, int16_t* x16, int16_t* angle16) {
+  constexpr int kLanes = 4;  // pixel i counts in lane i % 4: four independent chains of increments
+  counts.assign(kLanes * static_cast<size_t>(num_rows), 0);
+  rank.resize(n);
+  packed.resize(n);
+  int32_t* c = counts.data();
+  uint16_t* r = rank.data();
+  size_t i = 0;
+  for (; i + kLanes <= n; i += kLanes)
+    for (int l = 0; l < kLanes; ++l) r[i + l] = static_cast<uint16_t>(c[l * num_rows + row[i + l]]++);
+  for (; i < n; ++i) r[i] = static_cast<uint16_t>(c[row[i]]++);  // the tail counts in lane 0
+  int32_t running = 0;
+  for (int y = 0; y < num_rows; ++y) {
+    starts[y] = running;
+    for (int l = 0; l < kLanes; ++l) {
+      const int32_t lane_count = c[l * num_rows + y];
+      c[l * num_rows + y] = running;  // where lane l's pixels of row y start
+      running += lane_count;
+    }
+  }
+  starts[num_rows] = running;
+  uint32_t* out = packed.data();
+  auto word = [&](size_t p) {
+    return static_cast<uint32_t>(static_cast<uint16_t>(xq[p])) | static_cast<uint32_t>(static_cast<uint16_t>(angle[p])) << 16;
+  };
+  i = 0;
+  for (; i + kLanes <= n; i += kLanes)
+    for (int l = 0; l < kLanes; ++l) out[c[l * num_rows + row[i + l]] + r[i + l]] = word(i + l);
+  for (; i < n; ++i) out[c[row[i]] + r[i]] = word(i);
+  for (size_t k = 0; k < n; ++k) {  // vectorised by the compiler
+    x16[k] = static_cast<int16_t>(out[k] & 0xFFFF);
+    angle16[k] = static_cast<int16_t>(out[k] >> 16);
+  }
 }
 
 }  // namespace
 
-// Histograms pair bins into the four interleaved copies of the accumulator row.
-template <typename Bin>
-void Detector::add_votes(const Bin* bins, int votes, size_t hist_size, Scratch& s) const {
-  int32_t* h = s.hist.data();
+namespace {
+
+// The histogram index of a stored bin: the bin itself, or (kShift = 2) a non-negative pair sum >> 2.
+template <int kShift, typename Bin>
+inline auto histogram_index(Bin bin) {
+  if constexpr (kShift == 0) return bin;
+  else return static_cast<uint32_t>(static_cast<std::make_unsigned_t<Bin>>(bin)) >> kShift;
+}
+
+template <int kShift, typename Bin>
+void histogram4(const Bin* bins, int votes, size_t hist_size, int32_t* h) {
   int q = 0;
   for (; q + 4 <= votes; q += 4) {
-    ++h[bins[q]];
-    ++h[hist_size + bins[q + 1]];
-    ++h[2 * hist_size + bins[q + 2]];
-    ++h[3 * hist_size + bins[q + 3]];
+    ++h[histogram_index<kShift>(bins[q])];
+    ++h[hist_size + histogram_index<kShift>(bins[q + 1])];
+    ++h[2 * hist_size + histogram_index<kShift>(bins[q + 2])];
+    ++h[3 * hist_size + histogram_index<kShift>(bins[q + 3])];
   }
-  for (; q < votes; ++q) ++h[bins[q]];
+  for (; q < votes; ++q) ++h[histogram_index<kShift>(bins[q])];
+}
+
+}  // namespace
+
+// Histograms pair bins into the four interleaved copies of the accumulator row. Bins are
+// histogram indices, or with shift = 2 pair sums (non-negative) whose index is sum >> 2.
+template <typename Bin>
+void Detector::add_votes(const Bin* bins, int votes, size_t hist_size, Scratch& s, int shift) const {
+  if (shift == 2) histogram4<2>(bins, votes, hist_size, s.hist.data());
+  else histogram4<0>(bins, votes, hist_size, s.hist.data());
 }
 
 // One row's bins under the rule "a row of Rot increments a bin at most once" (sec. 3.2.3).
 template <typename Bin>
-void Detector::add_votes_once(const Bin* bins, int votes, int32_t row_id, Scratch& s) const {
+void Detector::add_votes_once(const Bin* bins, int votes, int32_t row_id, Scratch& s, int shift) const {
   int32_t* h = s.hist.data();
   for (int q = 0; q < votes; ++q) {
-    if (s.stamp[bins[q]] == row_id) continue;
-    s.stamp[bins[q]] = row_id;
-    ++h[bins[q]];
+    const uint32_t b = shift == 2 ? histogram_index<2>(bins[q]) : static_cast<uint32_t>(bins[q]);
+    if (s.stamp[b] == row_id) continue;
+    s.stamp[b] = row_id;
+    ++h[b];
   }
 }
 
@@ -407,10 +523,18 @@ void Detector::vote_thetas(const EdgeSet& edges, const std::vector<int>& thetas,
   for (double d : params_.skew_deg) tan_skew.push_back(std::tan(d * M_PI / 180.0));
   const PairRule base_rule{layout.dmin2, static_cast<uint32_t>(layout.dmax2 - layout.dmin2), offset + 2};
   const bool narrow = kernels.narrow;
-  if (narrow) s.sorted16.resize(n);
+  // The fast mirror loops read whole 32-lane vectors from a row's start: 32 entries of padding.
+  const size_t padding = kernels.fast_mirror ? 32 : 0;
+  if (narrow) s.sorted16.resize(n + padding);
   const bool mirror = params_.mirror_tolerance_deg > 0;
   const bool sorted_rows = kernels.windowed;  // rows of Rot keep the pixels' orientation grouping
-  if (mirror) s.angle16.resize(n);
+  const int sum_shift = kernels.fast_mirror ? 2 : 0;  // the fast mirror loops store pair sums, not indices
+  if (kernels.fast_mirror) {  // (u2, v2) as one word of two int16 (they fit: the 16-bit loops' images are small)
+    s.uv.resize(n);
+    for (size_t i = 0; i < n; ++i)
+      s.uv[i] = static_cast<uint32_t>(static_cast<uint16_t>(u2_[i])) | static_cast<uint32_t>(static_cast<uint16_t>(v2_[i])) << 16;
+  }
+  if (mirror) s.angle16.resize(n + padding);
   s.bucket_start.resize(2 * kAngleBuckets + 1);
 
   for (size_t ti = first; ti < thetas.size(); ti += step) {
@@ -423,10 +547,16 @@ void Detector::vote_thetas(const EdgeSet& edges, const std::vector<int>& thetas,
     int32_t* row = s.row.data();
     const int32_t* u = u2_.data();
     const int32_t* v = v2_.data();
-    for (size_t i = 0; i < n; ++i) {
+    size_t rotated = 0;
+    if (kernels.fast_mirror) rotated = rotate_pairs16(s.uv.data(), n, t, layout.row_max, xq, row);
+    for (size_t i = rotated; i < n; ++i) {
       xq[i] = detail::rotated_xq(u[i], v[i], t);
       row[i] = detail::rotated_row(u[i], v[i], t) + layout.row_max;
     }
+    if (kernels.fast_mirror) {
+      sort_rows_ranked(xq, row, angle_.data(), n, num_rows, s.fill, s.rank, s.packed, s.starts.data(), s.sorted16.data(),
+                       s.angle16.data());
+    } else {
     constexpr int kLanes = 4;
     int32_t* counts = s.fill.data();  // kLanes x num_rows, lane-major
     int16_t* angle_out_sorted = s.angle16.data();
@@ -493,6 +623,7 @@ void Detector::vote_thetas(const EdgeSet& edges, const std::vector<int>& thetas,
     else if (narrow) scatter(s.sorted16.data(), std::false_type{});
     else if (mirror) scatter(s.sorted.data(), std::true_type{});
     else scatter(s.sorted.data(), std::false_type{});
+    }
     const detail::MirrorRule mirror_rule = detail::mirror_rule(k, params_.mirror_tolerance_deg, params_.mirror_polarity);
 
     // A grouped row taken twice over (see row_pair_bins_windowed).
@@ -519,14 +650,16 @@ void Detector::vote_thetas(const EdgeSet& edges, const std::vector<int>& thetas,
         // stores that wrote them would stall on store-to-load forwarding.
         if (narrow) {
           if (pending + need > s.pairs16.size()) {
-            add_votes(s.pairs16.data(), static_cast<int>(pending), hist_size, s);
+            add_votes(s.pairs16.data(), static_cast<int>(pending), hist_size, s, sum_shift);
             pending = 0;
             if (need > s.pairs16.size()) s.pairs16.resize(std::max(need, size_t{16384}));
           }
           const int16_t* x16 = s.sorted16.data() + s.starts[r];
           int16_t* out16 = s.pairs16.data() + pending;
-          pending += mirror ? row_pair_bins16<true>(x16, s.angle16.data() + s.starts[r], count, rule, mirror_rule, out16)
-                            : row_pair_bins16<false>(x16, nullptr, count, rule, mirror_rule, out16);
+          const int16_t* a16 = mirror ? s.angle16.data() + s.starts[r] : nullptr;
+          if (kernels.fast_mirror) pending += row_pair_bins16<true, true>(x16, a16, count, rule, mirror_rule, out16);
+          else if (mirror) pending += row_pair_bins16<true>(x16, a16, count, rule, mirror_rule, out16);
+          else pending += row_pair_bins16<false>(x16, nullptr, count, rule, mirror_rule, out16);
         } else {
           if (pending + need > s.pairs.size()) {
             add_votes(s.pairs.data(), static_cast<int>(pending), hist_size, s);
@@ -547,12 +680,12 @@ void Detector::vote_thetas(const EdgeSet& edges, const std::vector<int>& thetas,
                                               : row_pair_bins_scalar(x32, count, rule, out32);
         }
         if (params_.once_per_row) {  // the rule needs each row's bins on their own
-          if (narrow) add_votes_once(s.pairs16.data(), static_cast<int>(pending), (k * num_layers + layer) * num_rows + r, s);
+          if (narrow) add_votes_once(s.pairs16.data(), static_cast<int>(pending), (k * num_layers + layer) * num_rows + r, s, sum_shift);
           else add_votes_once(s.pairs.data(), static_cast<int>(pending), (k * num_layers + layer) * num_rows + r, s);
           pending = 0;
         }
       }
-      if (narrow) add_votes(s.pairs16.data(), static_cast<int>(pending), hist_size, s);
+      if (narrow) add_votes(s.pairs16.data(), static_cast<int>(pending), hist_size, s, sum_shift);
       else add_votes(s.pairs.data(), static_cast<int>(pending), hist_size, s);
       pending = 0;
       // Sum the copies into the accumulator row and clear them for the next theta.

@@ -58,8 +58,9 @@ struct Params {
   // against the partners whose orientations can mirror its own about the current angle (the other
   // pairs cannot vote). Applies to the 32-bit pair loops (no AVX-512, vector_kernels = false, or
   // images too large for 16-bit lanes); the 16-bit AVX-512 loops check whole rows, which measured
-  // faster (docs/results/mirror_voting.md). The accumulator is the same either way; false checks
-  // every pair of every row.
+  // faster, and here take their fast path: a row sort with no counter chain and fewer vector
+  // operations per pair step (docs/results/mirror_voting.md). The accumulator is the same either
+  // way; false is the plain mirror voting: every pair of every row, the plain row sort.
   bool mirror_sorted_rows = true;
   // false: the portable scalar pair loops even where AVX-512 is available (what builds without it
   // run; for tests and measurements). Same accumulator.
@@ -153,11 +154,15 @@ class Detector {
     // orientation buckets start.
     std::vector<int16_t> doubled_angle;
     std::vector<int32_t> doubled_x, bucket_start;
+    // The mirror rule's ranked row sort (16-bit loops): each pixel's rank in its row, and the
+    // pixels' x and angle as one word in row order.
+    std::vector<uint16_t> rank;
+    std::vector<uint32_t> packed, uv;  // uv: the pixels' (u2, v2) as two int16 in one word
   };
   template <typename Bin>
-  void add_votes(const Bin* bins, int votes, size_t hist_size, Scratch& s) const;
+  void add_votes(const Bin* bins, int votes, size_t hist_size, Scratch& s, int shift = 0) const;
   template <typename Bin>
-  void add_votes_once(const Bin* bins, int votes, int32_t row_id, Scratch& s) const;
+  void add_votes_once(const Bin* bins, int votes, int32_t row_id, Scratch& s, int shift = 0) const;
   void vote_thetas(const EdgeSet& edges, const std::vector<int>& thetas, size_t first, size_t step,
                    Scratch& scratch);
   void add_support(const EdgeSet& edges, Line* line) const;
