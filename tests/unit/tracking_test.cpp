@@ -413,6 +413,32 @@ TEST(AutomaticStart, PicksTheConsistentAssociationOfTwentySeven) {
 
 // ---- Refinement and the rotated box ----------------------------------------------------------
 
+// Re-acquiring near the lost track (issue 15 follow-up: after a loss the automatic start took the
+// strongest moving line, e.g. a distractor crossing the place where a resting object was lost).
+// Three frames: a strong line moving steadily at R = 150, and a weaker one moving at R = -40, where
+// the lost track was. best_start alone takes the strong one; on the lines near the lost track it
+// takes the weak one; a frame with no line near the lost track keeps all its lines.
+TEST(AutomaticStart, PrefersLinesNearTheLostTrack) {
+  const std::vector<std::vector<LineMeasurement>> window = {
+      {{150, 3, 900}, {-40, 0, 300}}, {{147, 3, 900}, {-37, 0, 300}}, {{144, 3, 900}, {-34, 0, 300}}};
+  LineKalman lost;
+  lost.initialise({-45, 0});
+  lost.hold();
+  for (int i = 0; i < 3; ++i) lost.predict();  // its gate grows with the frames since the loss
+  LineKalman filter;
+  double error = 0;
+  ASSERT_TRUE(best_start(window, KalmanParams{}, &filter, &error, 1.0));
+  EXPECT_NEAR(filter.line().r, 144, 2) << "the strongest consistent chain";
+  const auto near = lines_near(lost, window);
+  ASSERT_TRUE(best_start(near, KalmanParams{}, &filter, &error, 1.0));
+  EXPECT_NEAR(filter.line().r, -34, 2) << "the chain where the object was lost";
+  // A frame without any line near the lost track keeps all of its lines.
+  const auto far = lines_near(lost, {{{150, 3, 900}}});
+  ASSERT_EQ(far.size(), 1u);
+  EXPECT_EQ(far[0].size(), 1u);
+  EXPECT_EQ(lines_near(lost, window)[0].size(), 1u);
+}
+
 TEST(Refine, DropsAsymmetricBlocksAndFillsHoles) {
   // 40 x 30 blocks of 8 px; a symmetric blob about the vertical line through x = 159.5 (R = 0).
   cv::Mat blocks = cv::Mat::zeros(30, 40, CV_8U);

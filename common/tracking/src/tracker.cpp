@@ -123,6 +123,7 @@ void validate(const TrackerParams& p) {
   require(p.start.max_frames >= 3, "tracker start max_frames must be >= 3");
   require(std::isfinite(p.start.tie_margin) && p.start.tie_margin >= 0, "tracker start tie_margin must be >= 0");
   require(p.start.rearm_frames >= 0, "tracker start rearm_frames must be >= 0");
+  require(p.start.reacquire_frames >= 0, "tracker start reacquire_frames must be >= 0");
   require(std::isfinite(p.gate_sigmas) && p.gate_sigmas > 0, "tracker gate_sigmas must be > 0");
   require(std::isfinite(p.min_half_width_deg) && p.min_half_width_deg >= 0.5 && p.min_half_width_deg <= 90,
           "tracker min_half_width_deg must be in [0.5, 90]");
@@ -198,8 +199,20 @@ int associate(const LineKalman& filter, const std::vector<LineMeasurement>& line
   return best;
 }
 
+std::vector<std::vector<LineMeasurement>> lines_near(const LineKalman& lost,
+                                                     const std::vector<std::vector<LineMeasurement>>& frames) {
+  std::vector<std::vector<LineMeasurement>> preferred;
+  for (const auto& lines : frames) {
+    std::vector<LineMeasurement> near;
+    for (const LineMeasurement& line : lines)
+      if (lost.in_gate(lost.gate_error(line))) near.push_back(line);
+    preferred.push_back(near.empty() ? lines : near);
+  }
+  return preferred;
+}
+
 SymmetryTracker::SymmetryTracker(TrackerParams params)
-    : params_(std::move(params)), reason_(kWaitingForFirstFrame), kalman_(params_.kalman) {
+    : params_(std::move(params)), reason_(kWaitingForFirstFrame), kalman_(params_.kalman), last_measured_track_(params_.kalman), lost_track_(params_.kalman) {
   validate(params_);
 }
 
@@ -212,6 +225,7 @@ void SymmetryTracker::reset(TrackStatus status, const std::string& reason) {
   start_frames_ = 0;
   missed_ = 0;
   frames_since_loss_ = -1;  // the past frames are forgotten: any motion starts a track
+  frames_since_lost_track_ = -1;
   object_blocks_.release();
   last_votes_ = 0;
   resting_ = 0;
@@ -226,10 +240,12 @@ void SymmetryTracker::start_at(const symmetry::Line& line) {
   start.r = line.r;
   start.theta_deg = line.theta * kDegPerRad;
   kalman_.initialise_at_rest(normalise(start));
+  last_measured_track_ = kalman_;
   status_ = TrackStatus::Tracking;
   reason_.clear();
   missed_ = 0;
   frames_since_loss_ = -1;
+  frames_since_lost_track_ = -1;
   ++tracks_started_;
   start_window_.clear();
   start_frames_ = 0;
@@ -268,6 +284,7 @@ void SymmetryTracker::process(const cv::Mat& grey, TrackState* state) {
   state->ms.motion_ms = watch.lap_ms();
   state->blocks = motion.blocks;
   state->moving_blocks = motion.moving_blocks;
+  age_lost_track();
   if (status_ == TrackStatus::Idle || status_ == TrackStatus::Lost) watch_for_start(motion);
   if (status_ == TrackStatus::Initialising) {
     initialise(grey, motion, state);
@@ -366,7 +383,10 @@ void SymmetryTracker::initialise(const cv::Mat& grey, const BlockMotion& motion,
   if (start_window_.size() > 3) start_window_.erase(start_window_.begin());
   Stopwatch watch;
   double error = 0;
-  if (start_window_.size() == 3 && best_start(start_window_, params_.kalman, &kalman_, &error, params_.start.tie_margin)) {
+  if (start_window_.size() == 3 &&
+      best_start(frames_since_lost_track_ >= 0 ? lines_near(lost_track_, start_window_) : start_window_, params_.kalman, &kalman_, &error, params_.start.tie_margin)) {
+    frames_since_lost_track_ = -1;
+    last_measured_track_ = kalman_;
     status_ = TrackStatus::Tracking;
     reason_.clear();
     missed_ = 0;
@@ -410,6 +430,7 @@ void SymmetryTracker::track(const cv::Mat& grey, const BlockMotion& motion, Trac
     kalman_.update(lines[best]);
     missed_ = 0;
     last_votes_ = lines[best].votes;
+    last_measured_track_ = kalman_;
     state->measurement_used = true;
     state->gate_error = best_error;
     reason_.clear();
@@ -489,6 +510,7 @@ bool SymmetryTracker::measure_in_place(const cv::Mat& grey, const BlockMotion& m
   // The object's own line measures it: the estimate stays sharp and the gate narrow, so a
   // neighbour that moves into the track's blocks cannot be taken for it.
   kalman_.update(lines[best]);
+  last_measured_track_ = kalman_;
   state->measurement_used = true;
   state->gate_error = gate_error;
   return true;
@@ -500,10 +522,25 @@ void SymmetryTracker::end_track(const std::string& reason, TrackState* state) {
   idle_baseline_ = state->moving_blocks;  // a new start needs a new jump in motion, or rearm_frames
   frames_since_loss_ = 0;
   start_window_.clear();
+  // Remember where the object was last measured (not where the predict-only frames carried the
+  // line): a new start prefers lines there for a while, in a gate grown by the frames since.
+  lost_track_ = last_measured_track_;
+  lost_track_.hold();
+  for (int i = 0; i < missed_; ++i) lost_track_.predict();
+  frames_since_lost_track_ = 0;
   missed_ = 0;
   object_blocks_.release();
   last_votes_ = 0;
   resting_ = 0;
+}
+
+void SymmetryTracker::age_lost_track() {
+  if (frames_since_lost_track_ < 0) return;
+  if (++frames_since_lost_track_ > params_.start.reacquire_frames) {
+    frames_since_lost_track_ = -1;
+    return;
+  }
+  lost_track_.predict();  // at rest: the line stays, its covariance (and so the gate) grows
 }
 
 void SymmetryTracker::describe_estimate(const BlockMotion& motion, TrackState* state) {
