@@ -55,9 +55,16 @@ const Sequence& sequence() {
   return s;
 }
 
+// Arg 1: the default tracker; arg 0: issue 15 follow-up's rest and re-acquisition switched off
+// (max_rest_frames 0, reacquire_frames 0), for a same-run comparison of their cost.
 void BM_TrackerFrame(benchmark::State& state) {
   const auto& frames = sequence().frames;
-  trk::SymmetryTracker tracker;
+  trk::TrackerParams params;
+  if (state.range(0) == 0) {
+    params.max_rest_frames = 0;
+    params.start.reacquire_frames = 0;
+  }
+  trk::SymmetryTracker tracker(params);
   int64_t utime = 0, i = 0;
   for (int k = 0; k < 2 * kPeriod; ++k) tracker.feed(frames[k % kPeriod], utime += 40000), ++i;  // warm up, start
   int64_t tracked = 0, fed = 0;
@@ -127,7 +134,7 @@ void BM_RefineAndBox(benchmark::State& state) {
 
 }  // namespace
 
-BENCHMARK(BM_TrackerFrame)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_TrackerFrame)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_BlockMotion)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_KalmanPredictUpdate)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_RefineAndBox)->Unit(benchmark::kMicrosecond);

@@ -19,6 +19,7 @@
 // is more than 30 px off. Scored frames: from three frames after the target first moves (the
 // symmetry tracker's automatic start needs them) to the end, where the target is visible.
 // Writes docs/results/tracker_comparison.{json,md} and tracker_comparison_errors.png.
+#include <algorithm>
 #include <cmath>
 #include <iostream>
 #include <map>
@@ -48,9 +49,10 @@ namespace {
 constexpr double kLossPx = 30.0;
 const std::vector<std::string> kTrackers = {"symmetry", "csrt", "kcf", "camshift"};
 const std::vector<std::string> kReferences = {"perfect_box", "perfect_axis"};
+std::vector<std::string> g_trackers = kTrackers;  // --trackers: the ones run
 
 std::vector<std::string> all_scored() {
-  std::vector<std::string> names = kTrackers;
+  std::vector<std::string> names = g_trackers;
   names.insert(names.end(), kReferences.begin(), kReferences.end());
   return names;
 }
@@ -543,6 +545,11 @@ int main(int argc, char** argv) {
   flags.add_int("first-seed", &first_seed, "first seed of the held-out scenarios (fixed in advance: 1000)");
   flags.add_int("seeds", &seeds, "number of held-out scenarios (fixed in advance: 20)");
   flags.add_string("photos", &photos, "directory of opencv-doc's pictures (the generator's walls and tables)");
+  std::string trackers;
+  bool heldout_only = false;
+  flags.add_string("trackers", &trackers, "run only these trackers, comma-separated (e.g. symmetry; results are not "
+                                           "written, totals are printed)");
+  flags.add_bool("heldout-only", &heldout_only, "skip the development videos (results are not written)");
   flags.add_string("preview", &preview, "write frames 0, middle and last of each video (both cameras) to this directory");
   try {
     if (!flags.parse(argc, argv)) return 0;
@@ -550,14 +557,27 @@ int main(int argc, char** argv) {
     if (frames < 0) throw FlagError("--frames: must be >= 0");
     if (seeds < 1) throw FlagError("--seeds: must be >= 1");
     if (first_seed < 0) throw FlagError("--first-seed: must be >= 0");
+    if (!trackers.empty()) {
+      g_trackers.clear();
+      std::stringstream list(trackers);
+      for (std::string name; std::getline(list, name, ',');) {
+        if (std::find(kTrackers.begin(), kTrackers.end(), name) == kTrackers.end())
+          throw FlagError("--trackers: unknown tracker '" + name + "'");
+        g_trackers.push_back(name);
+      }
+    }
+    const bool partial = !trackers.empty() || heldout_only;
     const std::vector<std::string> pictures = generator_photographs(photos);
     std::vector<int> held_seeds;
     for (int i = 0; i < seeds; ++i) held_seeds.push_back(first_seed + i);
     std::vector<Run> dev, heldout;
     nudge::Progress progress("nudge-exp-tracker-comparison",
-                             only.empty() ? static_cast<int>(tracking_scenarios().size() + held_seeds.size()) : 1);
-    for (const Scenario& sc : tracking_scenarios())
-      if (only.empty() || sc.name == only) dev.push_back(run_scenario(sc, camera, frames, preview, progress));
+                             only.empty() ? static_cast<int>((heldout_only ? 0 : tracking_scenarios().size()) +
+                                                             held_seeds.size())
+                                          : 1);
+    if (!heldout_only)
+      for (const Scenario& sc : tracking_scenarios())
+        if (only.empty() || sc.name == only) dev.push_back(run_scenario(sc, camera, frames, preview, progress));
     std::vector<std::string> unusable;  // a drawn scenario the simulator refuses, or with the target unseen in frame 0
     for (int seed : held_seeds) {
       if (!only.empty() && only != "seed_" + std::to_string(seed)) continue;
@@ -572,7 +592,16 @@ int main(int argc, char** argv) {
     if (dev.empty() && heldout.empty()) throw FlagError("--only: no video named '" + only + "'");
     const std::vector<int> cameras = camera < 0 ? std::vector<int>{0, 1} : std::vector<int>{camera};
     progress.clear_status();
-    if (only.empty()) write_results(dev, heldout, held_seeds, cameras, unusable);
+    if (partial) {  // a partial run: totals on stdout only
+      for (const auto& [set, runs] : {std::pair{"held-out", &heldout}, {"development", &dev}}) {
+        if (runs->empty()) continue;
+        std::ostringstream md;
+        set_table(md, *runs, cameras);
+        std::cout << "\n" << set << ":\n" << md.str();
+      }
+    } else if (only.empty()) {
+      write_results(dev, heldout, held_seeds, cameras, unusable);
+    }
     progress.finish(std::to_string(dev.size()) + " development and " + std::to_string(heldout.size()) + " held-out videos");
   } catch (const std::exception& e) {
     std::cerr << "nudge-exp-tracker-comparison: " << e.what() << "\n";

@@ -567,6 +567,7 @@ Scenario generated_scenario(uint64_t seed, const std::vector<std::string>& photo
   if (crossing) {
     crosser.position = Vector2d(b.x() + depth, b.y());
     sc.scene.objects.push_back(crosser);
+    sc.distractor = distractor;
     what << ", " << crosser.kind << " crossing " << (depth < 0 ? "behind" : "in front") << " after " << delay << " frames";
   }
   // Static clutter further back, clear of each other.
@@ -641,6 +642,7 @@ std::array<Video, 2> render_stereo_video(const Scenario& scenario, int max_frame
       VideoFrame f;
       f.image = images.colour[camera];
       f.target_mask = images.mask[camera] == scenario.target + 1;
+      if (scenario.distractor >= 0) f.distractor_mask = images.mask[camera] == scenario.distractor + 1;
       f.truth = world.axis_in_image(scenario.target, camera);
       f.target_moving = moving;
       Video& video = videos[camera];

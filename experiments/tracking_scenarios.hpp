@@ -28,6 +28,7 @@ struct Scenario {
   int target = 0;            // index of the tracked object
   int frames = 0;            // total frames
   int still_frames = 6;      // frames before anything moves
+  int distractor = -1;       // index of an object that crosses the target's path (-1: none)
   // Sets the pose of every moving object for frame k (0 .. frames - 1).
   std::function<void(sim::World& world, int k)> pose;
 };
@@ -35,6 +36,7 @@ struct Scenario {
 struct VideoFrame {
   cv::Mat image;             // BGR, the rig's size (640x480)
   cv::Mat target_mask;       // CV_8U 255 on the target's visible pixels (render_stereo_video only)
+  cv::Mat distractor_mask;   // CV_8U 255 on the crossing distractor's pixels (render_stereo_video; empty: none)
   sim::ImageLine truth;      // the target's axis in this camera
   bool target_moving = false;// the target's pose differs from the previous frame's
 };

@@ -63,10 +63,19 @@ void LineKalman::initialise(const LineMeasurement& first) {
   for (int i = 0; i < 6; ++i) p_(i, i) = params_.initial_variance[i];
 }
 
+namespace {
+constexpr std::array<double, 4> kAtRestVariance = {4.0, 1.0, 1.0, 0.25};  // R', theta', R'', theta''
+}
+
 void LineKalman::initialise_at_rest(const LineMeasurement& first) {
   initialise(first);
-  const std::array<double, 4> at_rest = {4.0, 1.0, 1.0, 0.25};  // R', theta', R'', theta''
-  for (int i = 0; i < 4; ++i) p_(i + 2, i + 2) = at_rest[i];
+  for (int i = 0; i < 4; ++i) p_(i + 2, i + 2) = kAtRestVariance[i];
+}
+
+void LineKalman::rest() {
+  hold();
+  p_.bottomRightCorner<4, 4>() = p_.bottomRightCorner<4, 4>().diagonal().asDiagonal();
+  for (int i = 0; i < 4; ++i) p_(i + 2, i + 2) = std::min(p_(i + 2, i + 2), kAtRestVariance[i]);
 }
 
 void LineKalman::predict() {

@@ -2,6 +2,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -94,6 +95,7 @@ double moving_fraction(const cv::Mat& object, const cv::Mat& moving) {
   }
   return total > 0 ? static_cast<double>(hit) / total : 1.0;
 }
+
 }  // namespace
 
 const char* to_string(TrackStatus status) {
@@ -121,6 +123,7 @@ void validate(const TrackerParams& p) {
   require(p.start.max_frames >= 3, "tracker start max_frames must be >= 3");
   require(std::isfinite(p.start.tie_margin) && p.start.tie_margin >= 0, "tracker start tie_margin must be >= 0");
   require(p.start.rearm_frames >= 0, "tracker start rearm_frames must be >= 0");
+  require(p.start.reacquire_frames >= 0, "tracker start reacquire_frames must be >= 0");
   require(std::isfinite(p.gate_sigmas) && p.gate_sigmas > 0, "tracker gate_sigmas must be > 0");
   require(std::isfinite(p.min_half_width_deg) && p.min_half_width_deg >= 0.5 && p.min_half_width_deg <= 90,
           "tracker min_half_width_deg must be in [0.5, 90]");
@@ -128,6 +131,7 @@ void validate(const TrackerParams& p) {
           "tracker still_fraction must be in [0, 1]");
   require(std::isfinite(p.support_weight) && p.support_weight >= 0, "tracker support_weight must be >= 0");
   require(p.max_missed_frames >= 1, "tracker max_missed_frames must be >= 1");
+  require(p.max_rest_frames >= 0, "tracker max_rest_frames must be >= 0");
   require(p.max_frame_gap_us > 0, "tracker max_frame_gap_us must be > 0");
 }
 
@@ -195,8 +199,20 @@ int associate(const LineKalman& filter, const std::vector<LineMeasurement>& line
   return best;
 }
 
+std::vector<std::vector<LineMeasurement>> lines_near(const LineKalman& lost,
+                                                     const std::vector<std::vector<LineMeasurement>>& frames) {
+  std::vector<std::vector<LineMeasurement>> preferred;
+  for (const auto& lines : frames) {
+    std::vector<LineMeasurement> near;
+    for (const LineMeasurement& line : lines)
+      if (lost.in_gate(lost.gate_error(line))) near.push_back(line);
+    preferred.push_back(near.empty() ? lines : near);
+  }
+  return preferred;
+}
+
 SymmetryTracker::SymmetryTracker(TrackerParams params)
-    : params_(std::move(params)), reason_(kWaitingForFirstFrame), kalman_(params_.kalman) {
+    : params_(std::move(params)), reason_(kWaitingForFirstFrame), kalman_(params_.kalman), last_measured_track_(params_.kalman), lost_track_(params_.kalman) {
   validate(params_);
 }
 
@@ -209,7 +225,10 @@ void SymmetryTracker::reset(TrackStatus status, const std::string& reason) {
   start_frames_ = 0;
   missed_ = 0;
   frames_since_loss_ = -1;  // the past frames are forgotten: any motion starts a track
+  frames_since_lost_track_ = -1;
   object_blocks_.release();
+  last_votes_ = 0;
+  resting_ = 0;
 }
 
 void SymmetryTracker::restart(const std::string& reason) {
@@ -221,14 +240,18 @@ void SymmetryTracker::start_at(const symmetry::Line& line) {
   start.r = line.r;
   start.theta_deg = line.theta * kDegPerRad;
   kalman_.initialise_at_rest(normalise(start));
+  last_measured_track_ = kalman_;
   status_ = TrackStatus::Tracking;
   reason_.clear();
   missed_ = 0;
   frames_since_loss_ = -1;
+  frames_since_lost_track_ = -1;
   ++tracks_started_;
   start_window_.clear();
   start_frames_ = 0;
   object_blocks_.release();  // the first frame's motion about the line becomes the object's
+  last_votes_ = 0;
+  resting_ = 0;
 }
 
 TrackState SymmetryTracker::feed(const cv::Mat& frame, int64_t utime) {
@@ -261,6 +284,7 @@ void SymmetryTracker::process(const cv::Mat& grey, TrackState* state) {
   state->ms.motion_ms = watch.lap_ms();
   state->blocks = motion.blocks;
   state->moving_blocks = motion.moving_blocks;
+  age_lost_track();
   if (status_ == TrackStatus::Idle || status_ == TrackStatus::Lost) watch_for_start(motion);
   if (status_ == TrackStatus::Initialising) {
     initialise(grey, motion, state);
@@ -359,11 +383,16 @@ void SymmetryTracker::initialise(const cv::Mat& grey, const BlockMotion& motion,
   if (start_window_.size() > 3) start_window_.erase(start_window_.begin());
   Stopwatch watch;
   double error = 0;
-  if (start_window_.size() == 3 && best_start(start_window_, params_.kalman, &kalman_, &error, params_.start.tie_margin)) {
+  if (start_window_.size() == 3 &&
+      best_start(frames_since_lost_track_ >= 0 ? lines_near(lost_track_, start_window_) : start_window_, params_.kalman, &kalman_, &error, params_.start.tie_margin)) {
+    frames_since_lost_track_ = -1;
+    last_measured_track_ = kalman_;
     status_ = TrackStatus::Tracking;
     reason_.clear();
     missed_ = 0;
     ++tracks_started_;
+    resting_ = 0;
+    last_votes_ = state->measurements.empty() ? 0 : state->measurements.front().votes;
     state->measurement_used = true;
     state->gate_error = error;
     state->ms.kalman_ms = watch.lap_ms();
@@ -384,24 +413,11 @@ void SymmetryTracker::track(const cv::Mat& grey, const BlockMotion& motion, Trac
   Stopwatch watch;
   state->object_motion = moving_fraction(object_blocks_, motion.blocks);
   if (state->object_motion < params_.still_fraction) {
-    // The object stopped: hold the line where it is and measure nothing (a line detected now
-    // belongs to something else that moves). The blocks of the last motion stay the object's.
-    kalman_.hold();
-    ++missed_;
-    reason_ = "holding: no motion at the tracked object";
-    state->holding = true;
-    state->missed_frames = missed_;
     state->ms.kalman_ms = watch.lap_ms();
-    // The box and blocks reported are those of the object's last motion, where it now stands.
-    const cv::Mat object = object_blocks_;
-    BlockMotion held = motion;
-    if (!object.empty()) held.blocks = object;
-    describe_estimate(held, state);
-    object_blocks_ = object;
-    if (missed_ >= params_.max_missed_frames)
-      end_track("no symmetry line inside the validation gate for " + std::to_string(missed_) + " frames", state);
+    hold(grey, motion, state);
     return;
   }
+  resting_ = 0;
   kalman_.predict();
   const AngleLimits limits = angle_limits(kalman_.line().theta_deg, kalman_.theta_sigma_deg(), params_.gate_sigmas,
                                           params_.min_half_width_deg);
@@ -413,9 +429,14 @@ void SymmetryTracker::track(const cv::Mat& grey, const BlockMotion& motion, Trac
   if (best >= 0) {
     kalman_.update(lines[best]);
     missed_ = 0;
+    last_votes_ = lines[best].votes;
+    last_measured_track_ = kalman_;
     state->measurement_used = true;
     state->gate_error = best_error;
     reason_.clear();
+  } else if (params_.max_rest_frames > 0 && measure_in_place(grey, motion, state)) {
+    missed_ = 0;  // the object's own line is where predicted, moving or not
+    reason_ = "measured in place: no moving line inside the gate, the object's own line is there";
   } else {
     ++missed_;
     reason_ = "predicting: no line inside the validation gate (" + std::to_string(lines.size()) + " detected)";
@@ -432,14 +453,94 @@ void SymmetryTracker::track(const cv::Mat& grey, const BlockMotion& motion, Trac
   }
 }
 
+// The object stopped: hold the line where it is and measure nothing from the motion (a moving line
+// now belongs to something else). The blocks of the last motion stay the object's. A held frame
+// counts as a missed one unless the object's own line is still there (resting).
+void SymmetryTracker::hold(const cv::Mat& grey, const BlockMotion& motion, TrackState* state) {
+  Stopwatch watch;
+  kalman_.hold();
+  const bool resting = params_.max_rest_frames > 0 && measure_in_place(grey, motion, state);
+  if (resting) {
+    kalman_.rest();
+    ++resting_;
+    reason_ = "holding: the object rests where it stopped (" + std::to_string(resting_) + " frames)";
+  } else {
+    resting_ = 0;
+    ++missed_;
+    reason_ = "holding: no motion at the tracked object";
+  }
+  state->holding = true;
+  state->resting_frames = resting_;
+  state->missed_frames = missed_;
+  state->ms.kalman_ms = watch.lap_ms();
+  // The box and blocks reported are those of the object's last motion, where it now stands.
+  const cv::Mat object = object_blocks_;
+  BlockMotion held = motion;
+  if (!object.empty()) held.blocks = object;
+  describe_estimate(held, state);
+  object_blocks_ = object;
+  if (missed_ >= params_.max_missed_frames)
+    end_track("no symmetry line inside the validation gate for " + std::to_string(missed_) + " frames", state);
+  else if (resting_ > params_.max_rest_frames)
+    end_track("the object rested for more than " + std::to_string(params_.max_rest_frames) + " frames", state);
+}
+
+// The object's own symmetry is still where the track predicts it: the edges inside the track's
+// blocks (all of them, not only moving ones) give a line inside the validation gate with at least
+// half the support of the last line used; it updates the filter. Used when the motion gives no
+// gated line: a still object (nothing moves), or one whose blocks another object's motion covers.
+// An object that vanished or was covered leaves no such line (the detector's votes of a background
+// pattern rarely reach the object's). The frame's reported measurements stay the motion's.
+bool SymmetryTracker::measure_in_place(const cv::Mat& grey, const BlockMotion& motion, TrackState* state) {
+  if (object_blocks_.empty() || last_votes_ <= 0) return false;
+  BlockMotion object = motion;
+  object.blocks = object_blocks_;
+  const AngleLimits limits = angle_limits(kalman_.line().theta_deg, kalman_.theta_sigma_deg(), params_.gate_sigmas,
+                                          params_.min_half_width_deg);
+  TrackState scratch;
+  std::vector<LineMeasurement> lines = detect_lines(grey, object, limits, &scratch);
+  state->ms.edges_ms += scratch.ms.edges_ms;
+  state->ms.detect_ms += scratch.ms.detect_ms;
+  lines.erase(std::remove_if(lines.begin(), lines.end(),
+                             [&](const LineMeasurement& l) { return l.votes < 0.5 * last_votes_; }),
+              lines.end());
+  double gate_error = 0;
+  const int best = associate(kalman_, lines, params_.support_weight, &gate_error);
+  if (best < 0) return false;
+  // The object's own line measures it: the estimate stays sharp and the gate narrow, so a
+  // neighbour that moves into the track's blocks cannot be taken for it.
+  kalman_.update(lines[best]);
+  last_measured_track_ = kalman_;
+  state->measurement_used = true;
+  state->gate_error = gate_error;
+  return true;
+}
+
 void SymmetryTracker::end_track(const std::string& reason, TrackState* state) {
   status_ = TrackStatus::Lost;
   reason_ = reason;
   idle_baseline_ = state->moving_blocks;  // a new start needs a new jump in motion, or rearm_frames
   frames_since_loss_ = 0;
   start_window_.clear();
+  // Remember where the object was last measured (not where the predict-only frames carried the
+  // line): a new start prefers lines there for a while, in a gate grown by the frames since.
+  lost_track_ = last_measured_track_;
+  lost_track_.hold();
+  for (int i = 0; i < missed_; ++i) lost_track_.predict();
+  frames_since_lost_track_ = 0;
   missed_ = 0;
   object_blocks_.release();
+  last_votes_ = 0;
+  resting_ = 0;
+}
+
+void SymmetryTracker::age_lost_track() {
+  if (frames_since_lost_track_ < 0) return;
+  if (++frames_since_lost_track_ > params_.start.reacquire_frames) {
+    frames_since_lost_track_ = -1;
+    return;
+  }
+  lost_track_.predict();  // at rest: the line stays, its covariance (and so the gate) grows
 }
 
 void SymmetryTracker::describe_estimate(const BlockMotion& motion, TrackState* state) {

@@ -66,6 +66,10 @@ class LineKalman {
   // set to zero and decoupled from R and theta, whose estimate and covariance stay as they are.
   // Used instead of predict() so that a track does not coast on after the object stopped.
   void hold();
+  // The object is seen at rest (its own line measured where it stopped): hold(), and the velocity
+  // and acceleration variances drop to initialise_at_rest's (never grow), so that frames predicted
+  // next keep a narrow gate about the resting object instead of one sized for its old motion.
+  void rest();
   // Normalised innovation squared (the thesis' "validation gate error") of a measurement.
   double gate_error(const LineMeasurement& measured) const;
   bool in_gate(double gate_error) const { return gate_error <= params_.gate; }

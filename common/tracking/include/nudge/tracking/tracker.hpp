@@ -57,6 +57,12 @@ struct StartParams {
   // thesis' jump rule alone never re-acquires an object whose motion goes on through the loss).
   // 0 = only a new jump re-arms.
   int rearm_frames = 5;
+  // Not in the thesis: for this many frames after a track is lost, the automatic start prefers
+  // lines near where the object was: in each frame of the start window, the lines inside the lost
+  // track's validation gate (its line held where it was last seen, its covariance growing with the
+  // frames since) are the only candidates when there are any. Without it the strongest moving line
+  // wins, and a distractor crossing the resting object's place is taken for it. 0 = off.
+  int reacquire_frames = 25;
 };
 
 struct TrackerParams {
@@ -84,6 +90,13 @@ struct TrackerParams {
   // estimate drifted onto is otherwise kept for ever, as it is always the nearest).
   double support_weight = 4.0;
   int max_missed_frames = 10;        // consecutive predict-only frames before the track is Lost
+  // Not in the thesis: a held object whose own symmetry line is still there (the edges in its
+  // blocks, moving or not, give a line inside the gate with at least half the support of the last
+  // line used) is resting, not missing: such frames do not count towards max_missed_frames, and
+  // the track survives a rest of up to this many frames (stop-and-go motion: pauses of 8-15 frames
+  // ended tracks at 10). An object that vanished or was covered leaves no such line: its held
+  // frames are missed ones. 0 = every held frame is a missed one (before issue 15's follow-up).
+  int max_rest_frames = 125;         // 5 s at 25 Hz
   int64_t max_frame_gap_us = 500000; // a longer gap between frames is a time jump: re-initialise
 
   static symmetry::Params default_detector() {
@@ -132,6 +145,7 @@ struct TrackState {
   AngleLimits limits;              // detection angle limits used for this frame, degrees
   double object_motion = -1;       // fraction of the track's blocks moving this frame (-1: not tracking)
   bool holding = false;            // the object stood still: line held, no detection this frame
+  int resting_frames = 0;          // consecutive held frames in which the object's own line was still there
   int tracks_started = 0;          // tracks begun since construction (automatic starts and start_at)
   TrackTiming ms;
 };
@@ -165,7 +179,10 @@ class SymmetryTracker {
   void watch_for_start(const BlockMotion& motion);
   void initialise(const cv::Mat& grey, const BlockMotion& motion, TrackState* state);
   void track(const cv::Mat& grey, const BlockMotion& motion, TrackState* state);
+  void hold(const cv::Mat& grey, const BlockMotion& motion, TrackState* state);
+  bool measure_in_place(const cv::Mat& grey, const BlockMotion& motion, TrackState* state);
   void end_track(const std::string& reason, TrackState* state);
+  void age_lost_track();
   void describe_estimate(const BlockMotion& motion, TrackState* state);
 
   TrackerParams params_;
@@ -181,7 +198,12 @@ class SymmetryTracker {
   int missed_ = 0;
   int frames_since_loss_ = -1;  // counting towards StartParams::rearm_frames; -1 = not after a loss
   int tracks_started_ = 0;
+  LineKalman last_measured_track_;  // the filter after the track's last update
+  LineKalman lost_track_;        // the last track's filter, held where it was last measured
+  int frames_since_lost_track_ = -1;  // -1: no recent lost track to re-acquire near
   cv::Mat object_blocks_;  // the track's symmetry-refined blocks of its last frame with motion
+  double last_votes_ = 0;  // support of the line of the track's last update
+  int resting_ = 0;        // consecutive held frames with the object looking as last measured
 };
 
 // The best of all associations of one line per frame across three frames (27 for Nlines = 3):
@@ -198,5 +220,11 @@ int associate(const LineKalman& filter, const std::vector<LineMeasurement>& line
 
 bool best_start(const std::vector<std::vector<LineMeasurement>>& frames, const KalmanParams& params,
                 LineKalman* filter, double* total_gate_error, double tie_margin = 0.0);
+
+// Re-acquiring near a lost track: each frame's lines inside `lost`'s validation gate, or all of
+// that frame's lines when none is (the start window the tracker gives best_start within
+// StartParams::reacquire_frames of a loss).
+std::vector<std::vector<LineMeasurement>> lines_near(const LineKalman& lost,
+                                                     const std::vector<std::vector<LineMeasurement>>& frames);
 
 }  // namespace nudge::tracking
