@@ -17,9 +17,9 @@ struct Features {
 
 // OpenCV's SIFT settings that matter for small, weakly textured objects. The contrast threshold
 // is half OpenCV's (and Lowe's) 0.04: a label a hundred pixels wide in a cluttered scene gives
-// twice the keypoints, and the learned bottles' test images keep two to three times the verified
-// matches (docs/results/learning.md); the ratio test and the geometric check keep out what the
-// extra, weaker keypoints would add by chance.
+// about twice the keypoints, and the learned bottles' test images keep more verified matches
+// (docs/learning.md); the ratio test and the geometric check keep out what the extra, weaker
+// keypoints would add by chance.
 struct SiftParams {
   double contrast_threshold = 0.02;  // OpenCV default 0.04
   double edge_threshold = 10;        // OpenCV default
