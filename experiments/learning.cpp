@@ -369,7 +369,7 @@ std::string json_report(const Options& o, const std::vector<Run>& runs, const st
 std::string markdown_report(const Options& o, const std::vector<Run>& runs, const std::vector<Judged>& judged,
                             const Totals& t, const RecognitionTiming& timing, int padded_objects,
                             const std::string& sheet_of, const std::vector<std::string>& match_pictures,
-                            const std::map<std::string, TrainingTruth>& training) {
+                            const std::map<std::string, TrainingTruth>& training, cv::Size test_size) {
   std::ostringstream md;
   md << "# Object learning by interaction (thesis sec. 7.4, Table 7.1)\n\n"
      << "`experiments/learning.sh`: each of the seven bottles of `experiments/scenes/learning/` learned in simulation by "
@@ -377,7 +377,11 @@ std::string markdown_report(const Options& o, const std::vector<Run>& runs, cons
         "`NUDGE_LOOP_LEARN=1`, `--learn on`), all into one object database, no retries; then `nudge-exp-learning` "
         "recognises the 28 test images (4 per bottle) and the 10 images of objects never learned "
         "(`nudge-exp-learning-scenes --set eval`, seeds fixed in advance: `learning_scenes.md`) with the learner's "
-        "`Recognizer` (defaults: ratio 0.6, >= 3 verified matches, RANSAC check, " << timing.matcher << ").\n\n"
+        "`Recognizer` (defaults: ratio 0.6, >= 3 verified matches, RANSAC check, SIFT contrast threshold "
+     << learning::SiftParams{}.contrast_threshold << ", " << timing.matcher << "). The test images are the right camera's "
+     << test_size.width << "x" << test_size.height << (test_size.width > 640 ? " high-resolution stills (as the robot "
+        "takes them to look closely and learn; the 640x480 video frames of the same scenes show the bottles at a third "
+        "of the training views' scale, docs/learning.md)" : " video frames") << ".\n\n"
      << machine_description() << ", " << today() << ".\n\n"
      << "| | here | thesis |\n|---|---|---|\n"
      << "| objects learned | " << t.objects_learned << " of " << runs.size() << " | 7 of 7 |\n"
@@ -415,7 +419,7 @@ std::string markdown_report(const Options& o, const std::vector<Run>& runs, cons
   md << "\n**Good and bad matches.** A verified match (the recognised object's best training view, after the RANSAC "
         "check) is good when the test image's keypoint and the training view's keypoint show the same surface point "
         "of the same object: both within one pixel of that object's pixels, their object-frame coordinates within "
-        << o.tolerance_mm << " mm (about three pixel footprints of a 640x480 test image at the bottles' distance). "
+        << o.tolerance_mm << " mm (about three pixel footprints of a 640x480 image, six of a 1280x960 still, at the bottles' distance). "
         "The test side's coordinates were rendered with the test image (`World::render_surface`). The training side's "
         "are rendered again from the run's LCM log: the camera service drew each view as `render_snapshot(right)` "
         "after `apply_poses` of the `SIM_STATE` with the view's utime, and the same calls on the same scene give "
@@ -491,6 +495,7 @@ int run(const Options& o) {
   }
 
   const std::vector<TestImage> images = read_test_images(o.test_images, "eval");
+  if (images.empty()) throw std::runtime_error(o.test_images + "/manifest.json: no test images");
   std::vector<Judged> judged;
   nudge::Progress progress("nudge-exp-learning", static_cast<int>(images.size()));
   for (const TestImage& t : images) {
@@ -531,7 +536,7 @@ int run(const Options& o) {
   const std::vector<std::string> pictures = write_match_pictures(o, judged, images, db, recognizer);
   write_result(o.name + ".json", json_report(o, runs, judged, totals, timing, descriptors));
   write_result(o.name + ".md", markdown_report(o, runs, judged, totals, timing, static_cast<int>(padded.size()), sheet_of,
-                                               pictures, training));
+                                               pictures, training, images.front().colour.size()));
   progress.finish(std::to_string(totals.objects_learned) + " objects learned, " + std::to_string(totals.correct) + " of " +
                   std::to_string(totals.test_images) + " test images recognised, " +
                   std::to_string(totals.false_recognitions) + " false recognitions");

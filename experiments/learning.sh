@@ -2,25 +2,32 @@
 # Thesis sec. 7.4 (Table 7.1) in simulation: each of the seven bottles of
 # experiments/scenes/learning/train*.yaml learned by the whole chain (survey -> nudge -> segment ->
 # grasp -> rotate -> learn -> place), one run per scene, no retries, all into ONE object database
-# (out/experiments/learning/objects: the later runs first ask whether their bottle is already known).
+# (OUT/learning/objects: the later runs first ask whether their bottle is already known).
 # Then nudge-exp-learning scores the database on the 28 test and 10 never-learned images into
 # docs/results/learning.{json,md} (docs/learning.md, "The experiment"). Runs land in
-# out/experiments/learning/<scene>/, the test images in out/experiments/learning_test_images/
-# (rendered when missing). A few minutes per scene.
-#   experiments/learning.sh                 the seven runs (a fresh database), then the scoring
-#   experiments/learning.sh --runs-only     the seven runs only
-#   experiments/learning.sh --score-only    the scoring of the runs already in out/ only
+# OUT/learning/<scene>/, the test images (the right camera's 1280x960 stills) in
+# OUT/learning_test_stills/ (rendered when missing). OUT is out/experiments unless --out says
+# otherwise (a folder outside the checkout keeps the runs across checkouts). A few minutes per scene.
+#   experiments/learning.sh [--out OUT]                the seven runs (a fresh database), then the scoring
+#   experiments/learning.sh [--out OUT] --runs-only    the seven runs only
+#   experiments/learning.sh [--out OUT] --score-only   the scoring of the runs already in OUT only
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/../scripts/lib.sh"
-runs=1 score=1
-case "${1:-}" in
-  --runs-only) score=0 ;;
-  --score-only) runs=0 ;;
-  "") ;;
-  *) echo "usage: $0 [--runs-only | --score-only]" >&2; exit 2 ;;
-esac
+runs=1 score=1 out="$NUDGE_ROOT/out/experiments"
+usage() { echo "usage: $0 [--out DIR] [--runs-only | --score-only]" >&2; exit 2; }
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --runs-only) score=0 ;;
+    --score-only) runs=0 ;;
+    --out) [ $# -ge 2 ] || usage; out="$2"; shift ;;
+    *) usage ;;
+  esac
+  shift
+done
+mkdir -p "$out"
+out="$(cd "$out" && pwd)"
 scenes_dir="$NUDGE_ROOT/experiments/scenes/learning"
-runs_dir="$NUDGE_ROOT/out/experiments/learning"
+runs_dir="$out/learning"
 calibration="$NUDGE_ROOT/config/calibration_sim.yaml"
 targets=(nudge-launch nudge-world nudge-camera nudge-symmetry nudge-triangulation nudge-arm nudge-learner nudge-supervisor)
 [ $score = 1 ] && targets+=(nudge-exp-learning nudge-exp-learning-scenes)
@@ -61,11 +68,12 @@ if [ $runs = 1 ]; then
   done
 fi
 if [ $score = 1 ]; then
-  # The test images, rendered once from the evaluation seeds (docs/results/learning_scenes.md).
-  test_images="$NUDGE_ROOT/out/experiments/learning_test_images"
+  # The test images, rendered once from the evaluation seeds (docs/results/learning_scenes.md):
+  # the right camera's high-resolution stills, as the robot takes them to look closely.
+  test_images="$out/learning_test_stills"
   if [ ! -f "$test_images/manifest.json" ]; then
     nudge_log "rendering the 38 test images into $test_images"
-    "$NUDGE_BUILD_DIR/bin/nudge-exp-learning-scenes" --out "$test_images" --set eval
+    "$NUDGE_BUILD_DIR/bin/nudge-exp-learning-scenes" --out "$test_images" --set eval --camera still
   fi
   "$NUDGE_BUILD_DIR/bin/nudge-exp-learning" --runs "$runs_dir" --scenes "$scenes_dir" --test-images "$test_images"
 fi

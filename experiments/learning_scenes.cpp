@@ -124,7 +124,10 @@ int solo_pixels(const TestImage& t, bool* touches_border) {
   return cv::countNonZero(target);
 }
 
-void render(TestImage& t) {
+// Draws the test image with the right camera: its video frame (the rig's 640x480), or its
+// high-resolution still (the rig's size x scene.render.snapshot_scale, 1280x960), the image the
+// robot takes when it looks closely (and learns from).
+void render(TestImage& t, TestCamera camera) {
   sim::World world(t.scene);
   if (t.lying) {
     const sim::ObjectState o = world.object(0);
@@ -133,8 +136,13 @@ void render(TestImage& t) {
                                Eigen::AngleAxisd(t.lying_roll, Eigen::Vector3d::UnitZ()));
     world.set_object_pose(0, Eigen::Vector3d(o.position.x(), o.position.y(), sim::model_of(t.scene.objects[0], 8).max_radius), q);
   }
-  t.colour = world.render(kRightCamera);
-  t.surface = world.render_surface(kRightCamera, &t.mask);
+  if (camera == TestCamera::Still) {
+    t.colour = world.render_snapshot(kRightCamera);
+    t.surface = world.render_snapshot_surface(kRightCamera, &t.mask);
+  } else {
+    t.colour = world.render(kRightCamera);
+    t.surface = world.render_surface(kRightCamera, &t.mask);
+  }
 }
 
 // Draws the scene of one test image from its seed; false if this draw does not meet the
@@ -192,7 +200,9 @@ bool compose(TestImage& t, const sim::ObjectSpec& target) {
   bool border = false;
   const int alone = solo_pixels(t, &border);
   if (border || alone < 400) return false;
-  render(t);
+  // The conditions are judged on the video frame whatever the camera drawn, so that the same
+  // seeds give the same scenes with either.
+  render(t, TestCamera::Video);
   t.visible_fraction = static_cast<double>(cv::countNonZero(t.mask == 1)) / alone;
   if (t.variant == TestVariant::Occluded) return t.visible_fraction >= 0.35 && t.visible_fraction <= 0.8;
   return t.visible_fraction >= 0.97;
@@ -282,6 +292,12 @@ std::string training_scene_yaml(int index) {
   return s.str();
 }
 
+TestCamera test_camera_from_name(const std::string& name) {
+  if (name == "still") return TestCamera::Still;
+  if (name == "video") return TestCamera::Video;
+  throw std::invalid_argument("test image camera must be still or video, not '" + name + "'");
+}
+
 const char* variant_name(TestVariant v) {
   switch (v) {
     case TestVariant::Plain: return "plain";
@@ -293,7 +309,7 @@ const char* variant_name(TestVariant v) {
   return "?";
 }
 
-std::vector<TestImage> make_test_images(const std::string& source_dir, const std::string& set,
+std::vector<TestImage> make_test_images(const std::string& source_dir, const std::string& set, TestCamera camera,
                                         const std::function<void(const std::string& name)>& before_image) {
   if (set != "eval" && set != "dev") throw std::invalid_argument("test image set must be eval or dev, not '" + set + "'");
   // Image i's seed at its attempt k: base + 1000 k + i (eval base 7100000, dev base 9100000).
@@ -321,7 +337,9 @@ std::vector<TestImage> make_test_images(const std::string& source_dir, const std
       t.variant = variant;
       t.seed = first_seed + 1000 * attempt + i;
       done = compose(t, object);
-      if (done) images.push_back(std::move(t));
+      if (!done) continue;
+      if (camera != TestCamera::Video) render(t, camera);
+      images.push_back(std::move(t));
     }
     if (!done) throw std::runtime_error("test image " + name.str() + ": no seed of " + std::to_string(kTries) + " drew it");
   }

@@ -31,6 +31,9 @@ std::vector<sim::ObjectSpec> unknown_objects(const std::string& source_dir);
 std::string training_scene_yaml(int index);
 
 enum class TestVariant { Plain, Cluttered, Orientation, Occluded, Unknown };
+enum class TestCamera { Still, Video };
+// "still" | "video"; throws std::invalid_argument naming the unknown name.
+TestCamera test_camera_from_name(const std::string& name);
 const char* variant_name(TestVariant v);
 
 // One test image: what is in it and how it was drawn.
@@ -42,7 +45,7 @@ struct TestImage {
   sim::Scene scene;       // objects[0] is the target (or the unknown object)
   bool lying = false;     // objects[0] is laid on its side after the world is built
   double lying_yaw = 0, lying_roll = 0;
-  cv::Mat colour;         // right camera, BGR 640x480
+  cv::Mat colour;         // right camera, BGR: 1280x960 still (TestCamera::Still) or 640x480 video frame
   cv::Mat mask;           // CV_8U, object index + 1
   cv::Mat surface;        // CV_32FC3, object-frame coordinates (World::render_surface)
   double visible_fraction = 1;  // of objects[0]'s pixels had nothing been in front of it
@@ -55,8 +58,12 @@ struct TestImage {
 // tune on.
 // Renders each with the simulator (right camera). Throws std::runtime_error if a scene cannot be
 // drawn within its retries.
+// `camera` chooses the right camera's image: its high-resolution still (1280x960, what the robot
+// takes when it looks closely, and learns from) or its 640x480 video frame (the images of the
+// first runs). The scenes are the same either way: a draw's conditions are judged on the video frame.
 // `before_image(name)`, when given, is called before each image is drawn (for progress output).
 std::vector<TestImage> make_test_images(const std::string& source_dir, const std::string& set,
+                                        TestCamera camera = TestCamera::Still,
                                         const std::function<void(const std::string& name)>& before_image = {});
 
 // The images nudge-exp-learning-scenes --out DIR wrote, read back from DIR/manifest.json: name,

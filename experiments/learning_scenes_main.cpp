@@ -1,5 +1,5 @@
 // The object-learning experiment's scenes (thesis sec. 7.4; issue 11; docs/sim.md):
-//   nudge-exp-learning-scenes --out DIR [--set eval|dev] [--training-scenes DIR] [--report]
+//   nudge-exp-learning-scenes --out DIR [--set eval|dev] [--camera still|video] [--training-scenes DIR] [--report]
 // renders the 28 test images (four per learned bottle: plain, cluttered, another orientation,
 // partly occluded) and the 10 images of objects never learned, with the right camera, into
 // DIR/NAME.png (colour), NAME_mask.png (object index + 1) and NAME_surface.png (object-surface
@@ -32,10 +32,11 @@ void write_image(const std::string& path, const cv::Mat& image) {
   if (!cv::imwrite(path, image)) throw std::runtime_error(path + ": cannot write");
 }
 
-std::string manifest(const std::vector<TestImage>& images, const std::string& set) {
+std::string manifest(const std::vector<TestImage>& images, const std::string& set, const std::string& camera) {
   JsonWriter j(2);
   j.begin_object();
-  j.field("set", set).field("camera", "right").field("width", 640).field("height", 480);
+  const cv::Size size = images.empty() ? cv::Size() : images.front().colour.size();
+  j.field("set", set).field("camera", "right " + camera).field("width", size.width).field("height", size.height);
   j.field("surface_encoding", "16-bit PNG, channel k = round((c + 0.5) * 65534) + 1, 0 = no object "
                               "(nudge::sim::decode_surface)");
   j.key("images").begin_array();
@@ -93,11 +94,12 @@ void write_report(const std::vector<TestImage>& images, double seconds, const st
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string out, set = "eval", training;
+  std::string out, set = "eval", training, camera = "still";
   bool report = false;
   Flags flags("nudge-exp-learning-scenes", "Render the object-learning experiment's test images and write its scenes.");
   flags.add_string("out", &out, "directory for the test images and manifest.json (made if missing)");
   flags.add_string("set", &set, "eval (the experiment's fixed seeds) or dev (another series, to tune on)");
+  flags.add_string("camera", &camera, "the right camera's still (1280x960, the robot's close look) or video (640x480) image");
   flags.add_string("training-scenes", &training, "also write the seven training scenes' YAML into this directory");
   flags.add_bool("report", &report, "write docs/results/learning_scenes.{json,md} and a contact sheet");
   try {
@@ -117,14 +119,14 @@ int main(int argc, char** argv) {
     const auto start = std::chrono::steady_clock::now();
     nudge::Progress progress("nudge-exp-learning-scenes",
                              static_cast<int>(4 * learning_bottles().size() + unknown_objects(NUDGE_SOURCE_DIR).size()));
-    const std::vector<TestImage> images =
-        make_test_images(NUDGE_SOURCE_DIR, set, [&](const std::string& name) { progress.step(name); });
+    const std::vector<TestImage> images = make_test_images(NUDGE_SOURCE_DIR, set, test_camera_from_name(camera),
+                                                           [&](const std::string& name) { progress.step(name); });
     for (const auto& t : images) {
       write_image(out + "/" + t.name + ".png", t.colour);
       write_image(out + "/" + t.name + "_mask.png", t.mask);
       write_image(out + "/" + t.name + "_surface.png", sim::encode_surface(t.surface));
     }
-    write_file_atomically(out + "/manifest.json", manifest(images, set));
+    write_file_atomically(out + "/manifest.json", manifest(images, set, camera));
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     progress.clear_status();  // the report's "wrote" lines follow on stderr
     if (report) write_report(images, seconds, set);

@@ -21,6 +21,8 @@ int main(int argc, char** argv) {
     f.add_double("box-margin", &options.learn.box_margin, "training box grown by this fraction each side");
     f.add_int("background-matches", &options.learn.background_matches,
               "a descriptor matching this many other views is background (thesis 3)");
+    f.add_double("sift-contrast", &options.recognize.sift.contrast_threshold,
+                 "SIFT's contrast threshold, learning and recognition (OpenCV's default 0.04; lower finds more on small labels)");
     f.add_double("view-expiry", &options.view_expiry_s, "drop views not committed within SECONDS of message time");
     if (!service.parse(argc, argv)) return 0;
     if (options.db_dir.empty()) throw FlagError("--db DIR is required");
@@ -33,7 +35,9 @@ int main(int argc, char** argv) {
     if (options.recognize.min_matches < 1) throw FlagError("--min-matches must be >= 1");
     if (options.learn.background_matches < 1) throw FlagError("--background-matches must be >= 1");
     if (options.view_expiry_s <= 0) throw FlagError("--view-expiry must be > 0");
+    if (!(options.recognize.sift.contrast_threshold > 0)) throw FlagError("--sift-contrast must be > 0");
     options.learn.ratio = options.recognize.ratio;
+    options.learn.sift = options.recognize.sift;
     service.start();
     const learner_service::Handlers handlers(service, options);
     return service.run();

@@ -138,7 +138,9 @@ class Shell {
       : service_(service), opt_(opt), scene_(sv::SceneGeometry::load(opt.calibration)),
         supervisor_(opt.config, scene_, opt.arm, sv::motion_segmentation()),
         required_(split(opt.require)), run_dir_(opt.out_dir + "/" + opt.run_id) {
-    supervisor_.set_left_segmentation(sv::motion_segmentation());  // its own scratch images: a thread of its own
+    // Its own scratch images: a thread of its own; no stages (only the right camera's are written).
+    supervisor_.set_left_segmentation(sv::motion_segmentation({}, false));
+    supervisor_.set_stageless_segmentation(sv::motion_segmentation({}, false));  // the grasp's (right) one
     std::error_code error;
     std::filesystem::create_directories(run_dir_, error);
     if (error) throw std::runtime_error(run_dir_ + ": cannot create the run's folder (" + error.message() + ")");

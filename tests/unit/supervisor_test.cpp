@@ -858,6 +858,38 @@ TEST_F(LearningTest, ARefusedGraspEndsTheLearningWithTheArmsReason) {
   EXPECT_EQ(s.state(), sv::State::FindCandidates);
 }
 
+TEST_F(LearningTest, TheGraspIsPlannedOnTheStagelessSegmentationAndTheStagesAreDrawnAfterIt) {
+  // The constructor's segmentation draws fig. 6.7's stages; the stageless one, given, is the one the
+  // grasp waits for. The stages still reach the attempt's files, drawn once the grasp is commanded.
+  std::vector<std::string> calls;
+  auto with_stages = [&](const cv::Mat& before, const cv::Mat& after, const nudge::symmetry::Line& l0,
+                         const nudge::symmetry::Line& l1) {
+    calls.push_back("with stages");
+    sv::Segmentation out = mask_of_difference(before, after, l0, l1);
+    out.stages = {{"c_difference", cv::Mat(4, 4, CV_8U, cv::Scalar(7))}};
+    return out;
+  };
+  auto stageless = [&](const cv::Mat& before, const cv::Mat& after, const nudge::symmetry::Line& l0,
+                       const nudge::symmetry::Line& l1) {
+    calls.push_back("stageless");
+    return mask_of_difference(before, after, l0, l1);
+  };
+  sv::Config config;
+  config.learn = sv::Config::Learn::On;
+  sv::Supervisor s(config, scene_, sv::ArmSetup{}, with_stages);
+  s.set_left_segmentation(mask_of_difference);
+  s.set_stageless_segmentation(stageless);
+  const sv::GraspCommand grasp = to_grasp(s);
+  EXPECT_EQ(calls, (std::vector<std::string>{"stageless", "with stages"}));
+  s.on_arm_state(arm(sv::ArmStatus::Motion::Refused, grasp.seq, "grasp: wrist below the table"), now_ += kSecond);
+  const auto a = ended(s.take_outputs());
+  ASSERT_TRUE(a);
+  ASSERT_EQ(a->segmentation.stages.size(), 1u);
+  EXPECT_EQ(a->segmentation.stages[0].first, "c_difference");
+  EXPECT_GT(cv::countNonZero(a->segmentation.mask), 1000) << "the stageless segmentation's mask";
+  EXPECT_GE(a->grasp_plan_ms, 0);
+}
+
 TEST_F(LearningTest, AGripperThatClosesFullyHoldsNothing) {
   sv::Supervisor s = make_learning();
   done(s, to_grasp(s).seq, 0.001);  // closed to 1 mm: missed

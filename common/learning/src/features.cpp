@@ -7,15 +7,23 @@
 
 namespace nudge::learning {
 
-Features detect_features(const cv::Mat& image) {
+Features detect_features(const cv::Mat& image, const SiftParams& params) {
   if (image.empty()) throw std::invalid_argument("SIFT: empty image");
   if (image.depth() != CV_8U) throw std::invalid_argument("SIFT: image is not 8-bit");
+  if (!(params.contrast_threshold > 0) || !(params.edge_threshold > 0) || params.octave_layers < 1)
+    throw std::invalid_argument("SIFT: contrast_threshold and edge_threshold must be positive, octave_layers >= 1");
   cv::Mat grey;
   if (image.channels() == 3) cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
   else if (image.channels() == 4) cv::cvtColor(image, grey, cv::COLOR_BGRA2GRAY);
   else grey = image;
-  // One detector per thread: cv::SIFT keeps scratch state.
-  thread_local cv::Ptr<cv::SIFT> sift = cv::SIFT::create();
+  // One detector per thread (cv::SIFT keeps scratch state), made again when the settings change.
+  thread_local cv::Ptr<cv::SIFT> sift;
+  thread_local SiftParams made_with;
+  if (!sift || made_with.contrast_threshold != params.contrast_threshold ||
+      made_with.edge_threshold != params.edge_threshold || made_with.octave_layers != params.octave_layers) {
+    sift = cv::SIFT::create(0, params.octave_layers, params.contrast_threshold, params.edge_threshold);
+    made_with = params;
+  }
   Features features;
   sift->detectAndCompute(grey, cv::noArray(), features.keypoints, features.descriptors);
   if (features.descriptors.empty()) features.descriptors.create(0, 128, CV_32F);

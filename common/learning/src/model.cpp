@@ -44,7 +44,7 @@ ObjectModel learn_object(const ObjectInfo& info, const std::vector<TrainingImage
     const TrainingImage& t = images[v];
     if (t.image.empty() || t.image.depth() != CV_8U)
       throw std::invalid_argument("object " + info.name + ": view " + std::to_string(v) + " is empty or not 8-bit");
-    const Features all = detect_features(t.image);
+    const Features all = detect_features(t.image, params.sift);
     const cv::Rect box = t.box.empty() ? cv::Rect() : generous_box(t.box, params.box_margin, t.image.size());
     boxed.push_back(features_inside(all, box));
     counts.detected += all.size();

@@ -252,7 +252,7 @@ Recognition Recognizer::recognize(const cv::Mat& image, const cv::Rect& roi) con
   if (image.empty()) throw std::invalid_argument("recognize: empty image");
   const cv::Rect area = roi.empty() ? cv::Rect(cv::Point(0, 0), image.size()) : roi & cv::Rect(cv::Point(0, 0), image.size());
   if (area.empty()) throw std::invalid_argument("recognize: the region lies outside the image");
-  Features query = detect_features(image(area));
+  Features query = detect_features(image(area), params_.sift);
   for (auto& k : query.keypoints) k.pt += cv::Point2f(static_cast<float>(area.x), static_cast<float>(area.y));
   Recognition result = recognize(query);
   result.elapsed_ms = watch.elapsed_ms();

@@ -318,10 +318,18 @@ void Supervisor::segment(int64_t now) {
   a.after_line = find_line_near(a.after, *predicted_after, config_.line_search);
   if (!a.before_line) a.before_line = predicted_before;
   if (!a.after_line) a.after_line = predicted_after;
-  a.segmentation = segment_(a.before, a.after, *a.before_line, *a.after_line);
+  const bool stages_later = a.learn && segment_stageless_;
+  a.segmentation = (stages_later ? segment_stageless_ : segment_)(a.before, a.after, *a.before_line, *a.after_line);
   keep_object_rows(a);
   if (left.valid()) left.get();  // joined before the attempt can end
+  // Fig. 6.7's stages for the attempt's files when the segmentation went without them: drawn
+  // after the grasp is planned, off its clock (an attempt that ended meanwhile waits in outputs_,
+  // not yet written, and `a` is still it).
+  auto draw_stages = [&] {
+    if (stages_later) a.segmentation.stages = segment_(a.before, a.after, *a.before_line, *a.after_line).stages;
+  };
   if (a.segmentation.mask.empty() || cv::countNonZero(a.segmentation.mask) < config_.min_mask_pixels) {
+    draw_stages();
     end_attempt(Outcome::SegmentationFailed,
                 "segmentation empty" + (a.segmentation.error.empty() ? std::string() : ": " + a.segmentation.error), now);
     return;
@@ -330,6 +338,7 @@ void Supervisor::segment(int64_t now) {
     plan_grasp(now);
     if (state_ == State::Grasp)
       a.grasp_plan_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started).count();
+    draw_stages();
     return;
   }
   end_attempt(Outcome::Segmented, "segmented", now);

@@ -55,6 +55,22 @@ TEST(LearningFeatures, SiftFindsTextureAndNothingOnABlankImage) {
   EXPECT_THROW(detect_features(cv::Mat(kImage, CV_32F, cv::Scalar(0))), std::invalid_argument);
 }
 
+TEST(LearningFeatures, ALowerContrastThresholdFindsMoreOnAFaintTextureAndBadSettingsAreRefused) {
+  // A faint texture (a third of its contrast): SIFT's contrast threshold decides how much it finds.
+  cv::Mat faint;
+  synthetic::random_texture(kImage, 3).convertTo(faint, -1, 0.3, 90);
+  SiftParams opencv_default;
+  opencv_default.contrast_threshold = 0.04;
+  const int at_default = detect_features(faint, opencv_default).size();
+  EXPECT_GT(detect_features(faint).size(), at_default + at_default / 4);  // the default, 0.02
+  SiftParams bad;
+  bad.contrast_threshold = 0;
+  EXPECT_THROW(detect_features(faint, bad), std::invalid_argument);
+  bad = SiftParams{};
+  bad.octave_layers = 0;
+  EXPECT_THROW(detect_features(faint, bad), std::invalid_argument);
+}
+
 TEST(LearningFeatures, GenerousBoxGrowsAndClips) {
   EXPECT_EQ(generous_box({100, 100, 40, 80}, 0.25, {640, 480}), cv::Rect(90, 80, 60, 120));
   EXPECT_EQ(generous_box({0, 0, 40, 80}, 0.5, {640, 480}), cv::Rect(0, 0, 60, 120));

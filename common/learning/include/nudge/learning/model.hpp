@@ -45,6 +45,7 @@ struct LearnParams {
   double box_margin = 0.25;   // of the box's size, each side
   double ratio = 0.6;         // Lowe's ratio between views (thesis: N = 0.6)
   int background_matches = 3; // a descriptor matching this many other views' descriptors is background
+  SiftParams sift;            // as the recognizer's, so that both find the same keypoints
 };
 
 struct LearnStats {

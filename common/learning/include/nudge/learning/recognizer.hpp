@@ -32,6 +32,7 @@ struct RecognizeParams {
   // an object's two nearest are usually among them) and k-d tree leaves checked to find them.
   int shared_neighbours = 16;
   int shared_checks = 64;
+  SiftParams sift;              // of the query image (recognize(image, roi)); as the learner's
 };
 
 // How one object scored against the query.

@@ -6,6 +6,9 @@
 
 namespace nudge::supervisor {
 
-SegmentFunction motion_segmentation(segmentation::MotionParams params = {});
+// `keep_stages`: fig. 6.7's stages in Segmentation::stages (the right camera's, written with the
+// attempt). They cost a whole-image difference and copies of both stills (a fifth of the
+// segmentation's time, grasp_plan_bench): the left camera's, never written, go without.
+SegmentFunction motion_segmentation(segmentation::MotionParams params = {}, bool keep_stages = true);
 
 }  // namespace nudge::supervisor

@@ -244,6 +244,10 @@ class Supervisor {
   // A second segmenter for the left stills (learning): the two cameras' segmentations then run on
   // two threads. Without it the left one runs after the right one, with the same function.
   void set_left_segmentation(SegmentFunction segment) { segment_left_ = std::move(segment); }
+  // The right camera's segmentation without fig. 6.7's stages, for a grasp (learning): the grasp
+  // is planned without waiting for the stages (two thirds of a segmentation's time), and the
+  // constructor's function draws them for the attempt's files once the grasp is commanded.
+  void set_stageless_segmentation(SegmentFunction segment) { segment_stageless_ = std::move(segment); }
 
   std::vector<Output> take_outputs();
   State state() const { return state_; }
@@ -303,6 +307,7 @@ class Supervisor {
   void before_lines();
   void segment_left(Attempt& attempt) const;
   SegmentFunction segment_left_;
+  SegmentFunction segment_stageless_;
   void recognise(int64_t now);
   void plan_grasp(int64_t now);
   void on_learning_arm_state(const ArmStatus& arm, int64_t now);
