@@ -27,6 +27,7 @@
 
 #include "nudge/flags.hpp"
 #include "nudge/json.hpp"
+#include "nudge/progress.hpp"
 #include "nudge/symmetry/line.hpp"
 #include "nudge/tracking/scoring.hpp"
 #include "nudge/tracking/tracker.hpp"
@@ -254,7 +255,9 @@ int main(int argc, char** argv) {
     std::vector<double> errors;
     JsonWriter per_video;
     per_video.begin_array();
+    nudge::Progress progress("nudge-exp-tracker-losses", seeds);
     for (int seed = first_seed; seed < first_seed + seeds; ++seed) {
+      progress.step("seed " + std::to_string(seed));
       const Scenario sc = generated_scenario(static_cast<uint64_t>(seed), pictures);
       if (!trace_name.empty() && trace_name != sc.name) continue;
       const std::array<Video, 2> videos = render_stereo_video(sc);
@@ -296,6 +299,7 @@ int main(int argc, char** argv) {
       }
     }
     per_video.end_array();
+    progress.finish(std::to_string(losses) + " of " + std::to_string(scored) + " scored frames lost");
     const double mean_error = errors.empty() ? NAN : mean(errors), median_error = errors.empty() ? NAN : median(errors);
     std::cout << "total " << losses << " / " << scored << " lost; mean error " << mean_error << " px, median "
               << median_error << " px" << std::endl;
