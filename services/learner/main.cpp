@@ -35,7 +35,13 @@ int main(int argc, char** argv) {
     if (options.view_expiry_s <= 0) throw FlagError("--view-expiry must be > 0");
     options.learn.ratio = options.recognize.ratio;
     service.start();
-    const learner_service::Handlers handlers(service, options);
-    return service.run();
+    learner_service::Handlers handlers(service, options);
+    // The tick keeps the heartbeat's status current while the worker learns and answers LEARNED.
+    const int code = service.run([&handlers] {
+      handlers.poll();
+      return 20;
+    });
+    handlers.finish_learning();  // a job under way is stored and answered, not cut off
+    return code;
   });
 }
