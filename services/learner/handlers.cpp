@@ -123,19 +123,24 @@ void Handlers::on_commit(const learn_commit_t& msg) {
     service_.publish(bus::channel::LEARNED, out);
   };
   const auto it = pending_.find({msg.run_id, msg.object_key});
+  if (worker_.busy() && it != pending_.end() && !it->second.views.empty())
+    // A queue of one: the views stay, the same commit sent again after that LEARNED is learned.
+    return fail("busy " + worker_.status() + ": LEARN_COMMIT refused, its views kept; send it again after that LEARNED");
   if (it == pending_.end() || it->second.views.empty()) {
     const std::string bad = it == pending_.end() ? "" : " (" + it->second.bad_views + ")";
     if (it != pending_.end()) pending_.erase(it);
     return fail("no usable views received for " + describe(msg.run_id, msg.object_key) + bad);
   }
+  if (!learning::valid_object_name(out.object_name)) {
+    pending_.erase(it);
+    return fail("object name '" + out.object_name + "' is not usable as a folder name ([A-Za-z0-9_.-])");
+  }
   Pending pending = std::move(it->second);
   pending_.erase(it);
-  if (!learning::valid_object_name(out.object_name))
-    return fail("object name '" + out.object_name + "' is not usable as a folder name ([A-Za-z0-9_.-])");
-  std::vector<learning::TrainingImage> images;
-  for (auto& [index, view] : pending.views) images.push_back(std::move(view));
-  if (static_cast<int>(images.size()) != msg.num_views)
-    log::warn() << what << ": " << images.size() << " of " << msg.num_views << " views arrived"
+  auto images = std::make_shared<std::vector<learning::TrainingImage>>();
+  for (auto& [index, view] : pending.views) images->push_back(std::move(view));
+  if (static_cast<int>(images->size()) != msg.num_views)
+    log::warn() << what << ": " << images->size() << " of " << msg.num_views << " views arrived"
                 << (pending.bad_views.empty() ? "" : " (" + pending.bad_views + ")");
   learning::ObjectInfo info;
   info.name = out.object_name;
@@ -144,17 +149,49 @@ void Handlers::on_commit(const learn_commit_t& msg) {
   info.learned_utime = msg.utime;
   info.height = msg.height;
   info.radius = msg.radius;
-  learning::LearnStats stats;
-  try {
-    learning::ObjectModel model = learning::learn_object(info, images, options_.learn, &stats);
-    db_.store(model);
-    recognizer_.add(without_images(std::move(model)));
-    recognizer_.build_index();  // the new object is found from the next request on
-  } catch (const std::exception& e) {  // a bad view or the database refusing: reported, nothing half-stored
-    return fail(e.what());
+  out.views_used = static_cast<int32_t>(images->size());
+  job_ = Job{out, {}, {}};
+  // The worker learns and stores (the database write is atomic: nothing half-written if it fails);
+  // the recognizer is only touched on this thread, in poll().
+  worker_.submit(msg.object_key, [this, info, images](const LearnWorker::Progress& progress) {
+    job_.model = learning::learn_object(info, *images, options_.learn, &job_.stats, progress);
+    db_.store(job_.model);
+  });
+  service_.set_status(worker_.status());
+}
+
+void Handlers::poll() {
+  if (const auto ended = worker_.take_ended()) learned(*ended);
+  service_.set_status(worker_.status());
+}
+
+void Handlers::finish_learning() {
+  worker_.wait_until_ended();
+  poll();
+}
+
+void Handlers::learned(const LearnWorker::Ended& ended) {
+  learn_result_t out = std::move(job_.answer);
+  learning::ObjectModel model = std::move(job_.model);
+  const learning::LearnStats stats = job_.stats;
+  job_ = Job{};
+  if (ended.error.empty()) {
+    try {
+      recognizer_.add(without_images(std::move(model)));
+      recognizer_.build_index();  // the new object is found from the next request on
+    } catch (const std::exception& e) {
+      out.reason = e.what();
+    }
+  } else {
+    out.reason = ended.error;  // a bad view or the database refusing: reported, nothing half-stored
+  }
+  if (!out.reason.empty()) {
+    out.views_used = 0;
+    report("LEARN_COMMIT " + describe(out.run_id, out.object_key) + ": " + out.reason);
+    service_.publish(bus::channel::LEARNED, out);
+    return;
   }
   out.ok = true;
-  out.views_used = static_cast<int32_t>(images.size());
   out.descriptors = stats.kept;
   out.descriptors_pruned = stats.outside_box + stats.background;
   log::info() << "learned " << out.object_name << " from " << out.views_used << " views: " << stats.kept

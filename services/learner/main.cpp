@@ -39,7 +39,13 @@ int main(int argc, char** argv) {
     options.learn.ratio = options.recognize.ratio;
     options.learn.sift = options.recognize.sift;
     service.start();
-    const learner_service::Handlers handlers(service, options);
-    return service.run();
+    learner_service::Handlers handlers(service, options);
+    // The tick keeps the heartbeat's status current while the worker learns and answers LEARNED.
+    const int code = service.run([&handlers] {
+      handlers.poll();
+      return 20;
+    });
+    handlers.finish_learning();  // a job under way is stored and answered, not cut off
+    return code;
   });
 }

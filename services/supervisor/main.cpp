@@ -228,6 +228,8 @@ class Shell {
     }
     last_beat_[m.service] = m.utime;
     newest_beat_ = std::max(newest_beat_, m.utime);
+    // "learning <object_key> ..." keeps LEARN waiting while the learner works on the object.
+    if (m.service == opt_.learner) supervisor_.on_learner_status(m.status, now_);
     check_services(service_.input_is_log() ? newest_beat_ : wall_utime());
   }
 
@@ -548,7 +550,8 @@ void add_flags(Flags& f, Options& o) {
   f.add_int("views", &o.config.views, "training views per learned object (thesis 12)");
   f.add_double("view-step", &o.config.view_step_deg, "wrist turn between training views, deg (thesis 30)");
   f.add_double("recognise-timeout", &o.config.recognise_timeout_s, "for a RECOGNITION answer, s of the task clock (then the nudge goes ahead)");
-  f.add_double("learn-timeout", &o.config.learn_timeout_s, "for a LEARNED answer, s of the task clock (then the object is put back)");
+  f.add_double("learn-timeout", &o.config.learn_timeout_s, "for a LEARNED answer, s of the task clock (then the object is put back); counted from the learner's last heartbeat saying it learns the object");
+  f.add_double("learn-max-wait", &o.config.learn_max_wait_s, "for a LEARNED answer however long the learner's heartbeat says it is learning the object, s of the task clock");
   f.add_double("held-min-opening", &o.config.held_min_opening_m,
                "ARM_STATE.gripper_measured below this after a grasp or turn: nothing held (dropped), m; 0: no check "
                "(no check either when the arm reports no measurement, -1)");
@@ -579,6 +582,8 @@ int main(int argc, char** argv) {
     if (opt.run_id.find('/') != std::string::npos) throw FlagError("--run-id must not contain '/'");
     if (opt.require.empty()) opt.require = std::string("camera,symmetry,triangulation,arm") + (opt.clock == "sim" ? ",world" : "");
     if (!(opt.service_timeout_s > 0)) throw FlagError("--service-timeout must be > 0");
+    if (!(opt.config.learn_timeout_s > 0)) throw FlagError("--learn-timeout must be > 0");
+    if (!(opt.config.learn_max_wait_s >= opt.config.learn_timeout_s)) throw FlagError("--learn-max-wait must be >= --learn-timeout");
     if (!(opt.nudge_speed_scale >= 0.01 && opt.nudge_speed_scale <= 1)) throw FlagError("--nudge-speed must lie in [0.01, 1]");
     if (opt.learn == "on") opt.config.learn = sv::Config::Learn::On;
     else if (opt.learn == "off") opt.config.learn = sv::Config::Learn::Off;

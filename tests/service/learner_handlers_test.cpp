@@ -7,12 +7,14 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <future>
 #include <memory>
 
 #include "learner/handlers.hpp"
 #include "nudge/bus/channels.hpp"
 #include "nudge/bus/image.hpp"
 #include "nudge/bus/latest.hpp"
+#include "nudge/heartbeat_t.hpp"
 #include "nudge/learn_result_t.hpp"
 #include "nudge/learning/synthetic.hpp"
 #include "nudge/recognition_t.hpp"
@@ -125,6 +127,8 @@ TEST(LearnerHandlers, LearnsStoresAndRecognisesWithAMatchPicture) {
   const auto commit = commit_message("run_1", "attempt_01", "cereal", 12, 120 * kSecond, 7);
   run.bus.publish(channel::LEARN_COMMIT, &commit);
   run.service.handle_pending();
+  run.handlers->finish_learning();  // the worker thread learns; LEARNED comes from poll()
+  run.service.handle_pending();
   ASSERT_TRUE(run.learned.has());
   const nudge::learn_result_t result = run.learned.get();
   EXPECT_TRUE(result.ok) << result.reason;
@@ -233,5 +237,92 @@ TEST(LearnerHandlers, BadInputIsReportedAndTheServiceKeepsAnswering) {
   EXPECT_EQ(run.recognition.get().reason, "empty database");
   EXPECT_EQ(run.recognition.get().match_picture.size, 0);
   EXPECT_TRUE(fs::is_empty(db)) << "nothing stored from bad input";
+  fs::remove_all(db);
+}
+
+// The worker alone, its job held at a gate: a queue of one, progress in the status, errors kept.
+TEST(LearnWorker, OneJobAtATimeWithProgressAndErrors) {
+  nudge::learner_service::LearnWorker worker;
+  EXPECT_FALSE(worker.busy());
+  EXPECT_EQ(worker.status(), "");
+  std::promise<void> reached, release;
+  std::shared_future<void> released = release.get_future().share();
+  ASSERT_TRUE(worker.submit("attempt_03", [&](const nudge::learner_service::LearnWorker::Progress& progress) {
+    progress(3, 12);
+    reached.set_value();
+    released.wait();
+  }));
+  reached.get_future().wait();
+  EXPECT_TRUE(worker.busy());
+  EXPECT_EQ(worker.status(), "learning attempt_03 (view 3/12)");
+  EXPECT_FALSE(worker.submit("attempt_04", [](const auto&) {})) << "a second job while one runs";
+  EXPECT_FALSE(worker.take_ended().has_value()) << "nothing ended yet";
+  release.set_value();
+  worker.wait_until_ended();
+  EXPECT_EQ(worker.status(), "");
+  EXPECT_TRUE(worker.busy()) << "busy until its end is taken";
+  EXPECT_FALSE(worker.submit("attempt_04", [](const auto&) {})) << "the end not taken yet";
+  auto ended = worker.take_ended();
+  ASSERT_TRUE(ended.has_value());
+  EXPECT_EQ(ended->what, "attempt_03");
+  EXPECT_EQ(ended->error, "");
+  EXPECT_FALSE(worker.busy());
+
+  ASSERT_TRUE(worker.submit("attempt_04", [](const auto&) { throw std::runtime_error("disk full"); }));
+  worker.wait_until_ended();
+  ended = worker.take_ended();
+  ASSERT_TRUE(ended.has_value());
+  EXPECT_EQ(ended->what, "attempt_04");
+  EXPECT_EQ(ended->error, "disk full");
+}
+
+// While it learns, the learner answers: its heartbeat says what it learns, a recognition request
+// is answered, a second commit is refused with the reason and its views kept for the resend.
+TEST(LearnerHandlers, StaysResponsiveWhileLearning) {
+  const std::string db = fresh_db("busy");
+  InProcess run(db);
+  nudge::bus::Subscriptions beats(run.bus, run.probe_counters);
+  Latest<nudge::heartbeat_t> beat(beats, channel::HEARTBEAT);
+  run.teach("run_4", "attempt_01", 21, 100 * kSecond);
+  run.teach("run_4", "attempt_02", 22, 130 * kSecond);
+  auto first = commit_message("run_4", "attempt_01", "first", 12, 120 * kSecond, 1);
+  run.bus.publish(channel::LEARN_COMMIT, &first);
+  run.service.handle_pending();  // returns with the job on the worker (busy until poll() takes its end)
+  EXPECT_TRUE(run.handlers->learning());
+  EXPECT_FALSE(run.learned.has()) << "LEARNED only when the worker is done";
+  run.service.publish_heartbeat_at(150 * kSecond);
+  run.service.handle_pending();
+  ASSERT_TRUE(beat.has());
+  EXPECT_EQ(beat.get().status.rfind("learning attempt_01", 0), 0u) << beat.get().status;
+
+  const auto ask = request(syn::random_texture({320, 240}, 3), 30, false);
+  run.bus.publish(channel::RECOGNIZE_REQUEST, &ask);
+  auto second = commit_message("run_4", "attempt_02", "second", 12, 145 * kSecond, 2);
+  run.bus.publish(channel::LEARN_COMMIT, &second);
+  run.service.handle_pending();
+  ASSERT_TRUE(run.recognition.has());
+  EXPECT_EQ(run.recognition.get().seq, 30);
+  ASSERT_TRUE(run.learned.has());
+  EXPECT_EQ(run.learned.get().seq, 2);
+  EXPECT_FALSE(run.learned.get().ok);
+  EXPECT_EQ(run.learned.get().reason.rfind("busy learning attempt_01", 0), 0u) << run.learned.get().reason;
+  EXPECT_EQ(run.handlers->pending_objects(), 1) << "the refused commit's views are kept";
+
+  run.handlers->finish_learning();
+  run.service.handle_pending();
+  EXPECT_EQ(run.learned.get().seq, 1);
+  EXPECT_TRUE(run.learned.get().ok) << run.learned.get().reason;
+  EXPECT_FALSE(run.handlers->learning());
+  run.service.publish_heartbeat_at(160 * kSecond);
+  run.service.handle_pending();
+  EXPECT_EQ(beat.get().status.find("learning"), std::string::npos) << beat.get().status;
+
+  run.bus.publish(channel::LEARN_COMMIT, &second);  // sent again: learned now
+  run.service.handle_pending();
+  run.handlers->finish_learning();
+  run.service.handle_pending();
+  EXPECT_EQ(run.learned.get().seq, 2);
+  EXPECT_TRUE(run.learned.get().ok) << run.learned.get().reason;
+  EXPECT_EQ(run.handlers->known_objects(), 2);
   fs::remove_all(db);
 }

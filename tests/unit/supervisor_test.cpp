@@ -844,6 +844,90 @@ TEST_F(LearningTest, ALearnerSilentAfterTheViewsStillGetsTheObjectPutBack) {
   EXPECT_EQ(s.summary().learned, 0);
 }
 
+// The learner learns on a worker thread and says so in its heartbeat: LEARN waits while it does
+// (beyond --learn-timeout), up to --learn-max-wait; heartbeats about another object do not count.
+TEST_F(LearningTest, LearnWaitsWhileTheLearnersHeartbeatSaysItLearnsTheObject) {
+  sv::Config few;
+  few.learn = sv::Config::Learn::On;
+  few.views = 2;
+  few.learn_timeout_s = 30;
+  few.learn_max_wait_s = 100;
+  for (const bool answered : {true, false}) {
+    sv::Supervisor s = make(few);
+    done(s, to_grasp(s).seq);
+    std::vector<sv::LearnCommit> commits;
+    for (int view = 0; view < 2; ++view) {
+      now_ += kSecond / 5;
+      s.on_right_still(draw_scene(scene_, {1280, 960}, {}), now_, now_);
+      const auto out = s.take_outputs();
+      if (view == 0) done(s, outputs_of<sv::RotateCommand>(out).at(0).seq);
+      if (view == 1) commits = outputs_of<sv::LearnCommit>(out);
+    }
+    ASSERT_EQ(s.state(), sv::State::Learn);
+    ASSERT_EQ(commits.size(), 1u);
+    const std::string key = commits[0].object_key;
+    // 60 s of heartbeats saying it learns this object: still waiting, past learn_timeout_s.
+    for (int beat = 1; beat <= 60; ++beat) {
+      s.on_learner_status("learning " + key + " (view " + std::to_string(beat % 12 + 1) + "/12)", now_ += kSecond);
+      s.on_learner_status("learning " + key + "9 (view 1/12)", now_);  // another object's key
+      s.on_time(now_);
+    }
+    ASSERT_EQ(s.state(), sv::State::Learn) << s.report().reason;
+    if (answered) {
+      s.on_learned(commits[0].seq, true, "cereal", "", now_ += kSecond);
+      ASSERT_EQ(s.state(), sv::State::Place) << s.report().reason;
+      done(s, outputs_of<sv::PlaceCommand>(s.take_outputs()).at(0).seq);
+      const auto a = ended(s.take_outputs());
+      ASSERT_TRUE(a);
+      EXPECT_EQ(a->learning, "learned");
+      EXPECT_EQ(a->learned_name, "cereal");
+      continue;
+    }
+    // Busy until the overall bound: then the object is put back with the reason.
+    for (int beat = 61; beat <= 101 && s.state() == sv::State::Learn; ++beat) {
+      s.on_learner_status("learning " + key + " (view 12/12)", now_ += kSecond);
+      s.on_time(now_);
+    }
+    ASSERT_EQ(s.state(), sv::State::Place) << s.report().reason;
+    done(s, outputs_of<sv::PlaceCommand>(s.take_outputs()).at(0).seq);
+    const auto a = ended(s.take_outputs());
+    ASSERT_TRUE(a);
+    EXPECT_EQ(a->learning, "learner too slow");
+    EXPECT_NE(a->learning_reason.find("--learn-max-wait"), std::string::npos) << a->learning_reason;
+    EXPECT_NE(a->learning_reason.find(key), std::string::npos) << a->learning_reason;
+  }
+}
+
+// A learner that stops saying it learns the object: learn_timeout_s after its last such heartbeat.
+TEST_F(LearningTest, LearnEndsWhenTheLearnerStopsSayingItLearns) {
+  sv::Config few;
+  few.learn = sv::Config::Learn::On;
+  few.views = 2;
+  sv::Supervisor s = make(few);
+  done(s, to_grasp(s).seq);
+  std::string key;
+  for (int view = 0; view < 2; ++view) {
+    now_ += kSecond / 5;
+    s.on_right_still(draw_scene(scene_, {1280, 960}, {}), now_, now_);
+    const auto out = s.take_outputs();
+    if (view == 0) done(s, outputs_of<sv::RotateCommand>(out).at(0).seq);
+    if (view == 1) key = outputs_of<sv::LearnCommit>(out).at(0).object_key;
+  }
+  ASSERT_EQ(s.state(), sv::State::Learn);
+  s.on_learner_status("learning " + key + " (view 3/12)", now_ += 20 * kSecond);
+  s.on_learner_status("ok", now_ += kSecond);  // idle: it forgot the object (restarted)
+  s.on_time(now_ += 25 * kSecond);
+  EXPECT_EQ(s.state(), sv::State::Learn) << "46 s after LEARN_COMMIT but 26 s after the busy heartbeat";
+  s.on_time(now_ += 5 * kSecond);
+  ASSERT_EQ(s.state(), sv::State::Place) << s.report().reason;
+  done(s, outputs_of<sv::PlaceCommand>(s.take_outputs()).at(0).seq);
+  const auto a = ended(s.take_outputs());
+  ASSERT_TRUE(a);
+  EXPECT_EQ(a->learning, "learner silent");
+  EXPECT_NE(a->learning_reason.find("last heartbeat saying it was learning " + key), std::string::npos)
+      << a->learning_reason;
+}
+
 TEST_F(LearningTest, ARefusedGraspEndsTheLearningWithTheArmsReason) {
   sv::Supervisor s = make_learning();
   const sv::GraspCommand grasp = to_grasp(s);

@@ -36,7 +36,7 @@ std::vector<std::vector<bool>> background_descriptors(const std::vector<Features
 }
 
 ObjectModel learn_object(const ObjectInfo& info, const std::vector<TrainingImage>& images, const LearnParams& params,
-                         LearnStats* stats) {
+                         LearnStats* stats, const LearnProgress& progress) {
   if (images.empty()) throw std::invalid_argument("object " + info.name + ": no training views");
   LearnStats counts;
   std::vector<Features> boxed;
@@ -49,6 +49,7 @@ ObjectModel learn_object(const ObjectInfo& info, const std::vector<TrainingImage
     boxed.push_back(features_inside(all, box));
     counts.detected += all.size();
     counts.outside_box += all.size() - boxed.back().size();
+    if (progress) progress(static_cast<int>(v) + 1, static_cast<int>(images.size()));
   }
   const auto background = background_descriptors(boxed, params.ratio, params.background_matches);
   ObjectModel model;

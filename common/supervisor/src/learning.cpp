@@ -208,6 +208,13 @@ void Supervisor::on_learned(int64_t seq, bool ok, const std::string& name, const
   place(now, ok ? "learned" : "learn failed", ok ? "learned as '" + name + "'" : reason);
 }
 
+void Supervisor::on_learner_status(const std::string& status, int64_t now) {
+  if (state_ != State::Learn) return;
+  const std::string busy = "learning " + attempt_->object_key();
+  if (status.rfind(busy, 0) == 0 && (status.size() == busy.size() || status[busy.size()] == ' '))
+    learner_busy_ = now;
+}
+
 // Sec. 7.2.3: the object goes back where it stood before the nudge (revisits stay possible).
 void Supervisor::place(int64_t now, const std::string& learning, const std::string& reason) {
   Attempt& a = *attempt_;

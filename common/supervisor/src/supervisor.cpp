@@ -449,10 +449,20 @@ void Supervisor::on_time(int64_t now) {
         start_nudge(now);
       }
       break;
-    case State::Learn:
-      if (timed_out(config_.learn_timeout_s, now))
-        place(now, "learner silent", "no LEARNED within " + seconds_text(config_.learn_timeout_s) + " (the views are in the attempt's folder)");
+    case State::Learn: {
+      // The learner learns on a worker thread and says so in its heartbeat: the wait goes on while
+      // it does, up to learn_max_wait_s; learn_timeout_s counts from the last such heartbeat.
+      const bool heard_busy = learner_busy_ > entered_;
+      if (timed_out(config_.learn_max_wait_s, now))
+        place(now, "learner too slow", "no LEARNED within " + seconds_text(config_.learn_max_wait_s) +
+                                           " (--learn-max-wait) though its heartbeat said it was learning " +
+                                           attempt_->object_key() + " (the views are in the attempt's folder)");
+      else if (static_cast<double>(now - std::max(entered_, learner_busy_)) > config_.learn_timeout_s * kMicro)
+        place(now, "learner silent", "no LEARNED within " + seconds_text(config_.learn_timeout_s) +
+                                         (heard_busy ? " of its last heartbeat saying it was learning " + attempt_->object_key() : "") +
+                                         " (the views are in the attempt's folder)");
       break;
+    }
     case State::Rotate:
       if (learn_seq_ == 0 && timed_out(config_.snapshot_timeout_s, now)) {
         place(now, "snapshot lost", "view " + std::to_string(attempt_->views.size()) + "'s still never came");

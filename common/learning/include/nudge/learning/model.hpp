@@ -4,6 +4,7 @@
 #include <opencv2/core.hpp>
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -64,7 +65,11 @@ std::vector<std::vector<bool>> background_descriptors(const std::vector<Features
 
 // Detects, prunes (box, then across views) and keeps the images. Throws std::invalid_argument
 // naming the view when an image is empty or not 8-bit, and when no views are given.
+// `progress`, when set, is called after each view's features with (views done, views in all), so a
+// caller learning on a worker thread can say how far it is (the learner's heartbeat).
+using LearnProgress = std::function<void(int done, int total)>;
 ObjectModel learn_object(const ObjectInfo& info, const std::vector<TrainingImage>& images,
-                         const LearnParams& params = {}, LearnStats* stats = nullptr);
+                         const LearnParams& params = {}, LearnStats* stats = nullptr,
+                         const LearnProgress& progress = {});
 
 }  // namespace nudge::learning

@@ -87,7 +87,8 @@ struct Config {
   double view_step_deg = 30;         // wrist turn between views (SIFT tolerates +-15 deg)
   double held_min_opening_m = 0.004; // the gripper closed tighter than this holds nothing
   double recognise_timeout_s = 5;    // for RECOGNITION; then the nudge goes ahead, the reason kept
-  double learn_timeout_s = 30;       // for LEARNED; then the object is put back, the reason kept
+  double learn_timeout_s = 30;       // for LEARNED, counted from the learner's last heartbeat saying it learns the object
+  double learn_max_wait_s = 300;     // for LEARNED however busy the learner says it is
   double arm_timeout_s = 60;         // for each grasp, wrist turn and place
 };
 
@@ -241,6 +242,9 @@ class Supervisor {
   void on_recognition(int64_t seq, const std::string& label, const std::string& reason, int64_t now);
   void on_learned(int64_t seq, bool ok, const std::string& name, const std::string& reason, int64_t now);
   void set_learner_alive(bool alive) { learner_alive_ = alive; }
+  // The learner's heartbeat status: "learning <object_key> ..." while it learns that object (its
+  // worker thread), which keeps LEARN waiting beyond learn_timeout_s, up to learn_max_wait_s.
+  void on_learner_status(const std::string& status, int64_t now);
   // A second segmenter for the left stills (learning): the two cameras' segmentations then run on
   // two threads. Without it the left one runs after the right one, with the same function.
   void set_left_segmentation(SegmentFunction segment) { segment_left_ = std::move(segment); }
@@ -319,6 +323,7 @@ class Supervisor {
   bool learner_alive_ = false;
   bool arm_away_ = false;      // the arm left home for the grasp: park it at the attempt's end
   int64_t learn_seq_ = 0;      // the awaited arm command, RECOGNITION or LEARNED
+  int64_t learner_busy_ = 0;   // task clock: the learner's last heartbeat saying it learns the attempt's object
   double wrist_step_ = 0;      // rad, signed: the direction the wrist has room to turn
   std::string pending_learning_, pending_reason_;  // the learning outcome, once the object is put back
   StateReport report_;
