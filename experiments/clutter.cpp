@@ -485,21 +485,12 @@ std::string fixed(double v, int digits = 3) {
   return s.str();
 }
 
+LineLoss total_line_loss(const std::vector<SceneResult>& rs);
+CandidateLoss total_candidate_loss(const std::vector<SceneResult>& rs);
+
 std::string losses_text(const std::vector<SceneResult>& results) {
-  LineLoss l;
-  CandidateLoss c;
-  for (const auto& r : results) {
-    l.found += r.line_loss.found;
-    l.verification += r.line_loss.verification;
-    l.suppressed += r.line_loss.suppressed;
-    l.rank_low += r.line_loss.rank_low;
-    l.below_ratio += r.line_loss.below_ratio;
-    l.no_peak += r.line_loss.no_peak;
-    c.candidate += r.candidate_loss.candidate;
-    c.never_both += r.candidate_loss.never_both;
-    c.no_intersect += r.candidate_loss.no_intersect;
-    c.not_clustered += r.candidate_loss.not_clustered;
-  }
+  const LineLoss l = total_line_loss(results);
+  const CandidateLoss c = total_candidate_loss(results);
   std::ostringstream s;
   s << "object-frames: in lines " << l.found << ", dropped by verification " << l.verification
     << ", a peak removed by suppression " << l.suppressed << ", a peak ranked below the peaks taken " << l.rank_low
