@@ -600,6 +600,71 @@ TEST_F(SupervisorTest, MotionFarAboveTheObjectIsNotKeptInItsMask) {
   EXPECT_GT(cv::countNonZero(mask), 1000) << "the object stays";
 }
 
+// A mug's handle moves its symmetry line differently in the two cameras: the settled axes lie
+// several cm nearer or farther along the right camera's ray than the mug stands (s03_red_mug:
+// 4.7 cm). They are still the pushed object, and its mask keeps the rows down to its real foot.
+TEST_F(SupervisorTest, AxesOffInDepthAlongTheCamerasRayAreStillThePushedObject) {
+  sv::Supervisor s = make();
+  const Eigen::Vector3d object(0.28, -0.05, 0);
+  start_with(s, {object});
+  s.on_right_still(draw_scene(scene_, {1280, 960}, {object}), now_, now_);
+  const auto nudge = outputs_of<sv::NudgeCommand>(s.take_outputs()).at(0);
+  const Eigen::Vector3d rest = object + 0.03 * nudge.direction;
+  Eigen::Vector3d ray = rest - scene_.right_camera_in_world();
+  ray.z() = 0;
+  ray.normalize();
+  play_nudge(s, nudge.seq, object, rest);
+  settle_with_axes(s, {rest + 0.05 * ray});  // 5 cm too far: more than the 3 cm off the push line
+  park(s);
+  ASSERT_EQ(s.state(), sv::State::SnapshotAfter) << s.report().reason;
+  s.on_right_still(draw_scene(scene_, {1280, 960}, {rest}), now_, now_);
+  const auto ended = outputs_of<sv::AttemptEnded>(s.take_outputs());
+  ASSERT_EQ(ended.size(), 1u);
+  EXPECT_EQ(ended[0].attempt->outcome, sv::Outcome::Segmented) << ended[0].attempt->reason;
+  // The rows just above the real foot are in the mask (the rest 5 cm farther would cut them).
+  const cv::Mat& mask = ended[0].attempt->segmentation.mask;
+  const int foot_row = static_cast<int>(scene_.project_right(rest, {1280, 960})->y);
+  EXPECT_GT(cv::countNonZero(mask.rowRange(foot_row - 12, foot_row - 2)), 100) << "the object's foot is kept";
+}
+
+// The object nudged is remembered where it now stands: a candidate that is the same object seen
+// through a stereo mismatch (on its line in one camera, 8 cm farther) is not nudged again, while
+// a candidate as far away but off both cameras' lines is.
+TEST_F(SupervisorTest, ACandidateOnTheRestedObjectsLineInACameraIsThatObjectNotNudgedAgain) {
+  sv::Supervisor s = make();
+  const Eigen::Vector3d object(0.28, -0.05, 0);
+  start_with(s, {object});
+  s.on_right_still(draw_scene(scene_, {1280, 960}, {object}), now_, now_);
+  const auto nudge = outputs_of<sv::NudgeCommand>(s.take_outputs()).at(0);
+  const Eigen::Vector3d rest = object + 0.03 * nudge.direction;
+  play_nudge(s, nudge.seq, object, rest);
+  settle_with_axes(s, {rest});
+  park(s);
+  s.on_right_still(draw_scene(scene_, {1280, 960}, {rest}), now_, now_);
+  ASSERT_EQ(outputs_of<sv::AttemptEnded>(s.take_outputs()).at(0).attempt->outcome, sv::Outcome::Segmented);
+  Eigen::Vector3d ray = rest - scene_.right_camera_in_world();
+  ray.z() = 0;
+  ray.normalize();
+  const Eigen::Vector3d mate = rest + 0.08 * ray;  // 8 cm farther from the camera on its ray
+  auto out = answer_survey(s, {mate});
+  EXPECT_EQ(s.state(), sv::State::Done) << s.report().reason;
+  EXPECT_EQ(s.summary().rejections.count("already explored"), 1u) << "passed over as the same object, not as out of reach";
+  EXPECT_TRUE(outputs_of<sv::SnapshotRequest>(out).empty());
+  // Another object as far from it, beside it (off both cameras' lines): nudged.
+  sv::Supervisor t = make();
+  start_with(t, {object});
+  t.on_right_still(draw_scene(scene_, {1280, 960}, {object}), now_, now_);
+  const auto second = outputs_of<sv::NudgeCommand>(t.take_outputs()).at(0);
+  play_nudge(t, second.seq, object, rest);
+  settle_with_axes(t, {rest});
+  park(t);
+  t.on_right_still(draw_scene(scene_, {1280, 960}, {rest}), now_, now_);
+  t.take_outputs();
+  const Eigen::Vector3d beside = rest + 0.08 * Eigen::Vector3d(-ray.y(), ray.x(), 0);
+  out = answer_survey(t, {beside});
+  EXPECT_EQ(t.state(), sv::State::SnapshotBefore) << t.report().reason;
+}
+
 // ---- learning by interaction (thesis ch. 7): recognise, grasp, turn, learn, put back ----
 
 TEST(Grasp, TheObjectTopIsTheLargestBlobsFirstPixelOnTheLine) {

@@ -130,7 +130,7 @@ void Supervisor::survey(int64_t now, const std::string& why) {
 
 void Supervisor::choose(int64_t now) {
   const Eigen::Vector3d camera = scene_.right_camera_in_world();
-  TargetChoice choice = choose_target(candidates_, explored_, empty_, camera, arm_, joints_, config_.targets);
+  TargetChoice choice = choose_target(candidates_, explored_with_ray_mates(), empty_, camera, arm_, joints_, config_.targets);
   summary_.rejections.clear();
   for (const Rejection& r : choice.rejected) ++summary_.rejections[r.reason];
   report_.num_candidates = static_cast<int>(candidates_.size());
@@ -157,6 +157,38 @@ void Supervisor::choose(int64_t now) {
   report_.candidate_index = choice.target.index;
   report_.target = choice.target.position;
   request_still(State::SnapshotBefore, now, choice.note);
+}
+
+// The horizontal direction from the right camera to a point on the table.
+Eigen::Vector2d Supervisor::viewing_ray(const Eigen::Vector3d& at) const {
+  const Eigen::Vector2d ray = (at - scene_.right_camera_in_world()).head<2>();
+  return ray.norm() > 1e-9 ? Eigen::Vector2d(ray.normalized()) : Eigen::Vector2d::UnitX();
+}
+
+// Two axes on the table that one camera sees as one line (a stereo mismatch of the other camera
+// puts the same object at another depth along this camera's ray).
+bool Supervisor::same_object_in_a_camera(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const {
+  if ((a - b).head<2>().norm() > config_.same_object_depth_m) return false;
+  const double max_angle = config_.agreement_angle_deg * M_PI / 180;
+  const auto la = scene_.left_axis_line(a, config_.object_height_m, config_.frame_size);
+  const auto lb = scene_.left_axis_line(b, config_.object_height_m, config_.frame_size);
+  const auto ra = scene_.right_axis_line(a, config_.object_height_m, config_.frame_size);
+  const auto rb = scene_.right_axis_line(b, config_.object_height_m, config_.frame_size);
+  return (la && lb && lines_agree(*lb, *la, max_angle, config_.agreement_offset_px)) ||
+         (ra && rb && lines_agree(*rb, *ra, max_angle, config_.agreement_offset_px));
+}
+
+// The places already explored, and this survey's candidates that are a rested object seen at
+// another depth: the object nudged before is remembered by where it now stands.
+std::vector<Eigen::Vector3d> Supervisor::explored_with_ray_mates() const {
+  std::vector<Eigen::Vector3d> explored = explored_;
+  for (const Candidate& c : candidates_)
+    for (const Eigen::Vector3d& rest : rests_)
+      if (same_object_in_a_camera(c.position, rest)) {
+        explored.push_back(c.position);
+        break;
+      }
+  return explored;
 }
 
 void Supervisor::request_still(State state, int64_t now, const std::string& note) {
@@ -273,11 +305,17 @@ bool Supervisor::verify_by_tracking(int64_t now) {
 bool Supervisor::verify_by_axes(int64_t now) {
   Attempt& a = *attempt_;
   std::vector<double> xs, ys, tilts;
+  const Eigen::Vector2d ray = viewing_ray(a.target.position);
   for (const Axis& axis : settled_axes_) {
     const Eigen::Vector3d offset = axis.foot - a.target.position;
     const double along = offset.head<2>().dot(a.direction.head<2>());
-    const double across = (offset.head<2>() - along * a.direction.head<2>()).norm();
-    if (along < -config_.max_lateral_m || along > config_.max_travel_m || across > config_.max_lateral_m) continue;
+    const Eigen::Vector2d across = offset.head<2>() - along * a.direction.head<2>();
+    // Off the push line: along the camera's ray by the stereo depth error, sideways by little.
+    const double in_depth = std::abs(across.dot(ray));
+    const double sideways = (across - across.dot(ray) * ray).norm();
+    if (along < -config_.max_lateral_m || along > config_.max_travel_m || sideways > config_.max_lateral_m ||
+        in_depth > config_.max_lateral_m + config_.max_depth_error_m)
+      continue;
     xs.push_back(axis.foot.x());
     ys.push_back(axis.foot.y());
     tilts.push_back(axis.tilt_rad);
@@ -340,12 +378,22 @@ void Supervisor::segment(int64_t now) {
 void Supervisor::keep_object_rows(Attempt& a) const {
   cv::Mat& mask = a.segmentation.mask;
   if (mask.empty() || !a.rest) return;
-  const auto foot = scene_.project_right(*a.rest, mask.size());
-  const auto top = scene_.project_right(*a.rest + Eigen::Vector3d(0, 0, config_.object_height_m), mask.size());
-  if (!foot || !top) return;
+  // The rest may be off by the stereo depth error along the camera's ray: the rows of the object
+  // standing anywhere in that range (nearer: its foot lower in the image).
+  const Eigen::Vector2d ray = viewing_ray(*a.rest);
+  const Eigen::Vector3d depth = config_.max_depth_error_m * Eigen::Vector3d(ray.x(), ray.y(), 0);
+  const Eigen::Vector3d up(0, 0, config_.object_height_m);
+  double lowest = -1e9, highest = 1e9;
+  for (const Eigen::Vector3d& foot_at : {Eigen::Vector3d(*a.rest - depth), Eigen::Vector3d(*a.rest + depth)}) {
+    const auto foot = scene_.project_right(foot_at, mask.size());
+    const auto top = scene_.project_right(foot_at + up, mask.size());
+    if (!foot || !top) return;
+    lowest = std::max({lowest, foot->y, top->y});
+    highest = std::min({highest, foot->y, top->y});
+  }
   const int margin = mask.rows / 48;  // 20 px at 960 rows: the foot's shadow and rounding
-  const int first = std::clamp(static_cast<int>(std::min(foot->y, top->y)) - margin, 0, mask.rows);
-  const int last = std::clamp(static_cast<int>(std::max(foot->y, top->y)) + margin, 0, mask.rows);
+  const int first = std::clamp(static_cast<int>(highest) - margin, 0, mask.rows);
+  const int last = std::clamp(static_cast<int>(lowest) + margin, 0, mask.rows);
   mask.rowRange(0, first).setTo(0);
   mask.rowRange(last, mask.rows).setTo(0);
   if (!a.segmentation.cutout.empty()) a.segmentation.cutout.setTo(cv::Scalar::all(0), mask == 0);
@@ -366,7 +414,10 @@ void Supervisor::end_attempt(Outcome outcome, const std::string& reason, int64_t
       if ((c.position - a.target.position).head<2>().norm() < config_.targets.same_object_radius) explored_.push_back(c.position);
   }
   if (outcome == Outcome::NoMotion && !a.rest) empty_.push_back(a.target.position);
-  if (a.rest) explored_.push_back(*a.rest);
+  if (a.rest) {
+    explored_.push_back(*a.rest);
+    rests_.push_back(*a.rest);
+  }
   if (outcome == Outcome::SnapshotLost && a.before.empty()) explored_.push_back(a.target.position);
   outputs_.push_back(AttemptEnded{std::shared_ptr<const Attempt>(attempt_.release())});
   watch_.reset();

@@ -54,6 +54,16 @@ struct Config {
   int min_axes = 3;                  // upright axes near the expected place that confirm the object
   double max_travel_m = 0.12;        // how far beyond its place a nudged object is looked for
   double max_lateral_m = 0.03;       // and how far off the push line
+  // How far a triangulated axis may lie from the object along the right camera's viewing ray: a
+  // stereo mismatch (a mug's handle moves its line differently in the two cameras) puts axes of the
+  // same object up to ~5 cm nearer or farther (measured on s03_red_mug: 4.4 and 4.7 cm). Axes
+  // this far off the push line along the ray still count as the pushed object's, and the mask's
+  // rows allow for a rest that far off in depth.
+  double max_depth_error_m = 0.07;
+  // A candidate whose axis projects onto a rested object's line in either camera (the same
+  // object seen through a stereo mismatch) within this distance of it is that object: not nudged
+  // again. (s01, s03, s10: the phantom nudged second stood 4-9 cm behind the object on its ray.)
+  double same_object_depth_m = 0.10;
   double upright_max_tilt_deg = 12;  // median tilt; thesis ch. 6 keeps candidates within 10 deg, a settled axis gets 2 deg for noise
   double min_displacement_m = 0.004; // a smaller slide gives no difference to segment
   double object_height_m = 0.25;     // the tallest expected object (lines drawn up to it)
@@ -280,6 +290,10 @@ class Supervisor {
   std::string after_home_;  // why the survey after homing happens
   std::vector<Candidate> candidates_;
   std::vector<Eigen::Vector3d> explored_, empty_;
+  std::vector<Eigen::Vector3d> rests_;  // where nudged objects came to rest (they stand there now)
+  std::vector<Eigen::Vector3d> explored_with_ray_mates() const;
+  bool same_object_in_a_camera(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const;
+  Eigen::Vector2d viewing_ray(const Eigen::Vector3d& at) const;
   std::vector<Axis> settled_axes_;
   std::vector<std::vector<symmetry::Line>> survey_lines_[2];  // [left, right]: per message, during a survey
   double stereo_agreement(const Candidate& candidate) const;
