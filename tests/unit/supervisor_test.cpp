@@ -665,6 +665,23 @@ TEST_F(SupervisorTest, ACandidateOnTheRestedObjectsLineInACameraIsThatObjectNotN
   EXPECT_EQ(t.state(), sv::State::SnapshotBefore) << t.report().reason;
 }
 
+// The arm's base column is symmetric: a stereo mismatch of its line gives a candidate behind it
+// (on its line in one camera), where that camera cannot see anything. Not nudged; the object is.
+TEST_F(SupervisorTest, ACandidateHiddenBehindTheArmsBaseIsPassedOverWithItsReason) {
+  sv::Supervisor s = make();
+  Eigen::Vector3d away = -scene_.right_camera_in_world();  // from the right camera through the base
+  away.z() = 0;
+  const Eigen::Vector3d behind = 0.18 * away.normalized();
+  const Eigen::Vector3d object(0.28, -0.05, 0);
+  start_with(s, {behind, object});
+  ASSERT_EQ(s.state(), sv::State::SnapshotBefore) << s.report().reason;
+  EXPECT_NEAR((s.report().target - object).norm(), 0.0, 1e-9);
+  sv::Supervisor alone = make();
+  start_with(alone, {behind});
+  EXPECT_EQ(alone.state(), sv::State::Done);
+  EXPECT_NE(alone.summary().end_reason.find("behind the arm's base"), std::string::npos) << alone.summary().end_reason;
+}
+
 // ---- learning by interaction (thesis ch. 7): recognise, grasp, turn, learn, put back ----
 
 TEST(Grasp, TheObjectTopIsTheLargestBlobsFirstPixelOnTheLine) {

@@ -293,6 +293,7 @@ class Supervisor {
   std::vector<Eigen::Vector3d> rests_;  // where nudged objects came to rest (they stand there now)
   std::vector<Eigen::Vector3d> explored_with_ray_mates() const;
   bool same_object_in_a_camera(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const;
+  std::vector<Candidate> drop_hidden_behind_arm_base(std::vector<Rejection>& rejected) const;
   Eigen::Vector2d viewing_ray(const Eigen::Vector3d& at) const;
   std::vector<Axis> settled_axes_;
   std::vector<std::vector<symmetry::Line>> survey_lines_[2];  // [left, right]: per message, during a survey
