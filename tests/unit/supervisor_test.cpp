@@ -410,6 +410,55 @@ TEST_F(SupervisorTest, AxesOfFramesTakenWhileTheObjectSettledAreIgnoredHoweverLa
   EXPECT_EQ(s.state(), sv::State::Home) << sv::to_string(s.state()) << ": " << s.report().reason;
 }
 
+// On a loaded machine the pipeline lagged 2-4 s (the held-out run): when the settling time is
+// over, no axes of the settled frames have arrived yet. The loop waits for them (at most
+// max_axes_lag_s), and the nudge's camera frames that arrive after the arm's DONE still count.
+TEST_F(SupervisorTest, ALaggingPipelineIsWaitedForNotTakenForATippedObjectOrAPhantom) {
+  sv::Supervisor s = make();
+  const Eigen::Vector3d object(0.28, -0.05, 0);
+  start_with(s, {object});
+  s.on_right_still(draw_scene(scene_, {1280, 960}, {object}), now_, now_);
+  const auto nudge = outputs_of<sv::NudgeCommand>(s.take_outputs()).at(0);
+  const Eigen::Vector3d rest = object + 0.03 * nudge.direction;
+  // The arm moves and is done before any of the push's frames have arrived.
+  const int64_t pushed_from = now_;
+  s.on_arm_state(arm(sv::ArmStatus::Motion::Moving, nudge.seq), now_);
+  now_ += 2 * kSecond;
+  s.on_arm_state(arm(sv::ArmStatus::Motion::Done, nudge.seq), now_);
+  ASSERT_EQ(s.state(), sv::State::Track);
+  const int64_t arm_done = now_;
+  for (int i = -3; i <= 15; ++i) {  // the push's frames, late
+    const Eigen::Vector3d at = object + (rest - object) * (std::clamp(i, 0, 15) / 15.0);
+    s.on_right_frame(draw_scene(scene_, {640, 480}, {at}), pushed_from + (i + 4) * kSecond / 10);
+  }
+  const int64_t lag = 3 * kSecond;
+  while (s.state() == sv::State::Track && now_ < arm_done + 10 * kSecond) {
+    now_ += kSecond / 10;
+    if (now_ - lag > arm_done) s.on_axes({{rest, 0.02}}, now_ - lag, now_);
+    s.on_time(now_);
+  }
+  EXPECT_TRUE(outputs_of<sv::AttemptEnded>(s.take_outputs()).empty()) << s.report().reason;
+  EXPECT_EQ(s.state(), sv::State::Home) << sv::to_string(s.state()) << ": " << s.report().reason;
+  EXPECT_GE(now_, arm_done + lag + static_cast<int64_t>(sv::Config{}.settle_s * kSecond)) << "waited for the axes";
+}
+
+// A pipeline that never catches up is not waited for forever: tipped or lost after the limit.
+TEST_F(SupervisorTest, AxesThatNeverComeEndTheAttemptAfterTheLagLimit) {
+  sv::Supervisor s = make();
+  const Eigen::Vector3d object(0.28, -0.05, 0);
+  start_with(s, {object});
+  s.on_right_still(draw_scene(scene_, {1280, 960}, {object}), now_, now_);
+  const auto nudge = outputs_of<sv::NudgeCommand>(s.take_outputs()).at(0);
+  play_nudge(s, nudge.seq, object, object + 0.03 * nudge.direction);
+  const int64_t arm_done = now_;
+  const sv::Config config;
+  while (s.state() == sv::State::Track && now_ < arm_done + 30 * kSecond) s.on_time(now_ += kSecond / 10);
+  const auto ended = outputs_of<sv::AttemptEnded>(s.take_outputs());
+  ASSERT_EQ(ended.size(), 1u);
+  EXPECT_EQ(ended[0].attempt->outcome, sv::Outcome::Tipped);
+  EXPECT_NEAR(static_cast<double>(now_ - arm_done) / kSecond, config.settle_s + config.max_axes_lag_s, 0.15);
+}
+
 // Lines of frames taken before a survey began (the arm still in view, delivered late) do not
 // count towards which candidates both cameras see.
 TEST_F(SupervisorTest, SurveyLinesOfFramesFromBeforeTheSurveyAreIgnored) {

@@ -510,7 +510,7 @@ void Supervisor::on_time(int64_t now) {
       }
       break;
     case State::Track:
-      if (static_cast<double>(now - arm_done_time_) >= config_.settle_s * kMicro) verify(now);
+      if (static_cast<double>(now - arm_done_time_) >= config_.settle_s * kMicro && axes_caught_up(now)) verify(now);
       break;
     case State::Home:
       if (timed_out(config_.nudge_timeout_s, now)) parked(now, "the arm did not report parking in time");
@@ -541,6 +541,15 @@ void Supervisor::on_time(int64_t now) {
     default:
       break;
   }
+}
+
+// AXES of the frames taken when the settling time ended have arrived (a lagging pipeline delivers
+// them late), or the wait for them is over.
+bool Supervisor::axes_caught_up(int64_t now) const {
+  if (tracking_started_) return true;  // the trackers decide, not the axes
+  const int64_t settled = arm_done_time_ + static_cast<int64_t>(config_.settle_s * kMicro);
+  return latest_axes_utime_ >= settled ||
+         static_cast<double>(now - arm_done_time_) >= (config_.settle_s + config_.max_axes_lag_s) * kMicro;
 }
 
 void Supervisor::on_services(const std::set<std::string>& silent, int64_t now) {
@@ -615,6 +624,7 @@ void Supervisor::on_arm_state(const ArmStatus& arm, int64_t now) {
     case ArmStatus::Motion::Done:
       arm_done_time_ = now;
       settled_axes_.clear();
+      latest_axes_utime_ = 0;
       enter(State::Track, now, "nudge done: waiting for the object to settle");
       break;
     default:
@@ -639,8 +649,14 @@ void Supervisor::feed_tracker(int camera, const cv::Mat& frame, int64_t utime) {
   }
 }
 
+// Frames of the nudge count however late they arrive (a lagging camera stream delivers the end
+// of the push after the arm reported done).
+bool Supervisor::frame_of_the_nudge(int64_t utime) const {
+  return state_ == State::Nudge || (state_ == State::Track && utime <= arm_done_time_);
+}
+
 void Supervisor::on_right_frame(const cv::Mat& frame, int64_t utime) {
-  if (state_ == State::Nudge && watch_) {
+  if (frame_of_the_nudge(utime) && watch_) {
     watch_->feed(frame);
     // Motion at the target starts the trackers, at the target's line in each camera.
     if (watch_->moved() && !tracking_started_ && trackers_[0] && trackers_[1]) {
@@ -655,7 +671,7 @@ void Supervisor::on_right_frame(const cv::Mat& frame, int64_t utime) {
 bool Supervisor::wants_frame(bool left) const {
   const int camera = left ? 0 : 1;
   const bool tracking = trackers_[camera] && !track_done_[camera] && (state_ == State::Nudge || state_ == State::Track);
-  return tracking || (!left && state_ == State::Nudge);
+  return tracking || (!left && (state_ == State::Nudge || state_ == State::Track) && watch_);
 }
 
 void Supervisor::on_left_frame(const cv::Mat& frame, int64_t utime) { feed_tracker(0, frame, utime); }
@@ -709,6 +725,7 @@ void Supervisor::on_axes(const std::vector<Axis>& axes, int64_t utime, int64_t n
   if (state_ != State::Track) return;
   // Judged by when the frames were taken, not when their axes arrived: a pipeline that lags
   // delivers, after the settling pause, axes of frames taken while the object still slid.
+  latest_axes_utime_ = std::max(latest_axes_utime_, utime);
   if (static_cast<double>(utime - arm_done_time_) < config_.axes_from_s * kMicro) return;
   settled_axes_.insert(settled_axes_.end(), axes.begin(), axes.end());
 }

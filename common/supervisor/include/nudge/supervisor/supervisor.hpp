@@ -51,6 +51,11 @@ struct Config {
   double nudge_timeout_s = 60;       // arm: from the command to MOTION_DONE
   double settle_s = 1.5;             // after the arm is done: the object comes to rest
   double axes_from_s = 0.5;          // AXES after this much of the settling time count
+  // The perception pipeline lags on a loaded machine (the held-out run: AXES 2-4 s behind their
+  // frames, so none of the settled frames' axes had arrived when the settling time was over). The
+  // verification waits until AXES of frames taken at the end of the settling time have come, at
+  // most this long past it; the nudge's own camera frames that arrive late still count as motion.
+  double max_axes_lag_s = 8;
   int min_axes = 3;                  // upright axes near the expected place that confirm the object
   double max_travel_m = 0.12;        // how far beyond its place a nudged object is looked for
   double max_lateral_m = 0.03;       // and how far off the push line
@@ -296,6 +301,9 @@ class Supervisor {
   std::vector<Candidate> drop_hidden_behind_arm_base(std::vector<Rejection>& rejected) const;
   Eigen::Vector2d viewing_ray(const Eigen::Vector3d& at) const;
   std::vector<Axis> settled_axes_;
+  int64_t latest_axes_utime_ = 0;  // the newest frame whose AXES arrived while settling
+  bool axes_caught_up(int64_t now) const;
+  bool frame_of_the_nudge(int64_t utime) const;
   std::vector<std::vector<symmetry::Line>> survey_lines_[2];  // [left, right]: per message, during a survey
   double stereo_agreement(const Candidate& candidate) const;
   robot::JointVector joints_ = robot::JointVector::Zero();
