@@ -676,6 +676,30 @@ TEST_F(SupervisorTest, AxesOffInDepthAlongTheCamerasRayAreStillThePushedObject) 
   EXPECT_GT(cv::countNonZero(mask.rowRange(foot_row - 12, foot_row - 2)), 100) << "the object's foot is kept";
 }
 
+// The depth tolerance lets axes further along the ray into the window (another object, a phantom):
+// the pushed object is the group of axes nearest the push line, not the median of everything.
+TEST_F(SupervisorTest, AxesOfSomethingElseFurtherAlongTheRayDoNotMoveTheRest) {
+  sv::Supervisor s = make();
+  const Eigen::Vector3d object(0.28, -0.05, 0);
+  start_with(s, {object});
+  s.on_right_still(draw_scene(scene_, {1280, 960}, {object}), now_, now_);
+  const auto nudge = outputs_of<sv::NudgeCommand>(s.take_outputs()).at(0);
+  const Eigen::Vector3d rest = object + 0.03 * nudge.direction;
+  Eigen::Vector3d ray = rest - scene_.right_camera_in_world();
+  ray.z() = 0;
+  ray.normalize();
+  play_nudge(s, nudge.seq, object, rest);
+  // Per frame: the object's axis, and two axes of something 7 cm behind it along the ray.
+  settle_with_axes(s, {rest, rest + 0.07 * ray, rest + 0.072 * ray});
+  park(s);
+  ASSERT_EQ(s.state(), sv::State::SnapshotAfter) << s.report().reason;
+  s.on_right_still(draw_scene(scene_, {1280, 960}, {rest}), now_, now_);
+  const auto ended = outputs_of<sv::AttemptEnded>(s.take_outputs());
+  ASSERT_EQ(ended.size(), 1u);
+  ASSERT_TRUE(ended[0].attempt->rest.has_value());
+  EXPECT_LT((*ended[0].attempt->rest - rest).norm(), 0.005) << "rested at the object's own axes";
+}
+
 // The object nudged is remembered where it now stands: a candidate that is the same object seen
 // through a stereo mismatch (on its line in one camera, 8 cm farther) is not nudged again, while
 // a candidate as far away but off both cameras' lines is.

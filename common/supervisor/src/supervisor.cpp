@@ -332,9 +332,17 @@ bool Supervisor::verify_by_tracking(int64_t now) {
 }
 
 // Without trackers: the settled AXES near the push line (upright, by the triangulation service).
+// The window reaches along the camera's ray by the stereo depth error, so it can hold the pushed
+// object's axes and another object's (or a phantom's) further along the ray. The axes are grouped
+// by where they stand, and the group nearest the push line with enough axes is the object: a
+// median over all of them would put the object between the two.
 bool Supervisor::verify_by_axes(int64_t now) {
   Attempt& a = *attempt_;
-  std::vector<double> xs, ys, tilts;
+  struct Near {
+    const Axis* axis;
+    double in_depth;
+  };
+  std::vector<Near> near;
   const Eigen::Vector2d ray = viewing_ray(a.target.position);
   for (const Axis& axis : settled_axes_) {
     const Eigen::Vector3d offset = axis.foot - a.target.position;
@@ -346,13 +354,24 @@ bool Supervisor::verify_by_axes(int64_t now) {
     if (along < -config_.max_lateral_m || along > config_.max_travel_m || sideways > config_.max_lateral_m ||
         in_depth > config_.max_lateral_m + config_.max_depth_error_m)
       continue;
-    xs.push_back(axis.foot.x());
-    ys.push_back(axis.foot.y());
-    tilts.push_back(axis.tilt_rad);
+    near.push_back({&axis, in_depth});
+  }
+  std::sort(near.begin(), near.end(), [](const Near& l, const Near& r) { return l.in_depth < r.in_depth; });
+  std::vector<double> xs, ys, tilts;
+  for (const Near& seed : near) {
+    xs.clear(), ys.clear(), tilts.clear();
+    for (const Near& other : near) {
+      if ((other.axis->foot - seed.axis->foot).head<2>().norm() > config_.same_axis_m) continue;
+      xs.push_back(other.axis->foot.x());
+      ys.push_back(other.axis->foot.y());
+      tilts.push_back(other.axis->tilt_rad);
+    }
+    if (static_cast<int>(xs.size()) >= config_.min_axes) break;
   }
   if (static_cast<int>(xs.size()) < config_.min_axes) {
     end_attempt(Outcome::Tipped, "object tipped or lost: " + std::to_string(xs.size()) +
-                                     " upright axes near the push line after the nudge", now);
+                                     " upright axes in one place near the push line after the nudge (" +
+                                     std::to_string(near.size()) + " near it)", now);
     return false;
   }
   const double tilt_deg = median(tilts) * 180 / M_PI;

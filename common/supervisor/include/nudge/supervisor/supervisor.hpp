@@ -59,6 +59,7 @@ struct Config {
   int min_axes = 3;                  // upright axes near the expected place that confirm the object
   double max_travel_m = 0.12;        // how far beyond its place a nudged object is looked for
   double max_lateral_m = 0.03;       // and how far off the push line
+  double same_axis_m = 0.025;        // settled axes this close together are one object's
   // How far a triangulated axis may lie from the object along the right camera's viewing ray: a
   // stereo mismatch (a mug's handle moves its line differently in the two cameras) puts axes of the
   // same object up to ~5 cm nearer or farther (measured on s03_red_mug: 4.4 and 4.7 cm). Axes
