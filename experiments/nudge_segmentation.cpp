@@ -8,7 +8,9 @@
 // own World (label mask: the simulator's truth, a mug's handle included); the object the mask
 // overlaps most is the one segmented; IoU with it, and the mask's pixels on the end effector (pad
 // or gripper: the pixels that change when it is hidden) are counted.
-//   nudge-exp-nudge-segmentation RUNS_DIR SCENE_DIR [RUN...]   (default: every scene in SCENE_DIR)
+//   nudge-exp-nudge-segmentation RUNS_DIR SCENE_DIR [RUN...] [--development RUNS_DIR SCENE_DIR]
+// (default: every scene in SCENE_DIR). The first set gives the headline keys (the held-out scenes); the
+// development set goes under its own key "development".
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -19,6 +21,7 @@
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <regex>
 #include <set>
 #include <sstream>
@@ -198,23 +201,29 @@ double time_motion_segmentation(const std::vector<fs::path>& attempt_dirs) {
   return ms.empty() ? 0 : ex::median(ms);
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  if (argc < 3) {
-    std::cerr << "usage: nudge-exp-nudge-segmentation RUNS_DIR SCENE_DIR [RUN...]\n";
-    return 2;
-  }
-  const fs::path runs_dir = argv[1], scene_dir = argv[2];
-  std::vector<std::string> names;
-  for (int i = 3; i < argc; ++i) names.push_back(argv[i]);
-  if (names.empty())
-    for (const auto& entry : fs::directory_iterator(scene_dir))
-      if (entry.path().extension() == ".yaml") names.push_back(entry.path().stem().string());
-  std::sort(names.begin(), names.end());
-
+// One set of scenes (held-out or development): its runs, aggregates, table and gallery rows.
+struct SetScore {
   std::vector<Run> runs;
   std::vector<fs::path> attempt_dirs;
+  int single_runs = 0, successes = 0, effector = 0, phantoms = 0, multi_found = 0, multi_present = 0;
+  std::vector<double> ious;
+  std::string table;
+  std::vector<cv::Mat> gallery;
+  double mean_iou() const { return ious.empty() ? 0 : ex::mean(ious); }
+  double min_iou() const { return ious.empty() ? 0 : *std::min_element(ious.begin(), ious.end()); }
+};
+
+std::vector<std::string> scene_names(const fs::path& scene_dir) {
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(scene_dir))
+    if (entry.path().extension() == ".yaml") names.push_back(entry.path().stem().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+SetScore score_set(const fs::path& runs_dir, const fs::path& scene_dir, std::vector<std::string> names) {
+  if (names.empty()) names = scene_names(scene_dir);
+  SetScore set;
   nudge::Progress progress("nudge-exp-nudge-segmentation", static_cast<int>(names.size()));
   for (const std::string& name : names) {
     progress.step(name);
@@ -223,86 +232,141 @@ int main(int argc, char** argv) {
       progress.note(name + ": no run in " + run_dir.string() + " (skipped)");
       continue;
     }
-    runs.push_back(evaluate(name, run_dir, scene_dir / (name + ".yaml")));
+    set.runs.push_back(evaluate(name, run_dir, scene_dir / (name + ".yaml")));
     for (const auto& entry : fs::directory_iterator(run_dir))
-      if (entry.is_directory() && entry.path().filename().string().rfind("attempt_", 0) == 0) attempt_dirs.push_back(entry.path());
+      if (entry.is_directory() && entry.path().filename().string().rfind("attempt_", 0) == 0) set.attempt_dirs.push_back(entry.path());
   }
-  progress.finish(std::to_string(runs.size()) + " runs read");
-  std::sort(attempt_dirs.begin(), attempt_dirs.end());
+  progress.finish(std::to_string(set.runs.size()) + " runs read");
+  std::sort(set.attempt_dirs.begin(), set.attempt_dirs.end());
 
-  int single_runs = 0, successes = 0, effector = 0, phantoms = 0, multi_found = 0, multi_present = 0;
-  std::vector<double> ious;
   std::ostringstream table;
   table << "| run | objects | attempts | segmented (object: IoU) | effector px | no motion | tipped | other | wall s | end |\n"
         << "|---|---|---|---|---|---|---|---|---|---|\n";
-  std::vector<cv::Mat> gallery;
-  for (const Run& r : runs) {
-    const bool multi = r.objects_present > 1;
-    if (multi) {
-      multi_found += static_cast<int>(r.objects_found.size());
-      multi_present += r.objects_present;
+  for (const Run& r : set.runs) {
+    if (r.objects_present > 1) {
+      set.multi_found += static_cast<int>(r.objects_found.size());
+      set.multi_present += r.objects_present;
     } else {
-      ++single_runs;
-      successes += r.success();
+      ++set.single_runs;
+      set.successes += r.success();
     }
-    phantoms += r.no_motion;
+    set.phantoms += r.no_motion;
     std::string segmented;
+    int run_effector = 0;
     for (const Segmented& s : r.segmented) {
       char text[48];
       std::snprintf(text, sizeof text, "%s%d: %.3f", segmented.empty() ? "" : ", ", s.object, s.iou);
       segmented += text;
-      ious.push_back(s.iou);
-      effector += s.effector_pixels;
-      if (!s.gallery.empty()) gallery.push_back(s.gallery);
+      set.ious.push_back(s.iou);
+      run_effector += s.effector_pixels;
+      if (!s.gallery.empty()) set.gallery.push_back(s.gallery);
     }
-    int run_effector = 0;
-    for (const Segmented& seg : r.segmented) run_effector += seg.effector_pixels;
+    set.effector += run_effector;
     char wall[32];
     std::snprintf(wall, sizeof wall, "%.0f", r.wall_s);
     table << "| " << r.name << " | " << r.objects_present << " | " << r.attempts << " | "
           << (segmented.empty() ? "–" : segmented) << " | " << run_effector << " | " << r.no_motion << " | " << r.tipped
           << " | " << r.other_failures << " | " << wall << " | " << r.end_reason << " |\n";
   }
+  set.table = table.str();
+  return set;
+}
+
+void json_fields(JsonWriter& j, const SetScore& s, double ms) {
+  j.field("runs", s.single_runs).field("successes", s.successes).field("mean_iou", s.mean_iou()).field("min_iou", s.min_iou());
+  j.field("segmentations", static_cast<int>(s.ious.size())).field("effector_pixels", s.effector);
+  j.field("mean_ms_motion_segmentation", ms).field("multi_object_found", s.multi_found).field("multi_object_present", s.multi_present);
+  j.field("phantoms_rejected", s.phantoms);
+}
+
+std::string figures_table(const SetScore& s, double ms) {
+  std::ostringstream md;
+  md << "| figure | thesis | here |\n|---|---|---|\n"
+     << "| single-object runs with the object segmented | 12/12 | " << s.successes << "/" << s.single_runs << " |\n";
+  char line[256];
+  std::snprintf(line, sizeof line, "| mean IoU (min) of every segmentation | – | %.3f (%.3f) over %zu |\n", s.mean_iou(), s.min_iou(), s.ious.size());
+  md << line;
+  std::snprintf(line, sizeof line, "| motion segmentation, ms per 1280x960 pair (one thread, median) | 80 | %.1f |\n", ms);
+  md << line << "| end-effector pixels in the masks | – | " << s.effector << " |\n"
+     << "| objects of the multi-object scenes segmented | (one object per scene) | " << s.multi_found << "/" << s.multi_present << " |\n"
+     << "| attempts that found no motion (phantoms, out-of-view) | – | " << s.phantoms << " |\n";
+  return md.str();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // nudge-exp-nudge-segmentation RUNS_DIR SCENE_DIR [RUN...] [--development RUNS_DIR SCENE_DIR]
+  std::vector<std::string> args(argv + 1, argv + argc);
+  std::optional<std::pair<fs::path, fs::path>> development;
+  for (size_t i = 0; i < args.size(); ++i)
+    if (args[i] == "--development") {
+      if (i + 2 >= args.size()) {
+        std::cerr << "--development needs RUNS_DIR SCENE_DIR\n";
+        return 2;
+      }
+      development = std::make_pair(fs::path(args[i + 1]), fs::path(args[i + 2]));
+      args.erase(args.begin() + static_cast<long>(i), args.begin() + static_cast<long>(i) + 3);
+      break;
+    }
+  if (args.size() < 2) {
+    std::cerr << "usage: nudge-exp-nudge-segmentation RUNS_DIR SCENE_DIR [RUN...] [--development RUNS_DIR SCENE_DIR]\n"
+                 "  (the first set gives the headline figures: the held-out scenes)\n";
+    return 2;
+  }
+  const fs::path runs_dir = args[0], scene_dir = args[1];
+  const std::vector<std::string> names(args.begin() + 2, args.end());
+  const SetScore main_set = score_set(runs_dir, scene_dir, names);
+  std::optional<SetScore> dev_set;
+  if (development) dev_set = score_set(development->first, development->second, {});
+  std::vector<fs::path> attempt_dirs = main_set.attempt_dirs;
+  if (dev_set) attempt_dirs.insert(attempt_dirs.end(), dev_set->attempt_dirs.begin(), dev_set->attempt_dirs.end());
   const double ms = time_motion_segmentation(attempt_dirs);
-  const double mean_iou = ious.empty() ? 0 : ex::mean(ious);
-  const double min_iou = ious.empty() ? 0 : *std::min_element(ious.begin(), ious.end());
 
   JsonWriter j(4);
   j.begin_object();
-  j.field("runs", single_runs).field("successes", successes).field("mean_iou", mean_iou).field("min_iou", min_iou);
-  j.field("segmentations", static_cast<int>(ious.size())).field("effector_pixels", effector);
-  j.field("mean_ms_motion_segmentation", ms).field("multi_object_found", multi_found).field("multi_object_present", multi_present);
-  j.field("phantoms_rejected", phantoms).field("machine", ex::machine_description()).field("date", ex::today());
+  j.field("scenes", scene_dir.filename().string());
+  json_fields(j, main_set, ms);
+  j.field("machine", ex::machine_description()).field("date", ex::today());
+  if (dev_set) {
+    j.key("development").begin_object();
+    j.field("scenes", development->second.filename().string());
+    json_fields(j, *dev_set, ms);
+    j.end_object();
+  }
   j.end_object();
   ex::write_result("nudge_segmentation.json", j.str() + "\n");
 
   std::ostringstream md;
   md << "# Autonomous segmentation by a robotic nudge (thesis sec. 6.5, in simulation)\n\n"
      << "`experiments/nudge_segmentation.sh` runs the whole loop (world, camera with stills, symmetry, triangulation, "
-        "arm, supervisor: every service its own process over LCM in a private network namespace) on each scene of "
-        "`experiments/scenes/nudge_segmentation/`: twelve single-object scenes (`s*`) and three with several objects "
-        "(`m*`), written before the first run and never re-staged (the loop was developed on `single_cup.yaml` and "
-        "`arm_three_objects.yaml`). `nudge-exp-nudge-segmentation` scores each segmentation against the simulator's "
-        "truth: the recorded state at the after still re-rendered at 1280x960 (label mask, handles included); the "
-        "object the mask overlaps most is the one segmented.\n\n"
+        "arm, supervisor: every service its own process over LCM in a private network namespace) on each scene of two "
+        "sets: the **held-out** scenes `experiments/scenes/nudge_segmentation_heldout/` (`h*` single objects, `hm*` "
+        "several; written by `nudge-exp-nudge-segmentation-scenes` from seeds 610001-610015, fixed on 2026-11-24 "
+        "before any change was made for them, never re-staged) give the headline figures; the **development** scenes "
+        "`experiments/scenes/nudge_segmentation/` (`s*`, `m*`: reported once, then used to find and fix the failures) "
+        "follow. `nudge-exp-nudge-segmentation` scores each segmentation against the simulator's truth: the recorded "
+        "state at the after still re-rendered at 1280x960 (label mask, handles included); the object the mask overlaps "
+        "most is the one segmented.\n\n"
      << ex::machine_description() << ", " << ex::today() << ".\n\n"
-     << "| figure | thesis | here |\n|---|---|---|\n"
-     << "| single-object runs with the object segmented | 12/12 | " << successes << "/" << single_runs << " |\n";
-  char line[256];
-  std::snprintf(line, sizeof line, "| mean IoU (min) of every segmentation | – | %.3f (%.3f) over %zu |\n", mean_iou, min_iou, ious.size());
-  md << line;
-  std::snprintf(line, sizeof line, "| motion segmentation, ms per 1280x960 pair (one thread, median) | 80 | %.1f |\n", ms);
-  md << line << "| end-effector pixels in the masks | – | " << effector << " |\n"
-     << "| objects of the multi-object scenes segmented | (one object per scene) | " << multi_found << "/" << multi_present << " |\n"
-     << "| attempts that found no motion (phantoms, out-of-view) | – | " << phantoms << " |\n\n"
-     << "## Runs\n\n" << table.str() << "\n"
-     << "`segmented`: scene index of the object covered and the mask's IoU with its true mask. `other`: attempts "
-        "refused by the arm, segmentations that came out empty, lost stills.\n\n"
-     << "## Gallery\n\nPer segmentation: before, after, the mask over the after still.\n\n"
+     << "## Held-out scenes (`" << scene_dir.filename().string() << "`)\n\n" << figures_table(main_set, ms) << "\n"
+     << main_set.table << "\n";
+  if (dev_set)
+    md << "## Development scenes (`" << development->second.filename().string() << "`)\n\n" << figures_table(*dev_set, ms)
+       << "\n" << dev_set->table << "\n";
+  md << "`segmented`: scene index of the object covered and the mask's IoU with its true mask. `other`: attempts "
+        "refused by the arm, segmentations that came out empty, lost stills. The motion segmentation time is over "
+        "both sets' stills.\n\n"
+     << "## Gallery\n\nPer segmentation (held-out scenes, then development): before, after, the mask over the after still.\n\n"
      << "![gallery](nudge_segmentation_gallery.png)\n";
   ex::write_result("nudge_segmentation.md", md.str());
-  if (!gallery.empty()) ex::write_png("nudge_segmentation_gallery.png", ex::tile(gallery, 1));
-  std::cerr << successes << "/" << single_runs << " single-object runs segmented, mean IoU " << mean_iou << ", multi-object "
-            << multi_found << "/" << multi_present << ", motion segmentation " << ms << " ms\n";
+  std::vector<cv::Mat> gallery = main_set.gallery;
+  if (dev_set) gallery.insert(gallery.end(), dev_set->gallery.begin(), dev_set->gallery.end());
+  if (!gallery.empty()) ex::write_png("nudge_segmentation_gallery.png", ex::tile(gallery, 2));
+  std::cerr << main_set.successes << "/" << main_set.single_runs << " single-object runs segmented, mean IoU " << main_set.mean_iou()
+            << ", multi-object " << main_set.multi_found << "/" << main_set.multi_present << ", motion segmentation " << ms << " ms\n";
+  if (dev_set)
+    std::cerr << "development: " << dev_set->successes << "/" << dev_set->single_runs << ", mean IoU " << dev_set->mean_iou()
+              << ", multi-object " << dev_set->multi_found << "/" << dev_set->multi_present << "\n";
   return 0;
 }

@@ -195,12 +195,23 @@ std::string scene_yaml(const Scene& scene, const std::string& comment, const std
   y << "background: { " << appearance_yaml(scene.background, directory) << " }\n";
   y << "render: { shadows: " << scene.render.shadows << ", reflections: " << scene.render.reflections
     << ", noise_sigma: " << fmt(scene.render.noise_sigma) << " }\n";
+  if (scene.arm.present) {
+    y << "arm: { present: 1, shoulder_height: " << fmt(scene.arm.shoulder_height) << ", joints_deg: [";
+    for (size_t i = 0; i < scene.arm.joints.size(); ++i) y << (i ? ", " : "") << fmt(scene.arm.joints[i] * 180 / M_PI);
+    y << "] }\n";
+  }
+  if (scene.physics.position_jitter > 0 || scene.physics.yaw_jitter > 0)
+    y << "physics: { position_jitter: " << fmt(scene.physics.position_jitter)
+      << ", yaw_jitter_deg: " << fmt(scene.physics.yaw_jitter * 180 / M_PI) << " }\n";
   y << "objects:\n";
   for (const ObjectSpec& o : scene.objects) {
     y << "  - { kind: " << o.kind << ", name: " << o.name << ", position: [" << fmt(o.position.x()) << ", "
       << fmt(o.position.y()) << "], yaw_deg: " << fmt(o.yaw * 180 / M_PI) << ",\n      "
       << appearance_yaml(o.appearance, directory);
     if (o.fill > 0) y << ", fill: " << fmt(o.fill);
+    if (o.label.present())
+      y << ",\n      label: { file: " << relative(o.label.file, directory) << ", bottom: " << fmt(o.label.bottom)
+        << ", top: " << fmt(o.label.top) << " }";
     y << " }\n";
   }
   return y.str();

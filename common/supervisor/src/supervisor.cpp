@@ -130,7 +130,10 @@ void Supervisor::survey(int64_t now, const std::string& why) {
 
 void Supervisor::choose(int64_t now) {
   const Eigen::Vector3d camera = scene_.right_camera_in_world();
-  TargetChoice choice = choose_target(candidates_, explored_, empty_, camera, arm_, joints_, config_.targets);
+  std::vector<Rejection> hidden;
+  const std::vector<Candidate> visible = drop_hidden_behind_arm_base(hidden);
+  TargetChoice choice = choose_target(visible, explored_with_ray_mates(), empty_, camera, arm_, joints_, config_.targets);
+  choice.rejected.insert(choice.rejected.end(), hidden.begin(), hidden.end());
   summary_.rejections.clear();
   for (const Rejection& r : choice.rejected) ++summary_.rejections[r.reason];
   report_.num_candidates = static_cast<int>(candidates_.size());
@@ -157,6 +160,65 @@ void Supervisor::choose(int64_t now) {
   report_.candidate_index = choice.target.index;
   report_.target = choice.target.position;
   request_still(State::SnapshotBefore, now, choice.note);
+}
+
+// The horizontal direction from the right camera to a point on the table.
+Eigen::Vector2d Supervisor::viewing_ray(const Eigen::Vector3d& at) const {
+  const Eigen::Vector2d ray = (at - scene_.right_camera_in_world()).head<2>();
+  return ray.norm() > 1e-9 ? Eigen::Vector2d(ray.normalized()) : Eigen::Vector2d::UnitX();
+}
+
+// Two axes on the table that one camera sees as one line (a stereo mismatch of the other camera
+// puts the same object at another depth along this camera's ray).
+bool Supervisor::same_object_in_a_camera(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const {
+  if ((a - b).head<2>().norm() > config_.same_object_depth_m) return false;
+  const double max_angle = config_.agreement_angle_deg * M_PI / 180;
+  const auto la = scene_.left_axis_line(a, config_.object_height_m, config_.frame_size);
+  const auto lb = scene_.left_axis_line(b, config_.object_height_m, config_.frame_size);
+  const auto ra = scene_.right_axis_line(a, config_.object_height_m, config_.frame_size);
+  const auto rb = scene_.right_axis_line(b, config_.object_height_m, config_.frame_size);
+  return (la && lb && lines_agree(*lb, *la, max_angle, config_.agreement_offset_px)) ||
+         (ra && rb && lines_agree(*rb, *ra, max_angle, config_.agreement_offset_px));
+}
+
+// The arm's base column (at the world origin) is symmetric too: a stereo mismatch of its line puts
+// a candidate behind it on its line in one camera (dev runs: (-232, -34), (-176, -25) mm, nudged
+// for nothing). That camera cannot see anything standing there: the column hides it.
+std::vector<Candidate> Supervisor::drop_hidden_behind_arm_base(std::vector<Rejection>& rejected) const {
+  const double max_angle = config_.agreement_angle_deg * M_PI / 180;
+  const Eigen::Vector3d base = Eigen::Vector3d::Zero();
+  const Eigen::Vector3d cameras[2] = {scene_.right_to_world(scene_.rig().left_centre()), scene_.right_camera_in_world()};
+  std::vector<Candidate> visible;
+  for (const Candidate& c : candidates_) {
+    bool hidden = false;
+    for (int camera = 0; camera < 2 && !hidden; ++camera) {
+      const auto line = [&](const Eigen::Vector3d& foot) {
+        return camera == 0 ? scene_.left_axis_line(foot, config_.object_height_m, config_.frame_size)
+                           : scene_.right_axis_line(foot, config_.object_height_m, config_.frame_size);
+      };
+      const auto of_base = line(base), of_candidate = line(c.position);
+      const bool farther = (c.position - cameras[camera]).head<2>().norm() > (base - cameras[camera]).head<2>().norm();
+      hidden = farther && of_base && of_candidate && lines_agree(*of_candidate, *of_base, max_angle, config_.agreement_offset_px);
+    }
+    if (hidden)
+      rejected.push_back({c.index, c.position, "behind the arm's base in a camera (a stereo mismatch of its column)"});
+    else
+      visible.push_back(c);
+  }
+  return visible;
+}
+
+// The places already explored, and this survey's candidates that are a rested object seen at
+// another depth: the object nudged before is remembered by where it now stands.
+std::vector<Eigen::Vector3d> Supervisor::explored_with_ray_mates() const {
+  std::vector<Eigen::Vector3d> explored = explored_;
+  for (const Candidate& c : candidates_)
+    for (const Eigen::Vector3d& rest : rests_)
+      if (same_object_in_a_camera(c.position, rest)) {
+        explored.push_back(c.position);
+        break;
+      }
+  return explored;
 }
 
 void Supervisor::request_still(State state, int64_t now, const std::string& note) {
@@ -270,21 +332,46 @@ bool Supervisor::verify_by_tracking(int64_t now) {
 }
 
 // Without trackers: the settled AXES near the push line (upright, by the triangulation service).
+// The window reaches along the camera's ray by the stereo depth error, so it can hold the pushed
+// object's axes and another object's (or a phantom's) further along the ray. The axes are grouped
+// by where they stand, and the group nearest the push line with enough axes is the object: a
+// median over all of them would put the object between the two.
 bool Supervisor::verify_by_axes(int64_t now) {
   Attempt& a = *attempt_;
-  std::vector<double> xs, ys, tilts;
+  struct Near {
+    const Axis* axis;
+    double in_depth;
+  };
+  std::vector<Near> near;
+  const Eigen::Vector2d ray = viewing_ray(a.target.position);
   for (const Axis& axis : settled_axes_) {
     const Eigen::Vector3d offset = axis.foot - a.target.position;
     const double along = offset.head<2>().dot(a.direction.head<2>());
-    const double across = (offset.head<2>() - along * a.direction.head<2>()).norm();
-    if (along < -config_.max_lateral_m || along > config_.max_travel_m || across > config_.max_lateral_m) continue;
-    xs.push_back(axis.foot.x());
-    ys.push_back(axis.foot.y());
-    tilts.push_back(axis.tilt_rad);
+    const Eigen::Vector2d across = offset.head<2>() - along * a.direction.head<2>();
+    // Off the push line: along the camera's ray by the stereo depth error, sideways by little.
+    const double in_depth = std::abs(across.dot(ray));
+    const double sideways = (across - across.dot(ray) * ray).norm();
+    if (along < -config_.max_lateral_m || along > config_.max_travel_m || sideways > config_.max_lateral_m ||
+        in_depth > config_.max_lateral_m + config_.max_depth_error_m)
+      continue;
+    near.push_back({&axis, in_depth});
+  }
+  std::sort(near.begin(), near.end(), [](const Near& l, const Near& r) { return l.in_depth < r.in_depth; });
+  std::vector<double> xs, ys, tilts;
+  for (const Near& seed : near) {
+    xs.clear(), ys.clear(), tilts.clear();
+    for (const Near& other : near) {
+      if ((other.axis->foot - seed.axis->foot).head<2>().norm() > config_.same_axis_m) continue;
+      xs.push_back(other.axis->foot.x());
+      ys.push_back(other.axis->foot.y());
+      tilts.push_back(other.axis->tilt_rad);
+    }
+    if (static_cast<int>(xs.size()) >= config_.min_axes) break;
   }
   if (static_cast<int>(xs.size()) < config_.min_axes) {
     end_attempt(Outcome::Tipped, "object tipped or lost: " + std::to_string(xs.size()) +
-                                     " upright axes near the push line after the nudge", now);
+                                     " upright axes in one place near the push line after the nudge (" +
+                                     std::to_string(near.size()) + " near it)", now);
     return false;
   }
   const double tilt_deg = median(tilts) * 180 / M_PI;
@@ -349,12 +436,22 @@ void Supervisor::segment(int64_t now) {
 void Supervisor::keep_object_rows(Attempt& a) const {
   cv::Mat& mask = a.segmentation.mask;
   if (mask.empty() || !a.rest) return;
-  const auto foot = scene_.project_right(*a.rest, mask.size());
-  const auto top = scene_.project_right(*a.rest + Eigen::Vector3d(0, 0, config_.object_height_m), mask.size());
-  if (!foot || !top) return;
+  // The rest may be off by the stereo depth error along the camera's ray: the rows of the object
+  // standing anywhere in that range (nearer: its foot lower in the image).
+  const Eigen::Vector2d ray = viewing_ray(*a.rest);
+  const Eigen::Vector3d depth = config_.max_depth_error_m * Eigen::Vector3d(ray.x(), ray.y(), 0);
+  const Eigen::Vector3d up(0, 0, config_.object_height_m);
+  double lowest = -1e9, highest = 1e9;
+  for (const Eigen::Vector3d& foot_at : {Eigen::Vector3d(*a.rest - depth), Eigen::Vector3d(*a.rest + depth)}) {
+    const auto foot = scene_.project_right(foot_at, mask.size());
+    const auto top = scene_.project_right(foot_at + up, mask.size());
+    if (!foot || !top) return;
+    lowest = std::max({lowest, foot->y, top->y});
+    highest = std::min({highest, foot->y, top->y});
+  }
   const int margin = mask.rows / 48;  // 20 px at 960 rows: the foot's shadow and rounding
-  const int first = std::clamp(static_cast<int>(std::min(foot->y, top->y)) - margin, 0, mask.rows);
-  const int last = std::clamp(static_cast<int>(std::max(foot->y, top->y)) + margin, 0, mask.rows);
+  const int first = std::clamp(static_cast<int>(highest) - margin, 0, mask.rows);
+  const int last = std::clamp(static_cast<int>(lowest) + margin, 0, mask.rows);
   mask.rowRange(0, first).setTo(0);
   mask.rowRange(last, mask.rows).setTo(0);
   if (!a.segmentation.cutout.empty()) a.segmentation.cutout.setTo(cv::Scalar::all(0), mask == 0);
@@ -375,7 +472,10 @@ void Supervisor::end_attempt(Outcome outcome, const std::string& reason, int64_t
       if ((c.position - a.target.position).head<2>().norm() < config_.targets.same_object_radius) explored_.push_back(c.position);
   }
   if (outcome == Outcome::NoMotion && !a.rest) empty_.push_back(a.target.position);
-  if (a.rest) explored_.push_back(*a.rest);
+  if (a.rest) {
+    explored_.push_back(*a.rest);
+    rests_.push_back(*a.rest);
+  }
   if (outcome == Outcome::SnapshotLost && a.before.empty()) explored_.push_back(a.target.position);
   outputs_.push_back(AttemptEnded{std::shared_ptr<const Attempt>(attempt_.release())});
   watch_.reset();
@@ -438,7 +538,7 @@ void Supervisor::on_time(int64_t now) {
       }
       break;
     case State::Track:
-      if (static_cast<double>(now - arm_done_time_) >= config_.settle_s * kMicro) verify(now);
+      if (static_cast<double>(now - arm_done_time_) >= config_.settle_s * kMicro && axes_caught_up(now)) verify(now);
       break;
     case State::Home:
       if (timed_out(config_.nudge_timeout_s, now)) parked(now, "the arm did not report parking in time");
@@ -479,6 +579,15 @@ void Supervisor::on_time(int64_t now) {
     default:
       break;
   }
+}
+
+// AXES of the frames taken when the settling time ended have arrived (a lagging pipeline delivers
+// them late), or the wait for them is over.
+bool Supervisor::axes_caught_up(int64_t now) const {
+  if (tracking_started_) return true;  // the trackers decide, not the axes
+  const int64_t settled = arm_done_time_ + static_cast<int64_t>(config_.settle_s * kMicro);
+  return latest_axes_utime_ >= settled ||
+         static_cast<double>(now - arm_done_time_) >= (config_.settle_s + config_.max_axes_lag_s) * kMicro;
 }
 
 void Supervisor::on_services(const std::set<std::string>& silent, int64_t now) {
@@ -553,6 +662,7 @@ void Supervisor::on_arm_state(const ArmStatus& arm, int64_t now) {
     case ArmStatus::Motion::Done:
       arm_done_time_ = now;
       settled_axes_.clear();
+      latest_axes_utime_ = 0;
       enter(State::Track, now, "nudge done: waiting for the object to settle");
       break;
     default:
@@ -577,8 +687,14 @@ void Supervisor::feed_tracker(int camera, const cv::Mat& frame, int64_t utime) {
   }
 }
 
+// Frames of the nudge count however late they arrive (a lagging camera stream delivers the end
+// of the push after the arm reported done).
+bool Supervisor::frame_of_the_nudge(int64_t utime) const {
+  return state_ == State::Nudge || (state_ == State::Track && utime <= arm_done_time_);
+}
+
 void Supervisor::on_right_frame(const cv::Mat& frame, int64_t utime) {
-  if (state_ == State::Nudge && watch_) {
+  if (frame_of_the_nudge(utime) && watch_) {
     watch_->feed(frame);
     // Motion at the target starts the trackers, at the target's line in each camera.
     if (watch_->moved() && !tracking_started_ && trackers_[0] && trackers_[1]) {
@@ -593,7 +709,7 @@ void Supervisor::on_right_frame(const cv::Mat& frame, int64_t utime) {
 bool Supervisor::wants_frame(bool left) const {
   const int camera = left ? 0 : 1;
   const bool tracking = trackers_[camera] && !track_done_[camera] && (state_ == State::Nudge || state_ == State::Track);
-  return tracking || (!left && state_ == State::Nudge);
+  return tracking || (!left && (state_ == State::Nudge || state_ == State::Track) && watch_);
 }
 
 void Supervisor::on_left_frame(const cv::Mat& frame, int64_t utime) { feed_tracker(0, frame, utime); }
@@ -647,6 +763,7 @@ void Supervisor::on_axes(const std::vector<Axis>& axes, int64_t utime, int64_t n
   if (state_ != State::Track) return;
   // Judged by when the frames were taken, not when their axes arrived: a pipeline that lags
   // delivers, after the settling pause, axes of frames taken while the object still slid.
+  latest_axes_utime_ = std::max(latest_axes_utime_, utime);
   if (static_cast<double>(utime - arm_done_time_) < config_.axes_from_s * kMicro) return;
   settled_axes_.insert(settled_axes_.end(), axes.begin(), axes.end());
 }
