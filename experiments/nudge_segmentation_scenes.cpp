@@ -19,6 +19,7 @@
 
 #include "learning_scenes.hpp"
 #include "nudge/flags.hpp"
+#include "nudge/progress.hpp"
 #include "nudge/sim/clutter.hpp"
 #include "nudge/sim/scene.hpp"
 
@@ -185,8 +186,10 @@ int main(int argc, char** argv) {
   }
   try {
     fs::create_directories(out);
+    nudge::Progress progress("nudge-exp-nudge-segmentation-scenes", static_cast<int>(plans().size()));
     for (size_t i = 0; i < plans().size(); ++i) {
       const Plan& plan = plans()[i];
+      progress.step(plan.name);
       const uint64_t seed = kFirstSeed + i;
       const sim::Scene scene = make_scene(plan, seed);
       const std::string file = out + "/" + plan.name + ".yaml";
@@ -201,6 +204,7 @@ int main(int argc, char** argv) {
       fs::rename(file + ".tmp", file);  // never a half-written scene
       std::cout << file << ": " << scene.objects.size() << " objects\n";
     }
+    progress.finish(std::to_string(plans().size()) + " scenes written to " + out);
   } catch (const std::exception& e) {
     std::cerr << "nudge-exp-nudge-segmentation-scenes: " << e.what() << "\n";
     return 1;
