@@ -222,9 +222,13 @@ TEST(LearningRecognizer, SharedIndexDecidesAsPerObjectBruteForce) {
       const int view_step = std::abs(g.best_view - w.best_view);
       EXPECT_TRUE(view_step == 0 || view_step == 1 || view_step == 11) << what;
       EXPECT_NEAR(g.verified_matches, w.verified_matches, 0.1 * w.verified_matches) << what;
-      if (view_step == 0) EXPECT_GE(common_pairs(w, g), 0.9 * w.verified_matches) << what;
+      if (view_step == 0) {
+        EXPECT_GE(common_pairs(w, g), 0.9 * w.verified_matches) << what;
+      }
       for (size_t i = 0; i < want.scores.size(); ++i) {
-        if (static_cast<int>(i) != want.best) EXPECT_LT(got.scores[i].verified_matches, got.best_score()->verified_matches / 3) << what;
+        if (static_cast<int>(i) != want.best) {
+          EXPECT_LT(got.scores[i].verified_matches, got.best_score()->verified_matches / 3) << what;
+        }
       }
     }
   }
