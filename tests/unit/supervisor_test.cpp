@@ -169,6 +169,38 @@ class SupervisorTest : public ::testing::Test {
     }
   }
 
+  // One object at (0.28, -0.05) nudged 3 cm; the settled axes stand at the given distances behind
+  // its rest along the right camera's ray. What the attempt ended with after the after still.
+  struct NudgedAlongRay {
+    Eigen::Vector3d rest;
+    sv::State state;
+    std::string reason;
+    std::vector<sv::AttemptEnded> ended;
+  };
+  NudgedAlongRay nudge_and_settle_along_ray(const std::vector<double>& axes_behind_m) {
+    sv::Supervisor s = make();
+    const Eigen::Vector3d object(0.28, -0.05, 0);
+    start_with(s, {object});
+    s.on_right_still(draw_scene(scene_, {1280, 960}, {object}), now_, now_);
+    const auto nudge = outputs_of<sv::NudgeCommand>(s.take_outputs()).at(0);
+    NudgedAlongRay run;
+    run.rest = object + 0.03 * nudge.direction;
+    Eigen::Vector3d ray = run.rest - scene_.right_camera_in_world();
+    ray.z() = 0;
+    ray.normalize();
+    play_nudge(s, nudge.seq, object, run.rest);
+    std::vector<Eigen::Vector3d> feet;
+    for (double behind : axes_behind_m) feet.push_back(run.rest + behind * ray);
+    settle_with_axes(s, feet);
+    park(s);
+    run.state = s.state();
+    run.reason = s.report().reason;
+    if (run.state != sv::State::SnapshotAfter) return run;
+    s.on_right_still(draw_scene(scene_, {1280, 960}, {run.rest}), now_, now_);
+    run.ended = outputs_of<sv::AttemptEnded>(s.take_outputs());
+    return run;
+  }
+
   sv::SceneGeometry scene_;
   int64_t now_ = 50 * kSecond;
   std::vector<Eigen::Vector3d> last_objects_;
@@ -653,21 +685,10 @@ TEST_F(SupervisorTest, MotionFarAboveTheObjectIsNotKeptInItsMask) {
 // several cm nearer or farther along the right camera's ray than the mug stands (s03_red_mug:
 // 4.7 cm). They are still the pushed object, and its mask keeps the rows down to its real foot.
 TEST_F(SupervisorTest, AxesOffInDepthAlongTheCamerasRayAreStillThePushedObject) {
-  sv::Supervisor s = make();
-  const Eigen::Vector3d object(0.28, -0.05, 0);
-  start_with(s, {object});
-  s.on_right_still(draw_scene(scene_, {1280, 960}, {object}), now_, now_);
-  const auto nudge = outputs_of<sv::NudgeCommand>(s.take_outputs()).at(0);
-  const Eigen::Vector3d rest = object + 0.03 * nudge.direction;
-  Eigen::Vector3d ray = rest - scene_.right_camera_in_world();
-  ray.z() = 0;
-  ray.normalize();
-  play_nudge(s, nudge.seq, object, rest);
-  settle_with_axes(s, {rest + 0.05 * ray});  // 5 cm too far: more than the 3 cm off the push line
-  park(s);
-  ASSERT_EQ(s.state(), sv::State::SnapshotAfter) << s.report().reason;
-  s.on_right_still(draw_scene(scene_, {1280, 960}, {rest}), now_, now_);
-  const auto ended = outputs_of<sv::AttemptEnded>(s.take_outputs());
+  const NudgedAlongRay run = nudge_and_settle_along_ray({0.05});  // 5 cm too far: more than the 3 cm off the push line
+  ASSERT_EQ(run.state, sv::State::SnapshotAfter) << run.reason;
+  const auto& ended = run.ended;
+  const Eigen::Vector3d& rest = run.rest;
   ASSERT_EQ(ended.size(), 1u);
   EXPECT_EQ(ended[0].attempt->outcome, sv::Outcome::Segmented) << ended[0].attempt->reason;
   // The rows just above the real foot are in the mask (the rest 5 cm farther would cut them).
@@ -679,22 +700,11 @@ TEST_F(SupervisorTest, AxesOffInDepthAlongTheCamerasRayAreStillThePushedObject) 
 // The depth tolerance lets axes further along the ray into the window (another object, a phantom):
 // the pushed object is the group of axes nearest the push line, not the median of everything.
 TEST_F(SupervisorTest, AxesOfSomethingElseFurtherAlongTheRayDoNotMoveTheRest) {
-  sv::Supervisor s = make();
-  const Eigen::Vector3d object(0.28, -0.05, 0);
-  start_with(s, {object});
-  s.on_right_still(draw_scene(scene_, {1280, 960}, {object}), now_, now_);
-  const auto nudge = outputs_of<sv::NudgeCommand>(s.take_outputs()).at(0);
-  const Eigen::Vector3d rest = object + 0.03 * nudge.direction;
-  Eigen::Vector3d ray = rest - scene_.right_camera_in_world();
-  ray.z() = 0;
-  ray.normalize();
-  play_nudge(s, nudge.seq, object, rest);
   // Per frame: the object's axis, and two axes of something 7 cm behind it along the ray.
-  settle_with_axes(s, {rest, rest + 0.07 * ray, rest + 0.072 * ray});
-  park(s);
-  ASSERT_EQ(s.state(), sv::State::SnapshotAfter) << s.report().reason;
-  s.on_right_still(draw_scene(scene_, {1280, 960}, {rest}), now_, now_);
-  const auto ended = outputs_of<sv::AttemptEnded>(s.take_outputs());
+  const NudgedAlongRay run = nudge_and_settle_along_ray({0.0, 0.07, 0.072});
+  ASSERT_EQ(run.state, sv::State::SnapshotAfter) << run.reason;
+  const auto& ended = run.ended;
+  const Eigen::Vector3d& rest = run.rest;
   ASSERT_EQ(ended.size(), 1u);
   ASSERT_TRUE(ended[0].attempt->rest.has_value());
   EXPECT_LT((*ended[0].attempt->rest - rest).norm(), 0.005) << "rested at the object's own axes";
