@@ -357,16 +357,23 @@ bool Supervisor::verify_by_axes(int64_t now) {
     near.push_back({&axis, in_depth});
   }
   std::sort(near.begin(), near.end(), [](const Near& l, const Near& r) { return l.in_depth < r.in_depth; });
-  std::vector<double> xs, ys, tilts;
+  // The object's group: the largest one standing on the push line itself; only when none does, the
+  // nearest one off it in depth (a few stray axes on the line must not outvote the object's many).
+  std::vector<const Near*> chosen;
   for (const Near& seed : near) {
-    xs.clear(), ys.clear(), tilts.clear();
-    for (const Near& other : near) {
-      if ((other.axis->foot - seed.axis->foot).head<2>().norm() > config_.same_axis_m) continue;
-      xs.push_back(other.axis->foot.x());
-      ys.push_back(other.axis->foot.y());
-      tilts.push_back(other.axis->tilt_rad);
-    }
-    if (static_cast<int>(xs.size()) >= config_.min_axes) break;
+    std::vector<const Near*> group;
+    for (const Near& other : near)
+      if ((other.axis->foot - seed.axis->foot).head<2>().norm() <= config_.same_axis_m) group.push_back(&other);
+    if (static_cast<int>(group.size()) < config_.min_axes) continue;
+    const bool on_line = seed.in_depth <= config_.max_lateral_m;
+    if (chosen.empty() || (on_line && group.size() > chosen.size())) chosen = std::move(group);
+    if (!on_line) break;
+  }
+  std::vector<double> xs, ys, tilts;
+  for (const Near* n : chosen) {
+    xs.push_back(n->axis->foot.x());
+    ys.push_back(n->axis->foot.y());
+    tilts.push_back(n->axis->tilt_rad);
   }
   if (static_cast<int>(xs.size()) < config_.min_axes) {
     end_attempt(Outcome::Tipped, "object tipped or lost: " + std::to_string(xs.size()) +
