@@ -149,9 +149,12 @@ class Shell {
   }
 
   void subscribe() {
-    auto& in = service_.input();
-    in.subscribe(".*", &Shell::record, this);
+    // The log holds exactly what the handlers were given, in that order: the typed subscriptions'
+    // messages through their tap (a stream handler that fell behind skips frames, and so does
+    // the log), every other channel through a catch-all with no queue limit.
     auto& subs = service_.subscriptions();
+    subs.set_tap([this](const lcm::ReceiveBuffer* rbuf, const std::string& channel) { record(rbuf, channel); });
+    service_.input().subscribe(".*", &Shell::record_unhandled, this)->setQueueCapacity(0);
     subs.subscribe<heartbeat_t>(bus::channel::HEARTBEAT, [this](const heartbeat_t& m, const std::string&) { on_heartbeat(m); });
     subs.subscribe<sim_state_t>(bus::channel::SIM_STATE, [this](const sim_state_t& m, const std::string&) { on_sim_state(m); });
     subs.subscribe<candidates_t>(bus::channel::CANDIDATES, [this](const candidates_t& m, const std::string&) { on_candidates(m); });
@@ -202,6 +205,9 @@ class Shell {
   void record(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
     if (kOwnChannels.count(channel)) return;
     log_->write(rbuf->recv_utime, channel, rbuf->data, rbuf->data_size);
+  }
+  void record_unhandled(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+    if (!service_.subscriptions().has_typed(channel)) record(rbuf, channel);
   }
 
   template <typename Msg>

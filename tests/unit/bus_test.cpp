@@ -208,6 +208,39 @@ TEST(Subscriptions, MalformedMessagesAreCountedAndSkippedNamingTheChannel) {
   EXPECT_NE(log.find("skipped a malformed message on HEARTBEAT_TEST"), std::string::npos) << log;
 }
 
+// The tap sees every message a typed handler is given, just before it (malformed ones too, which
+// the handler never sees), in order, and nothing on channels without a typed subscription: what a
+// recorder needs to log exactly what the handlers saw (the supervisor's run log).
+TEST(Subscriptions, TheTapSeesWhatTheTypedHandlersAreGivenInOrder) {
+  lcm::LCM lcm("memq://");
+  ASSERT_TRUE(lcm.good());
+  bus::Counters counters;
+  bus::Subscriptions subscriptions(lcm, counters);
+  std::vector<std::string> seen;
+  subscriptions.subscribe<image_t>("CAMERA_TEST", [&](const image_t&, const std::string& c) { seen.push_back("handled " + c); });
+  subscriptions.subscribe<heartbeat_t>("HEARTBEAT_TEST", [&](const heartbeat_t&, const std::string& c) { seen.push_back("handled " + c); });
+  subscriptions.set_tap([&](const lcm::ReceiveBuffer* rbuf, const std::string& c) {
+    seen.push_back("tapped " + c + " " + std::to_string(rbuf->data_size));
+  });
+  EXPECT_TRUE(subscriptions.has_typed("CAMERA_TEST"));
+  EXPECT_FALSE(subscriptions.has_typed("CAMERA"));
+  EXPECT_FALSE(subscriptions.has_typed("OTHER"));
+
+  const Bytes image = small_image_bytes(), heartbeat = encode(heartbeat_t{}), junk{1, 2, 3};
+  const std::vector<std::pair<std::string, Bytes>> sent = {
+      {"CAMERA_TEST", image}, {"OTHER", junk}, {"HEARTBEAT_TEST", heartbeat}, {"CAMERA_TEST", junk}};
+  testing::internal::CaptureStderr();
+  for (const auto& [channel, bytes] : sent) {
+    lcm.publish(channel, bytes.data(), static_cast<unsigned int>(bytes.size()));
+    lcm.handleTimeout(100);
+  }
+  testing::internal::GetCapturedStderr();
+  const std::vector<std::string> expected = {"tapped CAMERA_TEST " + std::to_string(image.size()), "handled CAMERA_TEST",
+                                             "tapped HEARTBEAT_TEST " + std::to_string(heartbeat.size()),
+                                             "handled HEARTBEAT_TEST", "tapped CAMERA_TEST 3"};
+  EXPECT_EQ(seen, expected);
+}
+
 // Which subscriptions are streams (their queue is --queue, docs/reliability.md "Soak"): frames and
 // what is computed from them, and the simulated world's state; never commands, requests, states
 // or heartbeats. (LCM 1.3.1's memq:// ignores queue capacities, so what udpm:// drops is measured

@@ -111,7 +111,8 @@ class Subscriptions {
   template <typename Msg>
   void subscribe_timed(const std::string& channel,
                        std::function<void(const Msg&, const std::string& channel, int64_t receive_utime)> handler) {
-    auto h = std::make_unique<Typed<Msg>>(std::move(handler), counters_);
+    auto h = std::make_unique<Typed<Msg>>(std::move(handler), counters_, tap_);
+    typed_channels_.push_back(channel);
     h->subscription = lcm_.subscribe(channel, &Typed<Msg>::on_raw, h.get());
     h->stream = IsStream<Msg>::value;
     if (h->stream && stream_queue_capacity_ >= 0) h->subscription->setQueueCapacity(stream_queue_capacity_);
@@ -125,6 +126,20 @@ class Subscriptions {
     stream_queue_capacity_ = messages;
     for (auto& h : handlers_)
       if (h->stream) h->subscription->setQueueCapacity(messages);
+  }
+
+  // tap(rbuf, channel) for every message a typed handler is given, just before it is decoded and
+  // handled (malformed ones too): a recorder that must hold exactly what the handlers saw, in the
+  // order they saw it. LCM keeps a queue per subscription and drops per subscription when one is
+  // full, so a separate catch-all subscription would log messages a stream handler skipped and
+  // miss ones it handled (docs/supervisor.md, "The run's log").
+  using Tap = std::function<void(const lcm::ReceiveBuffer* rbuf, const std::string& channel)>;
+  void set_tap(Tap tap) { tap_ = std::move(tap); }
+  // Whether a typed subscription was made on exactly this channel name.
+  bool has_typed(const std::string& channel) const {
+    for (const std::string& c : typed_channels_)
+      if (c == channel) return true;
+    return false;
   }
 
   // handler(channel, receive_utime) for every message on `channel`, undecoded and uncounted:
@@ -149,9 +164,10 @@ class Subscriptions {
   template <typename Msg>
   struct Typed : Base {
     using Handler = std::function<void(const Msg&, const std::string&, int64_t)>;
-    Typed(Handler f, Counters& c) : fn(std::move(f)), counters(c) {}
+    Typed(Handler f, Counters& c, const Tap& t) : fn(std::move(f)), counters(c), tap(t) {}
     void on_raw(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
       ++counters.messages_in;
+      if (tap) tap(rbuf, channel);
       Msg msg;
       const std::string problem = decode_message(rbuf->data, static_cast<int>(rbuf->data_size), &msg);
       if (!problem.empty()) {
@@ -178,12 +194,15 @@ class Subscriptions {
     }
     Handler fn;
     Counters& counters;
+    const Tap& tap;  // the Subscriptions' own: set_tap() reaches the subscriptions made before it
     int64_t next_gap_warning = 0;
   };
 
   lcm::LCM& lcm_;
   Counters& counters_;
   std::vector<std::unique_ptr<Base>> handlers_;
+  std::vector<std::string> typed_channels_;
+  Tap tap_;
   int stream_queue_capacity_ = -1;  // -1: LCM's default
 };
 
