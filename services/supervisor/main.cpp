@@ -545,6 +545,7 @@ void add_flags(Flags& f, Options& o) {
   f.add_int("max-attempts", &o.config.max_attempts, "nudges per run");
   f.add_double("settle", &o.config.settle_s, "after the nudge, wait this long for the object to rest, s");
   f.add_double("snapshot-timeout", &o.config.snapshot_timeout_s, "for a still, s of the task clock");
+  f.add_double("snapshot-retry", &o.config.snapshot_retry_s, "a still not come within this many s of the task clock is asked for again (a lost UDP fragment loses it)");
   f.add_double("candidates-timeout", &o.config.candidates_timeout_s, "for a CANDIDATES answer, s of the task clock");
   f.add_double("nudge-timeout", &o.config.nudge_timeout_s, "for the arm to finish a nudge, s of the task clock");
   f.add_double("nudge-speed", &o.nudge_speed_scale, "nudges at this fraction of the arm's joint speed limits (0.01-1)");

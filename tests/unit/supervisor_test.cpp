@@ -535,6 +535,44 @@ TEST_F(SupervisorTest, ASnapshotThatNeverComesEndsTheAttemptAfterItsTimeout) {
   EXPECT_THROW(s.on_right_still(cv::Mat(480, 640, CV_8UC3), now_, now_), std::invalid_argument);  // wrong size: named
 }
 
+// A still lost on the way (a dropped UDP fragment loses the whole 3.7 MB message) is asked for
+// again every snapshot_retry_s until the step's timeout; the answer to a later request is taken.
+TEST_F(SupervisorTest, AStillThatDoesNotComeIsAskedForAgainUntilTheTimeout) {
+  sv::Supervisor s = make();
+  const Eigen::Vector3d object(0.28, -0.05, 0);
+  const int64_t start = now_;
+  EXPECT_EQ(outputs_of<sv::SnapshotRequest>(start_with(s, {object})).size(), 1u);
+  ASSERT_EQ(s.state(), sv::State::SnapshotBefore);
+  s.on_time(now_ += 2 * kSecond);
+  EXPECT_TRUE(outputs_of<sv::SnapshotRequest>(s.take_outputs()).empty()) << "within snapshot_retry_s (3 s)";
+  s.on_time(now_ += 2 * kSecond);
+  EXPECT_EQ(outputs_of<sv::SnapshotRequest>(s.take_outputs()).size(), 1u) << "4 s after the request: asked again";
+  s.on_time(now_ += 2 * kSecond);
+  EXPECT_TRUE(outputs_of<sv::SnapshotRequest>(s.take_outputs()).empty()) << "2 s after the second request";
+  s.on_right_still(draw_scene(scene_, {1280, 960}, {object}), now_, now_);
+  std::string reasons;
+  for (const sv::StateReport& r : outputs_of<sv::StateReport>(s.take_outputs())) reasons += r.reason + "; ";
+  EXPECT_EQ(s.state(), sv::State::Nudge) << "the answer to the second request: " << reasons;
+
+  // Never answered: asked at 0, 4, 8 s; lost after 10 s, naming the requests.
+  sv::Supervisor lost = make();
+  now_ = start;
+  start_with(lost, {object});
+  ASSERT_EQ(lost.state(), sv::State::SnapshotBefore);
+  int requests = 0;
+  std::vector<sv::AttemptEnded> ended;
+  for (int i = 0; i < 11 && ended.empty(); ++i) {
+    lost.on_time(now_ += kSecond);
+    const auto outputs = lost.take_outputs();
+    requests += static_cast<int>(outputs_of<sv::SnapshotRequest>(outputs).size());
+    ended = outputs_of<sv::AttemptEnded>(outputs);
+  }
+  ASSERT_EQ(ended.size(), 1u);
+  EXPECT_EQ(ended[0].attempt->outcome, sv::Outcome::SnapshotLost);
+  EXPECT_NE(ended[0].attempt->reason.find("asked 3 times"), std::string::npos) << ended[0].attempt->reason;
+  EXPECT_EQ(requests, 2) << "the two requests after the first";
+}
+
 // A clock that goes back an hour (the world or the log restarted) would leave the run waiting an
 // hour for a snapshot; restarted, the timeout counts from the new time and the attempt ends.
 TEST_F(SupervisorTest, AClockThatGoesBackRestartsTheTimeoutsInsteadOfWaitingForItToCatchUp) {

@@ -167,7 +167,7 @@ void Supervisor::on_learning_arm_state(const ArmStatus& arm, int64_t now) {
   }
   request_time_ = now;
   enter(State::Rotate, now, "view " + std::to_string(attempt_->views.size() + 1) + " of " + std::to_string(config_.views));
-  outputs_.push_back(SnapshotRequest{false});
+  ask_for_still(now, true);
 }
 
 // One training view: the right still with the held object's box, to the learner and kept.

@@ -228,7 +228,26 @@ void Supervisor::request_still(State state, int64_t now, const std::string& note
                                                       : "still after the nudge";
   if (!note.empty()) reason += " (" + note + ")";
   enter(state, now, reason);
-  outputs_.push_back(SnapshotRequest{attempt_->learn});
+  ask_for_still(now, true);
+}
+
+void Supervisor::ask_for_still(int64_t now, bool first) {
+  still_asked_ = now;
+  still_requests_ = first ? 1 : still_requests_ + 1;
+  outputs_.push_back(SnapshotRequest{state_ != State::Rotate && attempt_->learn});
+}
+
+// Asks again for a still that has not come within snapshot_retry_s of the last request, while
+// the step's snapshot_timeout_s lasts. Returns whether the step timed out.
+bool Supervisor::still_overdue(int64_t now) {
+  if (timed_out(config_.snapshot_timeout_s, now)) return true;
+  if (static_cast<double>(now - still_asked_) > config_.snapshot_retry_s * kMicro) ask_for_still(now, false);
+  return false;
+}
+
+std::string Supervisor::still_requests_text() const {
+  return " (asked " + std::to_string(still_requests_) + (still_requests_ == 1 ? " time" : " times") + " in " +
+         seconds_text(config_.snapshot_timeout_s) + ")";
 }
 
 void Supervisor::start_nudge(int64_t now) {
@@ -513,6 +532,7 @@ void Supervisor::on_clock_restart(int64_t now) {
   entered_ = now;
   request_time_ = std::min(request_time_, now);
   arm_done_time_ = std::min(arm_done_time_, now);
+  still_asked_ = std::min(still_asked_, now);
 }
 
 void Supervisor::on_time(int64_t now) {
@@ -530,13 +550,16 @@ void Supervisor::on_time(int64_t now) {
       break;
     case State::SnapshotBefore:
     case State::SnapshotAfter:
+      if (!still_overdue(now)) break;
       // Learning without the left still: the attempt goes on as a segmentation only.
-      if (timed_out(config_.snapshot_timeout_s, now) && attempt_->learn && !(state_ == State::SnapshotBefore ? attempt_->before : attempt_->after).empty()) {
+      if (attempt_->learn && !(state_ == State::SnapshotBefore ? attempt_->before : attempt_->after).empty()) {
         attempt_->learn = false;
         attempt_->learning = "not grasped";
-        attempt_->learning_reason = "the left still never came";
+        attempt_->learning_reason = "the left still never came" + still_requests_text();
         stills_arrived(now);
-      } else if (timed_out(config_.snapshot_timeout_s, now)) end_attempt(Outcome::SnapshotLost, std::string("the ") + (state_ == State::SnapshotBefore ? "before" : "after") + " still never came", now);
+      } else {
+        end_attempt(Outcome::SnapshotLost, std::string("the ") + (state_ == State::SnapshotBefore ? "before" : "after") + " still never came" + still_requests_text(), now);
+      }
       break;
     case State::Nudge:
       if (timed_out(config_.nudge_timeout_s, now)) {
@@ -571,8 +594,8 @@ void Supervisor::on_time(int64_t now) {
       break;
     }
     case State::Rotate:
-      if (learn_seq_ == 0 && timed_out(config_.snapshot_timeout_s, now)) {
-        place(now, "snapshot lost", "view " + std::to_string(attempt_->views.size()) + "'s still never came");
+      if (learn_seq_ == 0 && still_overdue(now)) {
+        place(now, "snapshot lost", "view " + std::to_string(attempt_->views.size() + 1) + "'s still never came" + still_requests_text());
         break;
       }
       [[fallthrough]];

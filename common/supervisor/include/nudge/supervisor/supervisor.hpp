@@ -48,6 +48,10 @@ struct Config {
   double services_timeout_s = 60;    // for every required service's first heartbeat
   double candidates_timeout_s = 60;  // task-clock seconds for a CANDIDATES answer
   double snapshot_timeout_s = 10;
+  // A still not come by then is asked for again (until snapshot_timeout_s): a 1280x960 still is
+  // ~3.7 MB of UDP fragments, and LCM drops the whole message when one fragment is lost in a
+  // socket buffer that overflowed on a loaded machine (the held-out multi-object runs lost stills).
+  double snapshot_retry_s = 3;
   double nudge_timeout_s = 60;       // arm: from the command to MOTION_DONE
   double settle_s = 1.5;             // after the arm is done: the object comes to rest
   double axes_from_s = 0.5;          // AXES after this much of the settling time count
@@ -282,6 +286,9 @@ class Supervisor {
   void survey(int64_t now, const std::string& why = "");
   void choose(int64_t now);
   void request_still(State state, int64_t now, const std::string& note = "");
+  void ask_for_still(int64_t now, bool first);
+  bool still_overdue(int64_t now);
+  std::string still_requests_text() const;
   void start_nudge(int64_t now);
   void verify(int64_t now);
   void segment(int64_t now);
@@ -300,6 +307,8 @@ class Supervisor {
   std::vector<Output> outputs_;
   State state_ = State::Idle;
   State paused_from_ = State::Idle;
+  int64_t still_asked_ = 0;  // the newest SnapshotRequest of the current step (snapshot_retry_s)
+  int still_requests_ = 0;
   int64_t entered_ = 0, request_time_ = 0, arm_done_time_ = 0, next_seq_ = 1, nudge_seq_ = 0, home_seq_ = 0;
   std::string after_home_;  // why the survey after homing happens
   std::vector<Candidate> candidates_;
