@@ -15,8 +15,9 @@
 #   scripts/demo.sh synthetic             # the synthetic image sequence (generated into out/scenes)
 # NUDGE_DEMO_SECONDS (4) and NUDGE_DEMO_RATE (10 Hz) set the simulated run, NUDGE_DEMO_SYMMETRY_FLAGS
 # the symmetry extensions (default "--once-per-row --mirror-tolerance 15"); NUDGE_DEMO_FRAMES (20)
-# the length of the synthetic sequence. NUDGE_DEMO_SUPERVISOR_FLAGS adds supervisor flags to the loop
-# (e.g. "--track": the report then has each attempt's tracking plot).
+# the length of the synthetic sequence. NUDGE_DEMO_SUPERVISOR_FLAGS sets the loop's supervisor flags
+# (default "--track-trace": the trackers are watched, so the report has each attempt's tracking
+# plot, while the settled AXES decide; "--track": the trackers decide; "": no trackers).
 # By default the processes share a private network namespace (when run as root), so no
 # traffic leaves it; NUDGE_HOST_NETWORK=1 uses this host's network instead (to watch with
 # scripts/spy.sh).
@@ -104,7 +105,7 @@ if [ $# -eq 0 ]; then
   loop_start=$SECONDS
   nudge_in_private_network bash -c 'nudge_run_loop "$@"' loop "$NUDGE_BUILD_DIR/bin" "$scene" \
     "$NUDGE_ROOT/config/calibration_sim.yaml" "$NUDGE_ROOT/config/workspace.yaml" "$out/runs" "$run" \
-    ${NUDGE_DEMO_SUPERVISOR_FLAGS:-} || status=$?
+    ${NUDGE_DEMO_SUPERVISOR_FLAGS---track-trace} || status=$?
   dir="$out/runs/$run"
   if [ -f "$dir/summary.json" ]; then
     nudge_log "files: $dir/ (LCM log $run.lcmlog, summary.json, attempt_NN/ with before/after stills, mask, cutout, workspace.png, stages/, views/; objects/: what was learned)"

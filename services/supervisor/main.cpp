@@ -167,7 +167,11 @@ class Shell {
     subs.subscribe<image_t>(bus::channel::SNAPSHOT_RIGHT, [this](const image_t& m, const std::string&) { on_still(m); });
     subs.subscribe<image_t>(bus::channel::SNAPSHOT_LEFT, [this](const image_t& m, const std::string&) { on_left_still(m); });
     subs.subscribe<recognition_t>(bus::channel::RECOGNITION, [this](const recognition_t& m, const std::string&) {
-      supervisor_.on_recognition(m.seq, m.label, m.reason, now_);
+      // The match picture is decoded only for an answer the loop is waiting for.
+      const bool awaited = supervisor_.state() == sv::State::Recognise && m.seq == supervisor_.awaited_learn_seq();
+      cv::Mat picture;
+      if (awaited && m.match_picture.size > 0) picture = bus::to_mat(m.match_picture);
+      supervisor_.on_recognition(m.seq, m.label, m.reason, now_, picture);
       drain();
     });
     subs.subscribe<learn_result_t>(bus::channel::LEARNED, [this](const learn_result_t& m, const std::string&) {
@@ -423,7 +427,7 @@ class Shell {
     m.seq = r.seq;
     const int roi[4] = {r.roi.x, r.roi.y, r.roi.width, r.roi.height};
     std::copy(roi, roi + 4, m.roi);
-    m.want_match_picture = false;
+    m.want_match_picture = true;  // kept in the attempt's folder and shown in its report
     m.image = bus::to_message(r.image, image_t::FORMAT_PNG, now_, r.seq, "right");
     publish(bus::channel::RECOGNIZE_REQUEST, m);
   }
@@ -540,6 +544,9 @@ void add_flags(Flags& f, Options& o) {
   f.add_bool("track", &o.config.track,
              "start a symmetry tracker per camera at the target's line when it moves and judge the result by the "
              "tracked lines (thesis 6.3.2; default: by the settled AXES, docs/supervisor.md)");
+  f.add_bool("track-trace", &o.config.track_trace,
+             "run the trackers and keep their per-frame states (attempt.json's track_trace, the report's tracking "
+             "plot) while the settled AXES decide");
   f.add_int("survey-frames", &o.config.survey_frames, "stereo pairs per candidate survey (thesis 25)");
   f.add_int("survey-lines", &o.config.survey_lines, "lines per image in a survey (thesis 3)");
   f.add_int("max-attempts", &o.config.max_attempts, "nudges per run");

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <unistd.h>
@@ -158,6 +159,7 @@ class SupervisorTest : public ::testing::Test {
     last_objects_.push_back(to);
   }
   // The object at rest for two seconds (frames and, for the loop without trackers, upright AXES).
+  std::vector<sv::Output> slide_without_symmetry(sv::Supervisor& s);
   void settle_with_axes(sv::Supervisor& s, const std::vector<Eigen::Vector3d>& feet, double tilt = 0.02) {
     for (int i = 1; i <= 20; ++i) {
       now_ += kSecond / 10;
@@ -653,17 +655,15 @@ TEST_F(SupervisorTest, SameInputsSameOutputs) {
   EXPECT_FALSE(a.empty());
 }
 
-TEST_F(SupervisorTest, WhatTheTrackersSawDecidesNotTheSettledAxes) {
-  sv::Config with_trackers;
-  with_trackers.track = true;
-  sv::Supervisor s = make(with_trackers);
+// A nudge of the object at (0.28, -0.05): it starts to slide, then what the cameras see there keeps
+// changing but has no symmetry left (a splash, a crumpling object): motion without a line, and the
+// trackers give up. The settled AXES then say it stands 3 cm on. Returns the supervisor's outputs.
+std::vector<sv::Output> SupervisorTest::slide_without_symmetry(sv::Supervisor& s) {
   const Eigen::Vector3d object(0.28, -0.05, 0);
   start_with(s, {object});
   s.on_right_still(draw_scene(scene_, {1280, 960}, {object}), now_, now_);
   const auto nudge = outputs_of<sv::NudgeCommand>(s.take_outputs()).at(0);
   s.on_arm_state(arm(sv::ArmStatus::Motion::Moving, nudge.seq), now_);
-  // It starts to slide, then what the cameras see there keeps changing but has no symmetry left
-  // (a splash, a crumpling object): motion without a line, and the trackers give up.
   cv::RNG rng(3);
   for (int i = -3; i <= 25; ++i) {
     now_ += kSecond / 10;
@@ -683,14 +683,44 @@ TEST_F(SupervisorTest, WhatTheTrackersSawDecidesNotTheSettledAxes) {
     }
   }
   s.on_arm_state(arm(sv::ArmStatus::Motion::Done, nudge.seq), now_);
-  settle_with_axes(s, {object + 0.03 * nudge.direction});  // AXES would say "fine": the trackers decide
+  settle_with_axes(s, {object + 0.03 * nudge.direction});
+  return s.take_outputs();
+}
+
+TEST_F(SupervisorTest, WhatTheTrackersSawDecidesNotTheSettledAxes) {
+  sv::Config with_trackers;
+  with_trackers.track = true;
+  sv::Supervisor s = make(with_trackers);
+  const auto out = slide_without_symmetry(s);  // AXES would say "fine": the trackers decide
   ASSERT_EQ(s.state(), sv::State::Home) << sv::to_string(s.state()) << ": " << s.report().reason;
-  const auto ended = outputs_of<sv::AttemptEnded>(s.take_outputs());
+  const auto ended = outputs_of<sv::AttemptEnded>(out);
   ASSERT_EQ(ended.size(), 1u);
   // Lost, or what they held no longer makes an upright axis: either way no segmentation.
   const sv::Outcome outcome = ended[0].attempt->outcome;
   EXPECT_TRUE(outcome == sv::Outcome::TrackerLost || outcome == sv::Outcome::Tipped) << ended[0].attempt->reason;
   EXPECT_TRUE(ended[0].attempt->after.empty());
+}
+
+// Traced only, the same trackers are watched (their per-frame states kept for the report's plot)
+// while the settled AXES decide: the attempt goes on to the after still.
+TEST_F(SupervisorTest, TracedTrackersAreKeptButTheSettledAxesDecide) {
+  sv::Config traced;
+  traced.track_trace = true;
+  sv::Supervisor s = make(traced);
+  const auto out = slide_without_symmetry(s);
+  EXPECT_TRUE(outputs_of<sv::AttemptEnded>(out).empty()) << s.report().reason;
+  ASSERT_EQ(s.state(), sv::State::Home) << s.report().reason;
+  EXPECT_NE(s.report().reason.find("object at rest"), std::string::npos) << s.report().reason;
+  s.on_arm_state(arm(sv::ArmStatus::Motion::Done, s.awaited_arm_seq()), now_ += kSecond);
+  ASSERT_EQ(s.state(), sv::State::SnapshotAfter);
+  s.on_right_still(draw_scene(scene_, {1280, 960}, {}), now_, now_);
+  const auto ended = outputs_of<sv::AttemptEnded>(s.take_outputs());
+  ASSERT_EQ(ended.size(), 1u);
+  const sv::Attempt& a = *ended[0].attempt;
+  EXPECT_GT(a.track_trace[0].size(), 10u);
+  EXPECT_GT(a.track_trace[1].size(), 10u);
+  EXPECT_FALSE(a.tracked[0] || a.tracked[1]) << "the trackers' lines decided nothing";
+
 }
 
 TEST_F(SupervisorTest, MotionFarAboveTheObjectIsNotKeptInItsMask) {
@@ -999,7 +1029,8 @@ TEST_F(LearningTest, AKnownObjectIsNotNudgedAndTheSummaryNamesIt) {
   const auto projected = scene_.project_right(object_ + Eigen::Vector3d(0, 0, 0.05), {1280, 960});
   EXPECT_TRUE(request.roi.contains(cv::Point(*projected))) << "the candidate's region";
   EXPECT_EQ(request.image.size(), cv::Size(1280, 960));
-  s.on_recognition(request.seq, "green bottle", "", now_ += kSecond);
+  const cv::Mat match(40, 60, CV_8UC3, cv::Scalar(0, 0, 255));
+  s.on_recognition(request.seq, "green bottle", "", now_ += kSecond, match);
   auto out = s.take_outputs();
   EXPECT_TRUE(outputs_of<sv::NudgeCommand>(out).empty());
   EXPECT_TRUE(outputs_of<sv::HomeCommand>(out).empty()) << "the arm never moved";
@@ -1007,6 +1038,11 @@ TEST_F(LearningTest, AKnownObjectIsNotNudgedAndTheSummaryNamesIt) {
   ASSERT_TRUE(a);
   EXPECT_EQ(a->outcome, sv::Outcome::Known);
   EXPECT_EQ(a->recognised, "green bottle");
+  EXPECT_EQ(a->recognition_match.size(), match.size()) << "the learner's match picture, for the attempt's folder";
+  const std::string dir = testing::TempDir() + "/supervisor_known_" + std::to_string(::getpid());
+  const std::string folder = sv::save_attempt(dir, *a, sv::ArmSetup{}, scene_.right_camera_in_world());
+  EXPECT_EQ(cv::imread(folder + "/recognition_match.png").size(), match.size());
+  std::filesystem::remove_all(dir);
   EXPECT_EQ(s.state(), sv::State::FindCandidates);
   answer_survey(s, {object_});  // the same candidate again: not asked twice
   EXPECT_EQ(s.state(), sv::State::Done);

@@ -78,10 +78,12 @@ void Supervisor::recognise(int64_t now) {
   outputs_.push_back(RecognizeRequest{learn_seq_, roi, a.before});
 }
 
-void Supervisor::on_recognition(int64_t seq, const std::string& label, const std::string& reason, int64_t now) {
+void Supervisor::on_recognition(int64_t seq, const std::string& label, const std::string& reason, int64_t now,
+                                const cv::Mat& match_picture) {
   if (state_ != State::Recognise || seq != learn_seq_) return;
   learn_seq_ = 0;
   Attempt& a = *attempt_;
+  a.recognition_match = match_picture.clone();
   if (!label.empty()) {
     a.recognised = label;
     end_attempt(Outcome::Known, "recognised as '" + label + "': already learned, not nudged", now);

@@ -182,6 +182,7 @@ std::string save_attempt(const std::string& directory, const Attempt& attempt, c
   write_png((folder / "before_left.png").string(), attempt.before_left);
   write_png((folder / "after_left.png").string(), attempt.after_left);
   write_png((folder / "mask_left.png").string(), attempt.segmentation_left.mask);
+  write_png((folder / "recognition_match.png").string(), attempt.recognition_match);
   write_file_atomically((folder / "attempt.json").string(), attempt_json(attempt) + "\n");
   return folder.string();
 }

@@ -96,6 +96,10 @@ bool Supervisor::timed_out(double seconds, int64_t now) const {
 
 bool Supervisor::in_attempt() const { return attempt_ != nullptr; }
 
+// With `track` the trackers, once motion started them, decide where the object rests and whether
+// it stands; with `track_trace` alone they are only watched.
+bool Supervisor::trackers_decide() const { return config_.track && tracking_started_; }
+
 void Supervisor::enter(State state, int64_t now, const std::string& reason) {
   state_ = state;
   entered_ = now;
@@ -270,7 +274,7 @@ void Supervisor::start_nudge(int64_t now) {
     last_track_[camera] = tracking::TrackState{};
     track_lost_[camera].clear();
     track_done_[camera] = false;
-    if (config_.track && target_lines_[camera]) trackers_[camera] = std::make_unique<tracking::SymmetryTracker>(config_.tracker);
+    if ((config_.track || config_.track_trace) && target_lines_[camera]) trackers_[camera] = std::make_unique<tracking::SymmetryTracker>(config_.tracker);
   }
   nudge_seq_ = next_seq_++;
   enter(State::Nudge, now, "nudging candidate " + std::to_string(a.target.index) + " at " + millimetres(a.target.position));
@@ -285,7 +289,7 @@ void Supervisor::verify(int64_t now) {
     end_attempt(Outcome::NoMotion, "no motion after nudge: nothing stood there (phantom candidate)", now);
     return;
   }
-  const bool placed = tracking_started_ ? verify_by_tracking(now) : verify_by_axes(now);
+  const bool placed = trackers_decide() ? verify_by_tracking(now) : verify_by_axes(now);
   if (!placed) return;  // the attempt has ended with its reason
   const double moved = (*a.rest - a.target.position).head<2>().norm();
   if (moved < config_.min_displacement_m) {
@@ -614,7 +618,7 @@ void Supervisor::on_time(int64_t now) {
 // AXES of the frames taken when the settling time ended have arrived (a lagging pipeline delivers
 // them late), or the wait for them is over.
 bool Supervisor::axes_caught_up(int64_t now) const {
-  if (tracking_started_) return true;  // the trackers decide, not the axes
+  if (trackers_decide()) return true;  // not the axes
   const int64_t settled = arm_done_time_ + static_cast<int64_t>(config_.settle_s * kMicro);
   return latest_axes_utime_ >= settled ||
          static_cast<double>(now - arm_done_time_) >= (config_.settle_s + config_.max_axes_lag_s) * kMicro;

@@ -234,9 +234,14 @@ std::string attempt_section(const fs::path& run_dir, const json& attempt, const 
     for (const auto& s : stages) out << picture(run_dir, dir + "/stages/" + s, s.substr(0, s.size() - 4));
     out << "</div>";
   }
-  // Whatever else the attempt's folder holds (learned views, recognition matches, ...).
+  // The learner's matches when it recognised the object before the nudge (thesis fig. 7.10).
+  if (fs::exists(run_dir / dir / "recognition_match.png"))
+    out << "<h3>recognition</h3><div class=\"row\">"
+        << picture(run_dir, dir + "/recognition_match.png", "the still before the nudge (above) matched to its best learned view (below), fig. 7.10")
+        << "</div>";
+  // Whatever else the attempt's folder holds (learned views, left stills, ...).
   std::vector<std::string> others;
-  const std::vector<std::string> shown = {"before.png", "after.png", "mask.png", "cutout.png", "workspace.png"};
+  const std::vector<std::string> shown = {"before.png", "after.png", "mask.png", "cutout.png", "workspace.png", "recognition_match.png"};
   if (fs::is_directory(run_dir / dir))
     for (const auto& e : fs::recursive_directory_iterator(run_dir / dir)) {
       const std::string rel = fs::relative(e.path(), run_dir).string();

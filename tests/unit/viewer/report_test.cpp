@@ -107,6 +107,15 @@ TEST(RunReport, ARunThatLearnedSaysHowManyObjectsAndWhatRecognitionAnswered) {
   EXPECT_NE(html.find("recognition: nothing known (empty database) · learning: learned (learned as 'mug') · "
                       "grasp planned in 62 ms"), std::string::npos) << html;
   EXPECT_NE(html.find("recognition: recognised as mug · learning: known</p>"), std::string::npos);
+  EXPECT_EQ(html.find("<h3>recognition</h3>"), std::string::npos) << "no match picture yet";
+
+  // The learner's match picture, kept by the supervisor in the attempt's folder, has its own row.
+  cv::imwrite(dir + "/attempt_02/recognition_match.png", cv::Mat(60, 80, CV_8UC3, cv::Scalar(0, 0, 200)));
+  const std::string with_match = render_run_report(dir, states());
+  const size_t heading = with_match.find("<h3>recognition</h3>");
+  ASSERT_NE(heading, std::string::npos);
+  EXPECT_GT(heading, with_match.find("id=\"attempt_02\"")) << "under the attempt that recognised it";
+  EXPECT_EQ(count(with_match, "<img src=\"attempt_02/recognition_match.png\""), 1) << "shown once, not again below";
 }
 
 TEST(RunReport, ShowsTheIoUInSimulationPerObjectAndPerAttempt) {

@@ -93,6 +93,10 @@ struct Config {
   // Off because, measured in the simulated lab (docs/supervisor.md), the trackers lose the object
   // while the pad touches it: block motion then covers the pad too and the lines drift.
   bool track = false;
+  // The trackers run and their per-frame states are kept (attempt.json's track_trace, the run
+  // report's tracking plot), but the settled AXES decide: how the trackers fare is seen on every
+  // run without their losses ending attempts. Implied by `track`.
+  bool track_trace = false;
   tracking::TrackerParams tracker;
   LineSearchParams line_search;
 
@@ -199,6 +203,7 @@ struct Attempt {
   std::optional<GraspTarget> grasp;
   std::string recognised;                  // the learner's label: a known object, not nudged
   std::string recognition_reason;          // why none was recognised (or the learner was silent)
+  cv::Mat recognition_match;               // the learner's picture of the matches (recognised only)
   std::vector<LearnView> views;            // the training views taken
   std::string learning;                    // "learned", "not grasped", "dropped", "learner silent", ...
   std::string learning_reason;
@@ -259,7 +264,9 @@ class Supervisor {
   void on_lines(bool left, const std::vector<symmetry::Line>& lines, int64_t utime, int64_t now);
   // Learning: the left still (SNAPSHOT_LEFT), the learner's answers and whether it is alive.
   void on_left_still(const cv::Mat& still, int64_t utime, int64_t now);
-  void on_recognition(int64_t seq, const std::string& label, const std::string& reason, int64_t now);
+  // match_picture: the learner's drawing of the verified matches, when it recognised something.
+  void on_recognition(int64_t seq, const std::string& label, const std::string& reason, int64_t now,
+                      const cv::Mat& match_picture = cv::Mat());
   void on_learned(int64_t seq, bool ok, const std::string& name, const std::string& reason, int64_t now);
   void set_learner_alive(bool alive) { learner_alive_ = alive; }
   // The learner's heartbeat status: "learning <object_key> ..." while it learns that object (its
@@ -280,6 +287,8 @@ class Supervisor {
   bool finished() const { return state_ == State::Done || state_ == State::Failed; }
   // The seq of the arm command the loop waits for (a nudge or the homing after it), 0 if none.
   int64_t awaited_arm_seq() const;
+  // The seq of the RECOGNITION or LEARNED answer (or learning arm command) awaited; 0: none.
+  int64_t awaited_learn_seq() const { return learn_seq_; }
 
  private:
   void enter(State state, int64_t now, const std::string& reason);
@@ -288,6 +297,7 @@ class Supervisor {
   void request_still(State state, int64_t now, const std::string& note = "");
   void ask_for_still(int64_t now, bool first);
   bool still_overdue(int64_t now);
+  bool trackers_decide() const;
   std::string still_requests_text() const;
   void start_nudge(int64_t now);
   void verify(int64_t now);
