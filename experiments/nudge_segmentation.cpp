@@ -29,6 +29,7 @@
 #include <vector>
 
 #include <lcm/lcm-cpp.hpp>
+#include <nlohmann/json.hpp>
 
 #include "nudge/bus/image.hpp"
 #include "nudge/bus/sim_convert.hpp"
@@ -221,6 +222,42 @@ std::vector<std::string> scene_names(const fs::path& scene_dir) {
   return names;
 }
 
+// How the runs detected their candidates: the symmetry and triangulation services' flags, read
+// from the first run's launch file (services/launch.json, written by nudge_run_loop), so that the
+// figures say which pipeline (NUDGE_LOOP_TABLE: busy or plain) they measure.
+struct Detection {
+  std::string pipeline = "unknown";  // "busy" (accumulator peaks verified, the upright check) or "plain"
+  std::string flags;                 // markdown: each service's command line without its binary's path
+};
+Detection detection_of(const fs::path& runs_dir) {
+  Detection d;
+  if (!fs::is_directory(runs_dir)) return d;
+  std::vector<fs::path> files;
+  for (const auto& scene : fs::directory_iterator(runs_dir)) {
+    const fs::path file = scene.path() / scene.path().filename() / "services" / "launch.json";
+    if (fs::exists(file)) files.push_back(file);
+  }
+  if (files.empty()) return d;
+  std::sort(files.begin(), files.end());
+  std::ifstream in(files.front());
+  const nlohmann::json launch = nlohmann::json::parse(in, nullptr, false);
+  if (launch.is_discarded() || !launch.contains("processes")) return d;
+  for (const auto& process : launch["processes"]) {
+    const std::string name = process.value("name", "");
+    if (name != "symmetry" && name != "triangulation") continue;
+    std::string line = "`nudge-" + name;
+    const auto& command = process["command"];
+    for (size_t i = 1; i < command.size(); ++i) {
+      const std::string arg = command[i].get<std::string>();
+      line += " " + (arg.find('/') != std::string::npos ? fs::path(arg).filename().string() : arg);
+      if (arg == "--verify") d.pipeline = "busy";
+    }
+    d.flags += (d.flags.empty() ? "" : "; ") + line + "`";
+  }
+  if (d.pipeline == "unknown" && !d.flags.empty()) d.pipeline = "plain";
+  return d;
+}
+
 SetScore score_set(const fs::path& runs_dir, const fs::path& scene_dir, std::vector<std::string> names) {
   if (names.empty()) names = scene_names(scene_dir);
   SetScore set;
@@ -325,7 +362,8 @@ int main(int argc, char** argv) {
 
   JsonWriter j(4);
   j.begin_object();
-  j.field("scenes", scene_dir.filename().string());
+  const Detection detection = detection_of(runs_dir);
+  j.field("scenes", scene_dir.filename().string()).field("detection", detection.pipeline);
   json_fields(j, main_set, ms);
   j.field("machine", ex::machine_description()).field("date", ex::today());
   if (dev_set) {
@@ -349,6 +387,8 @@ int main(int argc, char** argv) {
         "state at the after still re-rendered at 1280x960 (label mask, handles included); the object the mask overlaps "
         "most is the one segmented.\n\n"
      << ex::machine_description() << ", " << ex::today() << ".\n\n"
+     << "Detection: the **" << detection.pipeline << "** pipeline (`NUDGE_LOOP_TABLE`, `scripts/lib.sh`): " << detection.flags
+     << ".\n\n"
      << "## Held-out scenes (`" << scene_dir.filename().string() << "`)\n\n" << figures_table(main_set, ms) << "\n"
      << main_set.table << "\n";
   if (dev_set)

@@ -132,6 +132,12 @@ nudge_in_private_network() {
 # database in NUDGE_OBJECT_DB (default OUT_DIR/RUN_ID/objects: each run starts knowing nothing; name
 # one folder to keep what was learned across runs) and the world's one hand carrying the pad and
 # the gripper (--tool auto); the supervisor (--learn auto) then recognises, grasps, turns and learns.
+# NUDGE_LOOP_TABLE picks the detection: "plain" (the default) the thesis' (5 lines per image, 3
+# surveyed); "busy" the busy-table pipeline of docs/clutter.md (80 accumulator peaks, only those
+# that can be upright axes on the calibrated table, verified by local support and mirrored colour,
+# 12 kept, 8 per image surveyed, stereo-checked candidates and AXES): it finds objects on a
+# patterned table that "plain" does not, but loses one standing in line with the arm's base column
+# (docs/supervisor.md, "Measured").
 nudge_run_loop() {
   local bin=$1 scene=$2 calibration=$3 workspace=$4 out=$5 run=$6
   shift 6
@@ -153,18 +159,28 @@ nudge_run_loop() {
   # (nudge-arm --supervisor-timeout; a loaded, shared machine may starve the supervisor that long).
   local arm_watchdog=
   [ -n "${NUDGE_LOOP_ARM_WATCHDOG:-}" ] && arm_watchdog=", \"--supervisor-timeout\", \"$NUDGE_LOOP_ARM_WATCHDOG\""
+  local symmetry_flags='"--lines", "5"' triangulation_flags= survey=()
+  case "${NUDGE_LOOP_TABLE:-plain}" in
+    busy)
+      symmetry_flags='"--lines", "80", "--suppress-r", "4", "--suppress-theta", "4", "--verify", "12",
+                      "--upright-calibration", "'"$calibration"'", "--colour-edges", "--blur", "2", "--dmin", "8", "--dmax", "90"'
+      triangulation_flags=', "--stereo-check", "--cluster-min-fraction", "0.03"'
+      survey=(--survey-lines 8) ;;
+    plain) ;;
+    *) echo "NUDGE_LOOP_TABLE: busy or plain, not '$NUDGE_LOOP_TABLE'" >&2; return 2 ;;
+  esac
   local viewer=
   [ -n "${NUDGE_VIEWER:-}" ] && viewer=",
     {\"name\": \"viewer\", \"command\": [\"$bin/nudge-viewer\", \"--port\", \"$NUDGE_VIEWER\", \"--calibration\", \"$calibration\"]}"
   cat >"$logs/launch.json" <<EOF
 {"lcm_url": "$url", "log_dir": "$logs", "backoff": {"initial_s": 1, "max_s": 10},
  "processes": [
-    {"name": "symmetry", "command": ["$bin/nudge-symmetry", "--lines", "5", "--theta-min", "-25", "--theta-max", "25",
+    {"name": "symmetry", "command": ["$bin/nudge-symmetry", $symmetry_flags, "--theta-min", "-25", "--theta-max", "25",
                                      "--once-per-row", "--mirror-tolerance", "15"]},
     {"name": "camera", "command": ["$bin/nudge-camera", "--source", "sim", "--scene", "$scene", "--snapshots",
                                    "--snapshot-format", "png"]},
     {"name": "triangulation", "command": ["$bin/nudge-triangulation", "--calibration", "$calibration",
-                                          "--workspace", "$workspace"]},
+                                          "--workspace", "$workspace"$triangulation_flags]},
     {"name": "arm", "command": ["$bin/nudge-arm", "--backend", "sim", "--clock", "sim", "--workspace", "$workspace"$arm_watchdog]}$learner$viewer
  ]}
 EOF
@@ -178,7 +194,7 @@ EOF
     --rate "${NUDGE_LOOP_RATE:-10}" --tool "$tool" 2>"$logs/world.log" & pids+=($!)
   local status=0
   timeout -s INT "${NUDGE_LOOP_TIMEOUT:-900}" "$bin/nudge-supervisor" --lcm-url "$url" --calibration "$calibration" \
-    --workspace "$workspace" --out "$out" --run-id "$run" "$@" || status=$?
+    --workspace "$workspace" --out "$out" --run-id "$run" "${survey[@]}" "$@" || status=$?
   kill -INT "${pids[@]}" 2>/dev/null || true
   wait "${pids[@]}" 2>/dev/null || true
   return $status

@@ -126,8 +126,14 @@ class Triangulation {
   }
 
   void publish_axes(int64_t utime, const Lines& left, const Lines& right) {
-    const geo::PairingResult result = geo::triangulate_pairings(rig_, left, right, table_ ? &*table_ : nullptr,
-                                                                opt_.filter, opt_.triangulation, opt_.lines);
+    geo::PairingResult result = geo::triangulate_pairings(rig_, left, right, table_ ? &*table_ : nullptr,
+                                                          opt_.filter, opt_.triangulation, opt_.lines);
+    // Busy tables: every line paired with every line gives ~140 axes a frame from 12 lines, most
+    // of them between two objects or in the table's texture, which the supervisor's settled-axes
+    // check then takes for the nudged object. The stereo check keeps each line's most consistent
+    // pairing only, as for CANDIDATES.
+    if (opt_.locations.stereo_check && table_)
+      result.axes = geo::consistent_pairings(rig_, left, right, result, *table_, opt_.locations);
     for (const auto& why : result.rejections) log::debug() << "utime " << utime << ": " << why;
     const axes_t msg = bus::to_message(result, utime, frame_ ? &*frame_ : nullptr);
     service_.publish(bus::channel::AXES, msg);
@@ -203,8 +209,8 @@ void add_flags(Flags& f, Options& o) {
   f.add_double("cluster-radius", &o.locations.qt.radius, "CANDIDATES: QT cluster radius, m");
   f.add_double("cluster-min-fraction", &o.locations.qt.min_fraction, "CANDIDATES: smallest cluster, fraction of all");
   f.add_bool("stereo-check", &o.locations.stereo_check,
-             "CANDIDATES: pair a left and a right line only if their support segments cover the same heights "
-             "on the axis, from the table up; each line once per frame (busy tables, docs/clutter.md)");
+             "CANDIDATES and AXES: pair a left and a right line only if their support segments cover the same "
+             "heights on the axis, from the table up; each line once per frame (busy tables, docs/clutter.md)");
   f.add_double("min-height-overlap", &o.locations.min_height_overlap,
                "CANDIDATES with --stereo-check: least overlap / union of the two lines' heights");
   f.add_double("max-foot-height", &o.locations.max_foot_height_m,
