@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <fstream>
 #include <map>
+#include <set>
 #include <string>
 
 #include "nudge/axes_t.hpp"
@@ -426,4 +427,37 @@ TEST(TriangulationService, BadCalibrationAndFlagsAreClearErrors) {
                               "ring_inner: 0.15\ntable_margin: 0.005\n";
   EXPECT_EQ(run(service + " --calibration x --workspace " + workspace, &err), 2);
   EXPECT_NE(err.find(workspace + ": ring_outer: missing"), std::string::npos) << err;
+}
+
+// Busy tables (--stereo-check): AXES carry each line's most consistent pairing only, as the
+// candidates do; every line paired with every line also gives pairings of two objects' lines.
+TEST(TriangulationService, WithTheStereoCheckAxesPairEachLineOnce) {
+  const Scene scene;
+  ServiceRun service("stereo_check");
+  geo::save_rig(scene.rig, service.rig);
+  write_input_log(scene, service.in);
+  auto line_used_twice = [](const nudge::axes_t& m) {
+    std::set<int> left, right;
+    for (const auto& a : m.axes)
+      if (!left.insert(a.left_index).second || !right.insert(a.right_index).second) return true;
+    return false;
+  };
+  ASSERT_EQ(service(table_flags(scene)), 0) << service.err;
+  const Output every = read_output(service.out);
+  int frames_with_repeats = 0;
+  for (const auto& [utime, m] : every.axes) frames_with_repeats += line_used_twice(m);
+  EXPECT_GT(frames_with_repeats, 0) << "without the check a line pairs with several";
+
+  ASSERT_EQ(service(table_flags(scene) + " --stereo-check"), 0) << service.err;
+  const Output checked = read_output(service.out);
+  ASSERT_EQ(checked.axes.size(), every.axes.size());
+  for (const auto& [utime, m] : checked.axes) {
+    EXPECT_FALSE(line_used_twice(m)) << "utime " << utime;
+    const int f = static_cast<int>((utime - kStart) / kPeriod);
+    for (int k = 0; k < 3; ++k) {
+      bool found = false;
+      for (const auto& a : m.axes) found |= a.left_index == k && a.right_index == right_order(f, k);
+      EXPECT_TRUE(found) << scene.objects[k].name << " at utime " << utime;
+    }
+  }
 }
