@@ -169,6 +169,10 @@ nudge_run_loop() {
     plain) ;;
     *) echo "NUDGE_LOOP_TABLE: busy or plain, not '$NUDGE_LOOP_TABLE'" >&2; return 2 ;;
   esac
+  # NUDGE_LOOP_COLUMN_MASK=1: the arm's base column is left out of the edges (its place from the
+  # calibration: nudge-symmetry --column-calibration).
+  [ "${NUDGE_LOOP_COLUMN_MASK:-0}" = 1 ] && symmetry_flags+=', "--column-calibration", "'"$calibration"'"'
+
   local viewer=
   [ -n "${NUDGE_VIEWER:-}" ] && viewer=",
     {\"name\": \"viewer\", \"command\": [\"$bin/nudge-viewer\", \"--port\", \"$NUDGE_VIEWER\", \"--calibration\", \"$calibration\"]}"

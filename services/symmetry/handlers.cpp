@@ -65,7 +65,8 @@ Handlers::Handlers(bus::Service& service, const Options& options)
   for (const auto& channel : options_.inputs) {
     const std::string out = bus::channel::derived(channel, bus::channel::SYMMETRY);
     const std::string contours_out = bus::channel::derived(channel, bus::channel::CONTOURS);
-    const geometry::Side side = options_.upright ? side_of_channel(channel) : geometry::Side::Left;
+    const bool needs_side = options_.upright || !options_.column_mask_left.empty();
+    const geometry::Side side = needs_side ? side_of_channel(channel) : geometry::Side::Left;
     service_.subscriptions().subscribe<image_t>(channel, [this, out, contours_out, side](const image_t& msg, const std::string&) {
       on_image(msg, out, contours_out, side);
     });
@@ -85,7 +86,14 @@ geometry::Side side_of_channel(const std::string& channel) {
 void Handlers::on_image(const image_t& msg, const std::string& out, const std::string& contours_out, geometry::Side side) {
   const cv::Mat image = bus::to_mat(msg);  // throws ImageError naming the image: counted, skipped
   Stopwatch watch;
-  const symmetry::EdgeSet edges = symmetry::detect_edges(image, options_.edge);
+  symmetry::EdgeSet edges = symmetry::detect_edges(image, options_.edge);
+  const cv::Mat& column = side == geometry::Side::Left ? options_.column_mask_left : options_.column_mask_right;
+  if (!column.empty()) {
+    if (column.size() != image.size())
+      throw std::runtime_error(out + " frame " + std::to_string(msg.frame_id) + ": image " + std::to_string(image.cols) +
+                               "x" + std::to_string(image.rows) + " differs from the column mask's calibration");
+    symmetry::remove_edges(edges, column);
+  }
   const double edges_ms = watch.elapsed_ms();
   symmetry::Result result = detector_.detect(edges);
   result.ms.edges_ms = edges_ms;

@@ -35,6 +35,9 @@ struct Options {
     double max_tilt_deg = 2;
   };
   std::optional<Upright> upright;
+  // The arm's base column left out of the edges (geometry/self_mask.hpp): one mask per camera,
+  // the calibration's image size; input channels must name their camera. Empty: off.
+  cv::Mat column_mask_left, column_mask_right;
 };
 
 // The camera of an input channel for the upright check: LEFT or RIGHT at the end of its name.

@@ -5,6 +5,7 @@
 #include "nudge/bus/channels.hpp"
 #include "nudge/bus/service.hpp"
 #include "nudge/flags.hpp"
+#include "nudge/geometry/self_mask.hpp"
 #include "nudge/geometry/workspace.hpp"
 
 using namespace nudge;
@@ -44,9 +45,18 @@ int main(int argc, char** argv) {
     std::string upright_calibration;
     std::vector<double> upright_table;
     double upright_tilt = 2;
+    std::string column_calibration;
+    geometry::Column column;
+    column.radius = 0.075;  // the PUMA 260's pedestal (65 mm) and its first link's housing, with room
+    column.height = 0.40;   // the shoulder (0.33 m) and the ball on it
     f.add_string("upright-calibration", &upright_calibration,
                  "with --verify: verify only peaks that can be upright axes on the table of this rig file (its table_plane "
                  "unless --upright-table); input channels must end in LEFT / RIGHT");
+    f.add_string("column-calibration", &column_calibration,
+                 "leave the arm's base column out of the edges: its place from this rig file's arm_base and table_plane "
+                 "(input channels must end in LEFT / RIGHT)");
+    f.add_double("column-radius", &column.radius, "with --column-calibration: the column's radius, m");
+    f.add_double("column-height", &column.height, "with --column-calibration: its height above the table, m");
     f.add_doubles("upright-table", &upright_table, 4, "with --upright-calibration: table plane NX NY NZ D (right camera frame, m)");
     f.add_double("upright-max-tilt", &upright_tilt, "with --upright-calibration: largest angle (deg) between the table normal "
                  "and the plane through the camera and a line");
@@ -85,6 +95,20 @@ int main(int argc, char** argv) {
       }
       upright.max_tilt_deg = upright_tilt;
       options.upright = upright;
+    }
+    if (!column_calibration.empty()) {
+      try {
+        const geometry::StereoRig rig = geometry::load_rig(column_calibration);
+        const geometry::Workspace scene = geometry::load_workspace(column_calibration);
+        if (!scene.table || !scene.arm_base)
+          throw std::invalid_argument(column_calibration + " needs table_plane and arm_base");
+        column.foot = *scene.arm_base;
+        options.column_mask_left = geometry::column_mask(rig, geometry::Side::Left, *scene.table, column);
+        options.column_mask_right = geometry::column_mask(rig, geometry::Side::Right, *scene.table, column);
+        for (const auto& channel : options.inputs) symmetry_service::side_of_channel(channel);
+      } catch (const std::exception& e) {
+        throw FlagError(std::string("--column-calibration: ") + e.what());
+      }
     }
     service.start();
     service.watch_heartbeats({"camera"});  // its input: say so when the camera goes quiet

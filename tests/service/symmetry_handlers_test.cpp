@@ -168,3 +168,33 @@ TEST(SymmetryHandlers, UprightCheckKeepsOnlyLinesThatCanStandOnTheTable) {
   EXPECT_EQ(nudge::symmetry_service::side_of_channel("CAMERA_RIGHT"), nudge::geometry::Side::Right);
   EXPECT_THROW(nudge::symmetry_service::side_of_channel("CAMERA"), std::invalid_argument);
 }
+
+// The arm's base column left out (Options::column_mask_*): a bottle inside the masked region gives
+// no line, the same bottle unmasked does; a frame of another size than the mask is an error,
+// counted, and the service goes on.
+TEST(SymmetryHandlers, TheColumnMaskLeavesTheMaskedRegionOutOfTheVoting) {
+  nudge::symmetry_service::Options options = mono_options();
+  options.inputs = {"CAMERA_RIGHT"};
+  options.column_mask_left = cv::Mat(240, 320, CV_8UC1, cv::Scalar(0));
+  options.column_mask_right = cv::Mat(240, 320, CV_8UC1, cv::Scalar(0));
+  options.column_mask_right(cv::Rect(140, 0, 80, 240)).setTo(255);  // around the line at r = 20
+  InProcess run(options);
+  Latest<nudge::symmetry_lines_t> right(run.probe, "SYMMETRY_RIGHT");
+  auto lines_at = [&](double r, int64_t utime) {
+    nudge::image_t image = bottle_image(r, 0, utime);
+    run.bus.publish("CAMERA_RIGHT", &image);
+    run.service.handle_pending();
+    const nudge::symmetry_lines_t m = right.get();
+    int near = 0;
+    for (int i = 0; i < m.num_lines; ++i) near += std::fabs(m.lines[i].r - r) < 3 && std::fabs(m.lines[i].theta) < 2 * kDeg;
+    return near;
+  };
+  EXPECT_EQ(lines_at(20, 1), 0) << "the bottle behind the mask";
+  EXPECT_EQ(lines_at(-90, 2), 1) << "the same bottle beside it";
+  nudge::image_t small = nudge::bus::to_message(cv::Mat(120, 160, CV_8UC3, cv::Scalar(200, 210, 220)),
+                                                nudge::image_t::FORMAT_GRAY8, 3, 3, "mono");
+  run.bus.publish("CAMERA_RIGHT", &small);
+  run.service.handle_pending();
+  EXPECT_EQ(run.service.counters().errors, 1);
+  EXPECT_NE(run.service.counters().last_error().find("column mask"), std::string::npos) << run.service.counters().last_error();
+}

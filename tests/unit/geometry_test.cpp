@@ -14,9 +14,11 @@
 #include "nudge/geometry/interesting_locations.hpp"
 #include "nudge/geometry/plane.hpp"
 #include "nudge/geometry/qt_cluster.hpp"
+#include "nudge/geometry/self_mask.hpp"
 #include "nudge/geometry/stereo_rig.hpp"
 #include "nudge/geometry/triangulation.hpp"
 #include "nudge/geometry/upright.hpp"
+#include "nudge/geometry/workspace.hpp"
 
 using namespace nudge::geometry;
 namespace sym = nudge::symmetry;
@@ -727,4 +729,55 @@ TEST(GeometryUpright, SnapsALineOntoTheImageOfAnUprightAxis) {
   const auto kept = upright_lines(rig, Side::Right, plane, {turned}, 5.0, true);
   ASSERT_EQ(kept.size(), 1u);
   EXPECT_NEAR(kept[0].theta, snapped->theta, 1e-12);
+}
+
+// The arm's base column in the shipped simulation calibration: both cameras see it; the mask
+// covers its axis from the table up, is about as wide as the column seen from there, and leaves
+// the table beside it alone.
+TEST(GeometryColumnMask, CoversTheArmsBaseColumnInBothCameras) {
+  const std::string shipped = std::string(NUDGE_SOURCE_DIR) + "/config/calibration_sim.yaml";
+  const StereoRig rig = load_rig(shipped);
+  const Workspace scene = load_workspace(shipped);
+  ASSERT_TRUE(scene.table && scene.arm_base);
+  Column column;
+  column.foot = *scene.arm_base;
+  column.radius = 0.07;
+  column.height = 0.4;
+  const Eigen::Vector3d n = scene.table->normal.normalized();
+  const Eigen::Vector3d up = scene.table->signed_distance(Eigen::Vector3d::Zero()) >= 0 ? n : Eigen::Vector3d(-n);
+  const Eigen::Vector3d foot = column.foot - scene.table->signed_distance(column.foot) * n;
+  for (const Side side : {Side::Left, Side::Right}) {
+    const Camera& camera = side == Side::Left ? rig.left : rig.right;
+    const auto project = [&](const Eigen::Vector3d& p) {
+      const Eigen::Vector3d q = side == Side::Left ? Eigen::Vector3d(rig.R.transpose() * (p - rig.T)) : p;
+      const Eigen::Vector2d px = camera.project(q);
+      return cv::Point(cvRound(px.x()), cvRound(px.y()));
+    };
+    const cv::Mat mask = column_mask(rig, side, *scene.table, column, 0);
+    ASSERT_EQ(mask.size(), cv::Size(camera.width, camera.height));
+    for (double h : {0.01, 0.1, 0.2, 0.25}) {  // its top is above the pictures
+      const cv::Point p = project(foot + h * up);
+      ASSERT_TRUE(cv::Rect(0, 0, mask.cols, mask.rows).contains(p)) << "the column is in view";
+      EXPECT_EQ(mask.at<uint8_t>(p), 255) << "its axis at " << h << " m";
+    }
+    // Its width across the middle: 2 r f / depth, within a tenth.
+    const Eigen::Vector3d middle = foot + 0.2 * up;
+    const Eigen::Vector3d in_camera = side == Side::Left ? Eigen::Vector3d(rig.R.transpose() * (middle - rig.T)) : middle;
+    const cv::Point c = project(middle);
+    const int width = cv::countNonZero(mask.row(c.y));
+    EXPECT_NEAR(width, 2 * column.radius * camera.K(0, 0) / in_camera.norm(), 0.1 * width);
+    // The table 20 cm to the side is not masked.
+    const Eigen::Vector3d side_dir = up.cross(in_camera).normalized();
+    EXPECT_EQ(mask.at<uint8_t>(project(foot + 0.2 * side_dir + 0.05 * up)), 0);
+    // The margin widens it.
+    EXPECT_GT(cv::countNonZero(column_mask(rig, side, *scene.table, column, 4)), cv::countNonZero(mask));
+  }
+  // Behind the cameras: nothing to mask. Bad sizes are named.
+  Column behind = column;
+  behind.foot = Eigen::Vector3d(0, 0, -2);
+  EXPECT_EQ(cv::countNonZero(column_mask(rig, Side::Right, *scene.table, behind)), 0);
+  Column flat = column;
+  flat.height = 0;
+  EXPECT_THROW(column_mask(rig, Side::Right, *scene.table, flat), std::invalid_argument);
+  EXPECT_THROW(column_mask(rig, Side::Right, *scene.table, column, -1), std::invalid_argument);
 }

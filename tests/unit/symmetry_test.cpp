@@ -1099,3 +1099,30 @@ TEST(LineDifference, OfLinesMatchesTheirParameters) {
   EXPECT_NEAR(d.r, 40 - 41, 1e-9);  // a taken as (40, -92 deg), 5 deg from b
   EXPECT_NEAR(d.theta, -5 * kDeg, 1e-12);
 }
+
+// The robot's own body left out: the masked edge pixels go with their orientations, the rest keep
+// their order; a mask of another size is refused.
+TEST(SymmetryEdges, RemoveEdgesDropsTheMaskedPixelsWithTheirOrientations) {
+  EdgeSet edges;
+  edges.width = 10;
+  edges.height = 4;
+  for (int x = 0; x < 10; ++x) {
+    edges.points.emplace_back(x, 2);
+    edges.orientation.push_back(static_cast<int16_t>(x));
+    edges.direction.push_back(static_cast<int16_t>(100 + x));
+  }
+  cv::Mat exclude(4, 10, CV_8UC1, cv::Scalar(0));
+  exclude(cv::Rect(0, 0, 5, 4)).setTo(255);
+  remove_edges(edges, exclude);
+  ASSERT_EQ(edges.points.size(), 5u);
+  for (size_t i = 0; i < 5; ++i) {
+    EXPECT_EQ(edges.points[i], cv::Point(static_cast<int>(i) + 5, 2));
+    EXPECT_EQ(edges.orientation[i], static_cast<int16_t>(i + 5));
+    EXPECT_EQ(edges.direction[i], static_cast<int16_t>(i + 105));
+  }
+  EdgeSet plain = edges_from_mask(cv::Mat::ones(4, 10, CV_8U));  // no orientations
+  remove_edges(plain, exclude);
+  EXPECT_EQ(plain.points.size(), 20u);
+  EXPECT_TRUE(plain.orientation.empty());
+  EXPECT_THROW(remove_edges(plain, cv::Mat(5, 10, CV_8UC1, cv::Scalar(0))), std::invalid_argument);
+}

@@ -77,6 +77,27 @@ std::vector<int> theta_bins_in_range(double theta_min_deg, double theta_max_deg)
   return bins;
 }
 
+void remove_edges(EdgeSet& edges, const cv::Mat& exclude) {
+  require(exclude.type() == CV_8UC1, "edge exclusion mask must be 8-bit single channel");
+  require(exclude.cols == edges.width && exclude.rows == edges.height,
+          "edge exclusion mask of " + std::to_string(exclude.cols) + "x" + std::to_string(exclude.rows) +
+              " for edges of " + std::to_string(edges.width) + "x" + std::to_string(edges.height));
+  const bool oriented = edges.orientation.size() == edges.points.size();
+  const bool directed = edges.direction.size() == edges.points.size();
+  size_t kept = 0;
+  for (size_t i = 0; i < edges.points.size(); ++i) {
+    const cv::Point p = edges.points[i];
+    if (exclude.at<uint8_t>(p.y, p.x)) continue;
+    edges.points[kept] = p;
+    if (oriented) edges.orientation[kept] = edges.orientation[i];
+    if (directed) edges.direction[kept] = edges.direction[i];
+    ++kept;
+  }
+  edges.points.resize(kept);
+  if (oriented) edges.orientation.resize(kept);
+  if (directed) edges.direction.resize(kept);
+}
+
 EdgeSet edges_from_mask(const cv::Mat& mask) {
   require(mask.type() == CV_8UC1, "edge mask must be 8-bit single channel");
   EdgeSet edges;

@@ -123,6 +123,10 @@ std::vector<int> theta_bins_in_range(double theta_min_deg, double theta_max_deg)
 // Canny edge pixels of an image (grey or colour, 8-bit).
 EdgeSet detect_edges(const cv::Mat& image, const EdgeParams& params, cv::Mat* edge_image = nullptr);
 EdgeSet edges_from_mask(const cv::Mat& mask);  // non-zero pixels of an 8-bit mask
+// Drops the edge pixels where `exclude` (8-bit, the edges' image size) is non-zero, with their
+// orientations: what the detector must not vote with (the robot's own body). Throws
+// std::invalid_argument for a mask of another size or type.
+void remove_edges(EdgeSet& edges, const cv::Mat& exclude);
 
 // The same line in an image of another size (a resized copy of the same view): pixel centres
 // map as x_to = (x_from + 0.5) * to.width / from.width - 0.5, and likewise in y. Meant for
