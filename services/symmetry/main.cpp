@@ -7,6 +7,7 @@
 #include "nudge/flags.hpp"
 #include "nudge/geometry/self_mask.hpp"
 #include "nudge/geometry/workspace.hpp"
+#include "nudge/robot/safety.hpp"
 
 using namespace nudge;
 
@@ -47,7 +48,7 @@ int main(int argc, char** argv) {
     double upright_tilt = 2;
     std::string column_calibration;
     geometry::Column column;
-    column.radius = 0.075;  // the PUMA 260's pedestal (65 mm) and its first link's housing, with room
+    column.radius = robot::SafetyConfig{}.pedestal_radius;  // the PUMA 260's pedestal, as the world models it
     column.height = 0.40;   // the shoulder (0.33 m) and the ball on it
     f.add_string("upright-calibration", &upright_calibration,
                  "with --verify: verify only peaks that can be upright axes on the table of this rig file (its table_plane "
@@ -57,6 +58,10 @@ int main(int argc, char** argv) {
                  "(input channels must end in LEFT / RIGHT)");
     f.add_double("column-radius", &column.radius, "with --column-calibration: the column's radius, m");
     f.add_double("column-height", &column.height, "with --column-calibration: its height above the table, m");
+    int column_band = 4;
+    f.add_int("column-band", &column_band, "with --column-calibration: leave out only a band this many px either side of the "
+                                           "column's outline (its silhouette edges; an object in front of it keeps its own); "
+                                           "0: the whole column");
     f.add_doubles("upright-table", &upright_table, 4, "with --upright-calibration: table plane NX NY NZ D (right camera frame, m)");
     f.add_double("upright-max-tilt", &upright_tilt, "with --upright-calibration: largest angle (deg) between the table normal "
                  "and the plane through the camera and a line");
@@ -103,8 +108,12 @@ int main(int argc, char** argv) {
         if (!scene.table || !scene.arm_base)
           throw std::invalid_argument(column_calibration + " needs table_plane and arm_base");
         column.foot = *scene.arm_base;
-        options.column_mask_left = geometry::column_mask(rig, geometry::Side::Left, *scene.table, column);
-        options.column_mask_right = geometry::column_mask(rig, geometry::Side::Right, *scene.table, column);
+        if (column_band < 0) throw std::invalid_argument("--column-band must be >= 0");
+        for (const geometry::Side side : {geometry::Side::Left, geometry::Side::Right}) {
+          cv::Mat mask = geometry::column_mask(rig, side, *scene.table, column, column_band > 0 ? 0 : 4);
+          if (column_band > 0) mask = geometry::outline_band(mask, column_band);
+          (side == geometry::Side::Left ? options.column_mask_left : options.column_mask_right) = mask;
+        }
         for (const auto& channel : options.inputs) symmetry_service::side_of_channel(channel);
       } catch (const std::exception& e) {
         throw FlagError(std::string("--column-calibration: ") + e.what());

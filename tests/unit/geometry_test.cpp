@@ -781,3 +781,17 @@ TEST(GeometryColumnMask, CoversTheArmsBaseColumnInBothCameras) {
   EXPECT_THROW(column_mask(rig, Side::Right, *scene.table, flat), std::invalid_argument);
   EXPECT_THROW(column_mask(rig, Side::Right, *scene.table, column, -1), std::invalid_argument);
 }
+
+// The band either side of a region's outline: the silhouette's edges, not what lies inside.
+TEST(GeometryColumnMask, OutlineBandKeepsTheSilhouetteNotTheInside) {
+  cv::Mat region(100, 100, CV_8UC1, cv::Scalar(0));
+  region(cv::Rect(30, 10, 40, 80)).setTo(255);
+  const cv::Mat band = outline_band(region, 3);
+  EXPECT_EQ(band.at<uint8_t>(50, 30), 255) << "on the left side";
+  EXPECT_EQ(band.at<uint8_t>(50, 69), 255) << "on the right side";
+  EXPECT_EQ(band.at<uint8_t>(50, 27), 255) << "3 px outside";
+  EXPECT_EQ(band.at<uint8_t>(50, 50), 0) << "the inside is kept";
+  EXPECT_EQ(band.at<uint8_t>(50, 20), 0) << "beyond the band";
+  EXPECT_THROW(outline_band(region, 0), std::invalid_argument);
+  EXPECT_THROW(outline_band(cv::Mat(10, 10, CV_8UC3), 2), std::invalid_argument);
+}

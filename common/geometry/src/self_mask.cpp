@@ -46,4 +46,14 @@ cv::Mat column_mask(const StereoRig& rig, Side side, const Plane& table, const C
   return mask;
 }
 
+cv::Mat outline_band(const cv::Mat& region, int band_px) {
+  if (band_px < 1) throw std::invalid_argument("outline band must be >= 1 px");
+  if (region.type() != CV_8UC1) throw std::invalid_argument("outline band: the region must be an 8-bit single-channel mask");
+  const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * band_px + 1, 2 * band_px + 1));
+  cv::Mat outer, inner;
+  cv::dilate(region, outer, kernel);
+  cv::erode(region, inner, kernel, cv::Point(-1, -1), 1, cv::BORDER_CONSTANT, cv::Scalar(0));
+  return outer - inner;
+}
+
 }  // namespace nudge::geometry

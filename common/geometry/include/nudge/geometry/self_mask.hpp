@@ -18,7 +18,7 @@ namespace nudge::geometry {
 // table), radius and height above the table, m. Right camera frame, as everywhere in the rig.
 struct Column {
   Eigen::Vector3d foot = Eigen::Vector3d::Zero();
-  double radius = 0.07;
+  double radius = 0.065;
   double height = 0.4;
 };
 
@@ -27,5 +27,11 @@ struct Column {
 // column is behind the camera. Throws std::invalid_argument for a non-positive radius or height,
 // or a negative margin.
 cv::Mat column_mask(const StereoRig& rig, Side side, const Plane& table, const Column& column, int margin_px = 4);
+
+// The band of a region's outline, band_px either side of it: the column's votes come from pairs
+// of its two silhouette edges, while an object standing in front of it has its own edges inside
+// the region, which the whole region would take away too. Throws std::invalid_argument for a
+// band < 1 px or a mask that is not 8-bit single channel.
+cv::Mat outline_band(const cv::Mat& region, int band_px);
 
 }  // namespace nudge::geometry
