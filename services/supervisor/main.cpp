@@ -151,10 +151,12 @@ class Shell {
   void subscribe() {
     // The log holds exactly what the handlers were given, in that order: the typed subscriptions'
     // messages through their tap (a stream handler that fell behind skips frames, and so does
-    // the log), every other channel through a catch-all with no queue limit.
+    // the log), every other channel through a catch-all. That one keeps LCM's queue of 30: without
+    // a limit it would hold every camera frame the stream handlers skip until it is handled, and
+    // defeat their skipping (what it drops are channels the loop does not read).
     auto& subs = service_.subscriptions();
     subs.set_tap([this](const lcm::ReceiveBuffer* rbuf, const std::string& channel) { record(rbuf, channel); });
-    service_.input().subscribe(".*", &Shell::record_unhandled, this)->setQueueCapacity(0);
+    service_.input().subscribe(".*", &Shell::record_unhandled, this);
     subs.subscribe<heartbeat_t>(bus::channel::HEARTBEAT, [this](const heartbeat_t& m, const std::string&) { on_heartbeat(m); });
     subs.subscribe<sim_state_t>(bus::channel::SIM_STATE, [this](const sim_state_t& m, const std::string&) { on_sim_state(m); });
     subs.subscribe<candidates_t>(bus::channel::CANDIDATES, [this](const candidates_t& m, const std::string&) { on_candidates(m); });

@@ -160,6 +160,18 @@ class SupervisorTest : public ::testing::Test {
   }
   // The object at rest for two seconds (frames and, for the loop without trackers, upright AXES).
   std::vector<sv::Output> slide_without_symmetry(sv::Supervisor& s);
+  // A run's first attempt on `object` up to the after still: surveyed, the before still taken,
+  // nudged 3 cm, settled and parked. Returns where it rests.
+  Eigen::Vector3d nudge_and_park(sv::Supervisor& s, const Eigen::Vector3d& object) {
+    start_with(s, {object});
+    s.on_right_still(draw_scene(scene_, {1280, 960}, {object}), now_, now_);
+    const auto nudge = outputs_of<sv::NudgeCommand>(s.take_outputs()).at(0);
+    const Eigen::Vector3d rest = object + 0.03 * nudge.direction;
+    play_nudge(s, nudge.seq, object, rest);
+    settle_with_axes(s, {rest});
+    park(s);
+    return rest;
+  }
   void settle_with_axes(sv::Supervisor& s, const std::vector<Eigen::Vector3d>& feet, double tilt = 0.02) {
     for (int i = 1; i <= 20; ++i) {
       now_ += kSecond / 10;
@@ -733,13 +745,7 @@ TEST_F(SupervisorTest, MotionFarAboveTheObjectIsNotKeptInItsMask) {
   };
   sv::Supervisor s(sv::Config{}, scene_, sv::ArmSetup{}, with_arm);
   const Eigen::Vector3d object(0.28, -0.05, 0);
-  start_with(s, {object});
-  s.on_right_still(draw_scene(scene_, {1280, 960}, {object}), now_, now_);
-  const auto nudge = outputs_of<sv::NudgeCommand>(s.take_outputs()).at(0);
-  const Eigen::Vector3d rest = object + 0.03 * nudge.direction;
-  play_nudge(s, nudge.seq, object, rest);
-  settle_with_axes(s, {rest});
-  park(s);
+  const Eigen::Vector3d rest = nudge_and_park(s, object);
   ASSERT_EQ(s.state(), sv::State::SnapshotAfter);
   s.on_right_still(draw_scene(scene_, {1280, 960}, {rest}), now_, now_);
   const auto ended = outputs_of<sv::AttemptEnded>(s.take_outputs());
@@ -784,13 +790,7 @@ TEST_F(SupervisorTest, AxesOfSomethingElseFurtherAlongTheRayDoNotMoveTheRest) {
 TEST_F(SupervisorTest, ACandidateOnTheRestedObjectsLineInACameraIsThatObjectNotNudgedAgain) {
   sv::Supervisor s = make();
   const Eigen::Vector3d object(0.28, -0.05, 0);
-  start_with(s, {object});
-  s.on_right_still(draw_scene(scene_, {1280, 960}, {object}), now_, now_);
-  const auto nudge = outputs_of<sv::NudgeCommand>(s.take_outputs()).at(0);
-  const Eigen::Vector3d rest = object + 0.03 * nudge.direction;
-  play_nudge(s, nudge.seq, object, rest);
-  settle_with_axes(s, {rest});
-  park(s);
+  const Eigen::Vector3d rest = nudge_and_park(s, object);
   s.on_right_still(draw_scene(scene_, {1280, 960}, {rest}), now_, now_);
   ASSERT_EQ(outputs_of<sv::AttemptEnded>(s.take_outputs()).at(0).attempt->outcome, sv::Outcome::Segmented);
   Eigen::Vector3d ray = rest - scene_.right_camera_in_world();
