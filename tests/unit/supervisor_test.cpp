@@ -160,12 +160,16 @@ class SupervisorTest : public ::testing::Test {
   }
   // The object at rest for two seconds (frames and, for the loop without trackers, upright AXES).
   std::vector<sv::Output> slide_without_symmetry(sv::Supervisor& s);
+  // A run started on `object` alone, its before still taken: the nudge the supervisor commands.
+  sv::NudgeCommand nudge_command_for(sv::Supervisor& s, const Eigen::Vector3d& object) {
+    start_with(s, {object});
+    s.on_right_still(draw_scene(scene_, {1280, 960}, {object}), now_, now_);
+    return outputs_of<sv::NudgeCommand>(s.take_outputs()).at(0);
+  }
   // A run's first attempt on `object` up to the after still: surveyed, the before still taken,
   // nudged 3 cm, settled and parked. Returns where it rests.
   Eigen::Vector3d nudge_and_park(sv::Supervisor& s, const Eigen::Vector3d& object) {
-    start_with(s, {object});
-    s.on_right_still(draw_scene(scene_, {1280, 960}, {object}), now_, now_);
-    const auto nudge = outputs_of<sv::NudgeCommand>(s.take_outputs()).at(0);
+    const sv::NudgeCommand nudge = nudge_command_for(s, object);
     const Eigen::Vector3d rest = object + 0.03 * nudge.direction;
     play_nudge(s, nudge.seq, object, rest);
     settle_with_axes(s, {rest});
@@ -194,9 +198,7 @@ class SupervisorTest : public ::testing::Test {
   NudgedAlongRay nudge_and_settle_along_ray(const std::vector<double>& axes_behind_m) {
     sv::Supervisor s = make();
     const Eigen::Vector3d object(0.28, -0.05, 0);
-    start_with(s, {object});
-    s.on_right_still(draw_scene(scene_, {1280, 960}, {object}), now_, now_);
-    const auto nudge = outputs_of<sv::NudgeCommand>(s.take_outputs()).at(0);
+    const sv::NudgeCommand nudge = nudge_command_for(s, object);
     NudgedAlongRay run;
     run.rest = object + 0.03 * nudge.direction;
     Eigen::Vector3d ray = run.rest - scene_.right_camera_in_world();
@@ -407,9 +409,7 @@ TEST_F(SupervisorTest, APhantomCandidateShowsNoMotionAndIsRecordedAsSuch) {
 TEST_F(SupervisorTest, ATippedObjectIsReportedNotSegmented) {
   sv::Supervisor s = make();  // without trackers: the settled AXES decide
   const Eigen::Vector3d object(0.28, -0.05, 0);
-  start_with(s, {object});
-  s.on_right_still(draw_scene(scene_, {1280, 960}, {object}), now_, now_);
-  const auto nudge = outputs_of<sv::NudgeCommand>(s.take_outputs()).at(0);
+  const sv::NudgeCommand nudge = nudge_command_for(s, object);
   play_nudge(s, nudge.seq, object, object + 0.03 * nudge.direction);
   settle_with_axes(s, {object + 0.03 * nudge.direction}, /*tilt=*/0.4);  // 23 deg from upright
   auto ended = outputs_of<sv::AttemptEnded>(s.take_outputs());
@@ -435,9 +435,7 @@ TEST_F(SupervisorTest, ATippedObjectIsReportedNotSegmented) {
 TEST_F(SupervisorTest, AxesOfFramesTakenWhileTheObjectSettledAreIgnoredHoweverLateTheyArrive) {
   sv::Supervisor s = make();  // without trackers: the settled AXES decide
   const Eigen::Vector3d object(0.28, -0.05, 0);
-  start_with(s, {object});
-  s.on_right_still(draw_scene(scene_, {1280, 960}, {object}), now_, now_);
-  const auto nudge = outputs_of<sv::NudgeCommand>(s.take_outputs()).at(0);
+  const sv::NudgeCommand nudge = nudge_command_for(s, object);
   const Eigen::Vector3d rest = object + 0.03 * nudge.direction;
   play_nudge(s, nudge.seq, object, rest);
   ASSERT_EQ(s.state(), sv::State::Track);
@@ -462,9 +460,7 @@ TEST_F(SupervisorTest, AxesOfFramesTakenWhileTheObjectSettledAreIgnoredHoweverLa
 TEST_F(SupervisorTest, ALaggingPipelineIsWaitedForNotTakenForATippedObjectOrAPhantom) {
   sv::Supervisor s = make();
   const Eigen::Vector3d object(0.28, -0.05, 0);
-  start_with(s, {object});
-  s.on_right_still(draw_scene(scene_, {1280, 960}, {object}), now_, now_);
-  const auto nudge = outputs_of<sv::NudgeCommand>(s.take_outputs()).at(0);
+  const sv::NudgeCommand nudge = nudge_command_for(s, object);
   const Eigen::Vector3d rest = object + 0.03 * nudge.direction;
   // The arm moves and is done before any of the push's frames have arrived.
   const int64_t pushed_from = now_;
@@ -492,9 +488,7 @@ TEST_F(SupervisorTest, ALaggingPipelineIsWaitedForNotTakenForATippedObjectOrAPha
 TEST_F(SupervisorTest, AxesThatNeverComeEndTheAttemptAfterTheLagLimit) {
   sv::Supervisor s = make();
   const Eigen::Vector3d object(0.28, -0.05, 0);
-  start_with(s, {object});
-  s.on_right_still(draw_scene(scene_, {1280, 960}, {object}), now_, now_);
-  const auto nudge = outputs_of<sv::NudgeCommand>(s.take_outputs()).at(0);
+  const sv::NudgeCommand nudge = nudge_command_for(s, object);
   play_nudge(s, nudge.seq, object, object + 0.03 * nudge.direction);
   const int64_t arm_done = now_;
   const sv::Config config;
@@ -609,9 +603,7 @@ TEST_F(SupervisorTest, AClockThatGoesBackRestartsTheTimeoutsInsteadOfWaitingForI
 TEST_F(SupervisorTest, AServiceDyingMidNudgeStopsTheArmPausesAndResumesWithASurvey) {
   sv::Supervisor s = make();
   const Eigen::Vector3d object(0.28, -0.05, 0);
-  start_with(s, {object});
-  s.on_right_still(draw_scene(scene_, {1280, 960}, {object}), now_, now_);
-  const auto nudge = outputs_of<sv::NudgeCommand>(s.take_outputs()).at(0);
+  const sv::NudgeCommand nudge = nudge_command_for(s, object);
   s.on_arm_state(arm(sv::ArmStatus::Motion::Moving, nudge.seq), now_);
   s.on_services({"camera"}, now_ += kSecond);
   auto out = s.take_outputs();
@@ -650,9 +642,7 @@ TEST_F(SupervisorTest, SameInputsSameOutputs) {
     now_ = 50 * kSecond;
     sv::Supervisor s = make();
     const Eigen::Vector3d object(0.28, -0.05, 0);
-    start_with(s, {object});
-    s.on_right_still(draw_scene(scene_, {1280, 960}, {object}), now_, now_);
-    const auto nudge = outputs_of<sv::NudgeCommand>(s.take_outputs()).at(0);
+    const sv::NudgeCommand nudge = nudge_command_for(s, object);
     play_nudge(s, nudge.seq, object, object + 0.03 * nudge.direction);
     settle_with_axes(s, {object + 0.03 * nudge.direction});
     park(s);
@@ -672,9 +662,7 @@ TEST_F(SupervisorTest, SameInputsSameOutputs) {
 // trackers give up. The settled AXES then say it stands 3 cm on. Returns the supervisor's outputs.
 std::vector<sv::Output> SupervisorTest::slide_without_symmetry(sv::Supervisor& s) {
   const Eigen::Vector3d object(0.28, -0.05, 0);
-  start_with(s, {object});
-  s.on_right_still(draw_scene(scene_, {1280, 960}, {object}), now_, now_);
-  const auto nudge = outputs_of<sv::NudgeCommand>(s.take_outputs()).at(0);
+  const sv::NudgeCommand nudge = nudge_command_for(s, object);
   s.on_arm_state(arm(sv::ArmStatus::Motion::Moving, nudge.seq), now_);
   cv::RNG rng(3);
   for (int i = -3; i <= 25; ++i) {
