@@ -224,9 +224,11 @@ std::vector<std::string> scene_names(const fs::path& scene_dir) {
 
 // How the runs detected their candidates: the symmetry and triangulation services' flags, read
 // from the first run's launch file (services/launch.json, written by nudge_run_loop), so that the
-// figures say which pipeline (NUDGE_LOOP_TABLE: busy or plain) they measure.
+// figures say which pipeline (NUDGE_LOOP_TABLE: verified, plain or busy) they measure.
 struct Detection {
-  std::string pipeline = "unknown";  // "busy" (accumulator peaks verified, the upright check) or "plain"
+  // "verified" (accumulator peaks verified, the upright check), "busy" (the same on colour edges),
+  // "plain" (the thesis'); "+ column mask" when the arm's base column was left out of the edges.
+  std::string pipeline = "unknown";
   std::string flags;                 // markdown: each service's command line without its binary's path
 };
 Detection detection_of(const fs::path& runs_dir) {
@@ -242,6 +244,7 @@ Detection detection_of(const fs::path& runs_dir) {
   std::ifstream in(files.front());
   const nlohmann::json launch = nlohmann::json::parse(in, nullptr, false);
   if (launch.is_discarded() || !launch.contains("processes")) return d;
+  bool verified = false, colour_edges = false, column_mask = false;
   for (const auto& process : launch["processes"]) {
     const std::string name = process.value("name", "");
     if (name != "symmetry" && name != "triangulation") continue;
@@ -250,11 +253,15 @@ Detection detection_of(const fs::path& runs_dir) {
     for (size_t i = 1; i < command.size(); ++i) {
       const std::string arg = command[i].get<std::string>();
       line += " " + (arg.find('/') != std::string::npos ? fs::path(arg).filename().string() : arg);
-      if (arg == "--verify") d.pipeline = "busy";
+      verified = verified || arg == "--verify";
+      colour_edges = colour_edges || arg == "--colour-edges";
+      column_mask = column_mask || arg == "--column-calibration";
     }
     d.flags += (d.flags.empty() ? "" : "; ") + line + "`";
   }
-  if (d.pipeline == "unknown" && !d.flags.empty()) d.pipeline = "plain";
+  if (d.flags.empty()) return d;
+  d.pipeline = !verified ? "plain" : colour_edges ? "busy" : "verified";
+  if (column_mask) d.pipeline += " + column mask";
   return d;
 }
 

@@ -132,12 +132,15 @@ nudge_in_private_network() {
 # database in NUDGE_OBJECT_DB (default OUT_DIR/RUN_ID/objects: each run starts knowing nothing; name
 # one folder to keep what was learned across runs) and the world's one hand carrying the pad and
 # the gripper (--tool auto); the supervisor (--learn auto) then recognises, grasps, turns and learns.
-# NUDGE_LOOP_TABLE picks the detection: "plain" (the default) the thesis' (5 lines per image, 3
-# surveyed); "busy" the busy-table pipeline of docs/clutter.md (80 accumulator peaks, only those
-# that can be upright axes on the calibrated table, verified by local support and mirrored colour,
-# 12 kept, 8 per image surveyed, stereo-checked candidates and AXES): it finds objects on a
-# patterned table that "plain" does not, but loses one standing in line with the arm's base column
-# (docs/supervisor.md, "Measured").
+# NUDGE_LOOP_TABLE picks the detection (docs/supervisor.md, "Detection in the loop"):
+#   "verified" (the default): the thesis' edges (blur 1, Canny 30/90, Dmin 25, Dmax 250), 80
+#     accumulator peaks, only those that can be upright axes on the calibrated table, verified by
+#     local support and mirrored colour, 12 kept, 8 per image surveyed, the arm's base column's
+#     outline left out of the edges, stereo-checked candidates and AXES;
+#   "plain": the thesis' (5 lines per image, 3 surveyed, every left line paired with every right);
+#   "busy": the busy-table pipeline of docs/clutter.md ("verified" with colour edges, blur 2,
+#     Dmin 8, Dmax 90, and no column mask).
+# NUDGE_LOOP_COLUMN_MASK=1 adds the column mask to "plain" and "busy" ("verified" has it).
 nudge_run_loop() {
   local bin=$1 scene=$2 calibration=$3 workspace=$4 out=$5 run=$6
   shift 6
@@ -159,19 +162,25 @@ nudge_run_loop() {
   # (nudge-arm --supervisor-timeout; a loaded, shared machine may starve the supervisor that long).
   local arm_watchdog=
   [ -n "${NUDGE_LOOP_ARM_WATCHDOG:-}" ] && arm_watchdog=", \"--supervisor-timeout\", \"$NUDGE_LOOP_ARM_WATCHDOG\""
-  local symmetry_flags='"--lines", "5"' triangulation_flags= survey=()
-  case "${NUDGE_LOOP_TABLE:-plain}" in
+  local symmetry_flags='"--lines", "5"' triangulation_flags= survey=() column_mask=${NUDGE_LOOP_COLUMN_MASK:-0}
+  local verified='"--lines", "80", "--suppress-r", "4", "--suppress-theta", "4", "--verify", "12",
+                  "--upright-calibration", "'"$calibration"'"'
+  case "${NUDGE_LOOP_TABLE:-verified}" in
+    verified)
+      symmetry_flags=$verified
+      triangulation_flags=', "--stereo-check", "--cluster-min-fraction", "0.03"'
+      survey=(--survey-lines 8)
+      column_mask=1 ;;
     busy)
-      symmetry_flags='"--lines", "80", "--suppress-r", "4", "--suppress-theta", "4", "--verify", "12",
-                      "--upright-calibration", "'"$calibration"'", "--colour-edges", "--blur", "2", "--dmin", "8", "--dmax", "90"'
+      symmetry_flags="$verified"', "--colour-edges", "--blur", "2", "--dmin", "8", "--dmax", "90"'
       triangulation_flags=', "--stereo-check", "--cluster-min-fraction", "0.03"'
       survey=(--survey-lines 8) ;;
     plain) ;;
-    *) echo "NUDGE_LOOP_TABLE: busy or plain, not '$NUDGE_LOOP_TABLE'" >&2; return 2 ;;
+    *) echo "NUDGE_LOOP_TABLE: verified, plain or busy, not '$NUDGE_LOOP_TABLE'" >&2; return 2 ;;
   esac
-  # NUDGE_LOOP_COLUMN_MASK=1: the arm's base column is left out of the edges (its place from the
-  # calibration: nudge-symmetry --column-calibration).
-  [ "${NUDGE_LOOP_COLUMN_MASK:-0}" = 1 ] && symmetry_flags+=', "--column-calibration", "'"$calibration"'"'
+  # The arm's base column's outline is left out of the edges (its place from the calibration:
+  # nudge-symmetry --column-calibration): a robot self-filter.
+  [ "$column_mask" = 1 ] && symmetry_flags+=', "--column-calibration", "'"$calibration"'"'
 
   local viewer=
   [ -n "${NUDGE_VIEWER:-}" ] && viewer=",

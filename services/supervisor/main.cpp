@@ -553,6 +553,8 @@ void add_flags(Flags& f, Options& o) {
   f.add_int("survey-lines", &o.config.survey_lines, "lines per image in a survey (thesis 3)");
   f.add_int("max-attempts", &o.config.max_attempts, "nudges per run");
   f.add_double("settle", &o.config.settle_s, "after the nudge, wait this long for the object to rest, s");
+  f.add_double("max-settle", &o.config.max_settle_s,
+               "with too few settled axes near the push line, settle on up to this long after the nudge, s");
   f.add_double("snapshot-timeout", &o.config.snapshot_timeout_s, "for a still, s of the task clock");
   f.add_double("snapshot-retry", &o.config.snapshot_retry_s, "a still not come within this many s of the task clock is asked for again (a lost UDP fragment loses it)");
   f.add_double("candidates-timeout", &o.config.candidates_timeout_s, "for a CANDIDATES answer, s of the task clock");

@@ -88,7 +88,10 @@ TEST(SupervisorLoop, FindsNudgesAndSegmentsACupThenReplaysItsRunIdentically) {
   std::filesystem::create_directories(dir);
   const std::string scene = kSource + "/common/sim/scenes/single_cup.yaml";
 
-  const LoopSetup setup{dir, scene, kCalibration};
+  LoopSetup setup;
+  setup.dir = dir;
+  setup.scene = scene;
+  setup.calibration = kCalibration;
   LoopServices services(setup);
   ASSERT_EQ(services.start_all(), std::vector<std::string>{}) << "services that did not start";
   Process supervisor(loop_supervisor_command(setup, "loop"), dir + "/supervisor.log");

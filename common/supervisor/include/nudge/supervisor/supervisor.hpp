@@ -55,6 +55,10 @@ struct Config {
   double nudge_timeout_s = 60;       // arm: from the command to MOTION_DONE
   double settle_s = 1.5;             // after the arm is done: the object comes to rest
   double axes_from_s = 0.5;          // AXES after this much of the settling time count
+  // With fewer than min_axes settled axes in one place near the push line when settle_s is over,
+  // the settling time goes on, up to this long after the arm was done, before the object is
+  // called tipped or lost (a rocking object, or the pad beside it, hides its axis for a while).
+  double max_settle_s = 4;
   // The perception pipeline lags on a loaded machine (the held-out run: AXES 2-4 s behind their
   // frames, so none of the settled frames' axes had arrived when the settling time was over). The
   // verification waits until AXES of frames taken at the end of the settling time have come, at
@@ -347,6 +351,14 @@ class Supervisor {
   void feed_tracker(int camera, const cv::Mat& frame, int64_t utime);
   bool verify_by_tracking(int64_t now);
   bool verify_by_axes(int64_t now);
+  // The settled axes that are the pushed object's: the largest group on the push line, else the
+  // nearest group off it in depth; `near` counts every settled axis near the push line.
+  struct RestGroup {
+    std::vector<const Axis*> axes;
+    int near = 0;
+  };
+  RestGroup rest_group() const;
+  bool settling_longer(int64_t now) const;
   // ---- learning ----
   bool learning_enabled() const;
   bool stills_complete() const;
