@@ -133,11 +133,13 @@ nudge_in_private_network() {
 # one folder to keep what was learned across runs) and the world's one hand carrying the pad and
 # the gripper (--tool auto); the supervisor (--learn auto) then recognises, grasps, turns and learns.
 # NUDGE_LOOP_TABLE picks the detection (docs/supervisor.md, "Detection in the loop"):
-#   "verified" (the default): the thesis' edges (blur 1, Canny 30/90, Dmin 25, Dmax 250), 80
-#     accumulator peaks, only those that can be upright axes on the calibrated table, verified by
-#     local support and mirrored colour, 12 kept, 8 per image surveyed, the arm's base column's
-#     outline left out of the edges, stereo-checked candidates and AXES;
-#   "plain": the thesis' (5 lines per image, 3 surveyed, every left line paired with every right);
+#   "plain" (the default): the thesis' (5 lines per image, 3 surveyed, every left line paired with
+#     every right);
+#   "verified": the thesis' edges (blur 1, Canny 30/90, Dmin 25, Dmax 250), 80 accumulator peaks,
+#     only those that can be upright axes on the calibrated table, verified by local support and
+#     mirrored colour, 12 kept, 8 per image surveyed, the arm's base column's outline left out of
+#     the edges, stereo-checked candidates and AXES: far fewer phantoms, but on the held-out scenes
+#     it segmented fewer objects than "plain";
 #   "busy": the busy-table pipeline of docs/clutter.md ("verified" with colour edges, blur 2,
 #     Dmin 8, Dmax 90, and no column mask).
 # NUDGE_LOOP_COLUMN_MASK=1 adds the column mask to "plain" and "busy" ("verified" has it).
@@ -165,7 +167,7 @@ nudge_run_loop() {
   local symmetry_flags='"--lines", "5"' triangulation_flags= survey=() column_mask=${NUDGE_LOOP_COLUMN_MASK:-0}
   local verified='"--lines", "80", "--suppress-r", "4", "--suppress-theta", "4", "--verify", "12",
                   "--upright-calibration", "'"$calibration"'"'
-  case "${NUDGE_LOOP_TABLE:-verified}" in
+  case "${NUDGE_LOOP_TABLE:-plain}" in
     verified)
       symmetry_flags=$verified
       triangulation_flags=', "--stereo-check", "--cluster-min-fraction", "0.03"'

@@ -176,6 +176,16 @@ class SupervisorTest : public ::testing::Test {
     park(s);
     return rest;
   }
+  // The object at (0.28, -0.05) nudged and pushed 3 cm; the arm is done and the supervisor waits
+  // for it to settle. Where it rests.
+  Eigen::Vector3d push_until_settling(sv::Supervisor& s) {
+    const Eigen::Vector3d object(0.28, -0.05, 0);
+    const sv::NudgeCommand nudge = nudge_command_for(s, object);
+    const Eigen::Vector3d rest = object + 0.03 * nudge.direction;
+    play_nudge(s, nudge.seq, object, rest);
+    return rest;
+  }
+
   // Two seconds of settled frames, and on while the supervisor settles longer (too few axes).
   void settle_with_axes(sv::Supervisor& s, const std::vector<Eigen::Vector3d>& feet, double tilt = 0.02) {
     for (int i = 1; i <= 20 || (s.state() == sv::State::Track && i <= 100); ++i) {
@@ -435,10 +445,7 @@ TEST_F(SupervisorTest, ATippedObjectIsReportedNotSegmented) {
 // frames' own time decides, so those are not taken for a tipped object.
 TEST_F(SupervisorTest, AxesOfFramesTakenWhileTheObjectSettledAreIgnoredHoweverLateTheyArrive) {
   sv::Supervisor s = make();  // without trackers: the settled AXES decide
-  const Eigen::Vector3d object(0.28, -0.05, 0);
-  const sv::NudgeCommand nudge = nudge_command_for(s, object);
-  const Eigen::Vector3d rest = object + 0.03 * nudge.direction;
-  play_nudge(s, nudge.seq, object, rest);
+  const Eigen::Vector3d rest = push_until_settling(s);
   ASSERT_EQ(s.state(), sv::State::Track);
   const int64_t arm_done = now_;
   const int64_t lag = 7 * kSecond / 10;
@@ -493,10 +500,7 @@ TEST_F(SupervisorTest, AnAxisHiddenPastTheSettlingTimeIsWaitedForUpToTheLongestS
   for (const double hidden_s : {2.5, config.max_settle_s + 0.5}) {
     SCOPED_TRACE("axes hidden for " + std::to_string(hidden_s) + " s");
     sv::Supervisor s = make();
-    const Eigen::Vector3d object(0.28, -0.05, 0);
-    const sv::NudgeCommand nudge = nudge_command_for(s, object);
-    const Eigen::Vector3d rest = object + 0.03 * nudge.direction;
-    play_nudge(s, nudge.seq, object, rest);
+    const Eigen::Vector3d rest = push_until_settling(s);
     ASSERT_EQ(s.state(), sv::State::Track);
     const int64_t arm_done = now_;
     while (s.state() == sv::State::Track && now_ < arm_done + 20 * kSecond) {
