@@ -57,7 +57,8 @@ struct Config {
   double axes_from_s = 0.5;          // AXES after this much of the settling time count
   // With fewer than min_axes settled axes in one place near the push line when settle_s is over,
   // the settling time goes on, up to this long after the arm was done, before the object is
-  // called tipped or lost (a rocking object, or the pad beside it, hides its axis for a while).
+  // called tipped or lost (a rocking object, or one found only in some frames, may show no axis
+  // in the settling second).
   double max_settle_s = 4;
   // The perception pipeline lags on a loaded machine (the held-out run: AXES 2-4 s behind their
   // frames, so none of the settled frames' axes had arrived when the settling time was over). The
