@@ -410,7 +410,7 @@ bool Supervisor::verify_by_axes(int64_t now) {
   if (static_cast<int>(xs.size()) < config_.min_axes) {
     end_attempt(Outcome::Tipped, "object tipped or lost: " + std::to_string(xs.size()) +
                                      " upright axes in one place near the push line after " +
-                                     seconds_text(std::round(static_cast<double>(latest_axes_utime_ - arm_done_time_) / 1e5) / 10) +
+                                     seconds_text(std::round(std::max<double>(0, latest_axes_utime_ - arm_done_time_) / 1e5) / 10) +
                                      " of settling (" + std::to_string(rest.near) + " near it)", now);
     return false;
   }
