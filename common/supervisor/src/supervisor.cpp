@@ -521,7 +521,7 @@ void Supervisor::end_attempt(Outcome outcome, const std::string& reason, int64_t
   watch_.reset();
   for (auto& tracker : trackers_) tracker.reset();
   tracking_started_ = false;
-  settled_axes_.clear();
+  clear_settled_axes();
   const std::string why = "attempt " + std::to_string(a.number) + " " + to_string(outcome) + ": " + reason;
   learn_seq_ = 0;
   if (nudge_seq_ == 0 && !arm_away_) {
@@ -641,8 +641,8 @@ bool Supervisor::axes_caught_up(int64_t now) const {
 // no axis in the settling second (s12's mug on a checkered table: placed after 4.3 s). Judged by
 // the frames' times, so a replay waits exactly as the run did.
 bool Supervisor::settling_longer(int64_t now) const {
-  if (trackers_decide() || !watch_ || !watch_->moved()) return false;  // a phantom is judged at once
-  if (static_cast<int>(rest_group().axes.size()) >= config_.min_axes) return false;
+  // A phantom (no motion) is judged at once, and so is an object whose rest has been found.
+  if (trackers_decide() || !watch_ || !watch_->moved() || rest_found_) return false;
   const int64_t longest = arm_done_time_ + static_cast<int64_t>(config_.max_settle_s * kMicro);
   return latest_axes_utime_ < longest &&
          static_cast<double>(now - arm_done_time_) < (config_.max_settle_s + config_.max_axes_lag_s) * kMicro;
@@ -668,7 +668,7 @@ void Supervisor::on_services(const std::set<std::string>& silent, int64_t now) {
       watch_.reset();
       for (auto& tracker : trackers_) tracker.reset();
       tracking_started_ = false;
-      settled_axes_.clear();
+      clear_settled_axes();
       Attempt& a = *attempt_;
       const bool touched = paused_from_ != State::SnapshotBefore && paused_from_ != State::Recognise;
       end_attempt(touched ? Outcome::Aborted : Outcome::SnapshotLost,
@@ -719,7 +719,7 @@ void Supervisor::on_arm_state(const ArmStatus& arm, int64_t now) {
       break;
     case ArmStatus::Motion::Done:
       arm_done_time_ = now;
-      settled_axes_.clear();
+      clear_settled_axes();
       latest_axes_utime_ = 0;
       enter(State::Track, now, "nudge done: waiting for the object to settle");
       break;
@@ -824,6 +824,14 @@ void Supervisor::on_axes(const std::vector<Axis>& axes, int64_t utime, int64_t n
   latest_axes_utime_ = std::max(latest_axes_utime_, utime);
   if (static_cast<double>(utime - arm_done_time_) < config_.axes_from_s * kMicro) return;
   settled_axes_.insert(settled_axes_.end(), axes.begin(), axes.end());
+  // Once per AXES message, not on every tick: the grouping is quadratic in the settled axes, and
+  // once a group is large enough, more axes cannot take it away.
+  if (!rest_found_) rest_found_ = static_cast<int>(rest_group().axes.size()) >= config_.min_axes;
+}
+
+void Supervisor::clear_settled_axes() {
+  settled_axes_.clear();
+  rest_found_ = false;
 }
 
 }  // namespace nudge::supervisor

@@ -334,6 +334,8 @@ class Supervisor {
   std::vector<Candidate> drop_hidden_behind_arm_base(std::vector<Rejection>& rejected) const;
   Eigen::Vector2d viewing_ray(const Eigen::Vector3d& at) const;
   std::vector<Axis> settled_axes_;
+  bool rest_found_ = false;  // settled_axes_ hold a rest group of at least min_axes
+  void clear_settled_axes();
   int64_t latest_axes_utime_ = 0;  // the newest frame whose AXES arrived while settling
   bool axes_caught_up(int64_t now) const;
   bool frame_of_the_nudge(int64_t utime) const;
