@@ -94,6 +94,10 @@ int main(int argc, char** argv) {
     f.add_double("push-height", &planner.nudge.push_height, "nudge P1/P2: tool above the table, m (default for 0)");
     f.add_double("start-distance", &planner.nudge.start_distance, "nudge Dmax: P1 before the target axis, m (default for 0)");
     f.add_double("stop-distance", &planner.nudge.stop_distance, "nudge Dmin: P2 before the target axis, m (default for 0)");
+    double nudge_tilt_deg = robot::rad_to_deg(planner.nudge.tool_tilt);
+    f.add_double("nudge-tilt-deg", &nudge_tilt_deg, "nudge: lean of the tool when the straight-down tool's wrist would strike the object, deg (0: never lean)");
+    f.add_double("object-height", &planner.nudge.object_height, "nudge: the tallest object the forearm and wrist must clear, m (0: no check)");
+    f.add_double("object-radius", &planner.nudge.object_radius, "nudge: that object's radius, m");
     f.add_double("grasp-approach-height", &planner.grasp.approach_height, "grasp/place: tool above the table before descending, m");
     f.add_double("lift-height", &planner.grasp.lift_height, "grasp: tool above the table after lifting, m");
     f.add_double("gripper-speed", &gripper_speed, "sim backend: gripper finger speed, m/s");
@@ -101,6 +105,7 @@ int main(int argc, char** argv) {
     f.add_bool("require-supervisor", &config.require_supervisor, "refuse motions until a supervisor heartbeat arrives");
     if (!service.parse(argc, argv)) return 0;
 
+    planner.nudge.tool_tilt = robot::deg_to_rad(nudge_tilt_deg);
     BusClock clock = parse_clock(clock_name, service.input_is_log());
     if (!(rate > 0 && rate <= 1000)) throw FlagError("--rate must lie in (0, 1000]");
     if (!(max_catch_up >= 0)) throw FlagError("--max-catch-up must not be negative");

@@ -648,6 +648,43 @@ TEST(Nudge, TargetInsideTheRingGivesASafeThesisMotion) {
   EXPECT_GT(trajectory.duration(), 0.0);
 }
 
+TEST(Nudge, TheToolLeansSoThatTheWristTrailsThePadPastATallObject) {
+  const ArmModel model = puma260();
+  const SafetyConfig safety;
+  const IkResult home = home_configuration(model, safety);
+  ASSERT_TRUE(home.ok()) << home.reason;
+  const Eigen::Vector3d target(0.26, 0.045, safety.table_z), direction(0.0, -1.0, 0.0);
+  NudgeParams tall;  // 0.25 m: the straight-down tool's wrist, 0.16 m up, would strike it
+  const NudgePlan leaned = plan_nudge(model, safety, target, direction, tall, home.q);
+  ASSERT_TRUE(leaned.ok()) << leaned.reason;
+  EXPECT_NEAR(leaned.tilt, tall.tool_tilt, 1e-12);
+  for (const JointVector& q : leaned.waypoints) {
+    EXPECT_GE(link_gap_to_pushed_object(model, safety, tall, target, leaned.direction, q), tall.link_clearance);
+  }
+  // The pad still faces the push: the tool's x axis keeps its horizontal part along it.
+  for (const Eigen::Isometry3d& pose : leaned.poses) {
+    const Eigen::Vector3d x = pose.linear().col(0);
+    EXPECT_NEAR(Eigen::Vector2d(x.x(), x.y()).normalized().dot(direction.head<2>()), 1.0, 1e-9);
+    EXPECT_NEAR(pose.linear().col(2).dot(-Eigen::Vector3d::UnitZ()), std::cos(tall.tool_tilt), 1e-9);
+  }
+  // A short object leaves the thesis' straight-down tool; no check at all, too.
+  NudgeParams short_object = tall;
+  short_object.object_height = 0.08;
+  const NudgePlan straight = plan_nudge(model, safety, target, direction, short_object, home.q);
+  ASSERT_TRUE(straight.ok()) << straight.reason;
+  EXPECT_EQ(straight.tilt, 0.0);
+  EXPECT_LT(rotation_error(straight.poses[1], tool_down_pose(straight.poses[1].translation(), -kPi / 2)), 1e-9);
+  // With leaning forbidden, the tall object is refused with the reason.
+  NudgeParams no_lean = tall;
+  no_lean.tool_tilt = 0;
+  const NudgePlan refused = plan_nudge(model, safety, target, direction, no_lean, home.q);
+  EXPECT_FALSE(refused.ok());
+  EXPECT_TRUE(contains(refused.reason, "forearm or wrist")) << refused.reason;
+  NudgeParams bad = tall;
+  bad.tool_tilt = deg_to_rad(70);
+  EXPECT_THROW(validate(bad), std::invalid_argument);
+}
+
 TEST(Nudge, AcrossTheCameraViewPushesPerpendicularToTheRay) {
   const ArmModel model = puma260();
   const SafetyConfig safety;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 namespace nudge::robot {
@@ -78,6 +79,20 @@ Eigen::Isometry3d tool_down_pose(const Eigen::Vector3d& point, double yaw) {
   return pose;
 }
 
+Eigen::Matrix3d tool_push_orientation(const Eigen::Vector3d& direction, const Eigen::Vector3d& lean,
+                                      double tilt) {
+  const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d z = -std::cos(tilt) * up + std::sin(tilt) * lean;
+  // x = direction + b * up with x . z = 0: its horizontal part stays along the push.
+  const double b = std::sin(tilt) * direction.dot(lean) / std::cos(tilt);
+  const Eigen::Vector3d x = (direction + b * up).normalized();
+  Eigen::Matrix3d r;
+  r.col(0) = x;
+  r.col(1) = z.cross(x);
+  r.col(2) = z;
+  return r;
+}
+
 JointPath cartesian_line(const ArmModel& model, const Eigen::Isometry3d& from,
                          const Eigen::Isometry3d& to, const JointVector& start, double step) {
   JointPath path;
@@ -149,20 +164,70 @@ void validate(const NudgeParams& p) {
   require(p.start_distance > p.stop_distance,
           "nudge params: start_distance must be larger than stop_distance");
   require(p.cartesian_step >= 0, "nudge params: cartesian_step must not be negative");
+  require(std::isfinite(p.tool_tilt) && p.tool_tilt >= 0 && p.tool_tilt <= deg_to_rad(60.0),
+          "nudge params: tool_tilt must lie in [0, 60] deg");
+  require(std::isfinite(p.object_height) && std::isfinite(p.object_radius) &&
+              std::isfinite(p.link_clearance) && std::isfinite(p.pad_front) &&
+              p.object_height >= 0 && p.object_radius >= 0 && p.link_clearance >= 0 && p.pad_front >= 0,
+          "nudge params: object_height, object_radius, link_clearance and pad_front must be finite and not negative");
+}
+
+double link_gap_to_pushed_object(const ArmModel& model, const SafetyConfig& safety,
+                                 const NudgeParams& params, const Eigen::Vector3d& target,
+                                 const Eigen::Vector3d& direction, const JointVector& q) {
+  const ArmCapsules links = arm_capsules(model, safety, q);
+  const ArmPoints points = arm_points(model, q);
+  // The object stands at the target until the pad's face reaches it, then goes along ahead of it.
+  const double ahead = (points.tool - target).dot(direction) + params.pad_front + params.object_radius;
+  const Eigen::Vector3d axis = target + std::max(0.0, ahead) * direction;
+  // From above the pad (its top is ~25 mm over the tool point) to the object's top.
+  const Eigen::Vector3d bottom(axis.x(), axis.y(), safety.table_z + params.push_height + 0.03);
+  const Eigen::Vector3d top(axis.x(), axis.y(), safety.table_z + params.object_height);
+  if (top.z() <= bottom.z()) return std::numeric_limits<double>::infinity();
+  double gap = std::numeric_limits<double>::infinity();
+  for (const Capsule& c : {links.upper_arm, links.forearm}) {
+    gap = std::min(gap, segment_distance(c.a, c.b, bottom, top) - c.radius);
+  }
+  gap = std::min(gap, segment_distance(points.wrist, points.wrist, bottom, top) - safety.forearm_radius);
+  return gap - params.object_radius;
 }
 
 namespace {
 
+// The first waypoint of `path` where a link comes within params.link_clearance of the pushed
+// object, as a reason; "" when none does.
+std::string link_clearance_problem(const ArmModel& model, const SafetyConfig& safety,
+                                   const NudgeParams& params, const Eigen::Vector3d& target,
+                                   const Eigen::Vector3d& direction,
+                                   const std::vector<JointVector>& path) {
+  if (params.object_height <= 0) return "";
+  for (const JointVector& q : path) {
+    const double gap = link_gap_to_pushed_object(model, safety, params, target, direction, q);
+    if (gap < params.link_clearance) {
+      return "the forearm or wrist would come within " + format_number(std::max(0.0, gap), 3) +
+             " m of the object (" + format_number(params.object_height, 3) + " m tall, " +
+             format_number(params.object_radius, 3) + " m radius)";
+    }
+  }
+  return "";
+}
+
 // Fills plan->waypoints and plan->key_joints for plan->poses starting from q0 at P0 and checks
 // the path; returns why it cannot, or "".
 std::string plan_nudge_path(const ArmModel& model, const SafetyConfig& safety,
-                            const NudgeParams& params, const JointVector& q0, NudgePlan* plan) {
+                            const NudgeParams& params, const Eigen::Vector3d& target,
+                            const JointVector& q0, NudgePlan* plan) {
   const JointPath down =
       cartesian_line(model, plan->poses[0], plan->poses[1], q0, params.cartesian_step);
   if (!down.ok()) return "nudge P0->P1: " + down.reason;
   const JointPath push = cartesian_line(model, plan->poses[1], plan->poses[2],
                                         down.waypoints.back(), params.cartesian_step);
   if (!push.ok()) return "nudge P1->P2: " + push.reason;
+  for (const JointPath* part : {&down, &push}) {
+    const std::string clash =
+        link_clearance_problem(model, safety, params, target, plan->direction, part->waypoints);
+    if (!clash.empty()) return std::string(part == &down ? "nudge P0->P1: " : "nudge P1->P2: ") + clash;
+  }
   // Retrace the way out exactly: P2 -> P1 -> P0 (going straight from P2 to P0 toppled objects).
   plan->waypoints = down.waypoints;
   append_without_first(&plan->waypoints, push.waypoints);
@@ -172,6 +237,32 @@ std::string plan_nudge_path(const ArmModel& model, const SafetyConfig& safety,
   plan->key_joints = {q0, q1, q2, q1, q0};
   const CheckResult safe = check_joint_path(model, safety, plan->waypoints);
   return safe.ok() ? "" : "nudge path: " + safe.reason;
+}
+
+// The nudge with the tool at one lean (plan->tilt, plan->lean): "" or why not.
+std::string plan_nudge_with_lean(const ArmModel& model, const SafetyConfig& safety,
+                                 const Eigen::Vector3d& target, const NudgeParams& params,
+                                 const JointVector& seed, NudgePlan* plan) {
+  const Eigen::Vector3d& d = plan->direction;
+  const Eigen::Vector3d p0 = on_table(target, safety, params.approach_height) - params.start_distance * d;
+  const Eigen::Vector3d p1 = on_table(target, safety, params.push_height) - params.start_distance * d;
+  const Eigen::Vector3d p2 = on_table(target, safety, params.push_height) - params.stop_distance * d;
+  auto pose_at = [&](const Eigen::Vector3d& point) {
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    pose.linear() = tool_push_orientation(d, plan->lean, plan->tilt);
+    pose.translation() = point;
+    return pose;
+  };
+  plan->poses = {pose_at(p0), pose_at(p1), pose_at(p2), pose_at(p1), pose_at(p0)};
+  const IkResult start = safe_inverse_kinematics(model, safety, plan->poses[0], seed);
+  if (!start.ok()) return "nudge P0: " + start.reason;
+  std::string first_reason;
+  for (const JointVector& q0 : joint6_alternatives(model, start.q)) {
+    const std::string reason = plan_nudge_path(model, safety, params, target, q0, plan);
+    if (reason.empty()) return "";
+    if (first_reason.empty()) first_reason = reason;
+  }
+  return first_reason;
 }
 
 }  // namespace
@@ -196,27 +287,23 @@ NudgePlan plan_nudge(const ArmModel& model, const SafetyConfig& safety,
       return plan;
     }
   }
-  const double yaw = std::atan2(d.y(), d.x());
-  const Eigen::Vector3d p0 = on_table(target, safety, params.approach_height) -
-                             params.start_distance * d;
-  const Eigen::Vector3d p1 = on_table(target, safety, params.push_height) -
-                             params.start_distance * d;
-  const Eigen::Vector3d p2 = on_table(target, safety, params.push_height) -
-                             params.stop_distance * d;
-  plan.poses = {tool_down_pose(p0, yaw), tool_down_pose(p1, yaw), tool_down_pose(p2, yaw),
-                tool_down_pose(p1, yaw), tool_down_pose(p0, yaw)};
-
-  const IkResult start = safe_inverse_kinematics(model, safety, plan.poses[0], seed);
-  if (!start.ok()) {
-    plan.reason = "nudge P0: " + start.reason;
-    return plan;
+  // Straight down first (the thesis' tool), then leaned: the wrist straight behind the pad, then
+  // swung 45 and 90 degrees to either side of that.
+  struct Lean {
+    double tilt, swing_deg;
+  };
+  std::vector<Lean> leans{{0.0, 0.0}};
+  if (params.tool_tilt > 0) {
+    for (double swing : {0.0, 45.0, -45.0, 90.0, -90.0}) leans.push_back({params.tool_tilt, swing});
   }
   std::string first_reason;
-  for (const JointVector& q0 : joint6_alternatives(model, start.q)) {
-    const std::string reason = plan_nudge_path(model, safety, params, q0, &plan);
+  for (const Lean& lean : leans) {
+    plan.tilt = lean.tilt;
+    plan.lean = Eigen::AngleAxisd(deg_to_rad(lean.swing_deg), Eigen::Vector3d::UnitZ()) * d;
+    const std::string reason = plan_nudge_with_lean(model, safety, target, params, seed, &plan);
     if (reason.empty()) {
-      first_reason.clear();
-      break;
+      plan.reason.clear();
+      return plan;
     }
     if (first_reason.empty()) first_reason = reason;
   }

@@ -149,31 +149,30 @@ TEST(SimArm, ToolsRideOnTheFlange) {
   EXPECT_THROW(armless.mount_tools_on_arm(), SimError);
 }
 
-TEST(SimArm, TheSimulatedArmNudgesACupAcrossTheTable) {
-  // The thesis' nudge (fig. 6.3-6.4) planned by the robot library and played on the simulated
-  // arm's servos, the pad mounted on its flange: the cup slides a few centimetres, upright.
+// Plays a nudge planned by the robot library on the simulated arm's servos, the pad mounted on
+// its flange (home first, then the path at no more than 0.5 deg per 10 ms), and lets the object
+// settle; returns it.
+static ObjectState play_planned_nudge(const Scene& scene, const Eigen::Vector2d& target, const Eigen::Vector2d& direction,
+                               const nudge::robot::NudgeParams& params, Eigen::Vector3d* before) {
   namespace robot = nudge::robot;
-  Scene scene = with_arm(one_object("cup", 0.25, 0.0));
   World world(scene);
   world.mount_tools_on_arm(0.15);
   const robot::ArmModel puma = robot::puma260();
   robot::SafetyConfig safety;
   safety.table_z = -scene.arm.shoulder_height;
   const robot::IkResult home = robot::home_configuration(puma, safety);
-  ASSERT_TRUE(home.ok()) << home.reason;
-  const robot::NudgePlan plan =
-      robot::plan_nudge(puma, safety, Eigen::Vector3d(0.25, 0.0, safety.table_z), Eigen::Vector3d(0, 1, 0),
-                        robot::NudgeParams{}, home.q);
-  ASSERT_TRUE(plan.ok()) << plan.reason;
+  EXPECT_TRUE(home.ok()) << home.reason;
+  const robot::NudgePlan plan = robot::plan_nudge(puma, safety, Eigen::Vector3d(target.x(), target.y(), safety.table_z),
+                                                  Eigen::Vector3d(direction.x(), direction.y(), 0), params, home.q);
+  EXPECT_TRUE(plan.ok()) << plan.reason;
   auto as_array = [](const robot::JointVector& q) {
     std::array<double, 6> a;
     for (int j = 0; j < 6; ++j) a[j] = q[j];
     return a;
   };
-  // Home first, then the planned path at no more than 0.5 deg per 10 ms.
   world.set_arm_joints(as_array(home.q));
   world.step_for(0.5);
-  const Eigen::Vector3d before = world.object(0).position;
+  *before = world.object(0).position;
   robot::JointVector at = home.q;
   for (const robot::JointVector& next : plan.waypoints) {
     const int steps = std::max(1, static_cast<int>(std::ceil((next - at).cwiseAbs().maxCoeff() / (0.5 * kDeg))));
@@ -184,12 +183,35 @@ TEST(SimArm, TheSimulatedArmNudgesACupAcrossTheTable) {
     at = next;
   }
   world.step_for(1.5);
-  const ObjectState after = world.object(0);
+  return world.object(0);
+}
+
+TEST(SimArm, TheSimulatedArmNudgesACupAcrossTheTable) {
+  // The thesis' nudge (fig. 6.3-6.4): the cup slides a few centimetres, upright.
+  Eigen::Vector3d before;
+  const ObjectState after = play_planned_nudge(with_arm(one_object("cup", 0.25, 0.0)), {0.25, 0.0}, {0, 1},
+                                               nudge::robot::NudgeParams{}, &before);
   const double moved = (after.position - before).head<2>().norm();
   EXPECT_GT(moved, 0.01) << "the cup moved 1-3 cm";
   EXPECT_LT(moved, 0.03) << "the cup moved 1-3 cm";
   EXPECT_GT(after.position.y() - before.y(), 0.004) << "along the push direction";
   EXPECT_LT(after.tilt(), 5 * kDeg) << "and stayed upright";
+}
+
+TEST(SimArm, TheNudgeKeepsTheWristOffATallBottle) {
+  // A 200 mm bottle pushed across the table: with the tool straight down (the thesis' tool) the
+  // wrist rides 150 mm above the pad, beside the bottle's shoulder, and knocks it over; the
+  // planner leans the tool so that the wrist trails the pad, and the bottle slides, upright.
+  const Scene scene = with_arm(one_object("bottle", 0.26, 0.045));
+  const Eigen::Vector2d target(0.26, 0.045), direction(0.14, -0.99);
+  Eigen::Vector3d before;
+  const ObjectState leaned = play_planned_nudge(scene, target, direction.normalized(), nudge::robot::NudgeParams{}, &before);
+  EXPECT_GT((leaned.position - before).head<2>().norm(), 0.01) << "the bottle moved";
+  EXPECT_LT(leaned.tilt(), 5 * kDeg) << "and stayed upright";
+  nudge::robot::NudgeParams straight_down;
+  straight_down.object_height = 0;  // no clearance check: the tool points straight down
+  const ObjectState struck = play_planned_nudge(scene, target, direction.normalized(), straight_down, &before);
+  EXPECT_GT(struck.tilt(), 30 * kDeg) << "the straight-down tool's wrist knocks the bottle over";
 }
 
 TEST(SimArm, TheTableStopsALinkCommandedThroughIt) {

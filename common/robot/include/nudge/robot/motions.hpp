@@ -23,6 +23,14 @@ namespace nudge::robot {
 Eigen::Matrix3d tool_down_orientation(double yaw);
 Eigen::Isometry3d tool_down_pose(const Eigen::Vector3d& point, double yaw);
 
+// The pushing tool for a push along the horizontal unit `direction`: pointing down and leaned by
+// `tilt` radians, its point ahead of the flange along `lean` (a horizontal unit vector; the flange
+// trails the tool point by tool_length * sin(tilt) along -lean). The tool's x axis stays in the
+// vertical plane of the push, so the pad (which keeps the x axis' horizontal part, see sim) faces
+// the push. tilt 0 is tool_down_orientation(atan2(direction)).
+Eigen::Matrix3d tool_push_orientation(const Eigen::Vector3d& direction, const Eigen::Vector3d& lean,
+                                      double tilt);
+
 // A joint path, or why there is none.
 struct JointPath {
   std::string reason;  // empty on success
@@ -47,6 +55,18 @@ struct NudgeParams {
   double start_distance = 0.110;  // Dmax: P1's horizontal distance from the target axis
   double stop_distance = 0.020;   // Dmin: P2 stops this far before the target axis
   double cartesian_step = 0.005;  // IK every this many metres along each line (see above)
+  // The arm's links must keep clear of the pushed object. With the tool straight down the wrist
+  // rides tool_length above the pad, beside the object: a bottle taller than that is struck by the
+  // wrist and toppled forwards. So the planner keeps the forearm and wrist `link_clearance` away
+  // from an upright cylinder of `object_radius` and `object_height` standing at the target (and
+  // pushed along ahead of the pad, whose face is `pad_front` ahead of the tool point), and when
+  // the straight-down tool cannot, leans it by `tool_tilt` so that the wrist trails the pad
+  // (plan_nudge). object_height 0 leaves the check out.
+  double object_height = 0.25;    // the tallest object to clear (P0's default is 70 mm above it)
+  double object_radius = 0.045;
+  double link_clearance = 0.01;
+  double pad_front = 0.01;
+  double tool_tilt = deg_to_rad(30.0);
 };
 
 // Thesis values from object sizes: P1 leaves `clearance` (20 mm) around the largest object,
@@ -59,9 +79,18 @@ NudgeParams nudge_params_for_objects(double largest_radius, double smallest_radi
 // Throws std::invalid_argument naming the field.
 void validate(const NudgeParams& params);
 
+// The least gap between the forearm (and upper arm) capsules or the wrist centre and the object
+// of `params` standing at `target` and pushed along `direction` ahead of the tool point, when
+// the arm is at `q`; negative when they overlap. Base frame.
+double link_gap_to_pushed_object(const ArmModel& model, const SafetyConfig& safety,
+                                 const NudgeParams& params, const Eigen::Vector3d& target,
+                                 const Eigen::Vector3d& direction, const JointVector& q);
+
 struct NudgePlan {
   std::string reason;  // empty on success
   Eigen::Vector3d direction = Eigen::Vector3d::UnitX();  // unit, horizontal
+  double tilt = 0;                                       // the tool's lean, rad (0: straight down)
+  Eigen::Vector3d lean = Eigen::Vector3d::UnitX();       // horizontal unit: the wrist trails along -lean
   std::array<Eigen::Isometry3d, 5> poses;  // P0, P1, P2, P1, P0: tool poses, base frame
   std::array<JointVector, 5> key_joints;   // their joint solutions
   std::vector<JointVector> waypoints;      // the whole joint path P0 ... P0, checked safe
@@ -69,7 +98,10 @@ struct NudgePlan {
 };
 
 // Plans a nudge of whatever stands at `target` (its x, y on the table) along `direction` (its
-// horizontal part is used). The tool points down with its x axis along the push direction.
+// horizontal part is used). The tool points down with its x axis along the push direction; when
+// that would bring the forearm or wrist within params.link_clearance of the object (see
+// NudgeParams), the tool leans by params.tool_tilt, the wrist trailing straight behind the pad or
+// 45 or 90 deg to either side of that, the first lean whose path is safe and clear.
 // The way back retraces the way out exactly (P2 -> P1 -> P0, as the thesis found necessary).
 NudgePlan plan_nudge(const ArmModel& model, const SafetyConfig& safety,
                      const Eigen::Vector3d& target, const Eigen::Vector3d& direction,
