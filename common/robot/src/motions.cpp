@@ -12,6 +12,9 @@ namespace {
 // jump means the line passes a singularity or a configuration change, which would swing the arm.
 constexpr double kMaxJointJumpPerStep = deg_to_rad(20.0);
 
+// The nudging pad's top edge above the tool point (a 30 mm tall sponge centred on it, with room).
+constexpr double kPadTopAboveToolPoint = 0.03;
+
 std::string format_point(const Eigen::Vector3d& p) {
   return "(" + format_number(p.x()) + ", " + format_number(p.y()) + ", " + format_number(p.z()) +
          ") m";
@@ -175,20 +178,22 @@ void validate(const NudgeParams& p) {
 double link_gap_to_pushed_object(const ArmModel& model, const SafetyConfig& safety,
                                  const NudgeParams& params, const Eigen::Vector3d& target,
                                  const Eigen::Vector3d& direction, const JointVector& q) {
+  // The capsules end at the wrist centre and the tool point: no second forward kinematics.
   const ArmCapsules links = arm_capsules(model, safety, q);
-  const ArmPoints points = arm_points(model, q);
+  const Eigen::Vector3d& wrist = links.tool.a;
+  const Eigen::Vector3d& tool_point = links.tool.b;
   // The object stands at the target until the pad's face reaches it, then goes along ahead of it.
-  const double ahead = (points.tool - target).dot(direction) + params.pad_front + params.object_radius;
+  const double ahead = (tool_point - target).dot(direction) + params.pad_front + params.object_radius;
   const Eigen::Vector3d axis = target + std::max(0.0, ahead) * direction;
-  // From above the pad (its top is ~25 mm over the tool point) to the object's top.
-  const Eigen::Vector3d bottom(axis.x(), axis.y(), safety.table_z + params.push_height + 0.03);
+  // From above the pad to the object's top: the pad itself touches the object by design.
+  const Eigen::Vector3d bottom(axis.x(), axis.y(), safety.table_z + params.push_height + kPadTopAboveToolPoint);
   const Eigen::Vector3d top(axis.x(), axis.y(), safety.table_z + params.object_height);
   if (top.z() <= bottom.z()) return std::numeric_limits<double>::infinity();
   double gap = std::numeric_limits<double>::infinity();
   for (const Capsule& c : {links.upper_arm, links.forearm}) {
     gap = std::min(gap, segment_distance(c.a, c.b, bottom, top) - c.radius);
   }
-  gap = std::min(gap, segment_distance(points.wrist, points.wrist, bottom, top) - safety.forearm_radius);
+  gap = std::min(gap, segment_distance(wrist, wrist, bottom, top) - safety.forearm_radius);
   return gap - params.object_radius;
 }
 
@@ -220,14 +225,14 @@ std::string plan_nudge_path(const ArmModel& model, const SafetyConfig& safety,
   const JointPath down =
       cartesian_line(model, plan->poses[0], plan->poses[1], q0, params.cartesian_step);
   if (!down.ok()) return "nudge P0->P1: " + down.reason;
+  // Each line's clearance is checked as soon as it is solved: a lean that fails costs no more.
+  std::string clash = link_clearance_problem(model, safety, params, target, plan->direction, down.waypoints);
+  if (!clash.empty()) return "nudge P0->P1: " + clash;
   const JointPath push = cartesian_line(model, plan->poses[1], plan->poses[2],
                                         down.waypoints.back(), params.cartesian_step);
   if (!push.ok()) return "nudge P1->P2: " + push.reason;
-  for (const JointPath* part : {&down, &push}) {
-    const std::string clash =
-        link_clearance_problem(model, safety, params, target, plan->direction, part->waypoints);
-    if (!clash.empty()) return std::string(part == &down ? "nudge P0->P1: " : "nudge P1->P2: ") + clash;
-  }
+  clash = link_clearance_problem(model, safety, params, target, plan->direction, push.waypoints);
+  if (!clash.empty()) return "nudge P1->P2: " + clash;
   // Retrace the way out exactly: P2 -> P1 -> P0 (going straight from P2 to P0 toppled objects).
   plan->waypoints = down.waypoints;
   append_without_first(&plan->waypoints, push.waypoints);
