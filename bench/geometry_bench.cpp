@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "nudge/geometry/interesting_locations.hpp"
+#include "nudge/geometry/table_texture.hpp"
 #include "nudge/segmentation/segment.hpp"
 #include "nudge/symmetry/detector.hpp"
 #include "nudge/symmetry/synthetic.hpp"
@@ -140,9 +141,33 @@ void BM_Triangulate25Pairings(benchmark::State& state) {
   state.counters["valid_axes"] = valid;
 }
 
+// The table's texture mask of one 640x480 camera image against the other's (the symmetry
+// service's --table-texture-calibration, per image): warp, 9 shifted window comparisons, erosion.
+// The images: the same synthetic indoor frame, so that most of it agrees somewhere.
+void BM_TableTextureMask(benchmark::State& state) {
+  const Stereo& s = stereo();
+  const geo::PlaneWarp warp = geo::plane_warp(s.rig, geo::Side::Right, s.table);
+  const cv::Mat image = sym::synthetic::indoor_scene(3, 640, 480, 4);
+  int table_px = 0;
+  for (auto _ : state) {
+    const cv::Mat mask = geo::table_texture_mask(image, image, warp);
+    table_px = cv::countNonZero(mask);
+    benchmark::DoNotOptimize(mask.data);
+  }
+  state.counters["table_px"] = table_px;
+}
+
+// Making the warp (once per calibration, at the service's start): every pixel's ray through both lenses.
+void BM_PlaneWarp(benchmark::State& state) {
+  const Stereo& s = stereo();
+  for (auto _ : state) benchmark::DoNotOptimize(geo::plane_warp(s.rig, geo::Side::Right, s.table).map_x.data);
+}
+
 }  // namespace
 
 BENCHMARK(BM_SegmentPerLine)->Arg(640)->Arg(250)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Sept)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Triangulate25Pairings)->Arg(0)->Arg(32)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_TableTextureMask)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_PlaneWarp)->Unit(benchmark::kMillisecond);
 BENCHMARK_MAIN();

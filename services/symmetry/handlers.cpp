@@ -65,10 +65,13 @@ Handlers::Handlers(bus::Service& service, const Options& options)
   for (const auto& channel : options_.inputs) {
     const std::string out = bus::channel::derived(channel, bus::channel::SYMMETRY);
     const std::string contours_out = bus::channel::derived(channel, bus::channel::CONTOURS);
-    const bool needs_side = options_.upright || !options_.column_mask_left.empty();
-    const geometry::Side side = needs_side ? side_of_channel(channel) : geometry::Side::Left;
-    service_.subscriptions().subscribe<image_t>(channel, [this, out, contours_out, side](const image_t& msg, const std::string&) {
-      on_image(msg, out, contours_out, side);
+    const bool needs_side = options_.upright || !options_.column_mask_left.empty() || options_.table_texture;
+    const Output output{out, contours_out, needs_side ? side_of_channel(channel) : geometry::Side::Left};
+    service_.subscriptions().subscribe<image_t>(channel, [this, output](const image_t& msg, const std::string&) {
+      if (options_.table_texture)
+        on_stereo_image(msg, output);
+      else
+        on_image(msg, output);
     });
     log::info() << channel << " -> " << out;
   }
@@ -83,8 +86,40 @@ geometry::Side side_of_channel(const std::string& channel) {
   throw std::invalid_argument("input channel " + channel + " names no camera (LEFT or RIGHT at its end): the upright check needs one");
 }
 
-void Handlers::on_image(const image_t& msg, const std::string& out, const std::string& contours_out, geometry::Side side) {
+void Handlers::on_image(const image_t& msg, const Output& out) {
   const cv::Mat image = bus::to_mat(msg);  // throws ImageError naming the image: counted, skipped
+  detect_and_publish(image, msg, out, cv::Mat());
+}
+
+void Handlers::on_stereo_image(const image_t& msg, const Output& out) {
+  cv::Mat image = bus::to_mat(msg);  // throws ImageError naming the image: counted, skipped
+  const Options::TableTexture& texture = *options_.table_texture;
+  const geometry::PlaneWarp& warp = out.side == geometry::Side::Left ? texture.to_left : texture.to_right;
+  if (image.size() != warp.size())
+    throw std::runtime_error(out.lines + " frame " + std::to_string(msg.frame_id) + ": image " +
+                             std::to_string(image.cols) + "x" + std::to_string(image.rows) +
+                             " differs from the table texture's calibration");
+  image_t meta = msg;
+  meta.data.clear();
+  meta.size = 0;
+  const bool partner = held_ && held_->out.side != out.side &&
+                       std::llabs(held_->meta.utime - msg.utime) <= texture.max_skew_us;
+  if (!partner) {
+    if (held_)
+      log::debug() << held_->out.lines << " frame " << held_->meta.frame_id
+                   << ": no image from the other camera within " << texture.max_skew_us << " us; dropped";
+    held_ = Held{std::move(meta), image.clone(), out};  // to_mat may share the message's buffer
+    return;
+  }
+  Held first = std::move(*held_);
+  held_.reset();
+  detect_and_publish(first.image, first.meta, first.out, image);
+  detect_and_publish(image, meta, out, first.image);
+}
+
+void Handlers::detect_and_publish(const cv::Mat& image, const image_t& msg, const Output& output, const cv::Mat& other) {
+  const std::string& out = output.lines;
+  const geometry::Side side = output.side;
   Stopwatch watch;
   symmetry::EdgeSet edges = symmetry::detect_edges(image, options_.edge);
   const cv::Mat& column = side == geometry::Side::Left ? options_.column_mask_left : options_.column_mask_right;
@@ -93,6 +128,11 @@ void Handlers::on_image(const image_t& msg, const std::string& out, const std::s
       throw std::runtime_error(out + " frame " + std::to_string(msg.frame_id) + ": image " + std::to_string(image.cols) +
                                "x" + std::to_string(image.rows) + " differs from the column mask's calibration");
     symmetry::remove_edges(edges, column);
+  }
+  if (!other.empty()) {
+    const Options::TableTexture& texture = *options_.table_texture;
+    const geometry::PlaneWarp& warp = side == geometry::Side::Left ? texture.to_left : texture.to_right;
+    symmetry::remove_edges(edges, geometry::table_texture_mask(image, other, warp, texture.params));
   }
   const double edges_ms = watch.elapsed_ms();
   symmetry::Result result = detector_.detect(edges);
@@ -112,7 +152,7 @@ void Handlers::on_image(const image_t& msg, const std::string& out, const std::s
   }
   service_.publish(out, bus::to_message(result, msg.utime, msg.frame_id, msg.camera));
   if (options_.contours > 0)
-    service_.publish(contours_out, contours_message(edges, result.lines, options_.contours, segmenter_, msg));
+    service_.publish(output.contours, contours_message(edges, result.lines, options_.contours, segmenter_, msg));
   log::debug() << out << " frame " << msg.frame_id << ": " << result.lines.size() << " lines, " << result.num_edges
                 << " edges, " << result.ms.total_ms() << " ms";
 }

@@ -13,6 +13,7 @@
 #include "nudge/geometry/plane.hpp"
 #include "nudge/geometry/stereo_pairing.hpp"
 #include "nudge/geometry/stereo_rig.hpp"
+#include "nudge/geometry/table_texture.hpp"
 #include "nudge/symmetry/verify.hpp"
 
 namespace nudge::symmetry_service {
@@ -38,6 +39,16 @@ struct Options {
   // The arm's base column left out of the edges (geometry/self_mask.hpp): one mask per camera,
   // the calibration's image size; input channels must name their camera. Empty: off.
   cv::Mat column_mask_left, column_mask_right;
+  // The table's own texture left out of the edges (geometry/table_texture.hpp): each image is
+  // compared with the other camera's image of the same moment through the table plane. Needs one
+  // input channel per camera (..._LEFT and ..._RIGHT); an image is handled when its partner (the
+  // other camera's, within max_skew_us) has come, and one whose partner never comes is dropped.
+  struct TableTexture {
+    geometry::PlaneWarp to_left, to_right;
+    geometry::TableTextureParams params;
+    int64_t max_skew_us = 20000;
+  };
+  std::optional<TableTexture> table_texture;
 };
 
 // The camera of an input channel for the upright check: LEFT or RIGHT at the end of its name.
@@ -54,7 +65,23 @@ class Handlers {
   Handlers& operator=(const Handlers&) = delete;
 
  private:
-  void on_image(const image_t& msg, const std::string& out, const std::string& contours_out, geometry::Side side);
+  struct Output {
+    std::string lines, contours;
+    geometry::Side side = geometry::Side::Left;
+  };
+  void on_image(const image_t& msg, const Output& out);
+  // With Options::table_texture: holds an image until the other camera's partner comes.
+  void on_stereo_image(const image_t& msg, const Output& out);
+  // Detects and publishes. `other`: the other camera's image of the same moment, whose agreement
+  // through the table plane marks the table's texture (empty: no table texture check).
+  void detect_and_publish(const cv::Mat& image, const image_t& meta, const Output& out, const cv::Mat& other);
+
+  struct Held {
+    image_t meta;  // without its pixels
+    cv::Mat image;
+    Output out;
+  };
+  std::optional<Held> held_;
 
   bus::Service& service_;
   Options options_;

@@ -65,6 +65,18 @@ int main(int argc, char** argv) {
     f.add_doubles("upright-table", &upright_table, 4, "with --upright-calibration: table plane NX NY NZ D (right camera frame, m)");
     f.add_double("upright-max-tilt", &upright_tilt, "with --upright-calibration: largest angle (deg) between the table normal "
                  "and the plane through the camera and a line");
+    std::string table_texture_calibration;
+    geometry::TableTextureParams table_texture;
+    double table_texture_skew_ms = 20;
+    f.add_string("table-texture-calibration", &table_texture_calibration,
+                 "leave the table's own texture out of the edges: where the two cameras' images agree through this rig "
+                 "file's table_plane (needs one ..._LEFT and one ..._RIGHT input)");
+    f.add_double("table-texture-difference", &table_texture.max_difference,
+                 "with --table-texture-calibration: largest mean grey difference of the two views for the table's pixels");
+    f.add_int("table-texture-window", &table_texture.window_radius,
+              "with --table-texture-calibration: half-size of the window the views are compared over, px");
+    f.add_double("table-texture-skew-ms", &table_texture_skew_ms,
+                 "with --table-texture-calibration: the two cameras' images of one moment differ in time by at most this");
     f.add_bool("colour-edges", &edge.colour, "Canny on the colour image (the channel that changes most)");
     f.add_int("contours", &options.contours, "also segment the contours of the top N lines (CONTOURS_*); 0: off");
     if (!service.parse(argc, argv)) return 0;
@@ -117,6 +129,26 @@ int main(int argc, char** argv) {
         for (const auto& channel : options.inputs) symmetry_service::side_of_channel(channel);
       } catch (const std::exception& e) {
         throw FlagError(std::string("--column-calibration: ") + e.what());
+      }
+    }
+    if (!table_texture_calibration.empty()) {
+      try {
+        geometry::validate(table_texture);
+        if (!(table_texture_skew_ms >= 0)) throw std::invalid_argument("--table-texture-skew-ms must be >= 0");
+        const geometry::StereoRig rig = geometry::load_rig(table_texture_calibration);
+        const geometry::Workspace scene = geometry::load_workspace(table_texture_calibration);
+        if (!scene.table) throw std::invalid_argument(table_texture_calibration + " has no table_plane");
+        int left = 0, right = 0;
+        for (const auto& channel : options.inputs)
+          (symmetry_service::side_of_channel(channel) == geometry::Side::Left ? left : right) += 1;
+        if (left != 1 || right != 1)
+          throw std::invalid_argument("needs exactly one ..._LEFT and one ..._RIGHT input channel");
+        options.table_texture = symmetry_service::Options::TableTexture{
+            geometry::plane_warp(rig, geometry::Side::Left, *scene.table),
+            geometry::plane_warp(rig, geometry::Side::Right, *scene.table), table_texture,
+            static_cast<int64_t>(table_texture_skew_ms * 1000)};
+      } catch (const std::exception& e) {
+        throw FlagError(std::string("--table-texture-calibration: ") + e.what());
       }
     }
     service.start();

@@ -198,3 +198,69 @@ TEST(SymmetryHandlers, TheColumnMaskLeavesTheMaskedRegionOutOfTheVoting) {
   EXPECT_EQ(run.service.counters().errors, 1);
   EXPECT_NE(run.service.counters().last_error().find("column mask"), std::string::npos) << run.service.counters().last_error();
 }
+
+// The table's texture left out (Options::table_texture). Two cameras at one place looking at a
+// plane ahead see it alike everywhere, so where both images agree the edges are the "table's":
+// a bottle in both images is left out; a bottle only in the right image (the left sees the bare
+// background there) keeps its line. An image waits for its partner from the other camera; one
+// whose partner is too far in time is dropped; an image of the wrong size is an error, counted.
+TEST(SymmetryHandlers, TheTableTextureLeavesWhatBothCamerasSeeAlikeOutOfTheVoting) {
+  nudge::symmetry_service::Options options = mono_options();
+  options.inputs = {"CAMERA_LEFT", "CAMERA_RIGHT"};
+  nudge::geometry::StereoRig rig;
+  for (nudge::geometry::Camera* camera : {&rig.left, &rig.right}) {
+    camera->width = 320;
+    camera->height = 240;
+    camera->K << 300, 0, 159.5, 0, 300, 119.5, 0, 0, 1;
+  }
+  nudge::geometry::Plane ahead;  // z = 1 m, facing the cameras
+  ahead.normal = Eigen::Vector3d(0, 0, -1);
+  ahead.offset = 1.0;
+  options.table_texture = nudge::symmetry_service::Options::TableTexture{
+      nudge::geometry::plane_warp(rig, nudge::geometry::Side::Left, ahead),
+      nudge::geometry::plane_warp(rig, nudge::geometry::Side::Right, ahead), {}, 20000};
+  InProcess run(options);
+  Latest<nudge::symmetry_lines_t> left(run.probe, "SYMMETRY_LEFT"), right(run.probe, "SYMMETRY_RIGHT");
+  const auto bare = nudge::bus::to_message(cv::Mat(240, 320, CV_8UC3, cv::Scalar(200, 210, 220)),
+                                           nudge::image_t::FORMAT_GRAY8, 0, 0, "left");
+  auto lines_near = [](const nudge::symmetry_lines_t& m, double r) {
+    int near = 0;
+    for (int i = 0; i < m.num_lines; ++i) near += std::fabs(m.lines[i].r - r) < 3 && std::fabs(m.lines[i].theta) < 2 * kDeg;
+    return near;
+  };
+  auto publish = [&](const char* channel, nudge::image_t image, int64_t utime) {
+    image.utime = utime;
+    image.frame_id = static_cast<int32_t>(utime);
+    run.bus.publish(channel, &image);
+    run.service.handle_pending();
+  };
+
+  publish("CAMERA_LEFT", bottle_image(20, 0, 0), 1000);
+  EXPECT_FALSE(left.has()) << "the left image waits for the right one";
+  publish("CAMERA_RIGHT", bottle_image(20, 0, 0), 1000);
+  ASSERT_EQ(left.count(), 1);
+  ASSERT_EQ(right.count(), 1);
+  EXPECT_EQ(left.get().utime, 1000);
+  EXPECT_EQ(lines_near(left.get(), 20), 0) << "both cameras see the bottle alike: the table's";
+  EXPECT_EQ(lines_near(right.get(), 20), 0);
+
+  publish("CAMERA_LEFT", bare, 2000);
+  publish("CAMERA_RIGHT", bottle_image(20, 0, 0), 2000);
+  ASSERT_EQ(right.count(), 2);
+  EXPECT_EQ(right.get().utime, 2000);
+  EXPECT_EQ(lines_near(right.get(), 20), 1) << "the bottle only the right camera sees";
+
+  publish("CAMERA_LEFT", bare, 3000);
+  publish("CAMERA_RIGHT", bottle_image(20, 0, 0), 3000 + 50000);  // 50 ms later: not its partner
+  EXPECT_EQ(left.count(), 2) << "the unpaired left image is not published";
+  EXPECT_EQ(right.count(), 2) << "the right one waits for its own partner";
+  publish("CAMERA_LEFT", bare, 3000 + 50000 + 5000);  // 5 ms off: its partner
+  EXPECT_EQ(left.count(), 3);
+  EXPECT_EQ(right.count(), 3);
+  EXPECT_EQ(right.get().utime, 53000);
+
+  publish("CAMERA_RIGHT", nudge::bus::to_message(cv::Mat(120, 160, CV_8UC3, cv::Scalar(200, 210, 220)),
+                                                 nudge::image_t::FORMAT_GRAY8, 0, 0, "right"), 4000);
+  EXPECT_EQ(run.service.counters().errors, 1);
+  EXPECT_NE(run.service.counters().last_error().find("table texture"), std::string::npos) << run.service.counters().last_error();
+}

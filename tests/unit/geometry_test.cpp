@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
 #include <opencv2/core/eigen.hpp>  // after Eigen, as OpenCV requires
 
 #include <cmath>
@@ -16,6 +17,7 @@
 #include "nudge/geometry/qt_cluster.hpp"
 #include "nudge/geometry/self_mask.hpp"
 #include "nudge/geometry/stereo_rig.hpp"
+#include "nudge/geometry/table_texture.hpp"
 #include "nudge/geometry/triangulation.hpp"
 #include "nudge/geometry/upright.hpp"
 #include "nudge/geometry/workspace.hpp"
@@ -794,4 +796,203 @@ TEST(GeometryColumnMask, OutlineBandKeepsTheSilhouetteNotTheInside) {
   EXPECT_EQ(band.at<uint8_t>(50, 20), 0) << "beyond the band";
   EXPECT_THROW(outline_band(region, 0), std::invalid_argument);
   EXPECT_THROW(outline_band(cv::Mat(10, 10, CV_8UC3), 2), std::invalid_argument);
+}
+
+// ---- The table's own texture, by stereo (table_texture.hpp) ----
+
+namespace {
+
+// The rig's cameras at 320x240 (the ray casting below is 4 rays a pixel).
+StereoRig half_size(StereoRig rig) {
+  for (Camera* camera : {&rig.left, &rig.right}) {
+    camera->width /= 2;
+    camera->height /= 2;
+    camera->K.topRows(2) *= 0.5;
+    camera->K(0, 2) -= 0.25;  // pixel centres: x_half = (x + 0.5) / 2 - 0.5
+    camera->K(1, 2) -= 0.25;
+  }
+  return rig;
+}
+
+// Both cameras' pictures of a checkered table (6 cm squares) with an upright white card standing
+// on it (7 cm wide, 15 cm tall, facing the cameras), ray-cast through the rig's lens model with
+// 2x2 rays a pixel (a renderer's anti-aliasing: hard-edged squares sampled once a pixel differ
+// between the views by a pixel's worth of aliasing along every edge). The
+// truth per pixel: 0 the table, 1 the card, 2 the table where the card hides it from the other camera.
+struct CardScene {
+  StereoRig rig = half_size(verged_rig(Lens::Typical));
+  Plane table;  // right camera frame
+  Eigen::Vector3d up, foot, across;
+  double half_width = 0.035, height = 0.15;
+
+  CardScene() {
+    const Table t;
+    up = rig.R * t.up();
+    const Eigen::Vector3d on_table = rig.left_to_right(t.at(0, 0.75));
+    table.normal = up;
+    table.offset = -up.dot(on_table);
+    foot = rig.left_to_right(t.at(0.03, 0.75));
+    const Eigen::Vector3d middle_of_cameras = rig.left_centre() / 2;
+    across = up.cross(foot - middle_of_cameras).normalized();
+  }
+
+  // Ray from `origin` along `dir` (right camera frame): the label and the grey level it sees.
+  // The card's hit distance along a ray, or infinity.
+  double card_hit(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir) const {
+    const Eigen::Vector3d facing = across.cross(up);
+    const double along_card = facing.dot(dir);
+    if (std::abs(along_card) < 1e-12) return INFINITY;
+    const double t = facing.dot(foot - origin) / along_card;
+    const Eigen::Vector3d q = origin + t * dir - foot;
+    return t > 0 && std::abs(q.dot(across)) <= half_width && q.dot(up) >= 0 && q.dot(up) <= height ? t : INFINITY;
+  }
+
+  // Ray from `origin` along `dir` (right camera frame), the other camera at `other_origin`: the
+  // label (0 the table, 2 the table hidden from the other camera by the card, 1 the card) and the
+  // grey level it sees.
+  std::pair<int, int> trace(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, const Eigen::Vector3d& other_origin) const {
+    double best = 1e9;
+    std::pair<int, int> seen{0, 0};
+    const double along_table = table.normal.dot(dir);
+    if (std::abs(along_table) > 1e-12) {
+      const double t = -(table.normal.dot(origin) + table.offset) / along_table;
+      if (t > 0) {
+        best = t;
+        const Eigen::Vector3d q = origin + t * dir - foot;
+        const int square = static_cast<int>(std::floor(q.dot(across) / 0.06)) + static_cast<int>(std::floor(q.dot(up.cross(across)) / 0.06));
+        const Eigen::Vector3d to_other = other_origin - (origin + t * dir);
+        const bool hidden = card_hit(origin + t * dir, to_other.normalized()) < to_other.norm();
+        seen = {hidden ? 2 : 0, (square & 1) ? 170 : 80};
+      }
+    }
+    if (card_hit(origin, dir) < best) seen = {1, 235};
+    return seen;
+  }
+
+  // The picture (BGR, `brightness` added) and the truth labels of one camera.
+  std::pair<cv::Mat, cv::Mat> render(Side side, int brightness = 0) const {
+    const Camera& camera = side == Side::Left ? rig.left : rig.right;
+    cv::Mat image(camera.height, camera.width, CV_8UC3), labels(camera.height, camera.width, CV_8UC1);
+    const Eigen::Vector3d origin = side == Side::Left ? rig.left_centre() : Eigen::Vector3d::Zero();
+    const Eigen::Vector3d other_origin = side == Side::Left ? Eigen::Vector3d::Zero() : rig.left_centre();
+    for (int v = 0; v < camera.height; ++v)
+      for (int u = 0; u < camera.width; ++u) {
+        int sum = 0, card_rays = 0, hidden_rays = 0;
+        for (const double dv : {-0.25, 0.25})
+          for (const double du : {-0.25, 0.25}) {
+            const auto n = camera.normalise(Eigen::Vector2d(u + du, v + dv));
+            Eigen::Vector3d dir(n.value().x(), n.value().y(), 1.0);
+            if (side == Side::Left) dir = rig.R * dir;
+            const auto [label, grey] = trace(origin, dir, other_origin);
+            sum += grey;
+            card_rays += label == 1;
+            hidden_rays += label == 2;
+          }
+        labels.at<uint8_t>(v, u) = card_rays >= 2 ? 1 : hidden_rays > 0 ? 2 : 0;
+        image.at<cv::Vec3b>(v, u) = cv::Vec3b::all(cv::saturate_cast<uint8_t>(sum / 4 + brightness));
+      }
+    return {image, labels};
+  }
+};
+
+}  // namespace
+
+// The warp takes a point of the table seen in one camera to where the other camera sees it,
+// through both lenses; above the horizon it is undefined.
+TEST(GeometryTableTexture, ThePlaneWarpMapsTablePointsBetweenTheCameras) {
+  const CardScene scene;
+  for (const Side to : {Side::Left, Side::Right}) {
+    const PlaneWarp warp = plane_warp(scene.rig, to, scene.table);
+    const Camera& camera = to == Side::Left ? scene.rig.left : scene.rig.right;
+    const Camera& other = to == Side::Left ? scene.rig.right : scene.rig.left;
+    ASSERT_EQ(warp.size(), cv::Size(camera.width, camera.height));
+    EXPECT_EQ(warp.other_size, cv::Size(other.width, other.height));
+    const Table t;
+    for (const auto& [lateral, distance] : std::vector<std::pair<double, double>>{{0, 0.7}, {-0.15, 0.6}, {0.1, 0.9}}) {
+      const Eigen::Vector3d p = scene.rig.left_to_right(t.at(lateral, distance));
+      const Eigen::Vector3d in_left = scene.rig.R.transpose() * (p - scene.rig.T);
+      const Eigen::Vector2d here = to == Side::Left ? scene.rig.left.project(in_left) : scene.rig.right.project(p);
+      const Eigen::Vector2d there = to == Side::Left ? scene.rig.right.project(p) : scene.rig.left.project(in_left);
+      const cv::Point px(cvRound(here.x()), cvRound(here.y()));
+      ASSERT_TRUE(cv::Rect(0, 0, camera.width, camera.height).contains(px));
+      // The warp is exact at pixel centres; `px` is up to half a pixel off `here`, which the
+      // plane's homography magnifies by about the ratio of the two depths.
+      EXPECT_NEAR(warp.map_x.at<float>(px), there.x(), 1.0) << lateral << ", " << distance;
+      EXPECT_NEAR(warp.map_y.at<float>(px), there.y(), 1.0) << lateral << ", " << distance;
+    }
+  }
+  // A plane behind both cameras is seen nowhere: the warp is undefined everywhere.
+  Plane behind;
+  behind.normal = Eigen::Vector3d::UnitZ();
+  behind.offset = 1.0;  // z = -1 m
+  EXPECT_EQ(cv::countNonZero(plane_warp(scene.rig, Side::Right, behind).map_x >= 0), 0);
+  Plane flat = scene.table;
+  flat.normal.setZero();
+  EXPECT_THROW(plane_warp(scene.rig, Side::Right, flat), std::invalid_argument);
+}
+
+// The checkered table agrees between the two views and is marked; the standing card's outline
+// does not (only its foot, on the table) and keeps its edges.
+TEST(GeometryTableTexture, MarksTheCheckeredTableNotTheStandingCard) {
+  const CardScene scene;
+  const auto [left, left_labels] = scene.render(Side::Left, 4);  // a camera a little brighter
+  const auto [right, right_labels] = scene.render(Side::Right);
+  for (const Side side : {Side::Left, Side::Right}) {
+    const cv::Mat& image = side == Side::Left ? left : right;
+    const cv::Mat& other = side == Side::Left ? right : left;
+    const cv::Mat& labels = side == Side::Left ? left_labels : right_labels;
+    const PlaneWarp warp = plane_warp(scene.rig, side, scene.table);
+    const cv::Mat table = table_texture_mask(image, other, warp);
+    ASSERT_EQ(table.size(), image.size());
+    ASSERT_EQ(table.type(), CV_8UC1);
+
+    // The card's outline: card pixels next to the table, 3 cm or more above its foot.
+    cv::Mat card = labels == 1, table_truth = labels == 0;
+    cv::Mat near_table;
+    cv::dilate(labels != 1, near_table, cv::Mat());
+    cv::Mat outline = card & near_table;
+    // Its foot: the lowest 3 cm of the card's image, measured as rows above its bottom.
+    cv::Rect box = cv::boundingRect(card);
+    const double foot_rows = box.height * 0.03 / scene.height;
+    outline(cv::Rect(0, box.y + box.height - static_cast<int>(std::ceil(foot_rows)) - 1, outline.cols,
+                     static_cast<int>(std::ceil(foot_rows)) + 1)).setTo(0);
+    ASSERT_GT(cv::countNonZero(outline), 100);
+    EXPECT_LT(cv::countNonZero(outline & table), 0.05 * cv::countNonZero(outline)) << "the card's outline is kept";
+
+    // The table that both cameras see, away from the card (10 px) and inside the other camera's
+    // view (the warp defined 8 px around): almost all of it is marked.
+    cv::Mat away;
+    cv::dilate(card, away, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(21, 21)));
+    cv::Mat seen_by_both = warp.map_x >= 0;
+    cv::erode(seen_by_both, seen_by_both, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(17, 17)), cv::Point(-1, -1), 1,
+              cv::BORDER_CONSTANT, cv::Scalar(0));  // and 8 px inside the image's border
+    const cv::Mat open_table = table_truth & ~away & seen_by_both;
+    ASSERT_GT(cv::countNonZero(open_table), 20000);
+    EXPECT_GT(cv::countNonZero(open_table & table), 0.97 * cv::countNonZero(open_table)) << "the table is marked";
+  }
+}
+
+TEST(GeometryTableTexture, BadImagesAndParametersAreNamed) {
+  const CardScene scene;
+  const PlaneWarp warp = plane_warp(scene.rig, Side::Right, scene.table);
+  const cv::Mat image(warp.size(), CV_8UC3, cv::Scalar::all(100));
+  EXPECT_THROW(table_texture_mask(cv::Mat(), image, warp), std::invalid_argument);
+  EXPECT_THROW(table_texture_mask(image, cv::Mat(), warp), std::invalid_argument);
+  EXPECT_THROW(table_texture_mask(image, cv::Mat(10, 10, CV_8UC3), warp), std::invalid_argument);
+  EXPECT_THROW(table_texture_mask(cv::Mat(warp.size(), CV_16UC1), image, warp), std::invalid_argument);
+  EXPECT_THROW(table_texture_mask(cv::Mat(warp.size(), CV_8UC4), image, warp), std::invalid_argument);
+  using Change = void (*)(TableTextureParams&);
+  for (const Change bad : {Change([](TableTextureParams& p) { p.window_radius = 0; }),
+                           Change([](TableTextureParams& p) { p.search_px = -1; }),
+                           Change([](TableTextureParams& p) { p.max_difference = 0; }),
+                           Change([](TableTextureParams& p) { p.margin_px = -1; }),
+                           Change([](TableTextureParams& p) { p.blur_sigma = -1; })}) {
+    TableTextureParams params;
+    bad(params);
+    EXPECT_THROW(validate(params), std::invalid_argument);
+    EXPECT_THROW(table_texture_mask(image, image, warp, params), std::invalid_argument);
+  }
+  // Grey images work as BGR ones do.
+  cv::Mat grey(warp.size(), CV_8UC1, cv::Scalar(100));
+  EXPECT_EQ(table_texture_mask(grey, grey, warp).size(), warp.size());
 }
