@@ -24,6 +24,7 @@
 #include "nudge/progress.hpp"
 #include "nudge/timing.hpp"
 #include "nudge/geometry/interesting_locations.hpp"
+#include "nudge/geometry/table_texture.hpp"
 #include "nudge/geometry/upright.hpp"
 #include "nudge/sim/world.hpp"
 #include "nudge/symmetry/detector.hpp"
@@ -52,6 +53,9 @@ struct Pipeline {
   bool verify_lines = false;
   double upright_max_deg = 0;  // > 0: only peaks that can be upright axes are verified
   bool upright_snap = false;    // the verified lines turned into images of upright axes
+  // The table's own texture left out of the edges (geometry/table_texture.hpp; nudge-symmetry
+  // --table-texture-calibration): --table-texture 1 adds it to every pipeline.
+  bool table_texture = false;
   geo::LocationParams locations;
 };
 
@@ -179,22 +183,27 @@ struct Detection {
   std::vector<sym::Line> lines;  // what the pipeline returns
 };
 
-// Where an image was taken, for the upright check.
+// Where an image was taken, for the upright check; with the table texture also the other
+// camera's image of the moment and the warp through the table plane.
 struct View {
   const geo::StereoRig* rig = nullptr;
   const geo::Plane* table = nullptr;
   geo::Side side = geo::Side::Left;
+  const cv::Mat* other = nullptr;
+  const geo::PlaneWarp* warp = nullptr;
 };
 
 Detection detect(sym::Detector& detector, const Pipeline& pipeline, const cv::Mat& image, const View& view) {
-  if (!pipeline.verify_lines) {
+  if (!pipeline.verify_lines && !pipeline.table_texture) {
     std::vector<sym::Line> lines = detector.detect(image).lines;
     return {lines, lines};
   }
   sym::EdgeParams edge = pipeline.edge;
   edge.gradients = true;  // as Detector::detect with the mirror rule on
-  const sym::EdgeSet edges = sym::detect_edges(image, edge);
+  sym::EdgeSet edges = sym::detect_edges(image, edge);
+  if (pipeline.table_texture) sym::remove_edges(edges, geo::table_texture_mask(image, *view.other, *view.warp));
   const sym::Result result = detector.detect(edges);
+  if (!pipeline.verify_lines) return {result.lines, result.lines};
   std::vector<sym::Line> peaks = result.lines;
   if (pipeline.upright_max_deg > 0)
     peaks = geo::upright_lines(*view.rig, view.side, *view.table, peaks, pipeline.upright_max_deg);
@@ -339,6 +348,9 @@ SceneResult run_scene(const std::string& file, const Pipeline& pipeline, int fra
   locations.frames = frames;
   geo::LocationFinder finder(rig, table, Eigen::Vector3d(right.t), locations);
   sym::Detector detector(pipeline.params, pipeline.edge);
+  std::array<geo::PlaneWarp, 2> warps;
+  if (pipeline.table_texture)
+    for (int c = 0; c < 2; ++c) warps[c] = geo::plane_warp(rig, c == 0 ? geo::Side::Left : geo::Side::Right, table);
 
   std::array<std::vector<sim::ImageLine>, 2> truth;
   std::array<std::vector<bool>, 2> visible;
@@ -358,7 +370,8 @@ SceneResult run_scene(const std::string& file, const Pipeline& pipeline, int fra
       }
       const cv::Mat& image = images.colour[c];
       nudge::Stopwatch watch;
-      const Detection detection = detect(detector, pipeline, image, {&rig, &table, c == 0 ? geo::Side::Left : geo::Side::Right});
+      const Detection detection = detect(detector, pipeline, image,
+                                         {&rig, &table, c == 0 ? geo::Side::Left : geo::Side::Right, &images.colour[1 - c], &warps[c]});
       result.pair_ms += watch.elapsed_ms();
       lines[c] = detection.lines;
       if (dump) dump_peaks(detector, pipeline, image, truth[c], visible[c], {dump, result.name, f, c}, world.camera(c));
@@ -717,7 +730,8 @@ int main(int argc, char** argv) {
   flags.add_int("seed-max", &seed_max, "only scenes whose seed is at most this");
   flags.add_bool("skip-before", &skip_before, "measure only the issue-14 pipeline (with --no-write, for tuning)");
   AfterOptions& a = after_options;
-  double verify_flag = 1, colour_flag = 1, stereo_flag = 1, refine_flag = a.refine, snap_flag = a.snap;
+  double verify_flag = 1, colour_flag = 1, stereo_flag = 1, refine_flag = a.refine, snap_flag = a.snap, table_texture_flag = 0;
+  flags.add_double("table-texture", &table_texture_flag, "1 = leave the table's own texture out of the edges (both pipelines)");
   flags.add_double("snap", &snap_flag, "after: 1 = turn the verified lines into images of upright axes");
   flags.add_double("refine", &refine_flag, "after: 1 = refit each verified line to its band's pair midpoints");
   flags.add_double("upright", &a.upright, "after: > 0: verify only peaks within this many deg of an upright axis' image");
@@ -766,6 +780,7 @@ int main(int argc, char** argv) {
   // breakdown on the development family); eval, held or dev alone are for looking.
   std::vector<std::string> sets = set == "both" ? std::vector<std::string>{"eval", "held", "dev"} : std::vector<std::string>{set};
   std::vector<Pipeline> pipelines = {before_issue14(), after_issue14(after_options)};
+  for (Pipeline& p : pipelines) p.table_texture = table_texture_flag != 0;
   if (skip_before) pipelines.erase(pipelines.begin());
   std::map<std::string, std::map<std::string, std::vector<SceneResult>>> results;  // [set][pipeline]
   std::ofstream dump;

@@ -426,6 +426,8 @@ TEST_F(SupervisorTest, ATippedObjectIsReportedNotSegmented) {
   auto ended = outputs_of<sv::AttemptEnded>(s.take_outputs());
   ASSERT_EQ(ended.size(), 1u);
   EXPECT_EQ(ended[0].attempt->outcome, sv::Outcome::Tipped);
+  ASSERT_TRUE(ended[0].attempt->rest_tilt_deg) << "the measured lean is kept (attempt.json)";
+  EXPECT_NEAR(*ended[0].attempt->rest_tilt_deg, 0.4 * 180 / M_PI, 0.1);
   EXPECT_TRUE(ended[0].attempt->after.empty());  // no still taken, nothing segmented
   EXPECT_EQ(s.report().failed_attempts, 1) << "an ended attempt that segmented nothing";
   // Lying down it has no upright axis at all: also reported.

@@ -144,6 +144,12 @@ std::string attempt_json(const Attempt& a) {
   } else {
     j.raw("null");
   }
+  j.key("rest_tilt_deg");
+  if (a.rest_tilt_deg) {
+    j.value(*a.rest_tilt_deg);
+  } else {
+    j.raw("null");
+  }
   j.field("motion_frames", a.motion_frames).field("motion_blocks", a.motion_blocks);
   j.field("tracking_started_s", a.tracking_started / 1e6);
   j.key("track_trace").begin_object();

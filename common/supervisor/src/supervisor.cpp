@@ -345,6 +345,7 @@ bool Supervisor::verify_by_tracking(int64_t now) {
     return false;
   }
   const geometry::TableHit& hit = *pair.axes[0].hit;
+  a.rest_tilt_deg = hit.tilt_deg;
   if (hit.tilt_deg > config_.upright_max_tilt_deg) {
     char text[96];
     std::snprintf(text, sizeof text, "object tipped: its tracked axis leans %.1f deg after the nudge", hit.tilt_deg);
@@ -415,6 +416,7 @@ bool Supervisor::verify_by_axes(int64_t now) {
     return false;
   }
   const double tilt_deg = median(tilts) * 180 / M_PI;
+  a.rest_tilt_deg = tilt_deg;
   if (tilt_deg > config_.upright_max_tilt_deg) {
     char text[96];
     std::snprintf(text, sizeof text, "object tipped: its axis leans %.1f deg after the nudge", tilt_deg);

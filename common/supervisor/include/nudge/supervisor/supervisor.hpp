@@ -194,6 +194,7 @@ struct Attempt {
   };
   std::vector<TrackSample> track_trace[2];   // every frame the trackers saw after the start
   std::optional<Eigen::Vector3d> rest;     // where the object came to rest
+  std::optional<double> rest_tilt_deg;     // its axis' angle from the table normal there (measured)
   cv::Mat before, after;                   // right stills
   int64_t after_utime = 0;                 // when the right after still was taken (segmentation_t.utime)
   std::optional<symmetry::Line> before_line, after_line;  // in the stills
