@@ -143,8 +143,9 @@ nudge_in_private_network() {
 #   "busy": the busy-table pipeline of docs/clutter.md ("verified" with colour edges, blur 2,
 #     Dmin 8, Dmax 90, and no column mask).
 # NUDGE_LOOP_COLUMN_MASK=1 adds the column mask to "plain" and "busy" ("verified" has it).
-# NUDGE_LOOP_TABLE_TEXTURE=1 leaves the table's own texture out of the edges (nudge-symmetry
-# --table-texture-calibration: where the two cameras agree through the calibrated table plane).
+# NUDGE_LOOP_TABLE_TEXTURE (1, the default; 0: off) leaves the table's own texture out of the
+# edges (nudge-symmetry --table-texture-calibration: where the two cameras agree through the
+# calibrated table plane; docs/clutter.md, "The table's own texture").
 nudge_run_loop() {
   local bin=$1 scene=$2 calibration=$3 workspace=$4 out=$5 run=$6
   shift 6
@@ -185,7 +186,7 @@ nudge_run_loop() {
   # The arm's base column's outline is left out of the edges (its place from the calibration:
   # nudge-symmetry --column-calibration): a robot self-filter.
   [ "$column_mask" = 1 ] && symmetry_flags+=', "--column-calibration", "'"$calibration"'"'
-  [ "${NUDGE_LOOP_TABLE_TEXTURE:-0}" = 1 ] && symmetry_flags+=', "--table-texture-calibration", "'"$calibration"'"'
+  [ "${NUDGE_LOOP_TABLE_TEXTURE:-1}" = 1 ] && symmetry_flags+=', "--table-texture-calibration", "'"$calibration"'"'
 
   local viewer=
   [ -n "${NUDGE_VIEWER:-}" ] && viewer=",
