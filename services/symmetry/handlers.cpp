@@ -83,7 +83,8 @@ geometry::Side side_of_channel(const std::string& channel) {
   };
   if (ends_with("LEFT")) return geometry::Side::Left;
   if (ends_with("RIGHT")) return geometry::Side::Right;
-  throw std::invalid_argument("input channel " + channel + " names no camera (LEFT or RIGHT at its end): the upright check needs one");
+  throw std::invalid_argument("input channel " + channel + " names no camera (LEFT or RIGHT at its end): the upright check, the column mask and the table "
+                              "texture need one");
 }
 
 void Handlers::on_image(const image_t& msg, const Output& out) {
@@ -99,9 +100,10 @@ void Handlers::on_stereo_image(const image_t& msg, const Output& out) {
     throw std::runtime_error(out.lines + " frame " + std::to_string(msg.frame_id) + ": image " +
                              std::to_string(image.cols) + "x" + std::to_string(image.rows) +
                              " differs from the table texture's calibration");
-  image_t meta = msg;
-  meta.data.clear();
-  meta.size = 0;
+  image_t meta;  // what the lines message repeats, without the pixels
+  meta.utime = msg.utime;
+  meta.frame_id = msg.frame_id;
+  meta.camera = msg.camera;
   const bool partner = held_ && held_->out.side != out.side &&
                        std::llabs(held_->meta.utime - msg.utime) <= texture.max_skew_us;
   if (!partner) {

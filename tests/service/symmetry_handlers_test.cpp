@@ -228,9 +228,10 @@ TEST(SymmetryHandlers, TheTableTextureLeavesWhatBothCamerasSeeAlikeOutOfTheVotin
     for (int i = 0; i < m.num_lines; ++i) near += std::fabs(m.lines[i].r - r) < 3 && std::fabs(m.lines[i].theta) < 2 * kDeg;
     return near;
   };
+  int frame = 0;
   auto publish = [&](const char* channel, nudge::image_t image, int64_t utime) {
     image.utime = utime;
-    image.frame_id = static_cast<int32_t>(utime);
+    image.frame_id = frame++ / 2;  // one frame number per moment, as a stereo camera sends
     run.bus.publish(channel, &image);
     run.service.handle_pending();
   };
