@@ -146,6 +146,9 @@ nudge_in_private_network() {
 # NUDGE_LOOP_TABLE_TEXTURE (1, the default; 0: off) leaves the table's own texture out of the
 # edges (nudge-symmetry --table-texture-calibration: where the two cameras agree through the
 # calibrated table plane; docs/clutter.md, "The table's own texture").
+# NUDGE_LOOP_REACH (1, the default; 0: off) makes "plain" take 20 peaks and keep the 5 first whose
+# support stands on the table within 0.45 m of the arm's base (nudge-symmetry --reach-calibration:
+# a wall's or the far table's lines cannot be objects the arm reaches).
 nudge_run_loop() {
   local bin=$1 scene=$2 calibration=$3 workspace=$4 out=$5 run=$6
   shift 6
@@ -180,7 +183,10 @@ nudge_run_loop() {
       symmetry_flags="$verified"', "--colour-edges", "--blur", "2", "--dmin", "8", "--dmax", "90"'
       triangulation_flags=', "--stereo-check", "--cluster-min-fraction", "0.03"'
       survey=(--survey-lines 8) ;;
-    plain) ;;
+    plain)
+      if [ "${NUDGE_LOOP_REACH:-1}" = 1 ]; then
+        symmetry_flags='"--lines", "20", "--reach-calibration", "'"$calibration"'", "--reach-keep", "5"'
+      fi ;;
     *) echo "NUDGE_LOOP_TABLE: verified, plain or busy, not '$NUDGE_LOOP_TABLE'" >&2; return 2 ;;
   esac
   # The arm's base column's outline is left out of the edges (its place from the calibration:

@@ -65,7 +65,8 @@ Handlers::Handlers(bus::Service& service, const Options& options)
   for (const auto& channel : options_.inputs) {
     const std::string out = bus::channel::derived(channel, bus::channel::SYMMETRY);
     const std::string contours_out = bus::channel::derived(channel, bus::channel::CONTOURS);
-    const bool needs_side = options_.upright || !options_.column_mask_left.empty() || options_.table_texture;
+    const bool needs_side =
+        options_.upright || !options_.column_mask_left.empty() || options_.table_texture || options_.reach;
     const Output output{out, contours_out, needs_side ? side_of_channel(channel) : geometry::Side::Left};
     service_.subscriptions().subscribe<image_t>(channel, [this, output](const image_t& msg, const std::string&) {
       if (options_.table_texture)
@@ -139,6 +140,13 @@ void Handlers::detect_and_publish(const cv::Mat& image, const image_t& msg, cons
   const double edges_ms = watch.elapsed_ms();
   symmetry::Result result = detector_.detect(edges);
   result.ms.edges_ms = edges_ms;
+  if (options_.reach) {  // part of finding the peaks
+    Stopwatch reach_watch;
+    const Options::Reach& reach = *options_.reach;
+    result.lines = geometry::lines_standing_within(reach.rig, side, reach.table, reach.centre, reach.radius, result.lines);
+    if (reach.keep > 0 && static_cast<int>(result.lines.size()) > reach.keep) result.lines.resize(reach.keep);
+    result.ms.peaks_ms += reach_watch.elapsed_ms();
+  }
   if (options_.verify) {  // part of finding the peaks
     Stopwatch verify_watch;
     if (options_.upright) {

@@ -49,6 +49,17 @@ struct Options {
     int64_t max_skew_us = 20000;
   };
   std::optional<TableTexture> table_texture;
+  // Only lines standing within reach (geometry/upright.hpp, lines_standing_within): of the
+  // params.num_lines peaks, those whose support segment stands on the table within `radius` of
+  // `centre` (right camera frame), the first `keep` of them (0: all). Needs the channels' cameras.
+  struct Reach {
+    geometry::StereoRig rig;
+    geometry::Plane table;
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    double radius = 0.45;
+    int keep = 0;
+  };
+  std::optional<Reach> reach;
 };
 
 // The camera of an input channel for the upright check: LEFT or RIGHT at the end of its name.

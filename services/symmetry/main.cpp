@@ -77,6 +77,14 @@ int main(int argc, char** argv) {
               "with --table-texture-calibration: half-size of the window the views are compared over, px");
     f.add_double("table-texture-skew-ms", &table_texture_skew_ms,
                  "with --table-texture-calibration: the two cameras' images of one moment differ in time by at most this");
+    std::string reach_calibration;
+    symmetry_service::Options::Reach reach;
+    f.add_string("reach-calibration", &reach_calibration,
+                 "only lines standing within reach: whose support segment's foot is on this rig file's table_plane "
+                 "within --reach-radius of its arm_base (input channels must end in LEFT / RIGHT)");
+    f.add_double("reach-radius", &reach.radius, "with --reach-calibration: the radius, m (the workspace ring's outer "
+                                                "edge and a margin: an object's lowest edges stand a little above the table)");
+    f.add_int("reach-keep", &reach.keep, "with --reach-calibration: publish at most this many of the lines standing within reach (0: all)");
     f.add_bool("colour-edges", &edge.colour, "Canny on the colour image (the channel that changes most)");
     f.add_int("contours", &options.contours, "also segment the contours of the top N lines (CONTOURS_*); 0: off");
     if (!service.parse(argc, argv)) return 0;
@@ -149,6 +157,21 @@ int main(int argc, char** argv) {
             static_cast<int64_t>(table_texture_skew_ms * 1000)};
       } catch (const std::exception& e) {
         throw FlagError(std::string("--table-texture-calibration: ") + e.what());
+      }
+    }
+    if (!reach_calibration.empty()) {
+      try {
+        if (!(reach.radius > 0)) throw std::invalid_argument("--reach-radius must be > 0");
+        if (reach.keep < 0) throw std::invalid_argument("--reach-keep must be >= 0");
+        reach.rig = geometry::load_rig(reach_calibration);
+        const geometry::Workspace scene = geometry::load_workspace(reach_calibration);
+        if (!scene.table || !scene.arm_base) throw std::invalid_argument(reach_calibration + " needs table_plane and arm_base");
+        reach.table = *scene.table;
+        reach.centre = *scene.arm_base;
+        for (const auto& channel : options.inputs) symmetry_service::side_of_channel(channel);
+        options.reach = reach;
+      } catch (const std::exception& e) {
+        throw FlagError(std::string("--reach-calibration: ") + e.what());
       }
     }
     service.start();

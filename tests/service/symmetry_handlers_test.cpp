@@ -265,3 +265,36 @@ TEST(SymmetryHandlers, TheTableTextureLeavesWhatBothCamerasSeeAlikeOutOfTheVotin
   EXPECT_EQ(run.service.counters().errors, 1);
   EXPECT_NE(run.service.counters().last_error().find("table texture"), std::string::npos) << run.service.counters().last_error();
 }
+
+// Only lines standing within reach (Options::reach): a camera looking level over a table 0.3 m
+// below it. The bottle's line stands on the table in front of the camera: kept when the reach
+// is around it, dropped when the reach is around a place 20 m away.
+TEST(SymmetryHandlers, OnlyLinesStandingWithinReachArePublished) {
+  nudge::symmetry_service::Options options = mono_options();
+  options.inputs = {"CAMERA_RIGHT"};
+  nudge::symmetry_service::Options::Reach reach;
+  for (nudge::geometry::Camera* camera : {&reach.rig.left, &reach.rig.right}) {
+    camera->width = 320;
+    camera->height = 240;
+    camera->K << 300, 0, 159.5, 0, 300, 119.5, 0, 0, 1;
+  }
+  reach.table.normal = Eigen::Vector3d(0, -1, 0);
+  reach.table.offset = 0.3;
+  reach.radius = 5.0;
+  reach.keep = 1;
+  auto lines_with = [&](const Eigen::Vector3d& centre) {
+    reach.centre = centre;
+    options.reach = reach;
+    InProcess run(options);
+    Latest<nudge::symmetry_lines_t> right(run.probe, "SYMMETRY_RIGHT");
+    nudge::image_t image = bottle_image(20, 0, 1);
+    run.bus.publish("CAMERA_RIGHT", &image);
+    run.service.handle_pending();
+    EXPECT_EQ(run.service.counters().errors, 0);
+    return right.get();
+  };
+  const nudge::symmetry_lines_t near = lines_with(Eigen::Vector3d(0, 0.3, 1.0));
+  ASSERT_EQ(near.num_lines, 1) << "--reach-keep 1";
+  EXPECT_NEAR(near.lines[0].r, 20, 1.0);
+  EXPECT_EQ(lines_with(Eigen::Vector3d(0, 0.3, 20.0)).num_lines, 0);
+}

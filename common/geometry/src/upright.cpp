@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 
 namespace nudge::geometry {
@@ -84,6 +85,42 @@ std::vector<symmetry::Line> upright_lines(const StereoRig& rig, Side side, const
     if (snapped) out.push_back(*snapped);
   }
   return out;
+}
+
+Outcome<Eigen::Vector3d> support_foot(const StereoRig& rig, Side side, const Plane& table, const symmetry::Line& line) {
+  const Camera& camera = side == Side::Left ? rig.left : rig.right;
+  const Eigen::Vector3d origin = side == Side::Left ? rig.left_centre() : Eigen::Vector3d::Zero();
+  std::optional<Eigen::Vector3d> foot;
+  for (const cv::Point2d& end : {line.seg1, line.seg2}) {
+    const auto n = camera.normalise(Eigen::Vector2d(end.x, end.y));
+    if (!n) return Outcome<Eigen::Vector3d>::failure("support foot: " + n.reason());
+    Eigen::Vector3d ray(n->x(), n->y(), 1.0);
+    if (side == Side::Left) ray = rig.R * ray;  // into the right camera's frame
+    const double along = table.normal.dot(ray);
+    if (std::fabs(along) < 1e-12) continue;
+    const double t = -table.signed_distance(origin) / along;
+    if (!(t > 0) || !std::isfinite(t)) continue;  // the ray leaves the table behind the camera
+    const Eigen::Vector3d hit = origin + t * ray;
+    if (!foot || (hit - origin).norm() < (*foot - origin).norm()) foot = hit;
+  }
+  if (!foot) return Outcome<Eigen::Vector3d>::failure("support foot: the line's support does not reach the table");
+  return Outcome<Eigen::Vector3d>::success(*foot);
+}
+
+std::vector<symmetry::Line> lines_standing_within(const StereoRig& rig, Side side, const Plane& table,
+                                                  const Eigen::Vector3d& centre, double radius,
+                                                  const std::vector<symmetry::Line>& lines) {
+  if (!(radius > 0)) throw std::invalid_argument("lines standing within: the radius must be > 0");
+  const Eigen::Vector3d n = table.normal.normalized();
+  std::vector<symmetry::Line> kept;
+  for (const symmetry::Line& line : lines) {
+    const auto foot = support_foot(rig, side, table, line);
+    if (!foot) continue;
+    Eigen::Vector3d offset = *foot - centre;
+    offset -= offset.dot(n) * n;  // along the table
+    if (offset.norm() <= radius) kept.push_back(line);
+  }
+  return kept;
 }
 
 }  // namespace nudge::geometry

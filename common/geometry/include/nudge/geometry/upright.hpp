@@ -36,4 +36,20 @@ std::vector<symmetry::Line> upright_lines(const StereoRig& rig, Side side, const
                                           const std::vector<symmetry::Line>& lines, double max_tilt_deg,
                                           bool snap = false);
 
+// Where the line's support segment stands on the table: of its two ends' rays, the table point
+// nearer the camera (the segment's lower end; the only one, when the other ray misses the table in
+// front of the camera). For an object's line that is its foot, or a little beyond it when its
+// lowest edges are above the table; for a wall's, the table behind the wall's foot or nothing.
+// Right camera frame. Fails where neither end's ray meets the table in front of the camera, or the
+// lens model cannot be inverted.
+Outcome<Eigen::Vector3d> support_foot(const StereoRig& rig, Side side, const Plane& table, const symmetry::Line& line);
+
+// The lines (in their order) whose support foot lies within `radius` of `centre` along the table
+// (right camera frame): a line standing on the wall, beyond the table's far edge or far out on the
+// table cannot be an object the arm reaches, and would take the place of one among the lines the
+// detector keeps. Lines without a foot are dropped. Throws std::invalid_argument unless radius > 0.
+std::vector<symmetry::Line> lines_standing_within(const StereoRig& rig, Side side, const Plane& table,
+                                                  const Eigen::Vector3d& centre, double radius,
+                                                  const std::vector<symmetry::Line>& lines);
+
 }  // namespace nudge::geometry
