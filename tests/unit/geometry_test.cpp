@@ -682,11 +682,20 @@ TEST(GeometryStereoCheck, LocationFinderUsesItOnlyWhenAsked) {
 // ---------------------------------------------------------------------------------------------
 // Lines that can be upright axes (issue 14)
 
+// A 12 cm upright axis 0.55 m out on the table, seen by the verged rig through its lenses.
+struct UprightScene {
+  StereoRig rig = verged_rig(Lens::Typical);
+  Table table;
+  Plane plane = table_plane_in_right(rig, table);
+  StereoAxis axis = observe_axis(rig, table, 0.03, 0.55, 0.12);
+};
+
 TEST(GeometryUpright, AnUprightAxisPassesATiltedOneAndATableLineDoNot) {
-  const StereoRig rig = verged_rig(Lens::Typical);
-  const Table table;
-  const Plane plane = table_plane_in_right(rig, table);
-  const StereoAxis upright = observe_axis(rig, table, 0.03, 0.55, 0.12);
+  const UprightScene scene;
+  const StereoRig& rig = scene.rig;
+  const Table& table = scene.table;
+  const Plane& plane = scene.plane;
+  const StereoAxis& upright = scene.axis;
   for (const Side side : {Side::Left, Side::Right}) {
     const auto tilt = upright_tilt_deg(rig, side, plane, side == Side::Left ? upright.left : upright.right);
     ASSERT_TRUE(tilt.ok()) << tilt.reason();
@@ -714,39 +723,37 @@ TEST(GeometryUpright, AnUprightAxisPassesATiltedOneAndATableLineDoNot) {
 // A line's support stands on the table at the object's foot (a little beyond it when its lowest
 // edges are above the table); lines standing far from the arm are dropped, the others kept in order.
 TEST(GeometryUpright, TheSupportStandsOnTheTableAtTheObjectsFoot) {
-  const StereoRig rig = verged_rig(Lens::Typical);
-  const Table table;
-  const Plane plane = table_plane_in_right(rig, table);
-  const StereoAxis near = observe_axis(rig, table, 0.03, 0.55, 0.12);
+  const UprightScene scene;
+  const StereoAxis& near = scene.axis;
   for (const Side side : {Side::Left, Side::Right}) {
-    const auto foot = support_foot(rig, side, plane, side == Side::Left ? near.left : near.right);
+    const auto foot = support_foot(scene.rig, side, scene.plane, side == Side::Left ? near.left : near.right);
     ASSERT_TRUE(foot.ok()) << foot.reason();
     EXPECT_LT((*foot - near.base).norm(), 0.003);
   }
   // Its lowest edges 3 cm above the table: the support stands beyond the foot, away from the camera.
   std::vector<Eigen::Vector3d> raised;
-  const Eigen::Vector3d base = table.at(0.03, 0.55);
-  for (int i = 0; i <= 60; ++i) raised.push_back(base + (0.03 + 0.09 * i / 60.0) * table.up());
-  const sym::Line raised_right = fit_line(project(raised, rig.right, rig.R, rig.T), 640, 480);
-  const auto beyond = support_foot(rig, Side::Right, plane, raised_right);
+  const Eigen::Vector3d base = scene.table.at(0.03, 0.55);
+  for (int i = 0; i <= 60; ++i) raised.push_back(base + (0.03 + 0.09 * i / 60.0) * scene.table.up());
+  const sym::Line raised_right = fit_line(project(raised, scene.rig.right, scene.rig.R, scene.rig.T), 640, 480);
+  const auto beyond = support_foot(scene.rig, Side::Right, scene.plane, raised_right);
   ASSERT_TRUE(beyond.ok()) << beyond.reason();
   EXPECT_GT(beyond->norm(), near.base.norm() + 0.02);
   EXPECT_LT(beyond->norm(), near.base.norm() + 0.10);
 
-  const StereoAxis far = observe_axis(rig, table, -0.05, 0.85, 0.12);
-  const std::vector<sym::Line> kept = lines_standing_within(rig, Side::Right, plane, near.base, 0.1, {far.right, near.right});
+  const StereoAxis far = observe_axis(scene.rig, scene.table, -0.05, 0.85, 0.12);
+  const std::vector<sym::Line> kept = lines_standing_within(scene.rig, Side::Right, scene.plane, near.base, 0.1, {far.right, near.right});
   ASSERT_EQ(kept.size(), 1u);
   EXPECT_EQ(kept[0].r, near.right.r);
-  const std::vector<sym::Line> both = lines_standing_within(rig, Side::Right, plane, near.base, 0.5, {far.right, near.right});
+  const std::vector<sym::Line> both = lines_standing_within(scene.rig, Side::Right, scene.plane, near.base, 0.5, {far.right, near.right});
   ASSERT_EQ(both.size(), 2u);
   EXPECT_EQ(both[0].r, far.right.r) << "in their order";
   // A table behind the cameras is met by no ray: no foot, and the line is dropped.
   Plane behind;
   behind.normal = Eigen::Vector3d::UnitZ();
   behind.offset = 1.0;
-  EXPECT_FALSE(support_foot(rig, Side::Right, behind, near.right).ok());
-  EXPECT_TRUE(lines_standing_within(rig, Side::Right, behind, near.base, 0.5, {near.right}).empty());
-  EXPECT_THROW(lines_standing_within(rig, Side::Right, plane, near.base, 0, {near.right}), std::invalid_argument);
+  EXPECT_FALSE(support_foot(scene.rig, Side::Right, behind, near.right).ok());
+  EXPECT_TRUE(lines_standing_within(scene.rig, Side::Right, behind, near.base, 0.5, {near.right}).empty());
+  EXPECT_THROW(lines_standing_within(scene.rig, Side::Right, scene.plane, near.base, 0, {near.right}), std::invalid_argument);
 }
 
 TEST(GeometryUpright, SnapsALineOntoTheImageOfAnUprightAxis) {
