@@ -176,6 +176,7 @@ TEST(SupervisorLearn, GraspsTurnsTwelveViewsAndPutsTheCupBack) {
   const std::vector<std::string> live = decisions(log), replayed = decisions(dir + "/replay_out.lcmlog");
   EXPECT_GT(live.size(), 30u);
   EXPECT_EQ(replayed, live) << read_file(dir + "/replay.log");
-  // The run's log is most of a gigabyte (every camera frame): kept only for a look at a failure.
-  if (!HasFailure()) std::filesystem::remove_all(dir);
+  // The run's log is most of a gigabyte (every camera frame): kept only for a look at a failure,
+  // or when NUDGE_KEEP_TEST_RUNS is set (to compare a passing run with a failing one).
+  if (!HasFailure() && !std::getenv("NUDGE_KEEP_TEST_RUNS")) std::filesystem::remove_all(dir);
 }

@@ -136,9 +136,17 @@ void Supervisor::plan_grasp(int64_t now) {
 
 // A gripper that closed (nearly) fully holds nothing: the object slipped or was never caught.
 // What a real robot knows (the fingers' opening), not the simulator's truth.
+// Right after the grasp, fingers that closed to nearly nothing may still pinch a thin part (one
+// finger inside a cup, the other outside its wall: the learning test's cup was carried off 9 cm
+// above the table), so they open again where they closed, down at the grasp height. After a turn
+// the object was held and has slipped out: there is nothing to put down.
 bool Supervisor::holding(const ArmStatus& arm, const std::string& when, int64_t now) {
   if (arm.gripper_opening < 0 || arm.gripper_opening >= config_.held_min_opening_m) return true;
-  learning_ended("dropped", "nothing held " + when + ": the gripper closed to " + mm(arm.gripper_opening), now);
+  const std::string reason = "nothing held " + when + ": the gripper closed to " + mm(arm.gripper_opening);
+  if (state_ == State::Grasp)
+    put_down(attempt_->grasp->foot, "the fingers open where they closed", now, "dropped", reason);
+  else
+    learning_ended("dropped", reason, now);
   return false;
 }
 
@@ -219,12 +227,18 @@ void Supervisor::on_learner_status(const std::string& status, int64_t now) {
 
 // Sec. 7.2.3: the object goes back where it stood before the nudge (revisits stay possible).
 void Supervisor::place(int64_t now, const std::string& learning, const std::string& reason) {
+  const Eigen::Vector3d& before_nudge = attempt_->target.position;
+  put_down(before_nudge, "putting the object back at " + millimetres(before_nudge), now, learning, reason);
+}
+
+void Supervisor::put_down(const Eigen::Vector3d& where, const std::string& what, int64_t now, const std::string& learning,
+                          const std::string& reason) {
   Attempt& a = *attempt_;
   pending_learning_ = learning;
   pending_reason_ = a.learning_reason.empty() ? reason : a.learning_reason + "; " + reason;
   learn_seq_ = next_seq_++;
-  enter(State::Place, now, "putting the object back at " + millimetres(a.target.position) + " (" + learning + ")");
-  outputs_.push_back(PlaceCommand{learn_seq_, a.target.position, a.grasp->grasp_height_m});
+  enter(State::Place, now, what + " (" + learning + ")");
+  outputs_.push_back(PlaceCommand{learn_seq_, where, a.grasp->grasp_height_m});
 }
 
 void Supervisor::learning_ended(const std::string& learning, const std::string& reason, int64_t now) {

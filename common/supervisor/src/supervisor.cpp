@@ -399,11 +399,37 @@ Supervisor::RestGroup Supervisor::rest_group() const {
   return rest;
 }
 
+namespace {
+
+// The axes within `radius` and `max_tilt_difference` of the group's axis with the most such
+// neighbours (of equals, the most upright, then the earliest); the whole group when that core has
+// fewer than `min_axes`, or when `radius` is 0.
+std::vector<const Axis*> repeating_core(const std::vector<const Axis*>& group, double radius, double max_tilt_difference,
+                                        int min_axes) {
+  if (radius <= 0) return group;
+  std::vector<const Axis*> best;
+  double best_tilt = 0;
+  for (const Axis* seed : group) {
+    std::vector<const Axis*> core;
+    for (const Axis* other : group)
+      if ((other->foot - seed->foot).head<2>().norm() <= radius && std::abs(other->tilt_rad - seed->tilt_rad) <= max_tilt_difference)
+        core.push_back(other);
+    if (core.size() > best.size() || (core.size() == best.size() && seed->tilt_rad < best_tilt)) {
+      best = std::move(core);
+      best_tilt = seed->tilt_rad;
+    }
+  }
+  return static_cast<int>(best.size()) >= min_axes ? best : group;
+}
+
+}  // namespace
+
 bool Supervisor::verify_by_axes(int64_t now) {
   Attempt& a = *attempt_;
   const RestGroup rest = rest_group();
   std::vector<double> xs, ys, tilts;
-  for (const Axis* axis : rest.axes) {
+  const double core_tilt = config_.rest_core_tilt_deg * M_PI / 180;
+  for (const Axis* axis : repeating_core(rest.axes, config_.rest_core_m, core_tilt, config_.min_axes)) {
     xs.push_back(axis->foot.x());
     ys.push_back(axis->foot.y());
     tilts.push_back(axis->tilt_rad);

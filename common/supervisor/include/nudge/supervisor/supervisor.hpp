@@ -69,6 +69,14 @@ struct Config {
   double max_travel_m = 0.12;        // how far beyond its place a nudged object is looked for
   double max_lateral_m = 0.03;       // and how far off the push line
   double same_axis_m = 0.025;        // settled axes this close together are one object's
+  // Within that group, the rest is where the axes repeat: the axes within rest_core_m and
+  // rest_core_tilt_deg of the group's best-supported axis. The group also holds the axes of
+  // frames the object was still sliding in, and mismatched pairings of its lines with others'
+  // (1-3 cm off, each leaning its own 7-15 deg); the object's own axis repeats to a millimetre or
+  // two and a degree frame after frame (the learning test's cup: the median over its whole group
+  // stood 7-16 mm off, leaning 10 deg, and the grasp missed).
+  double rest_core_m = 0.006;
+  double rest_core_tilt_deg = 3;
   // How far a triangulated axis may lie from the object along the right camera's viewing ray: a
   // stereo mismatch (a mug's handle moves its line differently in the two cameras) puts axes of the
   // same object up to ~5 cm nearer or farther (measured on s03_red_mug: 4.4 and 4.7 cm). Axes
@@ -381,7 +389,9 @@ class Supervisor {
   bool holding(const ArmStatus& arm, const std::string& when, int64_t now);
   void take_view(const cv::Mat& still, int64_t utime, int64_t now);
   void commit_views(int64_t now);
-  void place(int64_t now, const std::string& learning, const std::string& reason);
+  void place(int64_t now, const std::string& learning, const std::string& reason);  // where it stood before the nudge
+  void put_down(const Eigen::Vector3d& where, const std::string& what, int64_t now, const std::string& learning,
+                const std::string& reason);
   void learning_ended(const std::string& learning, const std::string& reason, int64_t now);
   bool learner_alive_ = false;
   bool arm_away_ = false;      // the arm left home for the grasp: park it at the attempt's end
