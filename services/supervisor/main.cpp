@@ -557,6 +557,9 @@ void add_flags(Flags& f, Options& o) {
                "with too few settled axes near the push line, settle on up to this long after the nudge, s");
   f.add_double("rest-core", &o.config.rest_core_m,
                "the settled axes within this of the densest one give the nudged object's rest, m (0: the whole group's median)");
+  f.add_double("rest-mask-disagreement", &o.config.rest_mask_disagreement_m,
+               "after the segmentation, the after still's mask's foot is the rest when the settled axes' rest is farther "
+               "from it than this (and within the push window), m (0: the axes' rest stays)");
   f.add_double("snapshot-timeout", &o.config.snapshot_timeout_s, "for a still, s of the task clock");
   f.add_double("snapshot-retry", &o.config.snapshot_retry_s, "a still not come within this many s of the task clock is asked for again (a lost UDP fragment loses it)");
   f.add_double("candidates-timeout", &o.config.candidates_timeout_s, "for a CANDIDATES answer, s of the task clock");
@@ -611,6 +614,8 @@ int main(int argc, char** argv) {
     else throw FlagError("--learn must be on, off or auto, not '" + opt.learn + "'");
     if (!(opt.config.rest_core_m >= 0 && opt.config.rest_core_m <= opt.config.same_axis_m))
       throw FlagError("--rest-core must lie in [0, 0.025] m (the group's own radius)");
+    if (!(opt.config.rest_mask_disagreement_m >= 0 && opt.config.rest_mask_disagreement_m < 0.1))
+      throw FlagError("--rest-mask-disagreement must lie in [0, 0.1) m");
     if (!(opt.config.held_min_opening_m >= 0 && opt.config.held_min_opening_m < 0.1)) throw FlagError("--held-min-opening must lie in [0, 0.1) m");
     if (opt.config.views <= 0 || opt.config.views > 36) throw FlagError("--views must lie in [1, 36]");
     if (!(opt.config.view_step_deg > 0 && opt.config.view_step_deg <= 90)) throw FlagError("--view-step must lie in (0, 90] deg");

@@ -108,6 +108,23 @@ sv::ArmStatus arm(sv::ArmStatus::Motion motion, int64_t seq, const std::string& 
   return a;
 }
 
+// The right camera's mask (255 = object) of an upright cylinder standing at `foot`: the convex hull
+// of its two rims, projected (a cylinder's silhouette is convex).
+cv::Mat cylinder_mask(const sv::SceneGeometry& scene, cv::Size size, const Eigen::Vector3d& foot, double radius, double height) {
+  std::vector<cv::Point> points;
+  for (double z : {0.0, height})
+    for (int k = 0; k < 72; ++k) {
+      const double a = k * M_PI / 36;
+      const auto p = scene.project_right(foot + Eigen::Vector3d(radius * std::cos(a), radius * std::sin(a), z), size);
+      points.emplace_back(cvRound(p->x), cvRound(p->y));
+    }
+  std::vector<cv::Point> hull;
+  cv::convexHull(points, hull);
+  cv::Mat mask = cv::Mat::zeros(size, CV_8U);
+  cv::fillConvexPoly(mask, hull, cv::Scalar(255));
+  return mask;
+}
+
 class SupervisorTest : public ::testing::Test {
  protected:
   SupervisorTest() : scene_(make_scene()) {}
@@ -861,6 +878,45 @@ TEST_F(SupervisorTest, TheRestIsWhereTheSettledAxesRepeatNotTheMedianOfTheirGrou
   EXPECT_LT(*attempt.rest_tilt_deg, 2.0) << "the object's own axis leans 1 deg";
 }
 
+// Settled axes that agree among themselves but stand 5 cm behind the object along the ray (one
+// camera's line paired with another line, every frame: the white bottle's) give way to the foot
+// of the after still's mask; 2 cm off, they stay (the mask's foot errs that much on a mug).
+TEST_F(SupervisorTest, AStableMismatchAlongTheRayGivesWayToTheMasksFoot) {
+  for (const double behind : {0.05, 0.02}) {
+    const Eigen::Vector3d object(0.28, -0.05, 0);
+    Eigen::Vector3d truth = object;
+    auto segment_cylinder = [&](const cv::Mat&, const cv::Mat& after, const nudge::symmetry::Line&, const nudge::symmetry::Line&) {
+      sv::Segmentation out;
+      out.mask = cylinder_mask(scene_, after.size(), truth, 0.035, 0.12);
+      return out;
+    };
+    sv::Supervisor s(sv::Config{}, scene_, sv::ArmSetup{}, segment_cylinder);
+    const sv::NudgeCommand nudge = nudge_command_for(s, object);
+    truth = object + 0.03 * nudge.direction;
+    Eigen::Vector3d ray = truth - scene_.right_camera_in_world();
+    ray.z() = 0;
+    ray.normalize();
+    play_nudge(s, nudge.seq, object, truth);
+    settle_with_axes(s, {truth + behind * ray});
+    park(s);
+    ASSERT_EQ(s.state(), sv::State::SnapshotAfter) << s.report().reason;
+    s.on_right_still(draw_scene(scene_, {1280, 960}, {truth}), now_, now_);
+    const auto ended = outputs_of<sv::AttemptEnded>(s.take_outputs());
+    ASSERT_EQ(ended.size(), 1u);
+    const sv::Attempt& a = *ended[0].attempt;
+    ASSERT_TRUE(a.rest && a.rest_from_mask) << a.reason;
+    EXPECT_LT((*a.rest_from_mask - truth).norm(), 0.005);
+    if (behind > 0.03) {
+      EXPECT_LT((*a.rest - truth).norm(), 0.005) << "the mask's foot";
+      ASSERT_TRUE(a.rest_from_axes);
+      EXPECT_LT((*a.rest_from_axes - (truth + behind * ray)).norm(), 0.002);
+    } else {
+      EXPECT_LT((*a.rest - (truth + behind * ray)).norm(), 0.002) << "the axes' rest stays";
+      EXPECT_FALSE(a.rest_from_axes);
+    }
+  }
+}
+
 // The object nudged is remembered where it now stands: a candidate that is the same object seen
 // through a stereo mismatch (on its line in one camera, 8 cm farther) is not nudged again, while
 // a candidate as far away but off both cameras' lines is.
@@ -927,6 +983,26 @@ TEST(Grasp, TheObjectTopIsTheLargestBlobsFirstPixelOnTheLine) {
   beside.r = 100;  // x = 249.5 misses the object
   EXPECT_FALSE(sv::object_top(mask, beside));
   EXPECT_FALSE(sv::object_top(cv::Mat::zeros(200, 300, CV_8U), vertical));
+}
+
+// One camera and the table find where a cylinder stands: its base's front on the line, pushed back
+// by the radius its mask's width gives; wherever a stereo mismatch would put it along the ray.
+TEST(Grasp, TheMasksFootIsWhereTheUprightObjectStands) {
+  const sv::SceneGeometry scene = make_scene();
+  const cv::Size still(1280, 960);
+  for (const Eigen::Vector3d& foot : {Eigen::Vector3d(0.25, 0.0, 0), Eigen::Vector3d(0.30, -0.08, 0), Eigen::Vector3d(0.22, 0.10, 0)})
+    for (double radius : {0.03, 0.045}) {
+      const cv::Mat mask = cylinder_mask(scene, still, foot, radius, 0.12);
+      const auto line = scene.right_axis_line(foot, 0.12, still);
+      ASSERT_TRUE(line);
+      const auto found = sv::foot_from_mask(scene, mask, *line);
+      ASSERT_TRUE(found) << foot.transpose();
+      EXPECT_LT((*found - foot).norm(), 0.004) << "at " << foot.transpose() << ", radius " << radius;
+    }
+  const Eigen::Vector3d foot(0.25, 0.0, 0);
+  nudge::symmetry::Line beside = *scene.right_axis_line(foot + Eigen::Vector3d(0, 0.2, 0), 0.12, still);
+  EXPECT_FALSE(sv::foot_from_mask(scene, cylinder_mask(scene, still, foot, 0.03, 0.12), beside)) << "the line misses the blob";
+  EXPECT_FALSE(sv::foot_from_mask(scene, cv::Mat::zeros(still, CV_8U), *scene.right_axis_line(foot, 0.12, still)));
 }
 
 // The fingers close 90 mm below the estimated top (below a bottle's shoulder, where its sides are

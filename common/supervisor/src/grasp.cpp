@@ -52,6 +52,67 @@ std::optional<cv::Point2d> object_top(const cv::Mat& mask, const symmetry::Line&
   return std::nullopt;
 }
 
+namespace {
+
+// The world point where the right camera's ray through `pixel` (at image size `size`) meets the
+// table (world z = 0).
+std::optional<Eigen::Vector3d> on_table_through(const SceneGeometry& scene, const cv::Point2d& pixel, cv::Size size) {
+  const geometry::Camera& camera = scene.rig().right;
+  const auto normalised = camera.normalise(to_calibration(camera, pixel, size));
+  if (!normalised) return std::nullopt;
+  const Eigen::Vector3d origin = scene.right_camera_in_world();
+  const Eigen::Vector3d direction = scene.right_to_world(Eigen::Vector3d(normalised->x(), normalised->y(), 1.0)) - origin;
+  if (!(direction.z() < 0)) return std::nullopt;  // looking up: the table is not there
+  return origin - (origin.z() / direction.z()) * direction;
+}
+
+}  // namespace
+
+std::optional<Eigen::Vector3d> foot_from_mask(const SceneGeometry& scene, const cv::Mat& mask, const symmetry::Line& line) {
+  if (mask.empty() || mask.type() != CV_8U) return std::nullopt;
+  cv::Mat labels;
+  const int blob = largest_blob(mask, labels);
+  const double c = std::cos(line.theta), s = std::sin(line.theta);
+  if (blob == 0 || std::abs(c) < 0.2) return std::nullopt;
+  const double cx = (mask.cols - 1) / 2.0, cy = (mask.rows - 1) / 2.0;
+  std::optional<cv::Point2d> front, top;
+  for (int y = 0; y < mask.rows; ++y) {
+    const double x = cx + (line.r - (y - cy) * s) / c;
+    const int column = static_cast<int>(std::lround(x));
+    if (column < 0 || column >= mask.cols || labels.at<int>(y, column) != blob) continue;
+    if (!top) top = cv::Point2d(x, y);
+    front = cv::Point2d(x, y);
+  }
+  if (!front) return std::nullopt;
+  const cv::Size size = mask.size();
+  const auto base_front = on_table_through(scene, *front, size);
+  if (!base_front) return std::nullopt;
+  // The base's width: the blob's widest row in the lowest fifth of its height on the line (the
+  // sides are vertical there; the front pixel itself is the ellipse's lowest point, of no width).
+  const int band = std::max(2, static_cast<int>((front->y - top->y) / 5));
+  int widest = 0;
+  for (int y = std::max(0, static_cast<int>(front->y) - band); y <= static_cast<int>(front->y); ++y) {
+    const int* row = labels.ptr<int>(y);
+    int first = -1, last = -1;
+    for (int x = 0; x < mask.cols; ++x)
+      if (row[x] == blob) {
+        if (first < 0) first = x;
+        last = x;
+      }
+    if (first >= 0) widest = std::max(widest, last - first + 1);
+  }
+  // At the foot's depth a pixel spans depth / f metres (f at the mask's size).
+  const geometry::Camera& camera = scene.rig().right;
+  const double focal = camera.K(0, 0) * static_cast<double>(size.width) / camera.width;
+  const double depth = scene.world_to_right(*base_front).z();
+  const double radius = 0.5 * widest * depth / focal;
+  Eigen::Vector3d along = *base_front - scene.right_camera_in_world();
+  along.z() = 0;
+  if (along.norm() < 1e-9) return std::nullopt;
+  const Eigen::Vector3d foot = *base_front + radius * along.normalized();
+  return Eigen::Vector3d(foot.x(), foot.y(), 0.0);
+}
+
 double grip_height(double top_height, const GraspTargetParams& params) {
   return std::max(top_height - params.grip_depth_m, params.min_grip_fraction * top_height);
 }

@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "nudge/robot/command_planner.hpp"
+#include "nudge/supervisor/grasp.hpp"
 
 namespace nudge::supervisor {
 
@@ -489,6 +490,7 @@ void Supervisor::segment(int64_t now) {
                 "segmentation empty" + (a.segmentation.error.empty() ? std::string() : ": " + a.segmentation.error), now);
     return;
   }
+  check_rest_with_mask(a);
   if (a.learn) {
     plan_grasp(now);
     if (state_ == State::Grasp)
@@ -497,6 +499,17 @@ void Supervisor::segment(int64_t now) {
     return;
   }
   end_attempt(Outcome::Segmented, "segmented", now);
+}
+
+// The settled axes' rest against the mask's foot (after the left segmentation has joined: it
+// reads the rest).
+void Supervisor::check_rest_with_mask(Attempt& a) const {
+  a.rest_from_mask = foot_from_mask(scene_, a.segmentation.mask, *a.after_line);
+  if (!a.rest_from_mask || !a.rest || config_.rest_mask_disagreement_m <= 0) return;
+  const double apart = (*a.rest_from_mask - *a.rest).head<2>().norm();
+  if (apart <= config_.rest_mask_disagreement_m || apart > config_.max_lateral_m + config_.max_depth_error_m) return;
+  a.rest_from_axes = a.rest;
+  a.rest = a.rest_from_mask;
 }
 
 // Only rows between the object's foot and the tallest object's top can be the object: motion

@@ -37,6 +37,15 @@ struct GraspTargetParams {
 // coordinates) from the image's top. Nothing when the mask is empty or the line misses the blob.
 std::optional<cv::Point2d> object_top(const cv::Mat& mask, const symmetry::Line& line);
 
+// The foot (world, z = 0) of an upright object from the right camera's segmentation alone: the
+// last pixel of the mask's largest blob met walking down `line` is the front of the object's base;
+// its ray meets the table there, and the axis stands the base's radius farther along the ray (the
+// radius from the blob's widest row in the band just above that pixel, at the foot's depth). One
+// camera and the table plane: unlike the stereo axes, a left line paired with the wrong right line
+// cannot move it along the ray. Nothing when the mask is empty, the line misses the blob, or the
+// ray misses the table.
+std::optional<Eigen::Vector3d> foot_from_mask(const SceneGeometry& scene, const cv::Mat& mask, const symmetry::Line& line);
+
 struct GraspTarget {
   std::string reason;                              // why there is none; empty when ok
   Eigen::Vector3d foot = Eigen::Vector3d::Zero();  // where the axis meets the table, world

@@ -77,6 +77,14 @@ struct Config {
   // stood 7-16 mm off, leaning 10 deg, and the grasp missed).
   double rest_core_m = 0.006;
   double rest_core_tilt_deg = 3;
+  // After the segmentation, the mask's foot (supervisor::foot_from_mask: the right camera's ray
+  // through the mask's lowest point on the after line meets the table) checks that rest. Farther
+  // from it than this (and within the push window's max_lateral_m + max_depth_error_m), the
+  // mask's foot is the rest: the settled axes were a stable mismatch, one camera's line paired
+  // with another line along the ray (development runs: 37-71 mm off where the mask's foot was
+  // 3-56 mm off). Nearer, the axes stay (a mug's handle widens the mask: 24 mm off on s03, the
+  // axes 1 mm). 0: the axes' rest always stays.
+  double rest_mask_disagreement_m = 0.03;
   // How far a triangulated axis may lie from the object along the right camera's viewing ray: a
   // stereo mismatch (a mug's handle moves its line differently in the two cameras) puts axes of the
   // same object up to ~5 cm nearer or farther (measured on s03_red_mug: 4.4 and 4.7 cm). Axes
@@ -207,6 +215,10 @@ struct Attempt {
   std::vector<TrackSample> track_trace[2];   // every frame the trackers saw after the start
   std::optional<Eigen::Vector3d> rest;     // where the object came to rest
   std::optional<double> rest_tilt_deg;     // its axis' angle from the table normal there (measured)
+  // The foot of the after still's mask (one camera and the table plane, after the segmentation);
+  // it becomes the rest when the settled axes' rest is far from it (Config::rest_mask_disagreement_m).
+  std::optional<Eigen::Vector3d> rest_from_mask;
+  std::optional<Eigen::Vector3d> rest_from_axes;  // the settled axes' rest, when the mask's replaced it
   cv::Mat before, after;                   // right stills
   int64_t after_utime = 0;                 // when the right after still was taken (segmentation_t.utime)
   std::optional<symmetry::Line> before_line, after_line;  // in the stills
@@ -324,6 +336,7 @@ class Supervisor {
   void park(int64_t now, const std::string& why);
   void parked(int64_t now, const std::string& how);
   void keep_object_rows(Attempt& attempt) const;
+  void check_rest_with_mask(Attempt& attempt) const;
   void finish(State state, const std::string& reason, int64_t now);
   bool timed_out(double seconds, int64_t now) const;
   bool in_attempt() const;
