@@ -230,9 +230,7 @@ class SupervisorTest : public ::testing::Test {
     const sv::NudgeCommand nudge = nudge_command_for(s, object);
     NudgedAlongRay run;
     run.rest = object + 0.03 * nudge.direction;
-    Eigen::Vector3d ray = run.rest - scene_.right_camera_in_world();
-    ray.z() = 0;
-    ray.normalize();
+    const Eigen::Vector3d ray = along_ray(run.rest);
     play_nudge(s, nudge.seq, object, run.rest);
     std::vector<Eigen::Vector3d> feet;
     for (double behind : axes_behind_m) feet.push_back(run.rest + behind * ray);
@@ -244,6 +242,29 @@ class SupervisorTest : public ::testing::Test {
     s.on_right_still(draw_scene(scene_, {1280, 960}, {run.rest}), now_, now_);
     run.ended = outputs_of<sv::AttemptEnded>(s.take_outputs());
     return run;
+  }
+
+  // Parks the arm and shows the after still with the object standing at `object`: the attempt
+  // that ended, or nothing (a failure).
+  std::shared_ptr<const sv::Attempt> park_and_show_after_still(sv::Supervisor& s, const Eigen::Vector3d& object) {
+    park(s);
+    if (s.state() != sv::State::SnapshotAfter) {
+      ADD_FAILURE() << "no after still asked for: " << s.report().reason;
+      return nullptr;
+    }
+    s.on_right_still(draw_scene(scene_, {1280, 960}, {object}), now_, now_);
+    const auto ended = outputs_of<sv::AttemptEnded>(s.take_outputs());
+    if (ended.size() != 1u) {
+      ADD_FAILURE() << ended.size() << " attempts ended";
+      return nullptr;
+    }
+    return ended[0].attempt;
+  }
+  // The right camera's viewing direction along the table at `point`.
+  Eigen::Vector3d along_ray(const Eigen::Vector3d& point) const {
+    Eigen::Vector3d ray = point - scene_.right_camera_in_world();
+    ray.z() = 0;
+    return ray.normalized();
   }
 
   sv::SceneGeometry scene_;
@@ -867,15 +888,10 @@ TEST_F(SupervisorTest, TheRestIsWhereTheSettledAxesRepeatNotTheMedianOfTheirGrou
     s.on_axes(axes, now_, now_);
     s.on_time(now_);
   }
-  park(s);
-  ASSERT_EQ(s.state(), sv::State::SnapshotAfter) << s.report().reason;
-  s.on_right_still(draw_scene(scene_, {1280, 960}, {rest}), now_, now_);
-  const auto ended = outputs_of<sv::AttemptEnded>(s.take_outputs());
-  ASSERT_EQ(ended.size(), 1u);
-  const sv::Attempt& attempt = *ended[0].attempt;
-  ASSERT_TRUE(attempt.rest && attempt.rest_tilt_deg) << attempt.reason;
-  EXPECT_LT((*attempt.rest - rest).norm(), 0.002);
-  EXPECT_LT(*attempt.rest_tilt_deg, 2.0) << "the object's own axis leans 1 deg";
+  const auto attempt = park_and_show_after_still(s, rest);
+  ASSERT_TRUE(attempt && attempt->rest && attempt->rest_tilt_deg);
+  EXPECT_LT((*attempt->rest - rest).norm(), 0.002);
+  EXPECT_LT(*attempt->rest_tilt_deg, 2.0) << "the object's own axis leans 1 deg";
 }
 
 // Settled axes that agree among themselves but stand 5 cm behind the object along the ray (one
@@ -893,17 +909,12 @@ TEST_F(SupervisorTest, AStableMismatchAlongTheRayGivesWayToTheMasksFoot) {
     sv::Supervisor s(sv::Config{}, scene_, sv::ArmSetup{}, segment_cylinder);
     const sv::NudgeCommand nudge = nudge_command_for(s, object);
     truth = object + 0.03 * nudge.direction;
-    Eigen::Vector3d ray = truth - scene_.right_camera_in_world();
-    ray.z() = 0;
-    ray.normalize();
+    const Eigen::Vector3d ray = along_ray(truth);
     play_nudge(s, nudge.seq, object, truth);
     settle_with_axes(s, {truth + behind * ray});
-    park(s);
-    ASSERT_EQ(s.state(), sv::State::SnapshotAfter) << s.report().reason;
-    s.on_right_still(draw_scene(scene_, {1280, 960}, {truth}), now_, now_);
-    const auto ended = outputs_of<sv::AttemptEnded>(s.take_outputs());
-    ASSERT_EQ(ended.size(), 1u);
-    const sv::Attempt& a = *ended[0].attempt;
+    const auto attempt = park_and_show_after_still(s, truth);
+    ASSERT_TRUE(attempt);
+    const sv::Attempt& a = *attempt;
     ASSERT_TRUE(a.rest && a.rest_from_mask) << a.reason;
     EXPECT_LT((*a.rest_from_mask - truth).norm(), 0.005);
     if (behind > 0.03) {
