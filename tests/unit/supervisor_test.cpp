@@ -110,12 +110,14 @@ sv::ArmStatus arm(sv::ArmStatus::Motion motion, int64_t seq, const std::string& 
 
 // The right camera's mask (255 = object) of an upright cylinder standing at `foot`: the convex hull
 // of its two rims, projected (a cylinder's silhouette is convex).
-cv::Mat cylinder_mask(const sv::SceneGeometry& scene, cv::Size size, const Eigen::Vector3d& foot, double radius, double height) {
+cv::Mat cylinder_mask(const sv::SceneGeometry& scene, cv::Size size, const Eigen::Vector3d& foot, double radius, double height,
+                      bool left = false) {
   std::vector<cv::Point> points;
   for (double z : {0.0, height})
     for (int k = 0; k < 72; ++k) {
       const double a = k * M_PI / 36;
-      const auto p = scene.project_right(foot + Eigen::Vector3d(radius * std::cos(a), radius * std::sin(a), z), size);
+      const Eigen::Vector3d rim = foot + Eigen::Vector3d(radius * std::cos(a), radius * std::sin(a), z);
+      const auto p = left ? scene.project_left(rim, size) : scene.project_right(rim, size);
       points.emplace_back(cvRound(p->x), cvRound(p->y));
     }
   std::vector<cv::Point> hull;
@@ -1185,6 +1187,48 @@ TEST_F(LearningTest, GraspsTurnsTwelveTimesLearnsAndPutsTheObjectBack) {
   EXPECT_GE(a->grasp_plan_ms, 0.0) << "the grasp's plan time is recorded for the report";
   EXPECT_EQ(outputs_of<sv::HomeCommand>(out).size(), 1u) << "the arm parks after putting it back";
   EXPECT_EQ(s.summary().learned, 1);
+}
+
+// A candidate 5 cm behind the object along the ray (a stable stereo mismatch), and the settled
+// axes as far behind its rest: the grasp goes where the after still's mask stands, and the object
+// goes back where it stood, not where the candidate was.
+TEST_F(LearningTest, AStableMismatchIsGraspedWhereTheMaskStandsAndPutBackWhereItStood) {
+  Eigen::Vector3d truth = object_;
+  auto cylinder = [&](bool left) {
+    return [&, left](const cv::Mat&, const cv::Mat& after, const nudge::symmetry::Line&, const nudge::symmetry::Line&) {
+      sv::Segmentation out;
+      out.mask = cylinder_mask(scene_, after.size(), truth, 0.035, 0.12, left);
+      return out;
+    };
+  };
+  sv::Config config;
+  config.learn = sv::Config::Learn::On;
+  config.views = 1;
+  sv::Supervisor s(config, scene_, sv::ArmSetup{}, cylinder(false));
+  s.set_left_segmentation(cylinder(true));
+  const Eigen::Vector3d mismatch = 0.05 * along_ray(object_);
+  start_with(s, {object_ + mismatch});
+  stills(s, {object_});
+  const auto request = outputs_of<sv::RecognizeRequest>(s.take_outputs()).at(0);
+  s.on_recognition(request.seq, "", "empty database", now_);
+  const auto nudge = outputs_of<sv::NudgeCommand>(s.take_outputs()).at(0);
+  truth = object_ + 0.03 * nudge.direction;
+  play_nudge(s, nudge.seq, object_, truth);
+  settle_with_axes(s, {truth + mismatch});
+  park(s);
+  s.take_outputs();
+  stills(s, {truth});
+  ASSERT_EQ(s.state(), sv::State::Grasp) << s.report().reason;
+  const auto grasp = outputs_of<sv::GraspCommand>(s.take_outputs()).at(0);
+  EXPECT_LT((grasp.position - truth).head<2>().norm(), 0.005) << "where the mask stands";
+  done(s, grasp.seq);
+  now_ += kSecond / 5;
+  s.on_right_still(draw_scene(scene_, {1280, 960}, {}), now_, now_);
+  const auto commit = outputs_of<sv::LearnCommit>(s.take_outputs()).at(0);
+  s.on_learned(commit.seq, true, "object_1", "", now_ += kSecond);
+  ASSERT_EQ(s.state(), sv::State::Place) << s.report().reason;
+  const auto place = outputs_of<sv::PlaceCommand>(s.take_outputs()).at(0);
+  EXPECT_LT((place.position - object_).head<2>().norm(), 0.005) << "where it stood, not where the candidate was";
 }
 
 TEST_F(LearningTest, AKnownObjectIsNotNudgedAndTheSummaryNamesIt) {

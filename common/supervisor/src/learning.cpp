@@ -227,7 +227,11 @@ void Supervisor::on_learner_status(const std::string& status, int64_t now) {
 
 // Sec. 7.2.3: the object goes back where it stood before the nudge (revisits stay possible).
 void Supervisor::place(int64_t now, const std::string& learning, const std::string& reason) {
-  const Eigen::Vector3d& before_nudge = attempt_->target.position;
+  const Attempt& a = *attempt_;
+  // The candidate was where the settled axes were, before the nudge: when the mask's foot moved
+  // the rest off a stable stereo mismatch, the same mismatch put the candidate as far off.
+  Eigen::Vector3d before_nudge = a.target.position;
+  if (a.rest_from_axes) before_nudge += *a.rest - *a.rest_from_axes;
   put_down(before_nudge, "putting the object back at " + millimetres(before_nudge), now, learning, reason);
 }
 
