@@ -74,6 +74,7 @@ void BM_GraspPlanAfterNudge(benchmark::State& state) {
   double grasp_height = 0;
   for (auto _ : state) {
     std::optional<cv::Point2d> top[2];
+    std::optional<Eigen::Vector3d> mask_foot;  // the supervisor's check of the settled axes' rest
     auto camera_top = [&](int c) {
       const Camera& cam = cameras[c];
       auto line_before = before_lines[c];
@@ -81,14 +82,15 @@ void BM_GraspPlanAfterNudge(benchmark::State& state) {
       if (!line_before) line_before = cam.predicted_before;
       if (!line_after) line_after = cam.predicted_after;
       const sv::Segmentation s = (c == 0 ? segment_left : segment)(cam.before, cam.after, *line_before, *line_after);
+      if (c == 1) mask_foot = sv::foot_from_mask(scene, s.mask, *line_after);
       top[c] = sv::object_top(s.mask, *line_after);
     };
     // As the supervisor does it: the left camera on a second thread (range 1) or after the right (0).
     std::future<void> left = std::async(parallel ? std::launch::async : std::launch::deferred, camera_top, 0);
     camera_top(1);
     left.get();
-    if (!top[0] || !top[1]) {
-      state.SkipWithError("no object top");
+    if (!top[0] || !top[1] || !mask_foot) {
+      state.SkipWithError("no object top or foot");
       return;
     }
     const sv::GraspTarget g = sv::grasp_target(scene, *top[0], *top[1], kStill, after);
@@ -141,5 +143,28 @@ void BM_GraspCheckByTheArmsPlanner(benchmark::State& state) {
 BENCHMARK(BM_GraspCheckByTheArmsPlanner)->Unit(benchmark::kMillisecond);
 
 }  // namespace
+
+// The after still's mask read twice on the critical path: the object's top (the grasp height)
+// and its foot (the check of the settled axes' rest). Both label the mask's largest blob.
+void BM_MaskTopAndFoot(benchmark::State& state) {
+  const sv::SceneGeometry scene = sv::SceneGeometry::load(NUDGE_SOURCE_DIR "/config/calibration_sim.yaml");
+  const Eigen::Vector3d after(0.28, -0.02, 0);
+  // The object's outline (draw()'s outer band) filled: the segmentation's mask of it.
+  cv::Mat mask = cv::Mat::zeros(kStill, CV_8U);
+  const Eigen::Vector3d across(0, 0.035, 0), up(0, 0, 0.12);
+  std::vector<cv::Point> corners;
+  for (const Eigen::Vector3d& c : {Eigen::Vector3d(after - across), Eigen::Vector3d(after + across), Eigen::Vector3d(after + across + up),
+                                   Eigen::Vector3d(after - across + up)}) {
+    const auto p = scene.project_right(c, kStill);
+    corners.emplace_back(cvRound(p->x), cvRound(p->y));
+  }
+  cv::fillConvexPoly(mask, corners, cv::Scalar(255));
+  const auto line = scene.right_axis_line(after, kHeight, kStill);
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(sv::object_top(mask, *line));
+    benchmark::DoNotOptimize(sv::foot_from_mask(scene, mask, *line));
+  }
+}
+BENCHMARK(BM_MaskTopAndFoot)->Unit(benchmark::kMillisecond);
 
 BENCHMARK_MAIN();
