@@ -57,6 +57,15 @@ Outcome<Eigen::Vector3d> intersect_axis_plane(const Segment3& axis, const Plane&
   return Result::success(axis.a + t * dir);
 }
 
+std::optional<Eigen::Vector3d> ray_meets_plane(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                                               const Plane& plane) {
+  const double along = plane.normal.dot(direction);
+  if (std::abs(along) < 1e-12) return std::nullopt;
+  const double t = -plane.signed_distance(origin) / along;
+  if (!(t > 0) || !std::isfinite(t)) return std::nullopt;
+  return origin + t * direction;
+}
+
 double tilt_from_normal_deg(const Segment3& axis, const Plane& plane) {
   if (axis.length() < 1e-12) return 90.0;
   const double c = std::min(1.0, std::fabs(plane.normal.dot(axis.direction())));

@@ -56,11 +56,9 @@ PlaneWarp plane_warp(const StereoRig& rig, Side to, const Plane& table) {
       const auto normalised = camera.normalise(Eigen::Vector2d(u, v));
       if (!normalised) continue;
       const Eigen::Vector3d ray(normalised.value().x(), normalised.value().y(), 1.0);
-      const double along = plane.normal.dot(ray);
-      if (std::abs(along) < 1e-12) continue;
-      const double t = -plane.offset / along;
-      if (!(t > 0) || !std::isfinite(t)) continue;  // the ray meets the plane behind the camera
-      const Eigen::Vector3d seen = to_other_camera(rig, to, t * ray);
+      const auto on_table = ray_meets_plane(Eigen::Vector3d::Zero(), ray, plane);
+      if (!on_table) continue;  // the ray misses the table in front of the camera
+      const Eigen::Vector3d seen = to_other_camera(rig, to, *on_table);
       if (seen.z() <= 1e-3) continue;
       const Eigen::Vector2d px = other.project(seen);
       if (!px.allFinite() || px.x() < 0 || px.y() < 0 || px.x() > other.width - 1 || px.y() > other.height - 1) continue;

@@ -96,12 +96,8 @@ Outcome<Eigen::Vector3d> support_foot(const StereoRig& rig, Side side, const Pla
     if (!n) return Outcome<Eigen::Vector3d>::failure("support foot: " + n.reason());
     Eigen::Vector3d ray(n->x(), n->y(), 1.0);
     if (side == Side::Left) ray = rig.R * ray;  // into the right camera's frame
-    const double along = table.normal.dot(ray);
-    if (std::fabs(along) < 1e-12) continue;
-    const double t = -table.signed_distance(origin) / along;
-    if (!(t > 0) || !std::isfinite(t)) continue;  // the ray leaves the table behind the camera
-    const Eigen::Vector3d hit = origin + t * ray;
-    if (!foot || (hit - origin).norm() < (*foot - origin).norm()) foot = hit;
+    const auto hit = ray_meets_plane(origin, ray, table);
+    if (hit && (!foot || (*hit - origin).norm() < (*foot - origin).norm())) foot = hit;
   }
   if (!foot) return Outcome<Eigen::Vector3d>::failure("support foot: the line's support does not reach the table");
   return Outcome<Eigen::Vector3d>::success(*foot);

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <vector>
 
+#include "nudge/geometry/plane.hpp"
 #include "nudge/geometry/workspace.hpp"
 
 namespace nudge::supervisor {
@@ -62,48 +63,15 @@ Eigen::Vector2d to_calibration(const geometry::Camera& camera, const cv::Point2d
 
 }  // namespace
 
-std::optional<cv::Point2d> object_top(const cv::Mat& mask, const symmetry::Line& line) {
+std::optional<MaskOnLine> read_mask_on_line(const cv::Mat& mask, const symmetry::Line& line) {
   if (mask.empty() || mask.type() != CV_8U) return std::nullopt;
-  const LargestBlob blob(mask);
-  if (blob.empty()) return std::nullopt;
-  // Points of the line: (x - cx) cos(theta) + (y - cy) sin(theta) = R. A near-horizontal line
-  // cannot be a standing object's axis.
-  const double c = std::cos(line.theta), s = std::sin(line.theta);
-  if (std::abs(c) < 0.2) return std::nullopt;
-  const double cx = (mask.cols - 1) / 2.0, cy = (mask.rows - 1) / 2.0;
-  for (int y = 0; y < mask.rows; ++y) {
-    const double x = cx + (line.r - (y - cy) * s) / c;
-    const int column = static_cast<int>(std::lround(x));
-    if (column < 0 || column >= mask.cols) continue;
-    if (blob.contains(column, y)) return cv::Point2d(x, y);
-  }
-  return std::nullopt;
-}
-
-namespace {
-
-// The world point where the right camera's ray through `pixel` (at image size `size`) meets the
-// table (world z = 0).
-std::optional<Eigen::Vector3d> on_table_through(const SceneGeometry& scene, const cv::Point2d& pixel, cv::Size size) {
-  const geometry::Camera& camera = scene.rig().right;
-  const auto normalised = camera.normalise(to_calibration(camera, pixel, size));
-  if (!normalised) return std::nullopt;
-  const Eigen::Vector3d origin = scene.right_camera_in_world();
-  const Eigen::Vector3d direction = scene.right_to_world(Eigen::Vector3d(normalised->x(), normalised->y(), 1.0)) - origin;
-  if (!(direction.z() < 0)) return std::nullopt;  // looking up: the table is not there
-  return origin - (origin.z() / direction.z()) * direction;
-}
-
-}  // namespace
-
-std::optional<Eigen::Vector3d> foot_from_mask(const SceneGeometry& scene, const cv::Mat& mask, const symmetry::Line& line) {
-  if (mask.empty() || mask.type() != CV_8U) return std::nullopt;
+  // Points of the line: (x - cx) cos(theta) + (y - cy) sin(theta) = R.
   const double c = std::cos(line.theta), s = std::sin(line.theta);
   if (std::abs(c) < 0.2) return std::nullopt;
   const LargestBlob blob(mask);
   if (blob.empty()) return std::nullopt;
   const double cx = (mask.cols - 1) / 2.0, cy = (mask.rows - 1) / 2.0;
-  std::optional<cv::Point2d> front, top;
+  std::optional<cv::Point2d> top, front;
   for (int y = 0; y < mask.rows; ++y) {
     const double x = cx + (line.r - (y - cy) * s) / c;
     const int column = static_cast<int>(std::lround(x));
@@ -111,26 +79,42 @@ std::optional<Eigen::Vector3d> foot_from_mask(const SceneGeometry& scene, const 
     if (!top) top = cv::Point2d(x, y);
     front = cv::Point2d(x, y);
   }
-  if (!front) return std::nullopt;
-  const cv::Size size = mask.size();
-  const auto base_front = on_table_through(scene, *front, size);
-  if (!base_front) return std::nullopt;
-  // The base's width: the blob's widest row in the lowest fifth of its height on the line (the
-  // sides are vertical there; the front pixel itself is the ellipse's lowest point, of no width).
+  if (!top) return std::nullopt;
+  MaskOnLine reading{*top, *front, 0, mask.size()};
   const int band = std::max(2, static_cast<int>((front->y - top->y) / 5));
-  int widest = 0;
   for (int y = std::max(0, static_cast<int>(front->y) - band); y <= static_cast<int>(front->y); ++y)
-    widest = std::max(widest, blob.width_in_row(y));
-  // At the foot's depth a pixel spans depth / f metres (f at the mask's size).
+    reading.base_width_px = std::max(reading.base_width_px, blob.width_in_row(y));
+  return reading;
+}
+
+std::optional<cv::Point2d> object_top(const cv::Mat& mask, const symmetry::Line& line) {
+  const auto reading = read_mask_on_line(mask, line);
+  if (!reading) return std::nullopt;
+  return reading->top;
+}
+
+std::optional<Eigen::Vector3d> foot_from_mask(const SceneGeometry& scene, const MaskOnLine& right_mask) {
   const geometry::Camera& camera = scene.rig().right;
-  const double focal = camera.K(0, 0) * static_cast<double>(size.width) / camera.width;
-  const double depth = scene.world_to_right(*base_front).z();
-  const double radius = 0.5 * widest * depth / focal;
-  Eigen::Vector3d along = *base_front - scene.right_camera_in_world();
+  const auto normalised = camera.normalise(to_calibration(camera, right_mask.front, right_mask.size));
+  if (!normalised) return std::nullopt;
+  const auto base_front = geometry::ray_meets_plane(Eigen::Vector3d::Zero(), Eigen::Vector3d(normalised->x(), normalised->y(), 1.0),
+                                                    scene.table());  // right camera frame
+  if (!base_front) return std::nullopt;
+  // At the foot's depth a pixel spans depth / f metres (f at the mask's size).
+  const double focal = camera.K(0, 0) * static_cast<double>(right_mask.size.width) / camera.width;
+  const double radius = 0.5 * right_mask.base_width_px * base_front->z() / focal;
+  const Eigen::Vector3d front = scene.right_to_world(*base_front);
+  Eigen::Vector3d along = front - scene.right_camera_in_world();
   along.z() = 0;
   if (along.norm() < 1e-9) return std::nullopt;
-  const Eigen::Vector3d foot = *base_front + radius * along.normalized();
+  const Eigen::Vector3d foot = front + radius * along.normalized();
   return Eigen::Vector3d(foot.x(), foot.y(), 0.0);
+}
+
+std::optional<Eigen::Vector3d> foot_from_mask(const SceneGeometry& scene, const cv::Mat& mask, const symmetry::Line& line) {
+  const auto reading = read_mask_on_line(mask, line);
+  if (!reading) return std::nullopt;
+  return foot_from_mask(scene, *reading);
 }
 
 double grip_height(double top_height, const GraspTargetParams& params) {

@@ -112,8 +112,7 @@ void Supervisor::segment_left(Attempt& a) const {
 void Supervisor::plan_grasp(int64_t now) {
   Attempt& a = *attempt_;
   if (!a.after_line_left) return learning_ended("not grasped", "the object is not in the left camera's view", now);
-  a.top[0] = object_top(a.segmentation_left.mask, *a.after_line_left);
-  a.top[1] = object_top(a.segmentation.mask, *a.after_line);
+  a.top[0] = object_top(a.segmentation_left.mask, *a.after_line_left);  // a.top[1]: read in segment()
   for (int camera = 0; camera < 2; ++camera)
     if (!a.top[camera])
       return learning_ended("not grasped", std::string("no object top in the ") + (camera == 0 ? "left" : "right") +

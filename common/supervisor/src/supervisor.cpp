@@ -490,7 +490,10 @@ void Supervisor::segment(int64_t now) {
                 "segmentation empty" + (a.segmentation.error.empty() ? std::string() : ": " + a.segmentation.error), now);
     return;
   }
-  check_rest_with_mask(a);
+  // The right mask read once: the object's top for the grasp, its foot for the rest's check.
+  const std::optional<MaskOnLine> right_mask = read_mask_on_line(a.segmentation.mask, *a.after_line);
+  if (right_mask) a.top[1] = right_mask->top;
+  check_rest_with_mask(a, right_mask);
   if (a.learn) {
     plan_grasp(now);
     if (state_ == State::Grasp)
@@ -503,8 +506,8 @@ void Supervisor::segment(int64_t now) {
 
 // The settled axes' rest against the mask's foot (after the left segmentation has joined: it
 // reads the rest).
-void Supervisor::check_rest_with_mask(Attempt& a) const {
-  a.rest_from_mask = foot_from_mask(scene_, a.segmentation.mask, *a.after_line);
+void Supervisor::check_rest_with_mask(Attempt& a, const std::optional<MaskOnLine>& right_mask) const {
+  if (right_mask) a.rest_from_mask = foot_from_mask(scene_, *right_mask);
   if (!a.rest_from_mask || !a.rest || config_.rest_mask_disagreement_m <= 0) return;
   const double apart = (*a.rest_from_mask - *a.rest).head<2>().norm();
   if (apart <= config_.rest_mask_disagreement_m || apart > config_.max_lateral_m + config_.max_depth_error_m) return;

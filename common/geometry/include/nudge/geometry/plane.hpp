@@ -28,6 +28,11 @@ Outcome<Plane> fit_plane(const std::vector<Eigen::Vector3d>& points);
 // Where the infinite line through the axis meets the plane. Fails if they are (nearly) parallel.
 Outcome<Eigen::Vector3d> intersect_axis_plane(const Segment3& axis, const Plane& plane);
 
+// Where the ray from `origin` along `direction` meets the plane, ahead of the origin; nothing when
+// it runs parallel to the plane or meets it behind the origin (a camera ray that misses the table).
+std::optional<Eigen::Vector3d> ray_meets_plane(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                                               const Plane& plane);
+
 // Angle between the axis and the plane's normal, degrees in [0, 90].
 double tilt_from_normal_deg(const Segment3& axis, const Plane& plane);
 

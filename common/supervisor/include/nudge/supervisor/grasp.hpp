@@ -32,18 +32,29 @@ struct GraspTargetParams {
   double max_object_height_m = 0.35; // a taller triangulated top is a mismatch, not an object
 };
 
-// The top of the object in a segmentation mask (CV_8U, non-zero = object): the first pixel of
-// the largest 8-connected blob met walking down `line` (the post-nudge symmetry line, in the mask's
-// coordinates) from the image's top. Nothing when the mask is empty or the line misses the blob.
+// What a segmentation mask (CV_8U, non-zero = object) shows along the object's symmetry line (the
+// post-nudge line, in the mask's coordinates): walking down the line from the image's top, the
+// first and the last pixel of the mask's largest 8-connected blob (the object's top, and the front
+// of its base), and the blob's widest row in the lowest fifth between them (its base's width: the
+// sides are vertical there; the front pixel is the base ellipse's lowest point, of no width).
+// Nothing when the mask is empty, the line is near horizontal (no standing object's axis) or misses
+// the blob. The mask's blobs are labelled once for all three.
+struct MaskOnLine {
+  cv::Point2d top, front;
+  int base_width_px = 0;
+  cv::Size size;  // the mask's
+};
+std::optional<MaskOnLine> read_mask_on_line(const cv::Mat& mask, const symmetry::Line& line);
+
+// The object's top in the mask: read_mask_on_line's `top`.
 std::optional<cv::Point2d> object_top(const cv::Mat& mask, const symmetry::Line& line);
 
 // The foot (world, z = 0) of an upright object from the right camera's segmentation alone: the
-// last pixel of the mask's largest blob met walking down `line` is the front of the object's base;
-// its ray meets the table there, and the axis stands the base's radius farther along the ray (the
-// radius from the blob's widest row in the band just above that pixel, at the foot's depth). One
-// camera and the table plane: unlike the stereo axes, a left line paired with the wrong right line
-// cannot move it along the ray. Nothing when the mask is empty, the line misses the blob, or the
-// ray misses the table.
+// front of its base's ray meets the calibrated table there, and the axis stands the base's radius
+// (half its width, at that depth) farther along the ray. One camera and the table plane: unlike
+// the stereo axes, a left line paired with the wrong right line cannot move it along the ray.
+// Nothing when the ray misses the table.
+std::optional<Eigen::Vector3d> foot_from_mask(const SceneGeometry& scene, const MaskOnLine& right_mask);
 std::optional<Eigen::Vector3d> foot_from_mask(const SceneGeometry& scene, const cv::Mat& mask, const symmetry::Line& line);
 
 struct GraspTarget {

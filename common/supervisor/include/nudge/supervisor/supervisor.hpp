@@ -336,7 +336,7 @@ class Supervisor {
   void park(int64_t now, const std::string& why);
   void parked(int64_t now, const std::string& how);
   void keep_object_rows(Attempt& attempt) const;
-  void check_rest_with_mask(Attempt& attempt) const;
+  void check_rest_with_mask(Attempt& attempt, const std::optional<MaskOnLine>& right_mask) const;
   void finish(State state, const std::string& reason, int64_t now);
   bool timed_out(double seconds, int64_t now) const;
   bool in_attempt() const;
