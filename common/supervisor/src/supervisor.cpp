@@ -139,7 +139,7 @@ void Supervisor::choose(int64_t now) {
   const Eigen::Vector3d camera = scene_.right_camera_in_world();
   std::vector<Rejection> hidden;
   const std::vector<Candidate> visible = drop_hidden_behind_arm_base(hidden);
-  TargetChoice choice = choose_target(visible, explored_with_ray_mates(), empty_, camera, arm_, joints_, config_.targets);
+  TargetChoice choice = choose_target(visible, explored_with_ray_mates(), phantoms_, empty_, camera, arm_, joints_, config_.targets);
   choice.rejected.insert(choice.rejected.end(), hidden.begin(), hidden.end());
   summary_.rejections.clear();
   for (const Rejection& r : choice.rejected) ++summary_.rejections[r.reason];
@@ -550,15 +550,20 @@ void Supervisor::end_attempt(Outcome outcome, const std::string& reason, int64_t
   if (outcome == Outcome::Segmented) ++summary_.segmented;
   if (outcome == Outcome::Known) summary_.known.push_back(a.recognised);
   // A place once nudged is not nudged again (unless the attempt never touched it).
-  if (outcome != Outcome::Aborted && outcome != Outcome::SnapshotLost) {
+  if (outcome == Outcome::NoMotion) {
+    // The target was a phantom, an axis between two objects (or something that would not move):
+    // its neighbours and what stands on its lines in a camera are those objects, still to nudge.
+    phantoms_.push_back(a.target.position);
+    if (a.rest) phantoms_.push_back(*a.rest);
+    else empty_.push_back(a.target.position);
+  } else if (outcome != Outcome::Aborted && outcome != Outcome::SnapshotLost) {
     explored_.push_back(a.target.position);
     for (const Candidate& c : a.candidates)  // the same object seen at another depth
       if ((c.position - a.target.position).head<2>().norm() < config_.targets.same_object_radius) explored_.push_back(c.position);
-  }
-  if (outcome == Outcome::NoMotion && !a.rest) empty_.push_back(a.target.position);
-  if (a.rest) {
-    explored_.push_back(*a.rest);
-    rests_.push_back(*a.rest);
+    if (a.rest) {
+      explored_.push_back(*a.rest);
+      rests_.push_back(*a.rest);
+    }
   }
   if (outcome == Outcome::SnapshotLost && a.before.empty()) explored_.push_back(a.target.position);
   outputs_.push_back(AttemptEnded{std::shared_ptr<const Attempt>(attempt_.release())});

@@ -68,14 +68,14 @@ bool near_any(const Eigen::Vector3d& p, const std::vector<Eigen::Vector3d>& plac
 // One pass over the candidates in camera order. With `strict`, a push that may touch another
 // candidate is refused; otherwise it is taken and noted.
 TargetChoice choose_pass(const std::vector<Candidate>& candidates, const std::vector<size_t>& order,
-                         const std::vector<Eigen::Vector3d>& explored, const std::vector<Eigen::Vector3d>& empty,
-                         const Eigen::Vector3d& camera_base, const ArmSetup& arm, const robot::JointVector& seed,
+                         const std::vector<Eigen::Vector3d>& explored, const std::vector<Eigen::Vector3d>& phantoms,
+                         const std::vector<Eigen::Vector3d>& empty, const Eigen::Vector3d& camera_base, const ArmSetup& arm, const robot::JointVector& seed,
                          const TargetParams& params, bool strict) {
   TargetChoice choice;
   for (size_t i : order) {
     const Candidate& c = candidates[i];
     auto reject = [&](const std::string& reason) { choice.rejected.push_back({c.index, c.position, reason}); };
-    if (near_any(c.position, explored, params.explored_radius)) {
+    if (near_any(c.position, explored, params.explored_radius) || near_any(c.position, phantoms, params.phantom_radius)) {
       reject("already explored");
       continue;
     }
@@ -128,7 +128,8 @@ TargetChoice choose_pass(const std::vector<Candidate>& candidates, const std::ve
 }  // namespace
 
 TargetChoice choose_target(const std::vector<Candidate>& candidates, const std::vector<Eigen::Vector3d>& explored,
-                           const std::vector<Eigen::Vector3d>& empty, const Eigen::Vector3d& right_camera,
+                           const std::vector<Eigen::Vector3d>& phantoms, const std::vector<Eigen::Vector3d>& empty,
+                           const Eigen::Vector3d& right_camera,
                            const ArmSetup& arm, const robot::JointVector& seed, const TargetParams& params) {
   std::vector<size_t> order(candidates.size());
   std::iota(order.begin(), order.end(), 0);
@@ -139,9 +140,9 @@ TargetChoice choose_target(const std::vector<Candidate>& candidates, const std::
     return (candidates[a].position - right_camera).norm() < (candidates[b].position - right_camera).norm();
   });
   const Eigen::Vector3d camera_base = arm.point_to_base(right_camera);
-  TargetChoice strict = choose_pass(candidates, order, explored, empty, camera_base, arm, seed, params, true);
+  TargetChoice strict = choose_pass(candidates, order, explored, phantoms, empty, camera_base, arm, seed, params, true);
   if (strict.found) return strict;
-  TargetChoice relaxed = choose_pass(candidates, order, explored, empty, camera_base, arm, seed, params, false);
+  TargetChoice relaxed = choose_pass(candidates, order, explored, phantoms, empty, camera_base, arm, seed, params, false);
   if (!relaxed.found) return strict;  // the strict pass's reasons say why each was passed over
   // Keep the strict pass's reasons for the candidates passed over before the chosen one.
   relaxed.rejected.clear();

@@ -353,7 +353,7 @@ class Supervisor {
   int64_t entered_ = 0, request_time_ = 0, arm_done_time_ = 0, next_seq_ = 1, nudge_seq_ = 0, home_seq_ = 0;
   std::string after_home_;  // why the survey after homing happens
   std::vector<Candidate> candidates_;
-  std::vector<Eigen::Vector3d> explored_, empty_;
+  std::vector<Eigen::Vector3d> explored_, phantoms_, empty_;
   std::vector<Eigen::Vector3d> rests_;  // where nudged objects came to rest (they stand there now)
   std::vector<Eigen::Vector3d> explored_with_ray_mates() const;
   bool same_object_in_a_camera(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const;

@@ -39,6 +39,9 @@ struct TargetParams {
   double object_radius = 0.045;   // the largest expected object (thesis: mugs, bottles)
   double travel = 0.04;           // how far a nudged object may slide beyond P2
   double explored_radius = 0.05;  // a candidate this close to a place already explored is skipped (two objects stand farther apart)
+  // A candidate this close to a place where a push moved nothing is that phantom seen again. A
+  // phantom lies between the objects whose lines make it, 4 cm from them on a crowded table.
+  double phantom_radius = 0.025;
   double pad_half_width = 0.02;   // the sponge pad across the push direction
   // Two candidates closer than this cannot both be objects: one is the other seen through a stereo
   // mismatch (it lies along the same viewing ray). Neither is an obstacle to the other's push, and
@@ -77,15 +80,17 @@ struct TargetChoice {
 std::string millimetres(const Eigen::Vector3d& p);
 
 // Candidates nearest the right camera first; the first nudgeable one is chosen. `explored` are
-// places already nudged (where a candidate stood, where a nudged object came to rest); `empty` are
-// places a nudge found nothing at (phantoms): they are no obstacle to other pushes.
+// places already nudged (where a candidate stood, where a nudged object came to rest); `phantoms`
+// are places where a push moved nothing (skipped within the smaller phantom_radius); `empty` are
+// places a nudge found nothing at: they are no obstacle to other pushes.
 // Beyond the thesis (one object per scene): on a crowded table every push may pass near another
 // candidate, many of them phantoms between two objects. When no push is clear, the nearest
 // candidate whose push only risks sliding it into another candidate is nudged anyway (the nudge
 // is gentle and short) and `note` says which; the pad itself never descends onto or sweeps
 // through another candidate, and the strict rule decides whenever it can.
 TargetChoice choose_target(const std::vector<Candidate>& candidates, const std::vector<Eigen::Vector3d>& explored,
-                           const std::vector<Eigen::Vector3d>& empty, const Eigen::Vector3d& right_camera,
+                           const std::vector<Eigen::Vector3d>& phantoms, const std::vector<Eigen::Vector3d>& empty,
+                           const Eigen::Vector3d& right_camera,
                            const ArmSetup& arm, const robot::JointVector& seed, const TargetParams& params = {});
 
 // Whether pushing `target` along `direction` would touch `other`, and how: the pad itself on its
