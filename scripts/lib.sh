@@ -147,8 +147,9 @@ nudge_in_private_network() {
 # edges (nudge-symmetry --table-texture-calibration: where the two cameras agree through the
 # calibrated table plane; docs/clutter.md, "The table's own texture").
 # NUDGE_LOOP_REACH (1, the default; 0: off) makes "plain" take 20 peaks and keep the 5 first whose
-# support stands on the table within 0.45 m of the arm's base (nudge-symmetry --reach-calibration:
-# a wall's or the far table's lines cannot be objects the arm reaches).
+# support stands on the table within 0.45 m of the arm's base and not within 0.10 m of it
+# (nudge-symmetry --reach-calibration, --reach-inner-radius: a wall's or the far table's lines
+# cannot be objects the arm reaches, and the arm's own base column, 65 mm in radius, is none).
 nudge_run_loop() {
   local bin=$1 scene=$2 calibration=$3 workspace=$4 out=$5 run=$6
   shift 6
@@ -185,7 +186,7 @@ nudge_run_loop() {
       survey=(--survey-lines 8) ;;
     plain)
       if [ "${NUDGE_LOOP_REACH:-1}" = 1 ]; then
-        symmetry_flags='"--lines", "20", "--reach-calibration", "'"$calibration"'", "--reach-keep", "5"'
+        symmetry_flags='"--lines", "20", "--reach-calibration", "'"$calibration"'", "--reach-inner-radius", "0.10", "--reach-keep", "5"'
       fi ;;
     *) echo "NUDGE_LOOP_TABLE: verified, plain or busy, not '$NUDGE_LOOP_TABLE'" >&2; return 2 ;;
   esac

@@ -373,6 +373,11 @@ class Shell {
     m.utime = now_;
     m.frames = r.frames;
     m.lines_per_image = r.lines;
+    for (const Eigen::Vector3d& place : r.explored) {
+      const Eigen::Vector3d p = scene_.world_to_table(Eigen::Vector3d(place.x(), place.y(), 0.0));
+      m.explored.push_back({p.x(), p.y(), 0.0});  // on the table
+    }
+    m.num_explored = static_cast<int32_t>(m.explored.size());
     publish(bus::channel::CANDIDATES_REQUEST, m);
   }
   void handle(const sv::SnapshotRequest& r) {

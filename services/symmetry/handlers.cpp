@@ -143,7 +143,8 @@ void Handlers::detect_and_publish(const cv::Mat& image, const image_t& msg, cons
   if (options_.reach) {  // part of finding the peaks
     Stopwatch reach_watch;
     const Options::Reach& reach = *options_.reach;
-    result.lines = geometry::lines_standing_within(reach.rig, side, reach.table, reach.centre, reach.radius, result.lines);
+    result.lines = geometry::lines_standing_within(reach.rig, side, reach.table, reach.centre, reach.radius, result.lines,
+                                                      reach.inner_radius);
     if (reach.keep > 0 && static_cast<int>(result.lines.size()) > reach.keep) result.lines.resize(reach.keep);
     result.ms.peaks_ms += reach_watch.elapsed_ms();
   }

@@ -51,12 +51,14 @@ struct Options {
   std::optional<TableTexture> table_texture;
   // Only lines standing within reach (geometry/upright.hpp, lines_standing_within): of the
   // params.num_lines peaks, those whose support segment stands on the table within `radius` of
-  // `centre` (right camera frame), the first `keep` of them (0: all). Needs the channels' cameras.
+  // `centre` (right camera frame) and not within `inner_radius` of it (the arm's base column), the
+  // first `keep` of them (0: all). Needs the channels' cameras.
   struct Reach {
     geometry::StereoRig rig;
     geometry::Plane table;
     Eigen::Vector3d centre = Eigen::Vector3d::Zero();
     double radius = 0.45;
+    double inner_radius = 0.0;
     int keep = 0;
   };
   std::optional<Reach> reach;

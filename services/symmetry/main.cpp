@@ -84,6 +84,9 @@ int main(int argc, char** argv) {
                  "within --reach-radius of its arm_base (input channels must end in LEFT / RIGHT)");
     f.add_double("reach-radius", &reach.radius, "with --reach-calibration: the radius, m (the workspace ring's outer "
                                                 "edge and a margin: an object's lowest edges stand a little above the table)");
+    f.add_double("reach-inner-radius", &reach.inner_radius,
+                 "with --reach-calibration: drop lines whose foot is nearer the arm_base than this, m (its base "
+                 "column's lines; 0: keep them)");
     f.add_int("reach-keep", &reach.keep, "with --reach-calibration: publish at most this many of the lines standing within reach (0: all)");
     f.add_bool("colour-edges", &edge.colour, "Canny on the colour image (the channel that changes most)");
     f.add_int("contours", &options.contours, "also segment the contours of the top N lines (CONTOURS_*); 0: off");
@@ -162,6 +165,8 @@ int main(int argc, char** argv) {
     if (!reach_calibration.empty()) {
       try {
         if (!(reach.radius > 0)) throw std::invalid_argument("--reach-radius must be > 0");
+        if (!(reach.inner_radius >= 0 && reach.inner_radius < reach.radius))
+          throw std::invalid_argument("--reach-inner-radius must be >= 0 and below --reach-radius");
         if (reach.keep < 0) throw std::invalid_argument("--reach-keep must be >= 0");
         reach.rig = geometry::load_rig(reach_calibration);
         const geometry::Workspace scene = geometry::load_workspace(reach_calibration);

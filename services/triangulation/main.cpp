@@ -147,12 +147,18 @@ class Triangulation {
     geo::LocationParams params = opt_.locations;
     if (request.frames > 0) params.frames = request.frames;
     if (request.lines_per_image > 0) params.lines_per_image = request.lines_per_image;
+    for (int i = 0; i < request.num_explored; ++i) {
+      const Eigen::Vector3d place(request.explored[i][0], request.explored[i][1], request.explored[i][2]);
+      if (!place.allFinite()) throw std::runtime_error("explored place " + std::to_string(i) + " is not finite; request ignored");
+      params.explored.push_back(frame_->to_camera(place));
+    }
     if (finder_) log::warn() << "a new candidates request replaces the one in progress";
     finder_.emplace(rig_, *table_, arm_base_, params, opt_.triangulation);
     request_utime_ = request.utime;
     stale_pairs_ = 0;
     log::info() << "candidates requested: gathering " << params.frames << " stereo pairs, " << params.lines_per_image
-                << " lines per image";
+                << " lines per image" << (params.explored.empty() ? std::string()
+                                          : ", leaving out the lines of " + std::to_string(params.explored.size()) + " explored object(s)");
   }
 
   void gather(int64_t utime, const Lines& left, const Lines& right) {

@@ -679,6 +679,39 @@ TEST(GeometryStereoCheck, LocationFinderUsesItOnlyWhenAsked) {
   EXPECT_THROW(LocationFinder(rig, plane, std::nullopt, params), std::invalid_argument);
 }
 
+// Several objects, one already explored: its lines would be the strongest in every later survey.
+// Left out, the one line taken per image is the other object's.
+TEST(GeometryLocations, AnExploredObjectsLinesAreLeftOutOfTheStrongest) {
+  const StereoRig rig = verged_rig(Lens::Typical);
+  const Table table;
+  const Plane plane = table_plane_in_right(rig, table);
+  const StereoAxis explored = observe_axis(rig, table, -0.06, 0.6, 0.15), other = observe_axis(rig, table, 0.07, 0.63, 0.10);
+  for (Side side : {Side::Left, Side::Right}) {
+    const sym::Line& own = side == Side::Left ? explored.left : explored.right;
+    const sym::Line& not_own = side == Side::Left ? other.left : other.right;
+    EXPECT_TRUE(is_image_of_upright_axis(rig, side, plane, own, explored.base, 2.0));
+    EXPECT_FALSE(is_image_of_upright_axis(rig, side, plane, not_own, explored.base, 8.0));
+    // 1 cm off across the view is about 12 px at 0.6 m: outside a 5 px tolerance, inside 20 px.
+    const Eigen::Vector3d off = explored.base + 0.01 * Eigen::Vector3d::UnitX();
+    EXPECT_FALSE(is_image_of_upright_axis(rig, side, plane, own, off, 5.0));
+    EXPECT_TRUE(is_image_of_upright_axis(rig, side, plane, own, off, 20.0));
+  }
+  LocationParams params;
+  params.frames = 1;
+  params.lines_per_image = 1;
+  LocationFinder thesis(rig, plane, std::nullopt, params);
+  thesis.add_frame({explored.left, other.left}, {explored.right, other.right});
+  ASSERT_EQ(thesis.intersects(), 1);
+  EXPECT_LT((thesis.intersect_points()[0] - explored.base).norm(), 0.01) << "the strongest lines are the explored object's";
+  params.explored = {explored.base};
+  LocationFinder beyond(rig, plane, std::nullopt, params);
+  beyond.add_frame({explored.left, other.left}, {explored.right, other.right});
+  ASSERT_EQ(beyond.intersects(), 1);
+  EXPECT_LT((beyond.intersect_points()[0] - other.base).norm(), 0.01);
+  params.explored = {Eigen::Vector3d(NAN, 0, 0.6)};
+  EXPECT_THROW(LocationFinder(rig, plane, std::nullopt, params), std::invalid_argument);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Lines that can be upright axes (issue 14)
 
@@ -747,6 +780,14 @@ TEST(GeometryUpright, TheSupportStandsOnTheTableAtTheObjectsFoot) {
   const std::vector<sym::Line> both = lines_standing_within(scene.rig, Side::Right, scene.plane, near.base, 0.5, {far.right, near.right});
   ASSERT_EQ(both.size(), 2u);
   EXPECT_EQ(both[0].r, far.right.r) << "in their order";
+  // Around the far axis' foot with an inner radius: the far line stands inside it (the arm's base
+  // column at the centre), the near one in the ring.
+  const double apart = (far.base - near.base).norm();
+  const std::vector<sym::Line> ring =
+      lines_standing_within(scene.rig, Side::Right, scene.plane, far.base, apart + 0.05, {far.right, near.right}, 0.05);
+  ASSERT_EQ(ring.size(), 1u);
+  EXPECT_EQ(ring[0].r, near.right.r);
+  EXPECT_THROW(lines_standing_within(scene.rig, Side::Right, scene.plane, near.base, 0.1, {near.right}, 0.1), std::invalid_argument);
   // A table behind the cameras is met by no ray: no foot, and the line is dropped.
   Plane behind;
   behind.normal = Eigen::Vector3d::UnitZ();

@@ -374,6 +374,11 @@ TEST_F(SupervisorTest, SegmentsTheObjectThenFindsNothingLeftToNudge) {
   ASSERT_TRUE(a.rest);
   EXPECT_LT((*a.rest - rest).norm(), 0.005);
   EXPECT_GT(cv::countNonZero(a.segmentation.mask), 1000);
+  // The next survey leaves the segmented object's lines out, where it now stands.
+  const auto surveys = outputs_of<sv::CandidatesRequest>(out);
+  ASSERT_EQ(surveys.size(), 1u);
+  ASSERT_EQ(surveys[0].explored.size(), 1u);
+  EXPECT_NEAR((surveys[0].explored[0] - *a.rest).norm(), 0.0, 1e-12);
   ASSERT_TRUE(a.before_line && a.after_line);
   // The lines found in the stills are the object's: where the calibration predicts them, apart
   // by the slide (3 cm at ~0.75 m is ~45 px at 1280x960).

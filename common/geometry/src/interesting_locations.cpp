@@ -97,6 +97,24 @@ void validate(const LocationParams& p) {
   if (!(p.min_height_overlap >= 0 && p.min_height_overlap <= 1))
     throw std::invalid_argument("location parameter min_height_overlap must be in [0, 1]");
   if (!(p.max_foot_height_m > 0)) throw std::invalid_argument("location parameter max_foot_height_m must be > 0");
+  if (!(p.explored_line_px > 0)) throw std::invalid_argument("location parameter explored_line_px must be > 0");
+  for (const Eigen::Vector3d& place : p.explored)
+    if (!place.allFinite()) throw std::invalid_argument("location parameter explored holds a non-finite place");
+}
+
+bool is_image_of_upright_axis(const StereoRig& rig, Side side, const Plane& table, const symmetry::Line& line,
+                              const Eigen::Vector3d& foot, double tolerance_px) {
+  const Camera& camera = side == Side::Left ? rig.left : rig.right;
+  const Eigen::Vector2d centre((camera.width - 1) / 2.0, (camera.height - 1) / 2.0);
+  const Eigen::Vector2d normal(std::cos(line.theta), std::sin(line.theta));
+  for (const double height : {0.0, 0.1}) {
+    Eigen::Vector3d point = foot + height * table.normal.normalized() * (table.normal.dot(-foot) > 0 ? 1 : -1);
+    if (side == Side::Left) point = rig.R.transpose() * (point - rig.T);  // x_right = R x_left + T
+    if (!(point.z() > 0)) return false;
+    const Eigen::Vector2d pixel = camera.project(point);
+    if (std::abs((pixel - centre).dot(normal) - line.r) > tolerance_px) return false;
+  }
+  return true;
 }
 
 namespace {
@@ -179,7 +197,19 @@ LocationFinder::LocationFinder(const StereoRig& rig, const Plane& table, const s
   if (arm_base) filter_.ring_centre = TableFrame(table, arm_base).origin();
 }
 
-int LocationFinder::add_frame(const std::vector<symmetry::Line>& left, const std::vector<symmetry::Line>& right) {
+std::vector<symmetry::Line> LocationFinder::unexplored(Side side, const std::vector<symmetry::Line>& lines) const {
+  if (params_.explored.empty()) return lines;
+  std::vector<symmetry::Line> kept;
+  for (const symmetry::Line& line : lines)
+    if (std::none_of(params_.explored.begin(), params_.explored.end(), [&](const Eigen::Vector3d& place) {
+          return is_image_of_upright_axis(rig_, side, table_, line, place, params_.explored_line_px);
+        }))
+      kept.push_back(line);
+  return kept;
+}
+
+int LocationFinder::add_frame(const std::vector<symmetry::Line>& all_left, const std::vector<symmetry::Line>& all_right) {
+  const std::vector<symmetry::Line> left = unexplored(Side::Left, all_left), right = unexplored(Side::Right, all_right);
   const PairingResult result =
       triangulate_pairings(rig_, left, right, &table_, filter_, triangulation_, params_.lines_per_image);
   const std::vector<PairedAxis> axes =

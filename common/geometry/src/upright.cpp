@@ -105,8 +105,10 @@ Outcome<Eigen::Vector3d> support_foot(const StereoRig& rig, Side side, const Pla
 
 std::vector<symmetry::Line> lines_standing_within(const StereoRig& rig, Side side, const Plane& table,
                                                   const Eigen::Vector3d& centre, double radius,
-                                                  const std::vector<symmetry::Line>& lines) {
+                                                  const std::vector<symmetry::Line>& lines, double inner_radius) {
   if (!(radius > 0)) throw std::invalid_argument("lines standing within: the radius must be > 0");
+  if (!(inner_radius >= 0 && inner_radius < radius))
+    throw std::invalid_argument("lines standing within: the inner radius must be >= 0 and below the radius");
   const Eigen::Vector3d n = table.normal.normalized();
   std::vector<symmetry::Line> kept;
   for (const symmetry::Line& line : lines) {
@@ -114,7 +116,7 @@ std::vector<symmetry::Line> lines_standing_within(const StereoRig& rig, Side sid
     if (!foot) continue;
     Eigen::Vector3d offset = *foot - centre;
     offset -= offset.dot(n) * n;  // along the table
-    if (offset.norm() <= radius) kept.push_back(line);
+    if (offset.norm() <= radius && offset.norm() >= inner_radius) kept.push_back(line);
   }
   return kept;
 }

@@ -26,6 +26,10 @@ Eigen::Vector3d SceneGeometry::table_to_world(const Eigen::Vector3d& table_point
   return right_to_world(table_frame_.to_camera(table_point));
 }
 
+Eigen::Vector3d SceneGeometry::world_to_table(const Eigen::Vector3d& world_point) const {
+  return table_frame_.to_table(world_to_right(world_point));
+}
+
 Eigen::Vector3d SceneGeometry::world_to_right(const Eigen::Vector3d& world_point) const {
   return arm_to_right_.apply(world_point);
 }

@@ -132,7 +132,7 @@ void Supervisor::survey(int64_t now, const std::string& why) {
   for (auto& lines : survey_lines_) lines.clear();
   enter(State::FindCandidates, now,
         (why.empty() ? std::string() : why + "; ") + "surveying: candidates from " + std::to_string(config_.survey_frames) + " stereo pairs");
-  outputs_.push_back(CandidatesRequest{config_.survey_frames, config_.survey_lines});
+  outputs_.push_back(CandidatesRequest{config_.survey_frames, config_.survey_lines, standing_});
 }
 
 void Supervisor::choose(int64_t now) {
@@ -563,6 +563,9 @@ void Supervisor::end_attempt(Outcome outcome, const std::string& reason, int64_t
     if (a.rest) {
       explored_.push_back(*a.rest);
       rests_.push_back(*a.rest);
+      standing_.push_back(*a.rest);
+    } else if (outcome == Outcome::Known || outcome == Outcome::Refused) {
+      standing_.push_back(a.target.position);  // never pushed: it stands where it was found
     }
   }
   if (outcome == Outcome::SnapshotLost && a.before.empty()) explored_.push_back(a.target.position);

@@ -73,7 +73,21 @@ struct LocationParams {
   bool stereo_check = false;
   double min_height_overlap = 0.3;
   double max_foot_height_m = 0.08;
+  // Beyond the thesis (one object per scene): objects already explored that still stand on the
+  // table (right camera frame, on it). Their lines are the strongest in every later survey and
+  // would crowd out the objects still to find, so a line that is the image of an upright axis at
+  // one of them (is_image_of_upright_axis, within explored_line_px) is not among the
+  // lines_per_image taken. An unexplored object standing in line with one in a camera loses its
+  // line in that camera too.
+  std::vector<Eigen::Vector3d> explored;
+  double explored_line_px = 8;
 };
+
+// Whether `line` (in the camera of `side`) is the image of an upright axis standing at `foot`
+// (right camera frame, on `table`): the foot and the point 0.1 m above it both project within
+// `tolerance_px` of the line. False for a foot behind the camera.
+bool is_image_of_upright_axis(const StereoRig& rig, Side side, const Plane& table, const symmetry::Line& line,
+                              const Eigen::Vector3d& foot, double tolerance_px);
 
 // Throws std::invalid_argument naming the offending parameter.
 void validate(const LocationParams& params);
@@ -116,6 +130,9 @@ class LocationFinder {
   void reset();
 
  private:
+  // The lines (in their order) that are not the image of an explored place's axis.
+  std::vector<symmetry::Line> unexplored(Side side, const std::vector<symmetry::Line>& lines) const;
+
   StereoRig rig_;
   Plane table_;
   LocationParams params_;

@@ -45,11 +45,13 @@ std::vector<symmetry::Line> upright_lines(const StereoRig& rig, Side side, const
 Outcome<Eigen::Vector3d> support_foot(const StereoRig& rig, Side side, const Plane& table, const symmetry::Line& line);
 
 // The lines (in their order) whose support foot lies within `radius` of `centre` along the table
-// (right camera frame): a line standing on the wall, beyond the table's far edge or far out on the
-// table cannot be an object the arm reaches, and would take the place of one among the lines the
-// detector keeps. Lines without a foot are dropped. Throws std::invalid_argument unless radius > 0.
+// (right camera frame), and not nearer than `inner_radius`: a line standing on the wall, beyond the
+// table's far edge or far out on the table cannot be an object the arm reaches, nor can the arm's
+// own base column standing at `centre`, and either would take the place of an object among the
+// lines the detector keeps. Lines without a foot are dropped. Throws std::invalid_argument unless
+// 0 <= inner_radius < radius.
 std::vector<symmetry::Line> lines_standing_within(const StereoRig& rig, Side side, const Plane& table,
                                                   const Eigen::Vector3d& centre, double radius,
-                                                  const std::vector<symmetry::Line>& lines);
+                                                  const std::vector<symmetry::Line>& lines, double inner_radius = 0.0);
 
 }  // namespace nudge::geometry

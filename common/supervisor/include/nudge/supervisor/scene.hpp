@@ -27,6 +27,7 @@ class SceneGeometry {
 
   // CANDIDATES / AXES positions (the triangulation service's table frame) -> world frame.
   Eigen::Vector3d table_to_world(const Eigen::Vector3d& table_point) const;
+  Eigen::Vector3d world_to_table(const Eigen::Vector3d& world_point) const;
   Eigen::Vector3d world_to_right(const Eigen::Vector3d& world_point) const;
   Eigen::Vector3d right_to_world(const Eigen::Vector3d& right_point) const;
   Eigen::Vector3d right_camera_in_world() const;

@@ -166,7 +166,12 @@ using SegmentFunction = std::function<Segmentation(const cv::Mat& before, const 
                                                    const symmetry::Line& before_line, const symmetry::Line& after_line)>;
 
 // ---- outputs ----
-struct CandidatesRequest { int frames = 25, lines = 3; };
+// `explored`: objects already explored that still stand there (world frame): their lines are left
+// out of the survey's strongest lines.
+struct CandidatesRequest {
+  int frames = 25, lines = 3;
+  std::vector<Eigen::Vector3d> explored;
+};
 struct SnapshotRequest { bool both = false; };  // both cameras (learning: the left segmentation too)
 // Learning (thesis ch. 7). Grasp/Place: the tool point `height` above the table over `position`.
 struct GraspCommand { int64_t seq = 0; Eigen::Vector3d position; double height = 0; };
@@ -354,6 +359,7 @@ class Supervisor {
   std::string after_home_;  // why the survey after homing happens
   std::vector<Candidate> candidates_;
   std::vector<Eigen::Vector3d> explored_, phantoms_, empty_;
+  std::vector<Eigen::Vector3d> standing_;  // explored objects where they stand now (CandidatesRequest::explored)
   std::vector<Eigen::Vector3d> rests_;  // where nudged objects came to rest (they stand there now)
   std::vector<Eigen::Vector3d> explored_with_ray_mates() const;
   bool same_object_in_a_camera(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const;
