@@ -177,13 +177,16 @@ int right_order(int frame, int k) { return (k + frame) % 3; }
 // size (skipped, so its left partner goes unmatched); a lone left message at the end.
 // The request comes first in the log, stamped `request_utime` (a later one: the lines of the
 // frames before it arrive late, as from a lagging pipeline).
+// `explored`: places sent with the request (table frame).
 void write_input_log(const Scene& scene, const std::string& path, int64_t request_utime = kStart - 1,
-                     int request_frames = 20) {
+                     int request_frames = 20, const std::vector<Eigen::Vector3d>& explored = {}) {
   LogWriter log(path);
   nudge::candidates_request_t request;
   request.utime = request_utime;
   request.frames = request_frames;
   request.lines_per_image = 3;
+  for (const Eigen::Vector3d& place : explored) request.explored.push_back({place.x(), place.y(), place.z()});
+  request.num_explored = static_cast<int32_t>(request.explored.size());
   log.raw(request.utime, "CANDIDATES_REQUEST", encode(request));
   for (int f = 0; f < kFrames; ++f) {
     const int64_t utime = kStart + f * kPeriod;
@@ -353,6 +356,31 @@ TEST(TriangulationService, CandidatesGatherOnlyPairsTakenAfterTheRequest) {
   // Frames 10..20 without frame 12 (its right image is refused): the tenth pair taken after it.
   EXPECT_EQ(output.candidates[0].utime, kStart + 20 * kPeriod);
   EXPECT_NE(err.find("10 stereo pair(s) taken before the request"), std::string::npos) << err;
+}
+
+// An object already explored (sent with the request) gives no candidate: its lines are left out
+// of the strongest lines paired. The other ring object's candidate stays.
+TEST(TriangulationService, AnExploredObjectsLinesAreNotPaired) {
+  const Scene scene;
+  const auto p = table_plane_in_right(scene.rig);
+  geo::Plane table;
+  table.normal = Eigen::Vector3d(p[0], p[1], p[2]);
+  table.offset = p[3];
+  const geo::TableFrame frame(table, scene.arm_base_right);
+  std::vector<const Object*> ring;
+  for (const Object& obj : scene.objects)
+    if (obj.in_ring) ring.push_back(&obj);
+  ASSERT_EQ(ring.size(), 2u);
+  ServiceRun service("explored");
+  geo::save_rig(scene.rig, service.rig);
+  write_input_log(scene, service.in, kStart - 1, 20, {frame.to_table(ring[0]->base_right)});
+  ASSERT_EQ(service(table_flags(scene)), 0) << service.command(table_flags(scene)) << "\n" << service.err;
+  const Output output = read_output(service.out);
+  ASSERT_EQ(output.candidates.size(), 1u) << service.err;
+  const auto& c = output.candidates[0];
+  ASSERT_EQ(c.num_candidates, 1);
+  EXPECT_LT((frame.to_camera(Eigen::Vector3d(c.position[0][0], c.position[0][1], c.position[0][2])) - ring[1]->base_right).norm(), 1e-3);
+  EXPECT_NE(service.err.find("leaving out the lines of 1 explored object(s)"), std::string::npos) << service.err;
 }
 
 TEST(TriangulationService, TableAndArmBaseCanComeFromTheCalibrationFile) {
