@@ -212,6 +212,9 @@ void add_flags(Flags& f, Options& o) {
   f.add_int("candidate-frames", &o.locations.frames, "CANDIDATES: stereo pairs gathered per request");
   f.add_int("candidate-lines", &o.locations.lines_per_image, "CANDIDATES: strongest lines per image");
   f.add_double("candidate-tilt", &o.locations.max_tilt_deg, "CANDIDATES: max angle from the table normal, degrees");
+  f.add_double("candidate-line-tilt", &o.locations.max_line_tilt_deg,
+               "CANDIDATES: pair only lines that are within this many degrees of the image of an upright axis "
+               "(0: any line, the thesis)");
   f.add_double("cluster-radius", &o.locations.qt.radius, "CANDIDATES: QT cluster radius, m");
   f.add_double("cluster-min-fraction", &o.locations.qt.min_fraction, "CANDIDATES: smallest cluster, fraction of all");
   f.add_bool("stereo-check", &o.locations.stereo_check,

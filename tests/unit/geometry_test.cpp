@@ -712,6 +712,40 @@ TEST(GeometryLocations, AnExploredObjectsLinesAreLeftOutOfTheStrongest) {
   EXPECT_THROW(LocationFinder(rig, plane, std::nullopt, params), std::invalid_argument);
 }
 
+// A stronger line that cannot be the image of an upright axis (turned 15 deg about its middle) is
+// not among the lines a survey takes when it asks for upright lines only.
+TEST(GeometryLocations, ASurveyCanTakeOnlyLinesThatCanBeUprightAxes) {
+  const StereoRig rig = verged_rig(Lens::None);
+  const Table table;
+  const Plane plane = table_plane_in_right(rig, table);
+  const StereoAxis object = observe_axis(rig, table, 0.02, 0.6, 0.15);
+  sym::Line leaning = object.left;
+  leaning.theta += 15 * M_PI / 180;
+  const cv::Point2d middle = 0.5 * (object.left.seg1 + object.left.seg2) - cv::Point2d(319.5, 239.5);
+  leaning.r = middle.x * std::cos(leaning.theta) + middle.y * std::sin(leaning.theta);
+  const double turn = 15 * M_PI / 180;  // the support segment turns with it
+  for (cv::Point2d* end : {&leaning.seg1, &leaning.seg2}) {
+    const cv::Point2d mid = 0.5 * (object.left.seg1 + object.left.seg2), d = *end - mid;
+    *end = mid + cv::Point2d(d.x * std::cos(turn) - d.y * std::sin(turn), d.x * std::sin(turn) + d.y * std::cos(turn));
+  }
+  const auto tilt = upright_tilt_deg(rig, Side::Left, plane, leaning);
+  ASSERT_TRUE(tilt.ok()) << tilt.reason();
+  EXPECT_GT(*tilt, 3.0);
+  LocationParams params;
+  params.frames = 1;
+  params.lines_per_image = 1;
+  LocationFinder any(rig, plane, std::nullopt, params);
+  any.add_frame({leaning, object.left}, {object.right});
+  for (const Eigen::Vector3d& p : any.intersect_points())
+    EXPECT_GT((p - object.base).norm(), 0.01) << "the strongest line is the leaning one: the object is not found";
+  params.max_line_tilt_deg = 2;
+  LocationFinder upright(rig, plane, std::nullopt, params);
+  ASSERT_EQ(upright.add_frame({leaning, object.left}, {object.right}), 1);
+  EXPECT_LT((upright.intersect_points()[0] - object.base).norm(), 0.01);
+  params.max_line_tilt_deg = -1;
+  EXPECT_THROW(LocationFinder(rig, plane, std::nullopt, params), std::invalid_argument);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Lines that can be upright axes (issue 14)
 

@@ -1,4 +1,5 @@
 #include "nudge/geometry/interesting_locations.hpp"
+#include "nudge/geometry/upright.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -98,6 +99,8 @@ void validate(const LocationParams& p) {
     throw std::invalid_argument("location parameter min_height_overlap must be in [0, 1]");
   if (!(p.max_foot_height_m > 0)) throw std::invalid_argument("location parameter max_foot_height_m must be > 0");
   if (!(p.explored_line_px > 0)) throw std::invalid_argument("location parameter explored_line_px must be > 0");
+  if (!(p.max_line_tilt_deg >= 0 && p.max_line_tilt_deg <= 90))
+    throw std::invalid_argument("location parameter max_line_tilt_deg must be in [0, 90]");
   for (const Eigen::Vector3d& place : p.explored)
     if (!place.allFinite()) throw std::invalid_argument("location parameter explored holds a non-finite place");
 }
@@ -197,19 +200,25 @@ LocationFinder::LocationFinder(const StereoRig& rig, const Plane& table, const s
   if (arm_base) filter_.ring_centre = TableFrame(table, arm_base).origin();
 }
 
-std::vector<symmetry::Line> LocationFinder::unexplored(Side side, const std::vector<symmetry::Line>& lines) const {
-  if (params_.explored.empty()) return lines;
+std::vector<symmetry::Line> LocationFinder::survey_lines(Side side, const std::vector<symmetry::Line>& lines) const {
+  if (params_.explored.empty() && params_.max_line_tilt_deg <= 0) return lines;
   std::vector<symmetry::Line> kept;
-  for (const symmetry::Line& line : lines)
-    if (std::none_of(params_.explored.begin(), params_.explored.end(), [&](const Eigen::Vector3d& place) {
+  for (const symmetry::Line& line : lines) {
+    if (std::any_of(params_.explored.begin(), params_.explored.end(), [&](const Eigen::Vector3d& place) {
           return is_image_of_upright_axis(rig_, side, table_, line, place, params_.explored_line_px);
         }))
-      kept.push_back(line);
+      continue;
+    if (params_.max_line_tilt_deg > 0) {
+      const Outcome<double> tilt = upright_tilt_deg(rig_, side, table_, line);
+      if (tilt && *tilt > params_.max_line_tilt_deg) continue;
+    }
+    kept.push_back(line);
+  }
   return kept;
 }
 
 int LocationFinder::add_frame(const std::vector<symmetry::Line>& all_left, const std::vector<symmetry::Line>& all_right) {
-  const std::vector<symmetry::Line> left = unexplored(Side::Left, all_left), right = unexplored(Side::Right, all_right);
+  const std::vector<symmetry::Line> left = survey_lines(Side::Left, all_left), right = survey_lines(Side::Right, all_right);
   const PairingResult result =
       triangulate_pairings(rig_, left, right, &table_, filter_, triangulation_, params_.lines_per_image);
   const std::vector<PairedAxis> axes =

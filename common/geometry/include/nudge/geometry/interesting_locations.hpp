@@ -81,6 +81,11 @@ struct LocationParams {
   // line in that camera too.
   std::vector<Eigen::Vector3d> explored;
   double explored_line_px = 8;
+  // Beyond the thesis: when > 0, a line whose plane leans more than this from the table's normal
+  // (upright_tilt_deg: it cannot be the image of an upright axis) is not among the lines taken.
+  // Objects' lines lean 0-1 deg, lines between two objects 2.5-5 deg, the clutter's often more
+  // (docs/supervisor.md). 0: off (the thesis takes the strongest lines whatever they are).
+  double max_line_tilt_deg = 0;
 };
 
 // Whether `line` (in the camera of `side`) is the image of an upright axis standing at `foot`
@@ -130,8 +135,9 @@ class LocationFinder {
   void reset();
 
  private:
-  // The lines (in their order) that are not the image of an explored place's axis.
-  std::vector<symmetry::Line> unexplored(Side side, const std::vector<symmetry::Line>& lines) const;
+  // The lines (in their order) that may be a new object's: not the image of an explored place's
+  // axis, and (with max_line_tilt_deg) the image of an upright axis.
+  std::vector<symmetry::Line> survey_lines(Side side, const std::vector<symmetry::Line>& lines) const;
 
   StereoRig rig_;
   Plane table_;
