@@ -313,7 +313,7 @@ TEST(Targets, NearestTheCameraFirstAndEveryPassOverHasAReason) {
                                                  {1, Eigen::Vector3d(0.30, -0.10, 0), 9},
                                                  {2, Eigen::Vector3d(0.62, 0.0, 0), 9},   // beyond the ring
                                                  {3, Eigen::Vector3d(0.05, 0.0, 0), 9}};  // inside it
-  const auto choice = sv::choose_target(candidates, {}, {}, {}, scene.right_camera_in_world(), arm,
+  const auto choice = sv::choose_target(candidates, {}, scene.right_camera_in_world(), arm,
                                         arm_state_joints(), sv::TargetParams{});
   ASSERT_TRUE(choice.found);
   EXPECT_EQ(choice.target.index, 1);  // the nearest reachable one
@@ -325,10 +325,20 @@ TEST(Targets, NearestTheCameraFirstAndEveryPassOverHasAReason) {
   EXPECT_NEAR(choice.direction.dot(Eigen::Vector3d(ray.x(), ray.y(), 0).normalized()), 0.0, 1e-6);
   EXPECT_NEAR(choice.direction.z(), 0.0, 1e-12);
   // Explored places are skipped; with everything explored or unreachable nothing is chosen.
-  const auto rest = sv::choose_target(candidates, {candidates[0].position, candidates[1].position}, {}, {},
+  const auto rest = sv::choose_target(candidates, sv::History{{candidates[0].position, candidates[1].position}, {}, {}, {}},
                                       scene.right_camera_in_world(), arm, arm_state_joints(), sv::TargetParams{});
   EXPECT_FALSE(rest.found);
   EXPECT_EQ(rest.rejected.size(), 4u);
+  // Explored objects standing on the pad's way either side (no candidates: later surveys leave
+  // their lines out) block both pushes as candidates would.
+  const double pad = 0.5 * (arm.nudge.start_distance + arm.nudge.stop_distance);
+  sv::History blocked;
+  blocked.standing = {choice.target.position - pad * choice.direction, choice.target.position + pad * choice.direction};
+  const auto around = sv::choose_target({candidates[1]}, blocked, scene.right_camera_in_world(), arm, arm_state_joints(),
+                                        sv::TargetParams{});
+  EXPECT_FALSE(around.found);
+  ASSERT_EQ(around.rejected.size(), 1u);
+  EXPECT_NE(around.rejected[0].reason.find("the pad would touch"), std::string::npos) << around.rejected[0].reason;
 }
 
 TEST_F(SupervisorTest, SegmentsTheObjectThenFindsNothingLeftToNudge) {
@@ -987,7 +997,8 @@ TEST_F(SupervisorTest, ACandidateOnTheRestedObjectsLineInACameraIsThatObjectNotN
   park(t);
   t.on_right_still(draw_scene(scene_, {1280, 960}, {rest}), now_, now_);
   t.take_outputs();
-  const Eigen::Vector3d beside = rest + 0.08 * Eigen::Vector3d(-ray.y(), ray.x(), 0);
+  // (On the side where its push away from the object at rest, an obstacle now, stays in reach.)
+  const Eigen::Vector3d beside = rest - 0.08 * Eigen::Vector3d(-ray.y(), ray.x(), 0);
   out = answer_survey(t, {beside});
   EXPECT_EQ(t.state(), sv::State::SnapshotBefore) << t.report().reason;
 }

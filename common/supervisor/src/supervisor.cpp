@@ -139,7 +139,8 @@ void Supervisor::choose(int64_t now) {
   const Eigen::Vector3d camera = scene_.right_camera_in_world();
   std::vector<Rejection> hidden;
   const std::vector<Candidate> visible = drop_hidden_behind_arm_base(hidden);
-  TargetChoice choice = choose_target(visible, explored_with_ray_mates(), phantoms_, empty_, camera, arm_, joints_, config_.targets);
+  const History history{explored_with_ray_mates(), phantoms_, empty_, standing_};
+  TargetChoice choice = choose_target(visible, history, camera, arm_, joints_, config_.targets);
   choice.rejected.insert(choice.rejected.end(), hidden.begin(), hidden.end());
   summary_.rejections.clear();
   for (const Rejection& r : choice.rejected) ++summary_.rejections[r.reason];

@@ -67,28 +67,42 @@ bool near_any(const Eigen::Vector3d& p, const std::vector<Eigen::Vector3d>& plac
 
 // One pass over the candidates in camera order. With `strict`, a push that may touch another
 // candidate is refused; otherwise it is taken and noted.
-TargetChoice choose_pass(const std::vector<Candidate>& candidates, const std::vector<size_t>& order,
-                         const std::vector<Eigen::Vector3d>& explored, const std::vector<Eigen::Vector3d>& phantoms,
-                         const std::vector<Eigen::Vector3d>& empty, const Eigen::Vector3d& camera_base, const ArmSetup& arm, const robot::JointVector& seed,
+// The places a push must keep clear of: the other candidates that count as objects, and the
+// explored objects standing where no candidate is (their lines left out of the survey).
+std::vector<Eigen::Vector3d> obstacles_to(const Candidate& c, const std::vector<Candidate>& candidates, const History& history,
+                                          const TargetParams& params) {
+  std::vector<Eigen::Vector3d> obstacles;
+  auto far_from_target = [&](const Eigen::Vector3d& p) { return horizontal(p - c.position).norm() >= params.same_object_radius; };
+  for (const Candidate& other : candidates) {
+    if (other.index == c.index || near_any(other.position, history.empty, params.explored_radius)) continue;
+    if (other.stereo_agreement < params.min_stereo_agreement) continue;
+    if (far_from_target(other.position)) obstacles.push_back(other.position);
+  }
+  for (const Eigen::Vector3d& object : history.standing)
+    if (far_from_target(object) && !near_any(object, obstacles, params.same_object_radius)) obstacles.push_back(object);
+  return obstacles;
+}
+
+TargetChoice choose_pass(const std::vector<Candidate>& candidates, const std::vector<size_t>& order, const History& history,
+                         const Eigen::Vector3d& camera_base, const ArmSetup& arm, const robot::JointVector& seed,
                          const TargetParams& params, bool strict) {
   TargetChoice choice;
   for (size_t i : order) {
     const Candidate& c = candidates[i];
     auto reject = [&](const std::string& reason) { choice.rejected.push_back({c.index, c.position, reason}); };
-    if (near_any(c.position, explored, params.explored_radius) || near_any(c.position, phantoms, params.phantom_radius)) {
+    if (near_any(c.position, history.explored, params.explored_radius) ||
+        near_any(c.position, history.phantoms, params.phantom_radius)) {
       reject("already explored");
       continue;
     }
     std::string why_not;
+    const std::vector<Eigen::Vector3d> obstacles = obstacles_to(c, candidates, history, params);
     for (const Eigen::Vector3d& direction_base :
          robot::directions_across_view(camera_base, arm.point_to_base(c.position))) {
       const Eigen::Vector3d direction = arm.direction_to_world(direction_base);
       PushConflict conflict;
-      for (const Candidate& other : candidates) {
-        if (other.index == c.index || near_any(other.position, empty, params.explored_radius)) continue;
-        if (other.stereo_agreement < params.min_stereo_agreement) continue;
-        if (horizontal(other.position - c.position).norm() < params.same_object_radius) continue;
-        PushConflict found = push_conflict(c.position, direction, other.position, arm, params);
+      for (const Eigen::Vector3d& other : obstacles) {
+        PushConflict found = push_conflict(c.position, direction, other, arm, params);
         if (found.kind == PushConflict::Kind::Pad || (found && !conflict)) conflict = found;
         if (conflict.kind == PushConflict::Kind::Pad) break;
       }
@@ -127,9 +141,7 @@ TargetChoice choose_pass(const std::vector<Candidate>& candidates, const std::ve
 
 }  // namespace
 
-TargetChoice choose_target(const std::vector<Candidate>& candidates, const std::vector<Eigen::Vector3d>& explored,
-                           const std::vector<Eigen::Vector3d>& phantoms, const std::vector<Eigen::Vector3d>& empty,
-                           const Eigen::Vector3d& right_camera,
+TargetChoice choose_target(const std::vector<Candidate>& candidates, const History& history, const Eigen::Vector3d& right_camera,
                            const ArmSetup& arm, const robot::JointVector& seed, const TargetParams& params) {
   std::vector<size_t> order(candidates.size());
   std::iota(order.begin(), order.end(), 0);
@@ -140,9 +152,9 @@ TargetChoice choose_target(const std::vector<Candidate>& candidates, const std::
     return (candidates[a].position - right_camera).norm() < (candidates[b].position - right_camera).norm();
   });
   const Eigen::Vector3d camera_base = arm.point_to_base(right_camera);
-  TargetChoice strict = choose_pass(candidates, order, explored, phantoms, empty, camera_base, arm, seed, params, true);
+  TargetChoice strict = choose_pass(candidates, order, history, camera_base, arm, seed, params, true);
   if (strict.found) return strict;
-  TargetChoice relaxed = choose_pass(candidates, order, explored, phantoms, empty, camera_base, arm, seed, params, false);
+  TargetChoice relaxed = choose_pass(candidates, order, history, camera_base, arm, seed, params, false);
   if (!relaxed.found) return strict;  // the strict pass's reasons say why each was passed over
   // Keep the strict pass's reasons for the candidates passed over before the chosen one.
   relaxed.rejected.clear();

@@ -79,18 +79,27 @@ struct TargetChoice {
 // "(x, y) mm" of a world point, for reasons.
 std::string millimetres(const Eigen::Vector3d& p);
 
-// Candidates nearest the right camera first; the first nudgeable one is chosen. `explored` are
-// places already nudged (where a candidate stood, where a nudged object came to rest); `phantoms`
-// are places where a push moved nothing (skipped within the smaller phantom_radius); `empty` are
-// places a nudge found nothing at: they are no obstacle to other pushes.
+// What the run's earlier attempts left on the table (world frame).
+struct History {
+  // Places already nudged (where a candidate stood, where a nudged object came to rest): skipped.
+  std::vector<Eigen::Vector3d> explored;
+  // Where a push moved nothing (phantoms): skipped within the smaller phantom_radius.
+  std::vector<Eigen::Vector3d> phantoms;
+  // Where a nudge found nothing: candidates there are no obstacle to other pushes.
+  std::vector<Eigen::Vector3d> empty;
+  // Explored objects where they stand now. Later surveys leave their lines out, so they may be
+  // no candidate; they are still obstacles to every push.
+  std::vector<Eigen::Vector3d> standing;
+};
+
+// Candidates nearest the right camera first; the first nudgeable one that `history` does not
+// rule out is chosen.
 // Beyond the thesis (one object per scene): on a crowded table every push may pass near another
 // candidate, many of them phantoms between two objects. When no push is clear, the nearest
 // candidate whose push only risks sliding it into another candidate is nudged anyway (the nudge
 // is gentle and short) and `note` says which; the pad itself never descends onto or sweeps
 // through another candidate, and the strict rule decides whenever it can.
-TargetChoice choose_target(const std::vector<Candidate>& candidates, const std::vector<Eigen::Vector3d>& explored,
-                           const std::vector<Eigen::Vector3d>& phantoms, const std::vector<Eigen::Vector3d>& empty,
-                           const Eigen::Vector3d& right_camera,
+TargetChoice choose_target(const std::vector<Candidate>& candidates, const History& history, const Eigen::Vector3d& right_camera,
                            const ArmSetup& arm, const robot::JointVector& seed, const TargetParams& params = {});
 
 // Whether pushing `target` along `direction` would touch `other`, and how: the pad itself on its
