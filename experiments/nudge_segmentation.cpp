@@ -55,6 +55,7 @@ struct Segmented {
   int object = -1;           // scene index of the object the mask covers most; -1: none
   double iou = 0;
   int effector_pixels = 0;
+  int tool_changed_pixels = 0;  // effector pixels and the tool's shadow
   int mask_pixels = 0;
   cv::Mat gallery;           // before | after | mask over after
 };
@@ -87,9 +88,10 @@ std::string json_string(const std::string& json, const std::string& key) {
   return std::regex_search(json, m, std::regex("\"" + key + "\":\"([^\"]*)\"")) ? std::string(m[1]) : "";
 }
 
-// The truth of one recorded state: label mask and effector pixels in the right still.
+// The truth of one recorded state in the right still: label mask, the end effector's own pixels,
+// and every pixel the tool changes (itself and its shadow: the count reported before 2026-11-25).
 struct Truth {
-  cv::Mat labels, effector;
+  cv::Mat labels, effector, tool_changed;
 };
 
 Truth render_truth(sim::World& world, const sim_state_t& state) {
@@ -104,7 +106,8 @@ Truth render_truth(sim::World& world, const sim_state_t& state) {
   cv::Mat change;
   cv::absdiff(with, without, change);
   cv::cvtColor(change, change, cv::COLOR_BGR2GRAY);
-  cv::threshold(change, truth.effector, 10, 255, cv::THRESH_BINARY);
+  cv::threshold(change, truth.tool_changed, 10, 255, cv::THRESH_BINARY);
+  truth.effector = world.render_snapshot_tool_mask(kRight);
   return truth;
 }
 
@@ -115,6 +118,7 @@ Segmented score(const cv::Mat& mask, const Truth& truth, int objects) {
   s.object = m.object;
   s.iou = m.iou;
   s.effector_pixels = cv::countNonZero(truth.effector & mask);
+  s.tool_changed_pixels = cv::countNonZero(truth.tool_changed & mask);
   return s;
 }
 
@@ -206,7 +210,7 @@ double time_motion_segmentation(const std::vector<fs::path>& attempt_dirs) {
 struct SetScore {
   std::vector<Run> runs;
   std::vector<fs::path> attempt_dirs;
-  int single_runs = 0, successes = 0, effector = 0, phantoms = 0, multi_found = 0, multi_present = 0;
+  int single_runs = 0, successes = 0, effector = 0, tool_changed = 0, phantoms = 0, multi_found = 0, multi_present = 0;
   std::vector<double> ious;
   std::string table;
   std::vector<cv::Mat> gallery;
@@ -303,6 +307,7 @@ SetScore score_set(const fs::path& runs_dir, const fs::path& scene_dir, std::vec
       segmented += text;
       set.ious.push_back(s.iou);
       run_effector += s.effector_pixels;
+      set.tool_changed += s.tool_changed_pixels;
       if (!s.gallery.empty()) set.gallery.push_back(s.gallery);
     }
     set.effector += run_effector;
@@ -319,6 +324,7 @@ SetScore score_set(const fs::path& runs_dir, const fs::path& scene_dir, std::vec
 void json_fields(JsonWriter& j, const SetScore& s, double ms) {
   j.field("runs", s.single_runs).field("successes", s.successes).field("mean_iou", s.mean_iou()).field("min_iou", s.min_iou());
   j.field("segmentations", static_cast<int>(s.ious.size())).field("effector_pixels", s.effector);
+  j.field("tool_changed_pixels", s.tool_changed);
   j.field("mean_ms_motion_segmentation", ms).field("multi_object_found", s.multi_found).field("multi_object_present", s.multi_present);
   j.field("phantoms_rejected", s.phantoms);
 }
@@ -331,7 +337,8 @@ std::string figures_table(const SetScore& s, double ms) {
   std::snprintf(line, sizeof line, "| mean IoU (min) of every segmentation | – | %.3f (%.3f) over %zu |\n", s.mean_iou(), s.min_iou(), s.ious.size());
   md << line;
   std::snprintf(line, sizeof line, "| motion segmentation, ms per 1280x960 pair (one thread, median) | 80 | %.1f |\n", ms);
-  md << line << "| end-effector pixels in the masks | – | " << s.effector << " |\n"
+  md << line << "| end-effector pixels in the masks (the pad's or gripper's own) | – | " << s.effector << " |\n"
+     << "| mask pixels the tool changes (itself and its shadow; the count reported before 2026-11-25) | – | " << s.tool_changed << " |\n"
      << "| objects of the multi-object scenes segmented | (one object per scene) | " << s.multi_found << "/" << s.multi_present << " |\n"
      << "| attempts that found no motion (phantoms, out-of-view) | – | " << s.phantoms << " |\n";
   return md.str();
@@ -343,6 +350,17 @@ int main(int argc, char** argv) {
   // nudge-exp-nudge-segmentation RUNS_DIR SCENE_DIR [RUN...] [--development RUNS_DIR SCENE_DIR]
   std::vector<std::string> args(argv + 1, argv + argc);
   std::optional<std::pair<fs::path, fs::path>> development;
+  std::string name = "nudge_segmentation";  // --name: the result files' stem
+  for (size_t i = 0; i < args.size(); ++i)
+    if (args[i] == "--name") {
+      if (i + 1 >= args.size() || args[i + 1].empty() || args[i + 1].find('/') != std::string::npos) {
+        std::cerr << "--name needs a file name stem (no '/')\n";
+        return 2;
+      }
+      name = args[i + 1];
+      args.erase(args.begin() + static_cast<long>(i), args.begin() + static_cast<long>(i) + 2);
+      break;
+    }
   for (size_t i = 0; i < args.size(); ++i)
     if (args[i] == "--development") {
       if (i + 2 >= args.size()) {
@@ -354,8 +372,9 @@ int main(int argc, char** argv) {
       break;
     }
   if (args.size() < 2) {
-    std::cerr << "usage: nudge-exp-nudge-segmentation RUNS_DIR SCENE_DIR [RUN...] [--development RUNS_DIR SCENE_DIR]\n"
-                 "  (the first set gives the headline figures: the held-out scenes)\n";
+    std::cerr << "usage: nudge-exp-nudge-segmentation RUNS_DIR SCENE_DIR [RUN...] [--development RUNS_DIR SCENE_DIR] [--name STEM]\n"
+                 "  (the first set gives the headline figures: the held-out scenes; STEM.json, STEM.md in docs/results,\n"
+                 "  default nudge_segmentation)\n";
     return 2;
   }
   const fs::path runs_dir = args[0], scene_dir = args[1];
@@ -380,15 +399,17 @@ int main(int argc, char** argv) {
     j.end_object();
   }
   j.end_object();
-  ex::write_result("nudge_segmentation.json", j.str() + "\n");
+  ex::write_result(name + ".json", j.str() + "\n");
 
   std::ostringstream md;
   md << "# Autonomous segmentation by a robotic nudge (thesis sec. 6.5, in simulation)\n\n"
      << "`experiments/nudge_segmentation.sh` runs the whole loop (world, camera with stills, symmetry, triangulation, "
         "arm, supervisor: every service its own process over LCM in a private network namespace) on each scene of two "
-        "sets: the **held-out** scenes `experiments/scenes/nudge_segmentation_heldout/` (`h*` single objects, `hm*` "
-        "several; written by `nudge-exp-nudge-segmentation-scenes` from seeds 610001-610015, fixed on 2026-11-24 "
-        "before any change was made for them, never re-staged) give the headline figures; the **development** scenes "
+        "sets: **held-out** scenes (`h*` single objects, `hm*` several; written by "
+        "`nudge-exp-nudge-segmentation-scenes` from seeds fixed before any run on them and never re-staged: "
+        "`experiments/scenes/nudge_segmentation_heldout/` from 610001-610015, fixed on 2026-11-24; "
+        "`nudge_segmentation_heldout2/` from 620001-620015, fixed on 2026-11-25 after the first set's failures had "
+        "been looked into) give the headline figures; the **development** scenes "
         "`experiments/scenes/nudge_segmentation/` (`s*`, `m*`: reported once, then used to find and fix the failures) "
         "follow. `nudge-exp-nudge-segmentation` scores each segmentation against the simulator's truth: the recorded "
         "state at the after still re-rendered at 1280x960 (label mask, handles included); the object the mask overlaps "
@@ -405,11 +426,11 @@ int main(int argc, char** argv) {
         "refused by the arm, segmentations that came out empty, lost stills. The motion segmentation time is over "
         "both sets' stills.\n\n"
      << "## Gallery\n\nPer segmentation (held-out scenes, then development): before, after, the mask over the after still.\n\n"
-     << "![gallery](nudge_segmentation_gallery.png)\n";
-  ex::write_result("nudge_segmentation.md", md.str());
+     << "![gallery](" << name << "_gallery.png)\n";
+  ex::write_result(name + ".md", md.str());
   std::vector<cv::Mat> gallery = main_set.gallery;
   if (dev_set) gallery.insert(gallery.end(), dev_set->gallery.begin(), dev_set->gallery.end());
-  if (!gallery.empty()) ex::write_png("nudge_segmentation_gallery.png", ex::tile(gallery, 2));
+  if (!gallery.empty()) ex::write_png(name + "_gallery.png", ex::tile(gallery, 2));
   std::cerr << main_set.successes << "/" << main_set.single_runs << " single-object runs segmented, mean IoU " << main_set.mean_iou()
             << ", multi-object " << main_set.multi_found << "/" << main_set.multi_present << ", motion segmentation " << ms << " ms\n";
   if (dev_set)

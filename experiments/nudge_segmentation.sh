@@ -4,8 +4,10 @@
 # of the development set (experiments/scenes/nudge_segmentation/), then nudge-exp-nudge-segmentation
 # scores the runs into docs/results/nudge_segmentation.{json,md}. Runs land in OUT/<set>/<scene>/
 # (--out, default out/experiments/nudge_segmentation). About a minute per single-object scene.
-#   experiments/nudge_segmentation.sh [--out DIR] [--set heldout|development|both] [SCENE_NAME...]
+#   experiments/nudge_segmentation.sh [--out DIR] [--set heldout|heldout2|development|both] [SCENE_NAME...]
 # Scene names run only those scenes of the one set chosen with --set (and score that set alone).
+# --set heldout2 runs the second held-out set (seeds 620001-620015, fixed 2026-11-25) and writes
+# docs/results/nudge_segmentation_heldout2.{json,md}.
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/../scripts/lib.sh"
 out_dir="$NUDGE_ROOT/out/experiments/nudge_segmentation"
@@ -15,19 +17,20 @@ while [ $# -gt 0 ]; do
   case "$1" in
     --out) out_dir="$(realpath -m "$2")"; shift 2 ;;
     --set) which_set="$2"; shift 2 ;;
-    -*) echo "unknown option $1 (--out DIR, --set heldout|development|both)" >&2; exit 2 ;;
+    -*) echo "unknown option $1 (--out DIR, --set heldout|heldout2|development|both)" >&2; exit 2 ;;
     *) names+=("$1"); shift ;;
   esac
 done
 case "$which_set" in
-  heldout|development) ;;
+  heldout|heldout2|development) ;;
   both) [ ${#names[@]} -eq 0 ] || { echo "scene names need --set heldout or --set development" >&2; exit 2; } ;;
-  *) echo "--set: heldout, development or both, not '$which_set'" >&2; exit 2 ;;
+  *) echo "--set: heldout, heldout2, development or both, not '$which_set'" >&2; exit 2 ;;
 esac
 nudge_install_packages
 nudge_build
 calibration="$NUDGE_ROOT/config/calibration_sim.yaml"
 declare -A scene_dirs=([heldout]="$NUDGE_ROOT/experiments/scenes/nudge_segmentation_heldout"
+                       [heldout2]="$NUDGE_ROOT/experiments/scenes/nudge_segmentation_heldout2"
                        [development]="$NUDGE_ROOT/experiments/scenes/nudge_segmentation")
 export -f nudge_run_loop
 
@@ -63,5 +66,7 @@ if [ "$which_set" = both ]; then
   "$score" "$out_dir/heldout" "${scene_dirs[heldout]}" --development "$out_dir/development" "${scene_dirs[development]}"
 else
   run_set "$which_set" "${names[@]}"
-  "$score" "$out_dir/$which_set" "${scene_dirs[$which_set]}" "${names[@]}"
+  result_name=nudge_segmentation
+  [ "$which_set" = heldout2 ] && result_name=nudge_segmentation_heldout2
+  "$score" "$out_dir/$which_set" "${scene_dirs[$which_set]}" "${names[@]}" --name "$result_name"
 fi

@@ -4,6 +4,10 @@
 // (experiments/scenes/nudge_segmentation/, reported once and tuned on since). Written once into
 // experiments/scenes/nudge_segmentation_heldout/ and never re-staged after results (docs/supervisor.md).
 //   nudge-exp-nudge-segmentation-scenes --out experiments/scenes/nudge_segmentation_heldout
+// A second set of the same plans from seeds 620001-620015, fixed 2026-11-25 before any run on it
+// (the first set's failures had been looked into by then, so it no longer tests what changed for
+// them):
+//   nudge-exp-nudge-segmentation-scenes --first-seed 620001 --out experiments/scenes/nudge_segmentation_heldout2
 // The objects are the learning experiment's (labelled bottles, cups, mugs: learning_scenes.hpp);
 // the files are written by the simulator's own scene writer (sim::scene_yaml).
 #include <Eigen/Core>
@@ -174,12 +178,15 @@ sim::Scene make_scene(const Plan& plan, uint64_t seed) {
 
 int main(int argc, char** argv) {
   std::string out;
+  int first_seed = static_cast<int>(kFirstSeed);
   nudge::Flags flags("nudge-exp-nudge-segmentation-scenes",
                      "Write the held-out scenes of the autonomous segmentation experiment (seeds fixed in advance).");
   flags.add_string("out", &out, "output directory (created)");
+  flags.add_int("first-seed", &first_seed, "scene i (1-based) is drawn from this seed + i - 1 (610001: the first held-out set; 620001: the second)");
   try {
     if (!flags.parse(argc, argv)) return 0;
     if (out.empty()) throw nudge::FlagError("--out DIR is required");
+    if (first_seed < 1) throw nudge::FlagError("--first-seed must be >= 1");
   } catch (const nudge::FlagError& e) {
     std::cerr << e.what() << "\n" << flags.help();
     return 2;
@@ -190,12 +197,13 @@ int main(int argc, char** argv) {
     for (size_t i = 0; i < plans().size(); ++i) {
       const Plan& plan = plans()[i];
       progress.step(plan.name);
-      const uint64_t seed = kFirstSeed + i;
+      const uint64_t seed = static_cast<uint64_t>(first_seed) + i;
       const sim::Scene scene = make_scene(plan, seed);
       const std::string file = out + "/" + plan.name + ".yaml";
       const std::string text = sim::scene_yaml(
           scene, "Held-out scene of nudge-exp-nudge-segmentation, written by nudge-exp-nudge-segmentation-scenes\n"
-                 "(seed " + std::to_string(seed) + ", fixed 2026-11-24 before any tuning; never re-staged).", "");
+                 "(seed " + std::to_string(seed) + ", fixed before any run on it: 610001-610015 on 2026-11-24,\n"
+                 "620001-620015 on 2026-11-25; never re-staged).", "");
       {
         std::ofstream f(file + ".tmp");
         f << text;

@@ -565,6 +565,10 @@ void add_flags(Flags& f, Options& o) {
   f.add_double("rest-mask-disagreement", &o.config.rest_mask_disagreement_m,
                "after the segmentation, the after still's mask's foot is the rest when the settled axes' rest is farther "
                "from it than this (and within the push window), m (0: the axes' rest stays)");
+  f.add_double("min-nudge-agreement", &o.config.targets.min_nudge_agreement,
+               "candidates that both cameras show upright in a smaller share of the survey's frames are not nudged (0: all are)");
+  f.add_double("min-mask-share", &o.config.min_mask_share,
+               "a mask smaller than this share of the smallest object's image at the rest is no segmentation (0: any)");
   f.add_double("snapshot-timeout", &o.config.snapshot_timeout_s, "for a still, s of the task clock");
   f.add_double("snapshot-retry", &o.config.snapshot_retry_s, "a still not come within this many s of the task clock is asked for again (a lost UDP fragment loses it)");
   f.add_double("candidates-timeout", &o.config.candidates_timeout_s, "for a CANDIDATES answer, s of the task clock");
@@ -621,6 +625,9 @@ int main(int argc, char** argv) {
       throw FlagError("--rest-core must lie in [0, 0.025] m (the group's own radius)");
     if (!(opt.config.rest_mask_disagreement_m >= 0 && opt.config.rest_mask_disagreement_m < 0.1))
       throw FlagError("--rest-mask-disagreement must lie in [0, 0.1) m");
+    if (!(opt.config.targets.min_nudge_agreement >= 0 && opt.config.targets.min_nudge_agreement <= 1))
+      throw FlagError("--min-nudge-agreement must lie in [0, 1]");
+    if (!(opt.config.min_mask_share >= 0 && opt.config.min_mask_share <= 1)) throw FlagError("--min-mask-share must lie in [0, 1]");
     if (!(opt.config.held_min_opening_m >= 0 && opt.config.held_min_opening_m < 0.1)) throw FlagError("--held-min-opening must lie in [0, 0.1) m");
     if (opt.config.views <= 0 || opt.config.views > 36) throw FlagError("--views must lie in [1, 36]");
     if (!(opt.config.view_step_deg > 0 && opt.config.view_step_deg <= 90)) throw FlagError("--view-step must lie in (0, 90] deg");

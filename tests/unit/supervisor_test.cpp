@@ -663,6 +663,29 @@ TEST_F(SupervisorTest, SurveyLinesOfFramesFromBeforeTheSurveyAreIgnored) {
   EXPECT_NE(chosen.find("(seen 100%)"), std::string::npos) << chosen;
 }
 
+// A candidate that no frame of the survey shows as an upright axis in both cameras (seen 0%: the
+// cameras see another object) is a stereo mismatch: passed over with its reason, not nudged.
+TEST_F(SupervisorTest, ACandidateNeitherCameraShowsUprightIsNotNudged) {
+  sv::Supervisor s = make();
+  const Eigen::Vector3d object(0.24, 0.08, 0), mismatch(0.31, -0.06, 0);
+  s.start(now_, 100);
+  s.on_services({}, now_);
+  const auto line_left = scene_.left_axis_line(object, 0.25, {640, 480});
+  const auto line_right = scene_.right_axis_line(object, 0.25, {640, 480});
+  ASSERT_TRUE(line_left && line_right);
+  for (int i = 0; i < 10; ++i) {
+    s.on_lines(true, {*line_left}, now_ + kSecond / 10, now_ + kSecond / 5);
+    s.on_lines(false, {*line_right}, now_ + kSecond / 10, now_ + kSecond / 5);
+  }
+  now_ += kSecond;
+  s.take_outputs();
+  s.on_candidates({{0, mismatch, 20}}, now_, now_);
+  EXPECT_EQ(s.state(), sv::State::Done);
+  EXPECT_EQ(s.summary().rejections.count("not seen upright by both cameras (a stereo mismatch)"), 1u);
+  EXPECT_NE(s.summary().end_reason.find("a stereo mismatch"), std::string::npos) << s.summary().end_reason;
+  EXPECT_EQ(s.summary().attempts, 0);
+}
+
 TEST_F(SupervisorTest, ASnapshotThatNeverComesEndsTheAttemptAfterItsTimeout) {
   sv::Supervisor s = make();
   start_with(s, {Eigen::Vector3d(0.28, -0.05, 0)});
@@ -876,6 +899,26 @@ TEST_F(SupervisorTest, MotionFarAboveTheObjectIsNotKeptInItsMask) {
   const cv::Mat& mask = ended[0].attempt->segmentation.mask;
   EXPECT_EQ(cv::countNonZero(mask(cv::Rect(600, 10, 80, 60))), 0) << "the high blob is gone";
   EXPECT_GT(cv::countNonZero(mask), 1000) << "the object stays";
+}
+
+// A few hundred pixels of motion (a cup's mask has ~20 000 in the still) are no object: the
+// attempt fails with its reason rather than reporting a segmentation of nothing (held-out hm1).
+TEST_F(SupervisorTest, AMaskTooSmallForAnyObjectIsNoSegmentation) {
+  auto speck = [](const cv::Mat& before, const cv::Mat& after, const nudge::symmetry::Line& l0, const nudge::symmetry::Line& l1) {
+    sv::Segmentation s = mask_of_difference(before, after, l0, l1);
+    cv::Rect box = cv::boundingRect(s.mask);
+    s.mask.setTo(0);
+    s.mask(cv::Rect(box.x, box.y + box.height - 20, std::min(box.width, 35), 20)).setTo(255);  // 700 px at its foot
+    return s;
+  };
+  sv::Supervisor s(sv::Config{}, scene_, sv::ArmSetup{}, speck);
+  const Eigen::Vector3d rest = nudge_and_park(s, Eigen::Vector3d(0.28, -0.05, 0));
+  ASSERT_EQ(s.state(), sv::State::SnapshotAfter);
+  s.on_right_still(draw_scene(scene_, {1280, 960}, {rest}), now_, now_);
+  const auto ended = outputs_of<sv::AttemptEnded>(s.take_outputs());
+  ASSERT_EQ(ended.size(), 1u);
+  EXPECT_EQ(ended[0].attempt->outcome, sv::Outcome::SegmentationFailed);
+  EXPECT_NE(ended[0].attempt->reason.find("too small for an object"), std::string::npos) << ended[0].attempt->reason;
 }
 
 // A mug's handle moves its symmetry line differently in the two cameras: the settled axes lie

@@ -573,6 +573,26 @@ cv::Mat World::render_snapshot(int camera_index) { return draw(camera_index, tru
 
 cv::Mat World::render_snapshot_mask(int camera_index) { return draw(camera_index, true, true); }
 
+cv::Mat World::render_snapshot_tool_mask(int camera_index) {
+  constexpr unsigned char kTool = 255;  // above every object's label (index + 1)
+  Impl& s = *impl_;
+  const std::vector<unsigned char> object_labels = s.geom_label;
+  for (int g = 0; g < s.model->ngeom; ++g) s.geom_label[g] = s.model->geom_group[g] == kPusherGroup ? kTool : 0;
+  const bool was_visible = pusher_visible;
+  pusher_visible = true;
+  cv::Mat labels;
+  try {
+    labels = draw(camera_index, true, true);
+  } catch (...) {
+    s.geom_label = object_labels;
+    pusher_visible = was_visible;
+    throw;
+  }
+  s.geom_label = object_labels;
+  pusher_visible = was_visible;
+  return labels == kTool;
+}
+
 CameraModel World::snapshot_camera(int camera_index) const {
   return scaled(camera(camera_index), scene_.render.snapshot_scale);
 }

@@ -485,10 +485,20 @@ void Supervisor::segment(int64_t now) {
   auto draw_stages = [&] {
     if (stages_later) a.segmentation.stages = segment_(a.before, a.after, *a.before_line, *a.after_line).stages;
   };
-  if (a.segmentation.mask.empty() || cv::countNonZero(a.segmentation.mask) < config_.min_mask_pixels) {
+  const int mask_pixels = a.segmentation.mask.empty() ? 0 : cv::countNonZero(a.segmentation.mask);
+  if (mask_pixels < config_.min_mask_pixels) {
     draw_stages();
     end_attempt(Outcome::SegmentationFailed,
                 "segmentation empty" + (a.segmentation.error.empty() ? std::string() : ": " + a.segmentation.error), now);
+    return;
+  }
+  const double smallest = smallest_object_pixels(*a.rest);
+  if (mask_pixels < config_.min_mask_share * smallest) {
+    draw_stages();
+    end_attempt(Outcome::SegmentationFailed,
+                "segmentation too small for an object: " + std::to_string(mask_pixels) + " px, the smallest object there shows " +
+                    std::to_string(static_cast<int>(smallest)) + " px",
+                now);
     return;
   }
   // The right mask read once: the object's top for the grasp, its foot for the rest's check.
@@ -503,6 +513,20 @@ void Supervisor::segment(int64_t now) {
     return;
   }
   end_attempt(Outcome::Segmented, "segmented", now);
+}
+
+// The still's pixels of the smallest object expected standing at `foot` (world): its width across
+// the right camera's view times its height, both projected.
+double Supervisor::smallest_object_pixels(const Eigen::Vector3d& foot) const {
+  const Eigen::Vector3d base(foot.x(), foot.y(), 0.0);
+  const Eigen::Vector2d ray = viewing_ray(base);
+  const Eigen::Vector3d across = config_.min_object_radius_m * Eigen::Vector3d(-ray.y(), ray.x(), 0.0);
+  const auto left = scene_.project_right(base - across, config_.still_size);
+  const auto right = scene_.project_right(base + across, config_.still_size);
+  const auto top = scene_.project_right(base + Eigen::Vector3d(0, 0, config_.min_object_height_m), config_.still_size);
+  const auto bottom = scene_.project_right(base, config_.still_size);
+  if (!left || !right || !top || !bottom) return 0.0;
+  return cv::norm(*left - *right) * cv::norm(*top - *bottom);
 }
 
 // The settled axes' rest against the mask's foot (after the left segmentation has joined: it

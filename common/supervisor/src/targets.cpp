@@ -95,6 +95,10 @@ TargetChoice choose_pass(const std::vector<Candidate>& candidates, const std::ve
       reject("already explored");
       continue;
     }
+    if (c.stereo_agreement < params.min_nudge_agreement) {
+      reject("not seen upright by both cameras (a stereo mismatch)");
+      continue;
+    }
     std::string why_not;
     const std::vector<Eigen::Vector3d> obstacles = obstacles_to(c, candidates, history, params);
     for (const Eigen::Vector3d& direction_base :

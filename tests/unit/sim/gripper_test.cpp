@@ -147,6 +147,30 @@ TEST(SimGripper, OnlyTheToolInUseIsDrawn) {
   EXPECT_EQ(cv::countNonZero(gripper > 1), 0) << "the gripper carries no object label";
 }
 
+// The tool's own pixels in a still (the experiment's end-effector count): the pad in front of a cup
+// covers some of the cup's pixels, and the tool mask is exactly those it hides plus where it
+// stands against the table; nothing where no tool is drawn, and the labels are left as they were.
+TEST(SimGripper, TheToolMaskIsTheToolsOwnPixels) {
+  World world(one_object("cup"));
+  world.set_state(world.state());
+  const cv::Mat nowhere = world.render_snapshot_tool_mask(1);
+  const cv::Mat alone = world.render_snapshot_mask(1);
+  world.set_pusher(Eigen::Vector3d(0.36, 0.0, 0.05), M_PI / 2);
+  world.set_state(world.state());
+  const cv::Mat tool = world.render_snapshot_tool_mask(1);
+  const cv::Mat labels = world.render_snapshot_mask(1);
+  const cv::Mat hidden_cup = (alone == 1) & (labels == 0);
+  EXPECT_GT(cv::countNonZero(hidden_cup), 300);
+  EXPECT_EQ(cv::countNonZero(hidden_cup & ~tool), 0) << "every cup pixel the pad hides is the tool's";
+  EXPECT_EQ(cv::countNonZero(tool & (labels == 1)), 0) << "no pixel of the cup itself";
+  EXPECT_LT(cv::countNonZero(nowhere & tool), cv::countNonZero(tool));
+  world.pusher_visible = false;
+  EXPECT_GT(cv::countNonZero(world.render_snapshot_tool_mask(1)), 300) << "drawn whatever pusher_visible says";
+  EXPECT_FALSE(world.pusher_visible);
+  world.pusher_visible = true;
+  EXPECT_EQ(cv::countNonZero(world.render_snapshot_mask(1) != labels), 0);
+}
+
 // Gripper runs are deterministic: two Worlds given the same calls end bit-identically, and a state
 // taken while the gripper holds a bottle (the fingers' commands and the tool in use are part of
 // it) replays exactly. (This needed set_state() to put qpos back after mj_forward(), which

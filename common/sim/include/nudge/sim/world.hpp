@@ -157,6 +157,9 @@ class World {
   // camera model that goes with it.
   cv::Mat render_snapshot(int camera);
   cv::Mat render_snapshot_mask(int camera);
+  // CV_8U, 255 where the still shows the tool itself (pusher pad or gripper; not its shadow), 0
+  // elsewhere: the end effector's pixels, occluded where objects stand in front of it.
+  cv::Mat render_snapshot_tool_mask(int camera);
   CameraModel snapshot_camera(int camera) const;
   // Which surface point of which object each pixel shows (ground truth for feature matches: two
   // pixels show the same point of an object when their coordinates agree). CV_32FC3: the point in

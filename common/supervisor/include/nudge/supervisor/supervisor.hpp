@@ -103,6 +103,11 @@ struct Config {
   double min_displacement_m = 0.004; // a smaller slide gives no difference to segment
   double object_height_m = 0.25;     // the tallest expected object (lines drawn up to it)
   int min_mask_pixels = 200;         // a smaller mask (in the still) is no object
+  // Nor is a mask smaller than this share of the still's image of the smallest object expected
+  // (min_object_radius_m x min_object_height_m standing at the rest). Held-out hm1 (2026-11-25):
+  // a 731 px mask (a cup's is ~20 000) was taken for a segmentation of nothing.
+  double min_mask_share = 0.25;
+  double min_object_radius_m = 0.025, min_object_height_m = 0.06;
   // Rows watched for motion: from the table to this height. The object's foot moves when it is
   // pushed; the arm's links, higher up, may pass beyond the line in the image, the pad never does.
   double motion_rows_height_m = 0.06;
@@ -362,6 +367,7 @@ class Supervisor {
   std::vector<Eigen::Vector3d> standing_;  // explored objects where they stand now (CandidatesRequest::explored)
   std::vector<Eigen::Vector3d> rests_;  // where nudged objects came to rest (they stand there now)
   std::vector<Eigen::Vector3d> explored_with_ray_mates() const;
+  double smallest_object_pixels(const Eigen::Vector3d& foot) const;
   bool same_object_in_a_camera(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const;
   std::vector<Candidate> drop_hidden_behind_arm_base(std::vector<Rejection>& rejected) const;
   Eigen::Vector2d viewing_ray(const Eigen::Vector3d& at) const;
