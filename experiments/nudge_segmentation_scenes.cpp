@@ -202,8 +202,10 @@ int main(int argc, char** argv) {
       const std::string file = out + "/" + plan.name + ".yaml";
       const std::string text = sim::scene_yaml(
           scene, "Held-out scene of nudge-exp-nudge-segmentation, written by nudge-exp-nudge-segmentation-scenes\n"
-                 "(seed " + std::to_string(seed) + ", fixed before any run on it: 610001-610015 on 2026-11-24,\n"
-                 "620001-620015 on 2026-11-25; never re-staged).", "");
+                 "(seed " + std::to_string(seed) +
+                 (first_seed == static_cast<int>(kFirstSeed) ? ", fixed 2026-11-24 before any tuning; never re-staged)."
+                                                             : "; seeds 620001-620015 fixed 2026-11-25 before any run on them; never re-staged)."),
+          "");
       {
         std::ofstream f(file + ".tmp");
         f << text;
