@@ -1,6 +1,8 @@
 #include "handlers.hpp"
 
+#include <algorithm>
 #include <stdexcept>
+#include <vector>
 
 #include "nudge/bus/image.hpp"
 #include "nudge/bus/symmetry_convert.hpp"
@@ -48,6 +50,24 @@ symmetry::EdgeParams edge_params_for(const Options& options) {
   return edge;
 }
 
+// With the reach filter, the weak-peak cut (min_peak_ratio of the top peak) is made after it,
+// against the top line standing within reach: the arm's base column, fully in view once the arm
+// has withdrawn, outvotes a cup in front of it tenfold, and its peak, dropped by the reach filter,
+// would otherwise have cut the cup's (held-out h01 cups, 2026-11-25).
+symmetry::Params detector_params_for(const Options& options) {
+  symmetry::Params params = options.params;
+  if (options.reach) params.min_peak_ratio = 0;
+  return params;
+}
+
+void drop_weak_lines(std::vector<symmetry::Line>& lines, double min_peak_ratio) {
+  double top = 0;
+  for (const symmetry::Line& line : lines) top = std::max(top, line.votes);
+  lines.erase(std::remove_if(lines.begin(), lines.end(),
+                             [&](const symmetry::Line& line) { return line.votes < min_peak_ratio * top; }),
+              lines.end());
+}
+
 segmentation::SegmentParams segment_params_for(const Options& options) {
   segmentation::SegmentParams params;
   if (options.params.dmax > 0) params.max_width = options.params.dmax;  // thesis: MAXw is usually Dmax
@@ -59,7 +79,7 @@ segmentation::SegmentParams segment_params_for(const Options& options) {
 Handlers::Handlers(bus::Service& service, const Options& options)
     : service_(service),
       options_(options),
-      detector_(options.params, edge_params_for(options)),
+      detector_(detector_params_for(options), edge_params_for(options)),
       segmenter_(segment_params_for(options)) {
   options_.edge = edge_params_for(options);
   for (const auto& channel : options_.inputs) {
@@ -145,6 +165,7 @@ void Handlers::detect_and_publish(const cv::Mat& image, const image_t& msg, cons
     const Options::Reach& reach = *options_.reach;
     result.lines = geometry::lines_standing_within(reach.rig, side, reach.table, reach.centre, reach.radius, result.lines,
                                                       reach.inner_radius);
+    drop_weak_lines(result.lines, options_.params.min_peak_ratio);
     if (reach.keep > 0 && static_cast<int>(result.lines.size()) > reach.keep) result.lines.resize(reach.keep);
     result.ms.peaks_ms += reach_watch.elapsed_ms();
   }

@@ -3,6 +3,7 @@
 // child process (the binary's log-to-log test is symmetry_service_test.cpp).
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include <cmath>
 #include <string>
@@ -297,4 +298,30 @@ TEST(SymmetryHandlers, OnlyLinesStandingWithinReachArePublished) {
   ASSERT_EQ(near.num_lines, 1) << "--reach-keep 1";
   EXPECT_NEAR(near.lines[0].r, 20, 1.0);
   EXPECT_EQ(lines_with(Eigen::Vector3d(0, 0.3, 20.0)).num_lines, 0);
+
+  // Beside the bottle, above the horizon (out of reach), a striped panel whose peak outvotes the
+  // bottle's more than tenfold, as the arm's base column does a cup once the arm has withdrawn.
+  // The weak-peak cut (min_peak_ratio 0.1) is made among the lines within reach: the bottle stays.
+  reach.centre = Eigen::Vector3d(0, 0.3, 1.0);
+  options.reach = reach;
+  options.params.num_lines = 60;  // the panel's stripes give dozens of peaks
+  InProcess run(options);
+  Latest<nudge::symmetry_lines_t> right(run.probe, "SYMMETRY_RIGHT");
+  cv::Mat img(240, 320, CV_8UC3, cv::Scalar(200, 210, 220));
+  syn::draw_shape(img, syn::bottle_profile(64, 20), 60, 0, 0, cv::Scalar(40, 60, 90));
+  for (int stripe = 0; stripe < 24; ++stripe)
+    if (stripe % 2 == 0) cv::rectangle(img, cv::Rect(10 + 5 * stripe, 0, 5, 115), cv::Scalar(30, 30, 30), cv::FILLED);
+  nudge::image_t image = nudge::bus::to_message(img, nudge::image_t::FORMAT_GRAY8, 1, 1, "right");
+  run.bus.publish("CAMERA_RIGHT", &image);
+  run.service.handle_pending();
+  const nudge::symmetry_lines_t lines = right.get();
+  ASSERT_GE(lines.num_lines, 1);
+  EXPECT_NEAR(lines.lines[0].r, 60, 1.0) << "the bottle, the strongest line within reach";
+  // The panel's own peak, as the detector alone finds it: more than ten times the bottle's.
+  nudge::symmetry::Params alone = options.params;
+  alone.min_peak_ratio = 0;
+  const auto all = nudge::symmetry::Detector(alone).detect(img);
+  ASSERT_GE(all.lines.size(), 2u);
+  EXPECT_NEAR(all.lines[0].r, 10 + 5 * 11.5 - 159.5, 3.0) << "the panel's axis";
+  EXPECT_GT(all.lines[0].votes, 10 * lines.lines[0].votes);
 }
