@@ -157,6 +157,16 @@ class SupervisorTest : public ::testing::Test {
     s.on_candidates(list, now_, now_);
     return s.take_outputs();
   }
+  // `frames` stereo pairs of survey lines, taken after the survey began, that show `object`'s axis.
+  void hear_survey_lines(sv::Supervisor& s, const Eigen::Vector3d& object, int frames) {
+    const auto line_left = scene_.left_axis_line(object, 0.25, {640, 480});
+    const auto line_right = scene_.right_axis_line(object, 0.25, {640, 480});
+    ASSERT_TRUE(line_left && line_right);
+    for (int i = 0; i < frames; ++i) {
+      s.on_lines(true, {*line_left}, now_ + kSecond / 10, now_ + kSecond / 5);
+      s.on_lines(false, {*line_right}, now_ + kSecond / 10, now_ + kSecond / 5);
+    }
+  }
   // A stereo pair of frames of `objects`.
   void show(sv::Supervisor& s, const std::vector<Eigen::Vector3d>& objects) {
     s.on_left_frame(draw_scene(scene_, {640, 480}, objects, true), now_);
@@ -642,18 +652,12 @@ TEST_F(SupervisorTest, SurveyLinesOfFramesFromBeforeTheSurveyAreIgnored) {
   s.start(now_, 100);
   s.on_services({}, now_);
   ASSERT_EQ(s.state(), sv::State::FindCandidates);
-  const auto line_left = scene_.left_axis_line(object, 0.25, {640, 480});
-  const auto line_right = scene_.right_axis_line(object, 0.25, {640, 480});
-  ASSERT_TRUE(line_left && line_right);
   // Before the survey: frames that see nothing there. After: frames that see the object.
   for (int i = 0; i < 10; ++i) {
     s.on_lines(true, {}, now_ - kSecond, now_ + i);
     s.on_lines(false, {}, now_ - kSecond, now_ + i);
   }
-  for (int i = 0; i < 5; ++i) {
-    s.on_lines(true, {*line_left}, now_ + kSecond / 10, now_ + kSecond / 5);
-    s.on_lines(false, {*line_right}, now_ + kSecond / 10, now_ + kSecond / 5);
-  }
+  hear_survey_lines(s, object, 5);
   now_ += kSecond;
   s.take_outputs();
   s.on_candidates({{0, object, 20}}, now_, now_);
@@ -670,13 +674,7 @@ TEST_F(SupervisorTest, ACandidateNeitherCameraShowsUprightIsNotNudged) {
   const Eigen::Vector3d object(0.24, 0.08, 0), mismatch(0.31, -0.06, 0);
   s.start(now_, 100);
   s.on_services({}, now_);
-  const auto line_left = scene_.left_axis_line(object, 0.25, {640, 480});
-  const auto line_right = scene_.right_axis_line(object, 0.25, {640, 480});
-  ASSERT_TRUE(line_left && line_right);
-  for (int i = 0; i < 10; ++i) {
-    s.on_lines(true, {*line_left}, now_ + kSecond / 10, now_ + kSecond / 5);
-    s.on_lines(false, {*line_right}, now_ + kSecond / 10, now_ + kSecond / 5);
-  }
+  hear_survey_lines(s, object, 10);
   now_ += kSecond;
   s.take_outputs();
   s.on_candidates({{0, mismatch, 20}}, now_, now_);
