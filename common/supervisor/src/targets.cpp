@@ -65,8 +65,6 @@ bool near_any(const Eigen::Vector3d& p, const std::vector<Eigen::Vector3d>& plac
   return std::any_of(places.begin(), places.end(), [&](const Eigen::Vector3d& e) { return horizontal(e - p).norm() < radius; });
 }
 
-// One pass over the candidates in camera order. With `strict`, a push that may touch another
-// candidate is refused; otherwise it is taken and noted.
 // The places a push must keep clear of: the other candidates that count as objects, and the
 // explored objects standing where no candidate is (their lines left out of the survey).
 std::vector<Eigen::Vector3d> obstacles_to(const Candidate& c, const std::vector<Candidate>& candidates, const History& history,
@@ -83,6 +81,8 @@ std::vector<Eigen::Vector3d> obstacles_to(const Candidate& c, const std::vector<
   return obstacles;
 }
 
+// One pass over the candidates in camera order. With `strict`, a push that may touch another
+// candidate is refused; otherwise it is taken and noted.
 TargetChoice choose_pass(const std::vector<Candidate>& candidates, const std::vector<size_t>& order, const History& history,
                          const Eigen::Vector3d& camera_base, const ArmSetup& arm, const robot::JointVector& seed,
                          const TargetParams& params, bool strict) {
