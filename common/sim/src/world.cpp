@@ -576,21 +576,20 @@ cv::Mat World::render_snapshot_mask(int camera_index) { return draw(camera_index
 cv::Mat World::render_snapshot_tool_mask(int camera_index) {
   constexpr unsigned char kTool = 255;  // above every object's label (index + 1)
   Impl& s = *impl_;
-  const std::vector<unsigned char> object_labels = s.geom_label;
+  // The objects' labels and the pusher's visibility come back however draw() ends.
+  struct Restore {
+    std::vector<unsigned char>& labels;
+    const std::vector<unsigned char> saved;
+    bool& visible;
+    const bool was;
+    ~Restore() {
+      labels = saved;
+      visible = was;
+    }
+  } restore{s.geom_label, s.geom_label, pusher_visible, pusher_visible};
   for (int g = 0; g < s.model->ngeom; ++g) s.geom_label[g] = s.model->geom_group[g] == kPusherGroup ? kTool : 0;
-  const bool was_visible = pusher_visible;
   pusher_visible = true;
-  cv::Mat labels;
-  try {
-    labels = draw(camera_index, true, true);
-  } catch (...) {
-    s.geom_label = object_labels;
-    pusher_visible = was_visible;
-    throw;
-  }
-  s.geom_label = object_labels;
-  pusher_visible = was_visible;
-  return labels == kTool;
+  return draw(camera_index, true, true) == kTool;
 }
 
 CameraModel World::snapshot_camera(int camera_index) const {
