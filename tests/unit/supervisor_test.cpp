@@ -1044,6 +1044,50 @@ TEST_F(SupervisorTest, ACandidateOnTheRestedObjectsLineInACameraIsThatObjectNotN
   EXPECT_EQ(t.state(), sv::State::SnapshotBefore) << t.report().reason;
 }
 
+// A striped object's other lines pair into candidates off its axis at other depths: one whose line
+// in the right camera runs through the segmented object's mask is that object (development s06:
+// the striped bottle nudged twice), one beside it is not.
+TEST_F(SupervisorTest, ACandidateWhoseLineCrossesASegmentedObjectIsThatObjectNotNudgedAgain) {
+  const Eigen::Vector3d object(0.28, -0.05, 0);
+  for (const bool on_the_object : {true, false}) {
+    SCOPED_TRACE(on_the_object ? "its line crosses the object's mask" : "its line passes beside it");
+    // A segmentation that is the whole object where it rests (the difference marks only the
+    // edges of the drawing's flat bands).
+    const cv::Mat empty_table = draw_scene(scene_, {1280, 960}, {});
+    sv::Supervisor s(sv::Config{}, scene_, sv::ArmSetup{}, [&](const cv::Mat&, const cv::Mat& after, const auto&, const auto&) {
+      sv::Segmentation whole;
+      cv::Mat diff, channels[3];
+      cv::absdiff(empty_table, after, diff);
+      cv::split(diff, channels);
+      whole.mask = cv::max(cv::max(channels[0], channels[1]), channels[2]) > 20;
+      return whole;
+    });
+    const Eigen::Vector3d rest = nudge_and_park(s, object);
+    s.on_right_still(draw_scene(scene_, {1280, 960}, {rest}), now_, now_);
+    const auto ended = outputs_of<sv::AttemptEnded>(s.take_outputs());
+    ASSERT_EQ(ended.at(0).attempt->outcome, sv::Outcome::Segmented);
+    const Eigen::Vector3d ray = along_ray(rest), across(-ray.y(), ray.x(), 0.0);
+    // 6 cm farther along the ray and 2 cm to one side (or 9 cm to the other, where its push stays
+    // clear of the object at rest): on neither camera's line of the object's axis (more than the
+    // 6 px agreement off), but 2 cm is inside its image.
+    const Eigen::Vector3d mate = rest + 0.06 * ray + (on_the_object ? 0.02 : -0.09) * across;
+    for (const bool left : {true, false}) {
+      const auto of_rest = left ? scene_.left_axis_line(rest, 0.25, {640, 480}) : scene_.right_axis_line(rest, 0.25, {640, 480});
+      const auto of_mate = left ? scene_.left_axis_line(mate, 0.25, {640, 480}) : scene_.right_axis_line(mate, 0.25, {640, 480});
+      ASSERT_TRUE(of_rest && of_mate);
+      EXPECT_FALSE(sv::lines_agree(*of_mate, *of_rest, 3 * M_PI / 180, 6)) << (left ? "left" : "right");
+    }
+    answer_survey(s, {mate});
+    if (on_the_object) {
+      EXPECT_EQ(s.state(), sv::State::Done) << s.report().reason;
+      ASSERT_EQ(s.summary().rejections.size(), 1u);
+      EXPECT_EQ(s.summary().rejections.begin()->first, "already explored");
+    } else {
+      EXPECT_EQ(s.state(), sv::State::SnapshotBefore) << s.report().reason;
+    }
+  }
+}
+
 // The arm's base column is symmetric: a stereo mismatch of its line gives a candidate behind it
 // (on its line in one camera), where that camera cannot see anything. Not nudged; the object is.
 TEST_F(SupervisorTest, ACandidateHiddenBehindTheArmsBaseIsPassedOverWithItsReason) {

@@ -7,6 +7,8 @@
 #include <future>
 #include <stdexcept>
 
+#include <opencv2/imgproc.hpp>
+
 #include "nudge/robot/command_planner.hpp"
 #include "nudge/supervisor/grasp.hpp"
 
@@ -221,12 +223,31 @@ std::vector<Candidate> Supervisor::drop_hidden_behind_arm_base(std::vector<Rejec
 std::vector<Eigen::Vector3d> Supervisor::explored_with_ray_mates() const {
   std::vector<Eigen::Vector3d> explored = explored_;
   for (const Candidate& c : candidates_)
-    for (const Eigen::Vector3d& rest : rests_)
-      if (same_object_in_a_camera(c.position, rest)) {
+    for (size_t i = 0; i < rests_.size(); ++i)
+      if (same_object_in_a_camera(c.position, rests_[i]) ||
+          ((c.position - rests_[i]).head<2>().norm() <= config_.same_object_depth_m &&
+           share_of_mask_rows_on_line(c.position, rest_masks_[i]) >= config_.same_object_mask_share)) {
         explored.push_back(c.position);
         break;
       }
   return explored;
+}
+
+double Supervisor::share_of_mask_rows_on_line(const Eigen::Vector3d& foot, const cv::Mat& mask) const {
+  if (mask.empty()) return 0.0;
+  const cv::Rect box = cv::boundingRect(mask);
+  const auto bottom = scene_.project_right(Eigen::Vector3d(foot.x(), foot.y(), 0.0), mask.size());
+  const auto top = scene_.project_right(Eigen::Vector3d(foot.x(), foot.y(), config_.object_height_m), mask.size());
+  if (box.empty() || !bottom || !top || std::fabs(top->y - bottom->y) < 1.0) return 0.0;
+  const int reach = 2;  // px either side: the line's rounding and the mask's ragged edge
+  int on = 0;
+  for (int y = box.y; y < box.y + box.height; ++y) {
+    const double t = (y - bottom->y) / (top->y - bottom->y);
+    const int x = cvRound(bottom->x + t * (top->x - bottom->x));
+    const int from = std::max(x - reach, 0), to = std::min(x + reach, mask.cols - 1);
+    if (from <= to && cv::countNonZero(mask.row(y).colRange(from, to + 1)) > 0) ++on;
+  }
+  return static_cast<double>(on) / box.height;
 }
 
 void Supervisor::request_still(State state, int64_t now, const std::string& note) {
@@ -588,6 +609,7 @@ void Supervisor::end_attempt(Outcome outcome, const std::string& reason, int64_t
     if (a.rest) {
       explored_.push_back(*a.rest);
       rests_.push_back(*a.rest);
+      rest_masks_.push_back(outcome == Outcome::Segmented ? a.segmentation.mask : cv::Mat());
       standing_.push_back(*a.rest);
     } else if (outcome == Outcome::Known || outcome == Outcome::Refused) {
       standing_.push_back(a.target.position);  // never pushed: it stands where it was found

@@ -95,6 +95,11 @@ struct Config {
   // object seen through a stereo mismatch) within this distance of it is that object: not nudged
   // again. (s01, s03, s10: the phantom nudged second stood 4-9 cm behind the object on its ray.)
   double same_object_depth_m = 0.10;
+  // So is one within that distance whose line in the right camera runs through the rested
+  // object's segmentation on at least this share of the mask's rows: a striped or labelled
+  // object's other lines pair into candidates at other depths, off its axis (development s06:
+  // a second nudge of the striped bottle; m02, m03: phantoms on a segmented object's lines).
+  double same_object_mask_share = 0.5;
   // Median tilt of the settled axis beyond which the object tipped. Upright objects measured up
   // to 12.6 deg in the development runs (a triangulated axis' depth-wise error); the thesis keeps
   // axes within 15 deg (ch. 4), as the triangulation service's AXES do: an object that tips over
@@ -366,9 +371,13 @@ class Supervisor {
   std::vector<Eigen::Vector3d> explored_, phantoms_, empty_;
   std::vector<Eigen::Vector3d> standing_;  // explored objects where they stand now (CandidatesRequest::explored)
   std::vector<Eigen::Vector3d> rests_;  // where nudged objects came to rest (they stand there now)
+  std::vector<cv::Mat> rest_masks_;     // each rest's segmentation (empty when there is none)
   std::vector<Eigen::Vector3d> explored_with_ray_mates() const;
   double smallest_object_pixels(const Eigen::Vector3d& foot) const;
   bool same_object_in_a_camera(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const;
+  // The share of `mask`'s rows (its bounding box's) where the right camera's image of an upright
+  // axis at `foot` passes through the mask (within 2 px): 1 for a line on the object, 0 beside it.
+  double share_of_mask_rows_on_line(const Eigen::Vector3d& foot, const cv::Mat& mask) const;
   std::vector<Candidate> drop_hidden_behind_arm_base(std::vector<Rejection>& rejected) const;
   Eigen::Vector2d viewing_ray(const Eigen::Vector3d& at) const;
   std::vector<Axis> settled_axes_;
