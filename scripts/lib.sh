@@ -150,10 +150,10 @@ nudge_in_private_network() {
 # support stands on the table within 0.45 m of the arm's base and not within 0.10 m of it
 # (nudge-symmetry --reach-calibration, --reach-inner-radius: a wall's or the far table's lines
 # cannot be objects the arm reaches, and the arm's own base column, 65 mm in radius, is none).
-# "plain" surveys pair only lines within 3 deg of the image of an upright axis
-# (nudge-triangulation --candidate-line-tilt 3): objects' lines lean 0-1 deg (a degraded one up
-# to 4), lines between two objects 2.5-5 deg; 3 was chosen on the development runs' logs
-# (docs/supervisor.md, "The survey-line tilt").
+# "plain" surveys pair only lines within 2 deg of the image of an upright axis
+# (nudge-triangulation --candidate-line-tilt 2): objects' lines lean 0-1 deg (a degraded one up
+# to 4), lines between two objects 2.5-5 deg; re-chosen on 33 recorded development runs
+# (docs/supervisor.md, nudge-exp-survey-line-tilt: 2 and 3 deg keep as many real candidates).
 nudge_run_loop() {
   local bin=$1 scene=$2 calibration=$3 workspace=$4 out=$5 run=$6
   shift 6
@@ -189,7 +189,7 @@ nudge_run_loop() {
       triangulation_flags=', "--stereo-check", "--cluster-min-fraction", "0.03"'
       survey=(--survey-lines 8) ;;
     plain)
-      triangulation_flags=', "--candidate-line-tilt", "3"'
+      triangulation_flags=', "--candidate-line-tilt", "2"'
       if [ "${NUDGE_LOOP_REACH:-1}" = 1 ]; then
         symmetry_flags='"--lines", "20", "--reach-calibration", "'"$calibration"'", "--reach-inner-radius", "0.10", "--reach-keep", "5"'
       fi ;;

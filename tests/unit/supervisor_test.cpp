@@ -1044,6 +1044,29 @@ TEST_F(SupervisorTest, ACandidateOnTheRestedObjectsLineInACameraIsThatObjectNotN
   EXPECT_EQ(t.state(), sv::State::SnapshotBefore) << t.report().reason;
 }
 
+// A push whose segmentation comes out empty leaves its place explored, but nothing is known to
+// stand there: its lines stay in later surveys and what stands on them is nudged (development m03:
+// a phantom's push barely moved a neighbour, and leaving out the phantom's lines - the cup's and
+// the bottle's - left the cup no candidate again).
+TEST_F(SupervisorTest, AFailedSegmentationsRestIsNoObjectToLeaveOut) {
+  sv::Supervisor s(sv::Config{}, scene_, sv::ArmSetup{}, [](const cv::Mat&, const cv::Mat&, const auto&, const auto&) {
+    sv::Segmentation nothing;
+    nothing.error = "segmentation empty";
+    return nothing;
+  });
+  const Eigen::Vector3d object(0.28, -0.05, 0);
+  const Eigen::Vector3d rest = nudge_and_park(s, object);
+  s.on_right_still(draw_scene(scene_, {1280, 960}, {rest}), now_, now_);
+  const auto out = s.take_outputs();
+  ASSERT_EQ(outputs_of<sv::AttemptEnded>(out).at(0).attempt->outcome, sv::Outcome::SegmentationFailed);
+  const auto surveys = outputs_of<sv::CandidatesRequest>(out);
+  ASSERT_EQ(surveys.size(), 1u);
+  EXPECT_TRUE(surveys[0].explored.empty());
+  // On its line in the right camera, 8 cm farther: not taken for the place nudged.
+  answer_survey(s, {rest + 0.08 * along_ray(rest)});
+  EXPECT_EQ(s.state(), sv::State::SnapshotBefore) << s.report().reason;
+}
+
 // A striped object's other lines pair into candidates off its axis at other depths: one whose line
 // in the right camera runs through the segmented object's mask is that object (development s06:
 // the striped bottle nudged twice), one beside it is not.

@@ -606,10 +606,14 @@ void Supervisor::end_attempt(Outcome outcome, const std::string& reason, int64_t
     explored_.push_back(a.target.position);
     for (const Candidate& c : a.candidates)  // the same object seen at another depth
       if ((c.position - a.target.position).head<2>().norm() < config_.targets.same_object_radius) explored_.push_back(c.position);
-    if (a.rest) {
-      explored_.push_back(*a.rest);
+    if (a.rest) explored_.push_back(*a.rest);
+    if (a.rest && outcome == Outcome::Segmented) {
+      // Only a segmented object is known to stand at its rest. Another outcome's rest may be the
+      // phantom's axes seen again after a push that barely moved a neighbour; leaving its lines
+      // out of the surveys would leave out the neighbours' lines that made it (development m03:
+      // the yellow cup was never a candidate again).
       rests_.push_back(*a.rest);
-      rest_masks_.push_back(outcome == Outcome::Segmented ? a.segmentation.mask : cv::Mat());
+      rest_masks_.push_back(a.segmentation.mask);
       standing_.push_back(*a.rest);
     } else if (outcome == Outcome::Known || outcome == Outcome::Refused) {
       standing_.push_back(a.target.position);  // never pushed: it stands where it was found

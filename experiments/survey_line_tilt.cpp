@@ -1,0 +1,227 @@
+// The survey-line tilt (nudge-triangulation --candidate-line-tilt) chosen on recorded runs: each
+// run's log (experiments/nudge_segmentation.sh's RUNS_DIR/<scene>/<scene>/<scene>.lcmlog) is
+// replayed through nudge-triangulation at each tilt, with the run's own SYMMETRY lines and
+// CANDIDATES_REQUESTs, and every candidate of every survey is scored against the simulator's
+// SIM_STATE of that moment: within --real-radius of an object it is that object (real), else a
+// phantom. Writes docs/results/NAME.{json,md} (default survey_line_tilt).
+//   nudge-exp-survey-line-tilt RUNS_DIR [RUNS_DIR...] [--tilts 1,2,3] [--real-radius 0.03] [--name STEM]
+// Later surveys follow what the recorded run did (its pushes, its explored places): a replay
+// scores the lines each tilt keeps, not a new run. Choose on development runs only.
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "nudge/candidates_t.hpp"
+#include "nudge/sim_state_t.hpp"
+#include "nudge/supervisor/scene.hpp"
+#include "report.hpp"
+
+namespace fs = std::filesystem;
+using nudge::supervisor::SceneGeometry;
+
+namespace {
+
+struct Score {
+  int surveys = 0, real = 0, phantom = 0;
+  std::set<std::string> objects_found;  // objects some survey's candidate stood on
+  int objects = 0;
+};
+
+std::vector<double> parse_list(const std::string& text) {
+  std::vector<double> values;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    char* end = nullptr;
+    const double v = std::strtod(item.c_str(), &end);
+    if (item.empty() || *end != '\0' || !(v > 0)) throw std::invalid_argument("--tilts: not a positive number: '" + item + "'");
+    values.push_back(v);
+  }
+  return values;
+}
+
+std::vector<nudge::sim_state_t> read_states(const fs::path& log_path) {
+  std::vector<nudge::sim_state_t> states;
+  lcm::LogFile log(log_path.string(), "r");
+  if (!log.good()) throw std::runtime_error("cannot read " + log_path.string());
+  for (const lcm::LogEvent* e = log.readNextEvent(); e; e = log.readNextEvent()) {
+    if (e->channel != "SIM_STATE") continue;
+    nudge::sim_state_t s;
+    if (s.decode(e->data, 0, e->datalen) >= 0) states.push_back(std::move(s));
+  }
+  return states;
+}
+
+std::vector<nudge::candidates_t> read_surveys(const fs::path& log_path) {
+  std::vector<nudge::candidates_t> surveys;
+  lcm::LogFile log(log_path.string(), "r");
+  if (!log.good()) throw std::runtime_error("cannot read " + log_path.string());
+  for (const lcm::LogEvent* e = log.readNextEvent(); e; e = log.readNextEvent()) {
+    if (e->channel != "CANDIDATES") continue;
+    nudge::candidates_t c;
+    if (c.decode(e->data, 0, e->datalen) >= 0) surveys.push_back(std::move(c));
+  }
+  return surveys;
+}
+
+// The latest state at or before `utime` (states are in log order, utime rising).
+const nudge::sim_state_t* state_at(const std::vector<nudge::sim_state_t>& states, int64_t utime) {
+  const nudge::sim_state_t* found = nullptr;
+  for (const auto& s : states) {
+    if (s.utime > utime) break;
+    found = &s;
+  }
+  return found;
+}
+
+void score_surveys(const std::vector<nudge::candidates_t>& surveys, const std::vector<nudge::sim_state_t>& states,
+                   const SceneGeometry& scene, double real_radius, Score* score) {
+  for (const auto& survey : surveys) {
+    const nudge::sim_state_t* state = state_at(states, survey.utime);
+    if (!state) continue;
+    ++score->surveys;
+    for (int i = 0; i < survey.num_candidates; ++i) {
+      const Eigen::Vector3d p = scene.table_to_world({survey.position[i][0], survey.position[i][1], survey.position[i][2]});
+      double nearest = real_radius;
+      std::string object;
+      for (const auto& o : state->objects) {
+        const double d = std::hypot(o.pose.position[0] - p.x(), o.pose.position[1] - p.y());
+        if (d <= nearest) nearest = d, object = o.name;
+      }
+      if (object.empty()) {
+        ++score->phantom;
+      } else {
+        ++score->real;
+        score->objects_found.insert(object);
+      }
+    }
+  }
+}
+
+fs::path own_directory() {
+  char path[4096];
+  const ssize_t n = readlink("/proc/self/exe", path, sizeof(path) - 1);
+  if (n <= 0) throw std::runtime_error("cannot find this program's directory");
+  path[n] = '\0';
+  return fs::path(path).parent_path();
+}
+
+std::string shell_quote(const std::string& s) {
+  std::string quoted = "'";
+  for (char c : s) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return quoted + "'";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) try {
+  std::vector<std::string> run_sets;
+  std::vector<double> tilts{1, 1.5, 2, 3, 4, 5, 7};
+  double real_radius = 0.03;
+  std::string name = "survey_line_tilt";
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    const bool has_value = i + 1 < argc;
+    if (arg == "--tilts" && has_value) tilts = parse_list(argv[++i]);
+    else if (arg == "--real-radius" && has_value) real_radius = std::stod(argv[++i]);
+    else if (arg == "--name" && has_value) name = argv[++i];
+    else if (!arg.empty() && arg[0] == '-') throw std::invalid_argument("unknown option " + arg);
+    else run_sets.push_back(arg);
+  }
+  if (run_sets.empty()) {
+    std::cerr << "usage: nudge-exp-survey-line-tilt RUNS_DIR [RUNS_DIR...] [--tilts 1,2,3] [--real-radius 0.03] [--name STEM]\n";
+    return 2;
+  }
+  const fs::path source = NUDGE_SOURCE_DIR;
+  const std::string calibration = (source / "config/calibration_sim.yaml").string();
+  const std::string workspace = (source / "config/workspace.yaml").string();
+  const SceneGeometry scene = SceneGeometry::load(calibration);
+  const std::string triangulation = (own_directory() / "nudge-triangulation").string();
+  const fs::path replay = fs::temp_directory_path() / ("survey_line_tilt_" + std::to_string(getpid()) + ".lcmlog");
+
+  // Each run is named by its set's number (the RUNS_DIRs in order) and its scene.
+  std::vector<std::pair<std::string, fs::path>> logs;
+  for (size_t k = 0; k < run_sets.size(); ++k) {
+    std::vector<std::pair<std::string, fs::path>> in_set;
+    for (const auto& entry : fs::directory_iterator(run_sets[k])) {
+      const std::string scene = entry.path().filename().string();
+      const fs::path log = entry.path() / scene / (scene + ".lcmlog");
+      if (fs::exists(log)) in_set.emplace_back(std::to_string(k + 1) + ":" + scene, log);
+    }
+    std::sort(in_set.begin(), in_set.end());
+    logs.insert(logs.end(), in_set.begin(), in_set.end());
+  }
+  if (logs.empty()) throw std::runtime_error("no run logs under the RUNS_DIRs given");
+
+  // tilt -> run -> score
+  std::map<double, std::map<std::string, Score>> scores;
+  for (const auto& [run, log] : logs) {
+    const auto states = read_states(log);
+    if (states.empty()) throw std::runtime_error(log.string() + ": no SIM_STATE (a simulated run's log is needed)");
+    std::cerr << run << ":";
+    for (double tilt : tilts) {
+      const std::string command = shell_quote(triangulation) + " --lcm-in " + shell_quote("file://" + log.string() + "?speed=0") +
+                                  " --lcm-out " + shell_quote("file://" + replay.string() + "?mode=w") + " --calibration " +
+                                  shell_quote(calibration) + " --workspace " + shell_quote(workspace) +
+                                  " --candidate-line-tilt " + std::to_string(tilt) + " >/dev/null 2>&1";
+      if (std::system(command.c_str()) != 0) throw std::runtime_error("nudge-triangulation failed on " + log.string());
+      Score& s = scores[tilt][run];
+      s.objects = static_cast<int>(states.front().objects.size());
+      score_surveys(read_surveys(replay), states, scene, real_radius, &s);
+      std::cerr << " " << tilt << "°: " << s.real << "/" << s.phantom;
+    }
+    std::cerr << "\n";
+  }
+  fs::remove(replay);
+
+  std::ostringstream json, md;
+  json << "{\n  \"runs\": " << logs.size() << ",\n  \"real_radius_m\": " << real_radius << ",\n  \"tilts\": [\n";
+  md << "# Survey-line tilt: candidates kept at each `--candidate-line-tilt`\n\n"
+     << "`nudge-exp-survey-line-tilt` replayed each recorded run's log through `nudge-triangulation` at each tilt "
+        "(the run's own SYMMETRY lines and CANDIDATES_REQUESTs) and scored every survey's candidates against the "
+        "simulator's state: within " << real_radius * 1000 << " mm of an object it is real, else a phantom. Later "
+        "surveys follow what the recorded run did. Runs: ";
+  for (size_t i = 0; i < run_sets.size(); ++i) md << (i ? ", " : "") << i + 1 << ": `" << run_sets[i] << "`";
+  md << " (" << logs.size() << " runs). " << nudge::experiments::machine_description() << ", "
+     << nudge::experiments::today() << ".\n\n"
+     << "| tilt (deg) | real candidates | phantoms | objects ever a candidate |\n|---|---|---|---|\n";
+  bool first = true;
+  for (const auto& [tilt, runs] : scores) {
+    int real = 0, phantom = 0, found = 0, objects = 0;
+    for (const auto& [run, s] : runs) real += s.real, phantom += s.phantom, found += static_cast<int>(s.objects_found.size()), objects += s.objects;
+    md << "| " << tilt << " | " << real << " | " << phantom << " | " << found << "/" << objects << " |\n";
+    json << (first ? "" : ",\n") << "    {\"tilt_deg\": " << tilt << ", \"real\": " << real << ", \"phantoms\": " << phantom
+         << ", \"objects_found\": " << found << ", \"objects\": " << objects << "}";
+    first = false;
+  }
+  json << "\n  ]\n}\n";
+  md << "\nPer run (set:scene; real/phantoms, and objects ever a candidate):\n\n| run |";
+  for (const auto& [tilt, runs] : scores) md << " " << tilt << "° |";
+  md << "\n|---|";
+  for (size_t i = 0; i < scores.size(); ++i) md << "---|";
+  md << "\n";
+  for (const auto& [run, log] : logs) {
+    md << "| " << run << " |";
+    for (auto& [tilt, runs] : scores) {
+      const Score& s = runs[run];
+      md << " " << s.real << "/" << s.phantom << " (" << s.objects_found.size() << "/" << s.objects << ") |";
+    }
+    md << "\n";
+  }
+  nudge::experiments::write_result(name + ".json", json.str());
+  nudge::experiments::write_result(name + ".md", md.str());
+  return 0;
+} catch (const std::exception& e) {
+  std::cerr << "nudge-exp-survey-line-tilt: " << e.what() << "\n";
+  return 1;
+}
