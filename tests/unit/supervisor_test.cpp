@@ -919,6 +919,26 @@ TEST_F(SupervisorTest, AMaskTooSmallForAnyObjectIsNoSegmentation) {
   EXPECT_NE(ended[0].attempt->reason.find("too small for an object"), std::string::npos) << ended[0].attempt->reason;
 }
 
+// A sliver a few rows tall (development m02: 3720 px along a table edge after a push that moved a
+// mug behind a bottle) is as large as a small object but no object's shape: no segmentation.
+TEST_F(SupervisorTest, AMaskOnlyAFewRowsTallIsNoSegmentation) {
+  auto sliver = [](const cv::Mat& before, const cv::Mat& after, const nudge::symmetry::Line& l0, const nudge::symmetry::Line& l1) {
+    sv::Segmentation s = mask_of_difference(before, after, l0, l1);
+    cv::Rect box = cv::boundingRect(s.mask);
+    s.mask.setTo(0);
+    s.mask(cv::Rect(box.x, box.y + box.height - 8, 600, 8)).setTo(255);  // 4800 px, 8 rows, at its foot
+    return s;
+  };
+  sv::Supervisor s(sv::Config{}, scene_, sv::ArmSetup{}, sliver);
+  const Eigen::Vector3d rest = nudge_and_park(s, Eigen::Vector3d(0.28, -0.05, 0));
+  ASSERT_EQ(s.state(), sv::State::SnapshotAfter);
+  s.on_right_still(draw_scene(scene_, {1280, 960}, {rest}), now_, now_);
+  const auto ended = outputs_of<sv::AttemptEnded>(s.take_outputs());
+  ASSERT_EQ(ended.size(), 1u);
+  EXPECT_EQ(ended[0].attempt->outcome, sv::Outcome::SegmentationFailed);
+  EXPECT_NE(ended[0].attempt->reason.find("too flat for an object"), std::string::npos) << ended[0].attempt->reason;
+}
+
 // A mug's handle moves its symmetry line differently in the two cameras: the settled axes lie
 // several cm nearer or farther along the right camera's ray than the mug stands (s03_red_mug:
 // 4.7 cm). They are still the pushed object, and its mask keeps the rows down to its real foot.

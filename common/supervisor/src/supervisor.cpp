@@ -24,6 +24,13 @@ std::string seconds_text(double seconds) {
   return text;
 }
 
+// How many rows of a 0/255 mask hold a pixel.
+int rows_with_pixels(const cv::Mat& mask) {
+  int rows = 0;
+  for (int y = 0; y < mask.rows; ++y) rows += cv::countNonZero(mask.row(y)) > 0;
+  return rows;
+}
+
 double median(std::vector<double> values) {
   std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
   return values[values.size() / 2];
@@ -513,12 +520,21 @@ void Supervisor::segment(int64_t now) {
                 "segmentation empty" + (a.segmentation.error.empty() ? std::string() : ": " + a.segmentation.error), now);
     return;
   }
-  const double smallest = smallest_object_pixels(*a.rest);
-  if (mask_pixels < config_.min_mask_share * smallest) {
+  const cv::Size2d smallest = smallest_object_image(*a.rest);
+  if (mask_pixels < config_.min_mask_share * smallest.area()) {
     draw_stages();
     end_attempt(Outcome::SegmentationFailed,
                 "segmentation too small for an object: " + std::to_string(mask_pixels) + " px, the smallest object there shows " +
-                    std::to_string(static_cast<int>(smallest)) + " px",
+                    std::to_string(static_cast<int>(smallest.area())) + " px",
+                now);
+    return;
+  }
+  const int mask_rows = rows_with_pixels(a.segmentation.mask);
+  if (mask_rows < config_.min_mask_share * smallest.height) {
+    draw_stages();
+    end_attempt(Outcome::SegmentationFailed,
+                "segmentation too flat for an object: " + std::to_string(mask_rows) + " rows, the smallest object there is " +
+                    std::to_string(static_cast<int>(smallest.height)) + " rows tall",
                 now);
     return;
   }
@@ -536,9 +552,9 @@ void Supervisor::segment(int64_t now) {
   end_attempt(Outcome::Segmented, "segmented", now);
 }
 
-// The still's pixels of the smallest object expected standing at `foot` (world): its width across
-// the right camera's view times its height, both projected.
-double Supervisor::smallest_object_pixels(const Eigen::Vector3d& foot) const {
+// The smallest object expected standing at `foot` (world) in the right still: its width across the
+// camera's view and its height, both projected.
+cv::Size2d Supervisor::smallest_object_image(const Eigen::Vector3d& foot) const {
   const Eigen::Vector3d base(foot.x(), foot.y(), 0.0);
   const Eigen::Vector2d ray = viewing_ray(base);
   const Eigen::Vector3d across = config_.min_object_radius_m * Eigen::Vector3d(-ray.y(), ray.x(), 0.0);
@@ -546,8 +562,8 @@ double Supervisor::smallest_object_pixels(const Eigen::Vector3d& foot) const {
   const auto right = scene_.project_right(base + across, config_.still_size);
   const auto top = scene_.project_right(base + Eigen::Vector3d(0, 0, config_.min_object_height_m), config_.still_size);
   const auto bottom = scene_.project_right(base, config_.still_size);
-  if (!left || !right || !top || !bottom) return 0.0;
-  return cv::norm(*left - *right) * cv::norm(*top - *bottom);
+  if (!left || !right || !top || !bottom) return {0.0, 0.0};
+  return {cv::norm(*left - *right), cv::norm(*top - *bottom)};
 }
 
 // The settled axes' rest against the mask's foot (after the left segmentation has joined: it

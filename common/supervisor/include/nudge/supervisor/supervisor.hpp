@@ -109,8 +109,10 @@ struct Config {
   double object_height_m = 0.25;     // the tallest expected object (lines drawn up to it)
   int min_mask_pixels = 200;         // a smaller mask (in the still) is no object
   // Nor is a mask smaller than this share of the still's image of the smallest object expected
-  // (min_object_radius_m x min_object_height_m standing at the rest). Held-out hm1 (2026-11-25):
-  // a 731 px mask (a cup's is ~20 000) was taken for a segmentation of nothing.
+  // (min_object_radius_m x min_object_height_m standing at the rest), or one whose rows span less
+  // than this share of that object's height. Held-out hm1 (2026-11-25): a 731 px mask (a cup's is
+  // ~20 000) was taken for a segmentation of nothing; development m02: a 3720 px sliver a few rows
+  // tall along a table edge.
   double min_mask_share = 0.25;
   double min_object_radius_m = 0.025, min_object_height_m = 0.06;
   // Rows watched for motion: from the table to this height. The object's foot moves when it is
@@ -373,7 +375,9 @@ class Supervisor {
   std::vector<Eigen::Vector3d> rests_;  // where nudged objects came to rest (they stand there now)
   std::vector<cv::Mat> rest_masks_;     // each rest's segmentation (empty when there is none)
   std::vector<Eigen::Vector3d> explored_with_ray_mates() const;
-  double smallest_object_pixels(const Eigen::Vector3d& foot) const;
+  // The smallest object expected standing at a foot, as the right still shows it (px; 0 x 0 when
+  // it cannot be projected).
+  cv::Size2d smallest_object_image(const Eigen::Vector3d& foot) const;
   bool same_object_in_a_camera(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const;
   // The share of `mask`'s rows (its bounding box's) where the right camera's image of an upright
   // axis at `foot` passes through the mask (within 2 px): 1 for a line on the object, 0 beside it.
