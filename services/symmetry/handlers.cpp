@@ -60,14 +60,6 @@ symmetry::Params detector_params_for(const Options& options) {
   return params;
 }
 
-void drop_weak_lines(std::vector<symmetry::Line>& lines, double min_peak_ratio) {
-  double top = 0;
-  for (const symmetry::Line& line : lines) top = std::max(top, line.votes);
-  lines.erase(std::remove_if(lines.begin(), lines.end(),
-                             [&](const symmetry::Line& line) { return line.votes < min_peak_ratio * top; }),
-              lines.end());
-}
-
 segmentation::SegmentParams segment_params_for(const Options& options) {
   segmentation::SegmentParams params;
   if (options.params.dmax > 0) params.max_width = options.params.dmax;  // thesis: MAXw is usually Dmax
@@ -165,7 +157,7 @@ void Handlers::detect_and_publish(const cv::Mat& image, const image_t& msg, cons
     const Options::Reach& reach = *options_.reach;
     result.lines = geometry::lines_standing_within(reach.rig, side, reach.table, reach.centre, reach.radius, result.lines,
                                                       reach.inner_radius);
-    drop_weak_lines(result.lines, options_.params.min_peak_ratio);
+    symmetry::drop_weak_lines(result.lines, options_.params.min_peak_ratio);
     if (reach.keep > 0 && static_cast<int>(result.lines.size()) > reach.keep) result.lines.resize(reach.keep);
     result.ms.peaks_ms += reach_watch.elapsed_ms();
   }

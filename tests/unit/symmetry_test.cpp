@@ -966,6 +966,26 @@ TEST(SymmetryGeometry, MapLineBetweenImageSizes) {
   EXPECT_NEAR(cv::norm(mapped.seg1 - mapped.seg2), 2 * cv::norm(small.lines[0].seg1 - small.lines[0].seg2), 2.0);
 }
 
+TEST(SymmetryGeometry, DropWeakLinesKeepsThoseNearTheStrongestInOrder) {
+  auto line = [](double r, double votes) {
+    Line l;
+    l.r = r;
+    l.votes = votes;
+    return l;
+  };
+  std::vector<Line> lines{line(1, 50), line(2, 400), line(3, 39), line(4, 40)};
+  drop_weak_lines(lines, 0.1);  // the strongest need not come first
+  ASSERT_EQ(lines.size(), 3u);
+  EXPECT_EQ(lines[0].r, 1);
+  EXPECT_EQ(lines[1].r, 2);
+  EXPECT_EQ(lines[2].r, 4);
+  drop_weak_lines(lines, 0.0);
+  EXPECT_EQ(lines.size(), 3u);
+  std::vector<Line> none;
+  drop_weak_lines(none, 0.5);
+  EXPECT_TRUE(none.empty());
+}
+
 TEST(SymmetryEdges, DetectionLeavesTheCallersImageUntouched) {
   cv::Mat img = blank();
   syn::draw_shape(img, syn::bottle_profile(150, 28), 0, 0, 0, cv::Scalar(40));

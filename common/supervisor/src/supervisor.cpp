@@ -538,6 +538,15 @@ void Supervisor::segment(int64_t now) {
                 now);
     return;
   }
+  const double mean_width = static_cast<double>(mask_pixels) / mask_rows;
+  if (mean_width < config_.min_mask_share * smallest.width) {
+    draw_stages();
+    end_attempt(Outcome::SegmentationFailed,
+                "segmentation too thin for an object: " + std::to_string(static_cast<int>(mean_width)) +
+                    " px wide on average, the smallest object there is " + std::to_string(static_cast<int>(smallest.width)) + " px wide",
+                now);
+    return;
+  }
   // The right mask read once: the object's top for the grasp, its foot for the rest's check.
   const std::optional<MaskOnLine> right_mask = read_mask_on_line(a.segmentation.mask, *a.after_line);
   if (right_mask) a.top[1] = right_mask->top;

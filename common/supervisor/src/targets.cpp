@@ -43,7 +43,8 @@ robot::JointVector ArmSetup::home() const {
 
 
 PushConflict push_conflict(const Eigen::Vector3d& target, const Eigen::Vector3d& direction,
-                           const Eigen::Vector3d& other, const ArmSetup& arm, const TargetParams& params) {
+                           const Eigen::Vector3d& other, const ArmSetup& arm, const TargetParams& params,
+                           const std::string& what) {
   const Eigen::Vector3d d = horizontal(direction).normalized();
   const Eigen::Vector3d offset = horizontal(other - target);
   const double along = offset.dot(d);
@@ -52,10 +53,10 @@ PushConflict push_conflict(const Eigen::Vector3d& target, const Eigen::Vector3d&
   const double nearest_along = std::clamp(along, -arm.nudge.start_distance, -arm.nudge.stop_distance);
   const double to_pad = std::hypot(along - nearest_along, across);
   if (to_pad < params.object_radius + params.pad_half_width)
-    return {PushConflict::Kind::Pad, "the pad would touch the candidate at " + millimetres(other)};
+    return {PushConflict::Kind::Pad, "the pad would touch the " + what + " at " + millimetres(other)};
   // The pushed object slides up to `travel` ahead: a band two object radii wide.
   if (along >= 0 && along <= params.travel + 2 * params.object_radius && across < 2 * params.object_radius)
-    return {PushConflict::Kind::Slide, "the pushed object may slide into the candidate at " + millimetres(other)};
+    return {PushConflict::Kind::Slide, "the pushed object may slide into the " + what + " at " + millimetres(other)};
   return {};
 }
 
@@ -65,19 +66,31 @@ bool near_any(const Eigen::Vector3d& p, const std::vector<Eigen::Vector3d>& plac
   return std::any_of(places.begin(), places.end(), [&](const Eigen::Vector3d& e) { return horizontal(e - p).norm() < radius; });
 }
 
+struct Obstacle {
+  Eigen::Vector3d place;
+  const char* what;  // for reasons
+};
+
 // The places a push must keep clear of: the other candidates that count as objects, and the
 // explored objects standing where no candidate is (their lines left out of the survey).
-std::vector<Eigen::Vector3d> obstacles_to(const Candidate& c, const std::vector<Candidate>& candidates, const History& history,
-                                          const TargetParams& params) {
-  std::vector<Eigen::Vector3d> obstacles;
+std::vector<Obstacle> obstacles_to(const Candidate& c, const std::vector<Candidate>& candidates, const History& history,
+                                   const TargetParams& params) {
+  std::vector<Obstacle> obstacles;
+  std::vector<Eigen::Vector3d> places;  // of the obstacles so far
   auto far_from_target = [&](const Eigen::Vector3d& p) { return horizontal(p - c.position).norm() >= params.same_object_radius; };
   for (const Candidate& other : candidates) {
     if (other.index == c.index || near_any(other.position, history.empty, params.explored_radius)) continue;
     if (other.stereo_agreement < params.min_stereo_agreement) continue;
-    if (far_from_target(other.position)) obstacles.push_back(other.position);
+    if (far_from_target(other.position)) {
+      obstacles.push_back({other.position, "candidate"});
+      places.push_back(other.position);
+    }
   }
   for (const Eigen::Vector3d& object : history.standing)
-    if (far_from_target(object) && !near_any(object, obstacles, params.same_object_radius)) obstacles.push_back(object);
+    if (far_from_target(object) && !near_any(object, places, params.same_object_radius)) {
+      obstacles.push_back({object, "explored object"});
+      places.push_back(object);
+    }
   return obstacles;
 }
 
@@ -100,13 +113,13 @@ TargetChoice choose_pass(const std::vector<Candidate>& candidates, const std::ve
       continue;
     }
     std::string why_not;
-    const std::vector<Eigen::Vector3d> obstacles = obstacles_to(c, candidates, history, params);
+    const std::vector<Obstacle> obstacles = obstacles_to(c, candidates, history, params);
     for (const Eigen::Vector3d& direction_base :
          robot::directions_across_view(camera_base, arm.point_to_base(c.position))) {
       const Eigen::Vector3d direction = arm.direction_to_world(direction_base);
       PushConflict conflict;
-      for (const Eigen::Vector3d& other : obstacles) {
-        PushConflict found = push_conflict(c.position, direction, other, arm, params);
+      for (const Obstacle& other : obstacles) {
+        PushConflict found = push_conflict(c.position, direction, other.place, arm, params, other.what);
         if (found.kind == PushConflict::Kind::Pad || (found && !conflict)) conflict = found;
         if (conflict.kind == PushConflict::Kind::Pad) break;
       }

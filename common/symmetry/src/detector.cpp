@@ -216,6 +216,13 @@ EdgeSet detect_edges(const cv::Mat& image, const EdgeParams& params, cv::Mat* ed
   return set;
 }
 
+void drop_weak_lines(std::vector<Line>& lines, double min_peak_ratio) {
+  double top = 0;
+  for (const Line& line : lines) top = std::max(top, line.votes);
+  lines.erase(std::remove_if(lines.begin(), lines.end(), [&](const Line& line) { return line.votes < min_peak_ratio * top; }),
+              lines.end());
+}
+
 Line map_line(const Line& line, cv::Size from, cv::Size to) {
   const double sx = static_cast<double>(to.width) / from.width, sy = static_cast<double>(to.height) / from.height;
   auto map_point = [&](cv::Point2d p) { return cv::Point2d((p.x + 0.5) * sx - 0.5, (p.y + 0.5) * sy - 0.5); };

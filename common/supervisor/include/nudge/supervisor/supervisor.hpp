@@ -110,9 +110,10 @@ struct Config {
   int min_mask_pixels = 200;         // a smaller mask (in the still) is no object
   // Nor is a mask smaller than this share of the still's image of the smallest object expected
   // (min_object_radius_m x min_object_height_m standing at the rest), or one whose rows span less
-  // than this share of that object's height. Held-out hm1 (2026-11-25): a 731 px mask (a cup's is
-  // ~20 000) was taken for a segmentation of nothing; development m02: a 3720 px sliver a few rows
-  // tall along a table edge.
+  // than this share of that object's height, or whose rows are on average narrower than this share
+  // of its width. Held-out hm1 (2026-11-25): a 731 px mask (a cup's is ~20 000) was taken for a
+  // segmentation of nothing; development m02: a 3720 px sliver a few rows tall along a table edge;
+  // second held-out set h06: a 2649 px sliver along a mug's edge, turned by a push beside it.
   double min_mask_share = 0.25;
   double min_object_radius_m = 0.025, min_object_height_m = 0.06;
   // Rows watched for motion: from the table to this height. The object's foot moves when it is

@@ -117,7 +117,9 @@ struct PushConflict {
   std::string reason;
   explicit operator bool() const { return kind != Kind::None; }
 };
+// `what` names `other` in the reason ("candidate", "explored object").
 PushConflict push_conflict(const Eigen::Vector3d& target, const Eigen::Vector3d& direction,
-                           const Eigen::Vector3d& other, const ArmSetup& arm, const TargetParams& params);
+                           const Eigen::Vector3d& other, const ArmSetup& arm, const TargetParams& params,
+                           const std::string& what = "candidate");
 
 }  // namespace nudge::supervisor

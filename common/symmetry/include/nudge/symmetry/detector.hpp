@@ -133,6 +133,11 @@ void remove_edges(EdgeSet& edges, const cv::Mat& exclude);
 // isotropic resizing; border endpoints and the support segment are mapped too.
 Line map_line(const Line& line, cv::Size from, cv::Size to);
 
+// Params::min_peak_ratio applied to lines already found: drops those with fewer votes than
+// `min_peak_ratio` times the strongest of them. For lines filtered after detection (by where they
+// stand, say), whose strongest may not be the accumulator's.
+void drop_weak_lines(std::vector<Line>& lines, double min_peak_ratio);
+
 class Detector {
  public:
   explicit Detector(Params params = {}, EdgeParams edge_params = {});
