@@ -568,7 +568,9 @@ void add_flags(Flags& f, Options& o) {
   f.add_double("min-nudge-agreement", &o.config.targets.min_nudge_agreement,
                "candidates that both cameras show upright in a smaller share of the survey's frames are not nudged (0: all are)");
   f.add_double("min-mask-share", &o.config.min_mask_share,
-               "a mask smaller than this share of the smallest object's image at the rest is no segmentation (0: any)");
+               "a mask smaller than this share of the smallest object's image at the rest (its pixels, rows or mean width) is no segmentation (0: any)");
+  f.add_double("min-mask-mirror", &o.config.min_mask_mirror_agreement,
+               "a mask that agrees less with its own mirror image about the object's line (IoU) is no segmentation (0: any)");
   f.add_double("snapshot-timeout", &o.config.snapshot_timeout_s, "for a still, s of the task clock");
   f.add_double("snapshot-retry", &o.config.snapshot_retry_s, "a still not come within this many s of the task clock is asked for again (a lost UDP fragment loses it)");
   f.add_double("candidates-timeout", &o.config.candidates_timeout_s, "for a CANDIDATES answer, s of the task clock");
@@ -628,6 +630,8 @@ int main(int argc, char** argv) {
     if (!(opt.config.targets.min_nudge_agreement >= 0 && opt.config.targets.min_nudge_agreement <= 1))
       throw FlagError("--min-nudge-agreement must lie in [0, 1]");
     if (!(opt.config.min_mask_share >= 0 && opt.config.min_mask_share <= 1)) throw FlagError("--min-mask-share must lie in [0, 1]");
+    if (!(opt.config.min_mask_mirror_agreement >= 0 && opt.config.min_mask_mirror_agreement <= 1))
+      throw FlagError("--min-mask-mirror must lie in [0, 1]");
     if (!(opt.config.held_min_opening_m >= 0 && opt.config.held_min_opening_m < 0.1)) throw FlagError("--held-min-opening must lie in [0, 0.1) m");
     if (opt.config.views <= 0 || opt.config.views > 36) throw FlagError("--views must lie in [1, 36]");
     if (!(opt.config.view_step_deg > 0 && opt.config.view_step_deg <= 90)) throw FlagError("--view-step must lie in (0, 90] deg");

@@ -451,3 +451,38 @@ TEST(MotionSegmentation, ChangeOnlyInTheThirdColourChannelIsSeen) {
   ASSERT_TRUE(result.found) << result.reason;
   EXPECT_GT(iou(result.mask, grey.truth), 0.95);
 }
+
+namespace {
+
+sym::Line line_at(double r, double theta_deg) {
+  sym::Line line;
+  line.r = r;
+  line.theta = theta_deg * M_PI / 180.0;
+  return line;
+}
+
+}  // namespace
+
+TEST(MirrorAgreement, AnObjectsMaskIsItsOwnMirrorImageAboutItsLine) {
+  cv::Mat mask = cv::Mat::zeros(480, 640, CV_8U);
+  // A cup-like outline about x = 400, R = 80.5 from the image centre (x = 319.5), theta = 0.
+  cv::ellipse(mask, cv::Point(400, 240), cv::Size(60, 100), 0, 0, 360, cv::Scalar(255), cv::FILLED);
+  EXPECT_GT(mirror_agreement(mask, line_at(80.5, 0)), 0.95);
+  EXPECT_LT(mirror_agreement(mask, line_at(40.5, 0)), 0.6) << "40 px off its axis";
+  // The same about a tilted line: rotate the mask with it.
+  cv::Mat tilted;
+  const cv::Mat turn = cv::getRotationMatrix2D(cv::Point2f(319.5f, 239.5f), -10.0, 1.0);
+  cv::warpAffine(mask, tilted, turn, mask.size(), cv::INTER_NEAREST);
+  EXPECT_GT(mirror_agreement(tilted, line_at(80.5, 10)), 0.9);
+  // A piece of one side (a hook, a neighbour's edge) is not.
+  cv::Mat piece = cv::Mat::zeros(480, 640, CV_8U);
+  cv::rectangle(piece, cv::Rect(400, 150, 60, 40), cv::Scalar(255), cv::FILLED);
+  cv::rectangle(piece, cv::Rect(440, 150, 20, 150), cv::Scalar(255), cv::FILLED);
+  EXPECT_LT(mirror_agreement(piece, line_at(80.5, 0)), 0.2);
+}
+
+TEST(MirrorAgreement, BadMasksAreNamed) {
+  EXPECT_EQ(mirror_agreement(cv::Mat::zeros(10, 10, CV_8U), line_at(0, 0)), 0.0);
+  EXPECT_THROW(mirror_agreement(cv::Mat(), line_at(0, 0)), std::invalid_argument);
+  EXPECT_THROW(mirror_agreement(cv::Mat::zeros(10, 10, CV_8UC3), line_at(0, 0)), std::invalid_argument);
+}

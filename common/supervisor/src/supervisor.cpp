@@ -10,6 +10,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "nudge/robot/command_planner.hpp"
+#include "nudge/segmentation/motion.hpp"
 #include "nudge/supervisor/grasp.hpp"
 
 namespace nudge::supervisor {
@@ -544,6 +545,16 @@ void Supervisor::segment(int64_t now) {
     end_attempt(Outcome::SegmentationFailed,
                 "segmentation too thin for an object: " + std::to_string(static_cast<int>(mean_width)) +
                     " px wide on average, the smallest object there is " + std::to_string(static_cast<int>(smallest.width)) + " px wide",
+                now);
+    return;
+  }
+  const double mirrored = segmentation::mirror_agreement(a.segmentation.mask, *a.after_line);
+  if (mirrored < config_.min_mask_mirror_agreement) {
+    draw_stages();
+    char text[48];
+    std::snprintf(text, sizeof text, "%.2f", mirrored);
+    end_attempt(Outcome::SegmentationFailed,
+                std::string("segmentation not symmetric about the object's line: it agrees ") + text + " with its mirror image",
                 now);
     return;
   }

@@ -115,6 +115,11 @@ struct Config {
   // segmentation of nothing; development m02: a 3720 px sliver a few rows tall along a table edge;
   // second held-out set h06: a 2649 px sliver along a mug's edge, turned by a push beside it.
   double min_mask_share = 0.25;
+  // Nor is a mask that agrees less than this with its mirror image about the object's line in the
+  // after still (segmentation::mirror_agreement): an upright symmetric object's mask is symmetric.
+  // Chosen on the development runs of 2026-11-25: every correct mask 0.79 or more, the wrong ones
+  // (a piece of a cup, a neighbour's edge) 0.32-0.81.
+  double min_mask_mirror_agreement = 0.7;
   double min_object_radius_m = 0.025, min_object_height_m = 0.06;
   // Rows watched for motion: from the table to this height. The object's foot moves when it is
   // pushed; the arm's links, higher up, may pass beyond the line in the image, the pad never does.
