@@ -50,28 +50,18 @@ std::vector<double> parse_list(const std::string& text) {
   return values;
 }
 
-std::vector<nudge::sim_state_t> read_states(const fs::path& log_path) {
-  std::vector<nudge::sim_state_t> states;
+// Every message of `channel` in a log, in log order.
+template <typename Message>
+std::vector<Message> read_channel(const fs::path& log_path, const std::string& channel) {
+  std::vector<Message> messages;
   lcm::LogFile log(log_path.string(), "r");
   if (!log.good()) throw std::runtime_error("cannot read " + log_path.string());
   for (const lcm::LogEvent* e = log.readNextEvent(); e; e = log.readNextEvent()) {
-    if (e->channel != "SIM_STATE") continue;
-    nudge::sim_state_t s;
-    if (s.decode(e->data, 0, e->datalen) >= 0) states.push_back(std::move(s));
+    if (e->channel != channel) continue;
+    Message m;
+    if (m.decode(e->data, 0, e->datalen) >= 0) messages.push_back(std::move(m));
   }
-  return states;
-}
-
-std::vector<nudge::candidates_t> read_surveys(const fs::path& log_path) {
-  std::vector<nudge::candidates_t> surveys;
-  lcm::LogFile log(log_path.string(), "r");
-  if (!log.good()) throw std::runtime_error("cannot read " + log_path.string());
-  for (const lcm::LogEvent* e = log.readNextEvent(); e; e = log.readNextEvent()) {
-    if (e->channel != "CANDIDATES") continue;
-    nudge::candidates_t c;
-    if (c.decode(e->data, 0, e->datalen) >= 0) surveys.push_back(std::move(c));
-  }
-  return surveys;
+  return messages;
 }
 
 // The latest state at or before `utime` (states are in log order, utime rising).
@@ -166,7 +156,7 @@ int main(int argc, char** argv) try {
   // tilt -> run -> score
   std::map<double, std::map<std::string, Score>> scores;
   for (const auto& [run, log] : logs) {
-    const auto states = read_states(log);
+    const auto states = read_channel<nudge::sim_state_t>(log, "SIM_STATE");
     if (states.empty()) throw std::runtime_error(log.string() + ": no SIM_STATE (a simulated run's log is needed)");
     std::cerr << run << ":";
     for (double tilt : tilts) {
@@ -177,7 +167,7 @@ int main(int argc, char** argv) try {
       if (std::system(command.c_str()) != 0) throw std::runtime_error("nudge-triangulation failed on " + log.string());
       Score& s = scores[tilt][run];
       s.objects = static_cast<int>(states.front().objects.size());
-      score_surveys(read_surveys(replay), states, scene, real_radius, &s);
+      score_surveys(read_channel<nudge::candidates_t>(replay, "CANDIDATES"), states, scene, real_radius, &s);
       std::cerr << " " << tilt << "°: " << s.real << "/" << s.phantom;
     }
     std::cerr << "\n";

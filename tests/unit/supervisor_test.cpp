@@ -280,6 +280,19 @@ class SupervisorTest : public ::testing::Test {
     }
     return ended[0].attempt;
   }
+  // One attempt on the object at (0.28, -0.05) whose stills `segment` segments: how it ended.
+  sv::Attempt attempt_segmented_by(const sv::SegmentFunction& segment) {
+    sv::Supervisor s(sv::Config{}, scene_, sv::ArmSetup{}, segment);
+    const Eigen::Vector3d rest = nudge_and_park(s, Eigen::Vector3d(0.28, -0.05, 0));
+    EXPECT_EQ(s.state(), sv::State::SnapshotAfter);
+    s.on_right_still(draw_scene(scene_, {1280, 960}, {rest}), now_, now_);
+    const auto ended = outputs_of<sv::AttemptEnded>(s.take_outputs());
+    if (ended.size() != 1u) {
+      ADD_FAILURE() << ended.size() << " attempts ended";
+      return {};
+    }
+    return *ended[0].attempt;
+  }
   // The right camera's viewing direction along the table at `point`.
   Eigen::Vector3d along_ray(const Eigen::Vector3d& point) const {
     Eigen::Vector3d ray = point - scene_.right_camera_in_world();
@@ -917,14 +930,9 @@ TEST_F(SupervisorTest, AMaskTooSmallForAnyObjectIsNoSegmentation) {
     s.mask(cv::Rect(box.x, box.y + box.height - 20, std::min(box.width, 35), 20)).setTo(255);  // 700 px at its foot
     return s;
   };
-  sv::Supervisor s(sv::Config{}, scene_, sv::ArmSetup{}, speck);
-  const Eigen::Vector3d rest = nudge_and_park(s, Eigen::Vector3d(0.28, -0.05, 0));
-  ASSERT_EQ(s.state(), sv::State::SnapshotAfter);
-  s.on_right_still(draw_scene(scene_, {1280, 960}, {rest}), now_, now_);
-  const auto ended = outputs_of<sv::AttemptEnded>(s.take_outputs());
-  ASSERT_EQ(ended.size(), 1u);
-  EXPECT_EQ(ended[0].attempt->outcome, sv::Outcome::SegmentationFailed);
-  EXPECT_NE(ended[0].attempt->reason.find("too small for an object"), std::string::npos) << ended[0].attempt->reason;
+  const sv::Attempt a = attempt_segmented_by(speck);
+  EXPECT_EQ(a.outcome, sv::Outcome::SegmentationFailed);
+  EXPECT_NE(a.reason.find("too small for an object"), std::string::npos) << a.reason;
 }
 
 // A sliver a few rows tall (development m02: 3720 px along a table edge after a push that moved a
@@ -941,15 +949,9 @@ TEST_F(SupervisorTest, AMaskOnlyAFewRowsTallOrPixelsWideIsNoSegmentation) {
       else s.mask(cv::Rect(box.x + box.width / 2, box.y, 10, box.height)).setTo(255);  // 1580 px down its middle
       return s;
     };
-    sv::Supervisor s(sv::Config{}, scene_, sv::ArmSetup{}, sliver);
-    const Eigen::Vector3d rest = nudge_and_park(s, Eigen::Vector3d(0.28, -0.05, 0));
-    ASSERT_EQ(s.state(), sv::State::SnapshotAfter);
-    s.on_right_still(draw_scene(scene_, {1280, 960}, {rest}), now_, now_);
-    const auto ended = outputs_of<sv::AttemptEnded>(s.take_outputs());
-    ASSERT_EQ(ended.size(), 1u);
-    EXPECT_EQ(ended[0].attempt->outcome, sv::Outcome::SegmentationFailed);
-    const std::string expected = flat ? "too flat for an object" : "too thin for an object";
-    EXPECT_NE(ended[0].attempt->reason.find(expected), std::string::npos) << ended[0].attempt->reason;
+    const sv::Attempt a = attempt_segmented_by(sliver);
+    EXPECT_EQ(a.outcome, sv::Outcome::SegmentationFailed);
+    EXPECT_NE(a.reason.find(flat ? "too flat for an object" : "too thin for an object"), std::string::npos) << a.reason;
   }
 }
 
@@ -963,19 +965,11 @@ TEST_F(SupervisorTest, AMaskNotSymmetricAboutTheObjectsLineIsNoSegmentation) {
     s.mask.colRange(0, box.x + box.width / 2).setTo(0);  // the half right of the line only
     return s;
   };
-  sv::Supervisor s(sv::Config{}, scene_, sv::ArmSetup{}, one_side);
-  const Eigen::Vector3d rest = nudge_and_park(s, Eigen::Vector3d(0.28, -0.05, 0));
-  ASSERT_EQ(s.state(), sv::State::SnapshotAfter);
-  s.on_right_still(draw_scene(scene_, {1280, 960}, {rest}), now_, now_);
-  const auto ended = outputs_of<sv::AttemptEnded>(s.take_outputs());
-  ASSERT_EQ(ended.size(), 1u);
-  EXPECT_EQ(ended[0].attempt->outcome, sv::Outcome::SegmentationFailed);
-  EXPECT_NE(ended[0].attempt->reason.find("not symmetric about the object's line"), std::string::npos) << ended[0].attempt->reason;
+  const sv::Attempt a = attempt_segmented_by(one_side);
+  EXPECT_EQ(a.outcome, sv::Outcome::SegmentationFailed);
+  EXPECT_NE(a.reason.find("not symmetric about the object's line"), std::string::npos) << a.reason;
   // The whole (symmetric) mask of the same push is a segmentation.
-  sv::Supervisor t = make();
-  const Eigen::Vector3d again = nudge_and_park(t, Eigen::Vector3d(0.28, -0.05, 0));
-  t.on_right_still(draw_scene(scene_, {1280, 960}, {again}), now_, now_);
-  EXPECT_EQ(outputs_of<sv::AttemptEnded>(t.take_outputs()).at(0).attempt->outcome, sv::Outcome::Segmented);
+  EXPECT_EQ(attempt_segmented_by(mask_of_difference).outcome, sv::Outcome::Segmented);
 }
 
 // A mug's handle moves its symmetry line differently in the two cameras: the settled axes lie
