@@ -521,41 +521,10 @@ void Supervisor::segment(int64_t now) {
                 "segmentation empty" + (a.segmentation.error.empty() ? std::string() : ": " + a.segmentation.error), now);
     return;
   }
-  const cv::Size2d smallest = smallest_object_image(*a.rest);
-  if (mask_pixels < config_.min_mask_share * smallest.area()) {
+  const std::string not_an_object = mask_shape_problem(a.segmentation.mask, *a.rest, *a.after_line);
+  if (!not_an_object.empty()) {
     draw_stages();
-    end_attempt(Outcome::SegmentationFailed,
-                "segmentation too small for an object: " + std::to_string(mask_pixels) + " px, the smallest object there shows " +
-                    std::to_string(static_cast<int>(smallest.area())) + " px",
-                now);
-    return;
-  }
-  const int mask_rows = rows_with_pixels(a.segmentation.mask);
-  if (mask_rows < config_.min_mask_share * smallest.height) {
-    draw_stages();
-    end_attempt(Outcome::SegmentationFailed,
-                "segmentation too flat for an object: " + std::to_string(mask_rows) + " rows, the smallest object there is " +
-                    std::to_string(static_cast<int>(smallest.height)) + " rows tall",
-                now);
-    return;
-  }
-  const double mean_width = static_cast<double>(mask_pixels) / mask_rows;
-  if (mean_width < config_.min_mask_share * smallest.width) {
-    draw_stages();
-    end_attempt(Outcome::SegmentationFailed,
-                "segmentation too thin for an object: " + std::to_string(static_cast<int>(mean_width)) +
-                    " px wide on average, the smallest object there is " + std::to_string(static_cast<int>(smallest.width)) + " px wide",
-                now);
-    return;
-  }
-  const double mirrored = segmentation::mirror_agreement(a.segmentation.mask, *a.after_line);
-  if (mirrored < config_.min_mask_mirror_agreement) {
-    draw_stages();
-    char text[48];
-    std::snprintf(text, sizeof text, "%.2f", mirrored);
-    end_attempt(Outcome::SegmentationFailed,
-                std::string("segmentation not symmetric about the object's line: it agrees ") + text + " with its mirror image",
-                now);
+    end_attempt(Outcome::SegmentationFailed, not_an_object, now);
     return;
   }
   // The right mask read once: the object's top for the grasp, its foot for the rest's check.
@@ -570,6 +539,30 @@ void Supervisor::segment(int64_t now) {
     return;
   }
   end_attempt(Outcome::Segmented, "segmented", now);
+}
+
+std::string Supervisor::mask_shape_problem(const cv::Mat& mask, const Eigen::Vector3d& rest, const symmetry::Line& line) const {
+  const int pixels = cv::countNonZero(mask);
+  const cv::Size2d smallest = smallest_object_image(rest);
+  const double share = config_.min_mask_share;
+  if (pixels < share * smallest.area())
+    return "segmentation too small for an object: " + std::to_string(pixels) + " px, the smallest object there shows " +
+           std::to_string(static_cast<int>(smallest.area())) + " px";
+  const int rows = rows_with_pixels(mask);
+  if (rows < share * smallest.height)
+    return "segmentation too flat for an object: " + std::to_string(rows) + " rows, the smallest object there is " +
+           std::to_string(static_cast<int>(smallest.height)) + " rows tall";
+  const double mean_width = static_cast<double>(pixels) / rows;
+  if (mean_width < share * smallest.width)
+    return "segmentation too thin for an object: " + std::to_string(static_cast<int>(mean_width)) +
+           " px wide on average, the smallest object there is " + std::to_string(static_cast<int>(smallest.width)) + " px wide";
+  const double mirrored = segmentation::mirror_agreement(mask, line);
+  if (mirrored < config_.min_mask_mirror_agreement) {
+    char text[16];
+    std::snprintf(text, sizeof text, "%.2f", mirrored);
+    return std::string("segmentation not symmetric about the object's line: it agrees ") + text + " with its mirror image";
+  }
+  return "";
 }
 
 // The smallest object expected standing at `foot` (world) in the right still: its width across the

@@ -384,6 +384,9 @@ class Supervisor {
   // The smallest object expected standing at a foot, as the right still shows it (px; 0 x 0 when
   // it cannot be projected).
   cv::Size2d smallest_object_image(const Eigen::Vector3d& foot) const;
+  // Why a non-empty right mask (the still's size) is no object standing at `rest`, upright about
+  // `line`: too small, too flat, too thin, or not its own mirror image; "" when it may be one.
+  std::string mask_shape_problem(const cv::Mat& mask, const Eigen::Vector3d& rest, const symmetry::Line& line) const;
   bool same_object_in_a_camera(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const;
   // The share of `mask`'s rows (its bounding box's) where the right camera's image of an upright
   // axis at `foot` passes through the mask (within 2 px): 1 for a line on the object, 0 beside it.
