@@ -276,6 +276,29 @@ TEST(PlanCommand, ReachableNudgeIsPlannedAndChecked) {
   EXPECT_EQ(check_steps(config.model, safety, plan.steps, home), "");
 }
 
+// A leaned tool can put P0 in another arm configuration (a left arm, where the right arm's joint 5
+// would pass its limit by 0.2 deg); the straight joint line from home to it swings the tool out of
+// the workspace ring, and the arm would refuse the nudge. Another lean is planned instead.
+TEST(PlanCommand, NudgesAcrossTheRingStartWhereTheArmCanSwingTo) {
+  const PlannerConfig config = planner_config(Workspace{});
+  const JointVector home = home_joints(config);
+  const MotionPlan swung = plan_command(config, nudge_at({0.0, -0.27, 0.0}, {-1.0, 0.0, 0.0}), home);
+  EXPECT_TRUE(swung.ok()) << swung.reason;
+  int refused_at_p0 = 0, planned = 0;
+  for (double radius : {0.20, 0.25, 0.30})
+    for (double bearing_deg = -90; bearing_deg <= 90; bearing_deg += 30) {
+      const double b = bearing_deg * M_PI / 180;
+      for (double way : {1.0, -1.0}) {
+        const MotionPlan plan = plan_command(
+            config, nudge_at({radius * std::cos(b), radius * std::sin(b), 0.0}, {-way * std::sin(b), way * std::cos(b), 0.0}), home);
+        planned += plan.ok();
+        refused_at_p0 += contains(plan.reason, "the move to P0");
+      }
+    }
+  EXPECT_EQ(refused_at_p0, 0);  // 6 of these 42 before, when 36 planned
+  EXPECT_GE(planned, 40);
+}
+
 TEST(PlanCommand, NudgeIsPlannedInTheWorldFrameOfATurnedBase) {
   Workspace turned;
   turned.base_yaw = M_PI / 2;  // base x along world y

@@ -261,6 +261,12 @@ std::string plan_nudge_with_lean(const ArmModel& model, const SafetyConfig& safe
   plan->poses = {pose_at(p0), pose_at(p1), pose_at(p2), pose_at(p1), pose_at(p0)};
   const IkResult start = safe_inverse_kinematics(model, safety, plan->poses[0], seed);
   if (!start.ok()) return "nudge P0: " + start.reason;
+  // The arm goes from the seed (where it is) to P0 in a straight joint line. When P0 takes another
+  // configuration (a left arm for a right one, where a leaned tool puts joint 5 past its limit),
+  // that line can swing the tool out of the workspace ring: then another lean or direction is
+  // tried rather than a nudge the arm would refuse (13% of the pushes across the ring did so).
+  const CheckResult move = check_joint_path(model, safety, seed, start.q);
+  if (!move.ok()) return "the move to P0: " + move.reason;
   std::string first_reason;
   for (const JointVector& q0 : joint6_alternatives(model, start.q)) {
     const std::string reason = plan_nudge_path(model, safety, params, target, q0, plan);

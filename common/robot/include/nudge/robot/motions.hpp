@@ -101,7 +101,8 @@ struct NudgePlan {
 // horizontal part is used). The tool points down with its x axis along the push direction; when
 // that would bring the forearm or wrist within params.link_clearance of the object (see
 // NudgeParams), the tool leans by params.tool_tilt, the wrist trailing straight behind the pad or
-// 45 or 90 deg to either side of that, the first lean whose path is safe and clear.
+// 45 or 90 deg to either side of that, the first lean whose path is safe and clear and whose P0
+// the arm reaches from `seed` (where it is) along a safe straight joint line.
 // The way back retraces the way out exactly (P2 -> P1 -> P0, as the thesis found necessary).
 NudgePlan plan_nudge(const ArmModel& model, const SafetyConfig& safety,
                      const Eigen::Vector3d& target, const Eigen::Vector3d& direction,
