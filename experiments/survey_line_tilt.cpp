@@ -22,6 +22,7 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "nudge/candidates_t.hpp"
+#include "nudge/progress.hpp"
 #include "nudge/sim_state_t.hpp"
 #include "nudge/supervisor/scene.hpp"
 #include "report.hpp"
@@ -155,10 +156,12 @@ int main(int argc, char** argv) try {
 
   // tilt -> run -> score
   std::map<double, std::map<std::string, Score>> scores;
+  nudge::Progress progress("nudge-exp-survey-line-tilt", static_cast<int>(logs.size()));
   for (const auto& [run, log] : logs) {
+    progress.step(run);
     const auto states = read_channel<nudge::sim_state_t>(log, "SIM_STATE");
     if (states.empty()) throw std::runtime_error(log.string() + ": no SIM_STATE (a simulated run's log is needed)");
-    std::cerr << run << ":";
+    std::string line = run + ":";
     for (double tilt : tilts) {
       const std::string command = shell_quote(triangulation) + " --lcm-in " + shell_quote("file://" + log.string() + "?speed=0") +
                                   " --lcm-out " + shell_quote("file://" + replay.string() + "?mode=w") + " --calibration " +
@@ -168,10 +171,11 @@ int main(int argc, char** argv) try {
       Score& s = scores[tilt][run];
       s.objects = static_cast<int>(states.front().objects.size());
       score_surveys(read_channel<nudge::candidates_t>(replay, "CANDIDATES"), states, scene, real_radius, &s);
-      std::cerr << " " << tilt << "°: " << s.real << "/" << s.phantom;
+      line += " " + std::to_string(tilt).substr(0, 4) + " deg: " + std::to_string(s.real) + "/" + std::to_string(s.phantom);
     }
-    std::cerr << "\n";
+    progress.note(line);
   }
+  progress.finish(std::to_string(logs.size()) + " runs replayed at " + std::to_string(tilts.size()) + " tilts");
   fs::remove(replay);
 
   std::ostringstream json, md;
