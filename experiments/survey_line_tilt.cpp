@@ -22,6 +22,7 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "nudge/candidates_t.hpp"
+#include "nudge/json.hpp"
 #include "nudge/progress.hpp"
 #include "nudge/sim_state_t.hpp"
 #include "nudge/supervisor/scene.hpp"
@@ -178,8 +179,10 @@ int main(int argc, char** argv) try {
   progress.finish(std::to_string(logs.size()) + " runs replayed at " + std::to_string(tilts.size()) + " tilts");
   fs::remove(replay);
 
-  std::ostringstream json, md;
-  json << "{\n  \"runs\": " << logs.size() << ",\n  \"real_radius_m\": " << real_radius << ",\n  \"tilts\": [\n";
+  nudge::JsonWriter json(4);
+  json.begin_object().field("machine", nudge::experiments::machine_description()).field("date", nudge::experiments::today());
+  json.field("runs", static_cast<int>(logs.size())).field("real_radius_m", real_radius).key("tilts").begin_array();
+  std::ostringstream md;
   md << "# Survey-line tilt: candidates kept at each `--candidate-line-tilt`\n\n"
      << "`nudge-exp-survey-line-tilt` replayed each recorded run's log through `nudge-triangulation` at each tilt "
         "(the run's own SYMMETRY lines and CANDIDATES_REQUESTs) and scored every survey's candidates against the "
@@ -189,16 +192,14 @@ int main(int argc, char** argv) try {
   md << " (" << logs.size() << " runs). " << nudge::experiments::machine_description() << ", "
      << nudge::experiments::today() << ".\n\n"
      << "| tilt (deg) | real candidates | phantoms | objects ever a candidate |\n|---|---|---|---|\n";
-  bool first = true;
   for (const auto& [tilt, runs] : scores) {
     int real = 0, phantom = 0, found = 0, objects = 0;
     for (const auto& [run, s] : runs) real += s.real, phantom += s.phantom, found += static_cast<int>(s.objects_found.size()), objects += s.objects;
     md << "| " << tilt << " | " << real << " | " << phantom << " | " << found << "/" << objects << " |\n";
-    json << (first ? "" : ",\n") << "    {\"tilt_deg\": " << tilt << ", \"real\": " << real << ", \"phantoms\": " << phantom
-         << ", \"objects_found\": " << found << ", \"objects\": " << objects << "}";
-    first = false;
+    json.begin_object().field("tilt_deg", tilt).field("real", real).field("phantoms", phantom);
+    json.field("objects_found", found).field("objects", objects).end_object();
   }
-  json << "\n  ]\n}\n";
+  json.end_array().end_object();
   md << "\nPer run (set:scene; real/phantoms, and objects ever a candidate):\n\n| run |";
   for (const auto& [tilt, runs] : scores) md << " " << tilt << "° |";
   md << "\n|---|";
@@ -212,7 +213,7 @@ int main(int argc, char** argv) try {
     }
     md << "\n";
   }
-  nudge::experiments::write_result(name + ".json", json.str());
+  nudge::experiments::write_result(name + ".json", json.str() + "\n");
   nudge::experiments::write_result(name + ".md", md.str());
   return 0;
 } catch (const std::exception& e) {

@@ -15,6 +15,7 @@
 #include <iterator>
 #include <random>
 
+#include "nudge/segmentation/motion.hpp"
 #include "nudge/supervisor/report.hpp"
 #include "nudge/supervisor/supervisor.hpp"
 
@@ -86,12 +87,7 @@ sv::Segmentation mask_of_difference(const cv::Mat& before, const cv::Mat& after,
   cv::absdiff(before, after, diff);
   cv::cvtColor(diff, grey, cv::COLOR_BGR2GRAY);
   cv::threshold(grey, s.mask, 40, 255, cv::THRESH_BINARY);
-  const double nx = std::cos(after_line.theta), ny = std::sin(after_line.theta);
-  const double offset = 2.0 * (nx * 0.5 * (s.mask.cols - 1) + ny * 0.5 * (s.mask.rows - 1) + after_line.r);
-  const cv::Matx23d reflect(1 - 2 * nx * nx, -2 * nx * ny, offset * nx, -2 * nx * ny, 1 - 2 * ny * ny, offset * ny);
-  cv::Mat mirrored;
-  cv::warpAffine(s.mask, mirrored, reflect, s.mask.size(), cv::INTER_NEAREST);
-  s.mask |= mirrored;
+  s.mask |= nudge::segmentation::mirror_image(s.mask, after_line);
   return s;
 }
 

@@ -520,19 +520,22 @@ void MotionStages::save(const std::string& directory) const {
   }
 }
 
-double mirror_agreement(const cv::Mat& mask, const symmetry::Line& line) {
-  if (mask.empty() || mask.type() != CV_8UC1) throw std::invalid_argument("mirror_agreement: the mask must be 8-bit, one channel");
-  const cv::Mat object = mask != 0;
-  const int area = cv::countNonZero(object);
-  if (area == 0) return 0.0;
+cv::Mat mirror_image(const cv::Mat& image, const symmetry::Line& line) {
   // Reflection about n . (p - c) = R: p' = p - 2 (n . p - n . c - R) n, its own inverse.
   const double nx = std::cos(line.theta), ny = std::sin(line.theta);
-  const double cx = 0.5 * (mask.cols - 1), cy = 0.5 * (mask.rows - 1);
-  const double offset = 2.0 * (nx * cx + ny * cy + line.r);
+  const double offset = 2.0 * (nx * 0.5 * (image.cols - 1) + ny * 0.5 * (image.rows - 1) + line.r);
   const cv::Matx23d reflect(1 - 2 * nx * nx, -2 * nx * ny, offset * nx,  //
                             -2 * nx * ny, 1 - 2 * ny * ny, offset * ny);
   cv::Mat mirrored;
-  cv::warpAffine(object, mirrored, reflect, object.size(), cv::INTER_NEAREST, cv::BORDER_CONSTANT, 0);
+  cv::warpAffine(image, mirrored, reflect, image.size(), cv::INTER_NEAREST, cv::BORDER_CONSTANT, 0);
+  return mirrored;
+}
+
+double mirror_agreement(const cv::Mat& mask, const symmetry::Line& line) {
+  if (mask.empty() || mask.type() != CV_8UC1) throw std::invalid_argument("mirror_agreement: the mask must be 8-bit, one channel");
+  const cv::Mat object = mask != 0;
+  if (cv::countNonZero(object) == 0) return 0.0;
+  cv::Mat mirrored = mirror_image(object, line);
   cv::dilate(mirrored, mirrored, cv::Mat::ones(3, 3, CV_8U));
   const int both = cv::countNonZero(object & mirrored);
   const int either = cv::countNonZero(object | mirrored);

@@ -231,19 +231,20 @@ std::vector<Candidate> Supervisor::drop_hidden_behind_arm_base(std::vector<Rejec
 std::vector<Eigen::Vector3d> Supervisor::explored_with_ray_mates() const {
   std::vector<Eigen::Vector3d> explored = explored_;
   for (const Candidate& c : candidates_)
-    for (size_t i = 0; i < rests_.size(); ++i)
-      if (same_object_in_a_camera(c.position, rests_[i]) ||
-          ((c.position - rests_[i]).head<2>().norm() <= config_.same_object_depth_m &&
-           share_of_mask_rows_on_line(c.position, rest_masks_[i]) >= config_.same_object_mask_share)) {
+    for (const Rested& object : rested_)
+      if (same_object_in_a_camera(c.position, object.place) ||
+          ((c.position - object.place).head<2>().norm() <= config_.same_object_depth_m &&
+           share_of_mask_rows_on_line(c.position, object) >= config_.same_object_mask_share)) {
         explored.push_back(c.position);
         break;
       }
   return explored;
 }
 
-double Supervisor::share_of_mask_rows_on_line(const Eigen::Vector3d& foot, const cv::Mat& mask) const {
+double Supervisor::share_of_mask_rows_on_line(const Eigen::Vector3d& foot, const Rested& object) const {
+  const cv::Mat& mask = object.mask;
+  const cv::Rect& box = object.box;
   if (mask.empty()) return 0.0;
-  const cv::Rect box = cv::boundingRect(mask);
   const auto bottom = scene_.project_right(Eigen::Vector3d(foot.x(), foot.y(), 0.0), mask.size());
   const auto top = scene_.project_right(Eigen::Vector3d(foot.x(), foot.y(), config_.object_height_m), mask.size());
   if (box.empty() || !bottom || !top || std::fabs(top->y - bottom->y) < 1.0) return 0.0;
@@ -641,8 +642,7 @@ void Supervisor::end_attempt(Outcome outcome, const std::string& reason, int64_t
       // phantom's axes seen again after a push that barely moved a neighbour; leaving its lines
       // out of the surveys would leave out the neighbours' lines that made it (development m03:
       // the yellow cup was never a candidate again).
-      rests_.push_back(*a.rest);
-      rest_masks_.push_back(a.segmentation.mask);
+      rested_.push_back({*a.rest, a.segmentation.mask, cv::boundingRect(a.segmentation.mask)});
       standing_.push_back(*a.rest);
     } else if (outcome == Outcome::Known || outcome == Outcome::Refused) {
       standing_.push_back(a.target.position);  // never pushed: it stands where it was found

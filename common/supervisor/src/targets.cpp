@@ -76,21 +76,18 @@ struct Obstacle {
 std::vector<Obstacle> obstacles_to(const Candidate& c, const std::vector<Candidate>& candidates, const History& history,
                                    const TargetParams& params) {
   std::vector<Obstacle> obstacles;
-  std::vector<Eigen::Vector3d> places;  // of the obstacles so far
   auto far_from_target = [&](const Eigen::Vector3d& p) { return horizontal(p - c.position).norm() >= params.same_object_radius; };
+  auto near_an_obstacle = [&](const Eigen::Vector3d& p) {
+    return std::any_of(obstacles.begin(), obstacles.end(),
+                       [&](const Obstacle& o) { return horizontal(o.place - p).norm() < params.same_object_radius; });
+  };
   for (const Candidate& other : candidates) {
     if (other.index == c.index || near_any(other.position, history.empty, params.explored_radius)) continue;
     if (other.stereo_agreement < params.min_stereo_agreement) continue;
-    if (far_from_target(other.position)) {
-      obstacles.push_back({other.position, "candidate"});
-      places.push_back(other.position);
-    }
+    if (far_from_target(other.position)) obstacles.push_back({other.position, "candidate"});
   }
   for (const Eigen::Vector3d& object : history.standing)
-    if (far_from_target(object) && !near_any(object, places, params.same_object_radius)) {
-      obstacles.push_back({object, "explored object"});
-      places.push_back(object);
-    }
+    if (far_from_target(object) && !near_an_obstacle(object)) obstacles.push_back({object, "explored object"});
   return obstacles;
 }
 

@@ -122,6 +122,10 @@ class MotionSegmenter {
   detail::MotionScratch scratch_;
 };
 
+// `image` reflected about `line` ((R, theta) about the image centre), same size and type; what
+// falls outside is dropped, what nothing maps to is 0.
+cv::Mat mirror_image(const cv::Mat& image, const symmetry::Line& line);
+
 // How nearly a mask (8-bit, non-zero = object) is its own mirror image about `line` ((R, theta)
 // about the image centre): the intersection over union of the mask and its reflection grown by
 // one pixel, in [0, 1]; 0 for an empty mask. The mask of an upright, bilaterally symmetric object

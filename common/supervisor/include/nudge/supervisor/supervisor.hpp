@@ -378,8 +378,13 @@ class Supervisor {
   std::vector<Candidate> candidates_;
   std::vector<Eigen::Vector3d> explored_, phantoms_, empty_;
   std::vector<Eigen::Vector3d> standing_;  // explored objects where they stand now (CandidatesRequest::explored)
-  std::vector<Eigen::Vector3d> rests_;  // where nudged objects came to rest (they stand there now)
-  std::vector<cv::Mat> rest_masks_;     // each rest's segmentation (empty when there is none)
+  // The segmented objects where they came to rest (they stand there now), with their masks.
+  struct Rested {
+    Eigen::Vector3d place;
+    cv::Mat mask;  // the right still's segmentation
+    cv::Rect box;  // its bounding box
+  };
+  std::vector<Rested> rested_;
   std::vector<Eigen::Vector3d> explored_with_ray_mates() const;
   // The smallest object expected standing at a foot, as the right still shows it (px; 0 x 0 when
   // it cannot be projected).
@@ -388,9 +393,9 @@ class Supervisor {
   // `line`: too small, too flat, too thin, or not its own mirror image; "" when it may be one.
   std::string mask_shape_problem(const cv::Mat& mask, const Eigen::Vector3d& rest, const symmetry::Line& line) const;
   bool same_object_in_a_camera(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const;
-  // The share of `mask`'s rows (its bounding box's) where the right camera's image of an upright
-  // axis at `foot` passes through the mask (within 2 px): 1 for a line on the object, 0 beside it.
-  double share_of_mask_rows_on_line(const Eigen::Vector3d& foot, const cv::Mat& mask) const;
+  // The share of the object's mask rows (its bounding box's) where the right camera's image of an
+  // upright axis at `foot` passes through the mask (within 2 px): 1 on the object, 0 beside it.
+  double share_of_mask_rows_on_line(const Eigen::Vector3d& foot, const Rested& object) const;
   std::vector<Candidate> drop_hidden_behind_arm_base(std::vector<Rejection>& rejected) const;
   Eigen::Vector2d viewing_ray(const Eigen::Vector3d& at) const;
   std::vector<Axis> settled_axes_;
