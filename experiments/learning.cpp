@@ -73,9 +73,31 @@ const ThesisRow* thesis_row(const std::string& bottle) {
 }
 
 struct Options {
-  std::string runs, scenes, test_images, name = "learning";
+  std::string runs, scenes, test_images, name = "learning", set = "eval";
   double tolerance_mm = 5;
+  // Learn every stored object again from its stored training views with `learn` (the learner's
+  // defaults unless flags say otherwise): the database as today's learner would have written it
+  // from the same views, so that a change to learning is measured without re-running the arm.
+  bool relearn = false;
+  learning::LearnParams learn;
+  learning::RecognizeParams recognize;  // the learner's defaults unless flags say otherwise
 };
+
+// The model learn_object makes from a stored model's training images, boxes and wrist angles.
+std::shared_ptr<const learning::ObjectModel> relearned(const learning::ObjectModel& stored,
+                                                       const learning::LearnParams& params) {
+  std::vector<learning::TrainingImage> images;
+  for (const learning::ModelView& v : stored.views) {
+    if (v.image.empty()) throw std::runtime_error(stored.info.name + ": a training view without its image");
+    images.push_back({v.image, v.box, v.wrist_angle});
+  }
+  learning::LearnStats stats;
+  auto model = std::make_shared<learning::ObjectModel>(learning::learn_object(stored.info, images, params, &stats));
+  std::cerr << "relearned " << stored.info.name << ": " << stats.detected << " detected, " << stats.outside_box
+            << " outside the box, " << stats.background << " background, " << stats.kept << " kept (stored: "
+            << stored.descriptor_count() << ")\n";
+  return model;
+}
 
 // One training scene's run, as its summary tells it.
 struct Run {
@@ -477,9 +499,11 @@ int run(const Options& o) {
   for (const fs::path& f : scene_files) runs.push_back(read_run(o.runs, f));
 
   const learning::ObjectDatabase db(o.runs + "/objects");
-  const learning::LoadReport loaded = db.load_all();
+  learning::LoadReport loaded = db.load_all(o.relearn);
   for (const std::string& e : loaded.errors) std::cerr << "nudge-exp-learning: database: " << e << "\n";
-  learning::Recognizer recognizer;
+  if (o.relearn)
+    for (auto& m : loaded.models) m = relearned(*m, o.learn);
+  learning::Recognizer recognizer(o.recognize);
   std::map<std::string, std::string> bottle_of;  // learned name -> bottle
   std::map<std::string, TrainingTruth> training;
   for (const auto& m : loaded.models) {
@@ -494,7 +518,7 @@ int run(const Options& o) {
     std::cerr << "learned " << run->bottle << " as " << m->info.name << " (" << m->descriptor_count() << " descriptors)\n";
   }
 
-  const std::vector<TestImage> images = read_test_images(o.test_images, "eval");
+  const std::vector<TestImage> images = read_test_images(o.test_images, o.set);
   if (images.empty()) throw std::runtime_error(o.test_images + "/manifest.json: no test images");
   std::vector<Judged> judged;
   nudge::Progress progress("nudge-exp-learning", static_cast<int>(images.size()));
@@ -553,8 +577,20 @@ int main(int argc, char** argv) {
   flags.add_string("test-images", &o.test_images, "nudge-exp-learning-scenes --set eval's output folder");
   flags.add_double("tolerance-mm", &o.tolerance_mm, "a good match's two surface points lie within this distance, mm");
   flags.add_string("name", &o.name, "result name (docs/results/NAME.*)");
+  flags.add_string("set", &o.set, "the test images' set: eval (reported) or dev (tuning; nudge-exp-learning-scenes --set dev)");
+  flags.add_bool("relearn", &o.relearn, "learn every stored object again from its stored views with today's learning");
+  flags.add_int("background-matches", &o.learn.background_matches, "--relearn: other views a background descriptor matches");
+  flags.add_double("background-static-px", &o.learn.background_static_px,
+                   "--relearn: a match counts towards background only within this many pixels (0: anywhere)");
+  std::string affine = o.recognize.affine_check ? "on" : "off";
+  flags.add_string("affine-check", &affine, "on|off: the geometric check also tries an affine map (foreshortening)");
+  flags.add_double("ratio", &o.recognize.ratio, "Lowe's ratio in recognition");
+  flags.add_double("ransac-px", &o.recognize.ransac_px, "the geometric check's inlier distance, pixels");
+  flags.add_int("min-support", &o.recognize.min_support, "matches agreeing with a mapping beyond those that fixed it");
   try {
     if (!flags.parse(argc, argv)) return 0;
+    if (affine != "on" && affine != "off") throw FlagError("--affine-check must be on or off");
+    o.recognize.affine_check = affine == "on";
     if (o.runs.empty() || o.scenes.empty() || o.test_images.empty()) throw FlagError("--runs, --scenes and --test-images are required");
     if (!(o.tolerance_mm > 0)) throw FlagError("--tolerance-mm must be positive");
     return run(o);

@@ -21,6 +21,8 @@ int main(int argc, char** argv) {
     f.add_double("box-margin", &options.learn.box_margin, "training box grown by this fraction each side");
     f.add_int("background-matches", &options.learn.background_matches,
               "a descriptor matching this many other views is background (thesis 3)");
+    f.add_double("background-static-px", &options.learn.background_static_px,
+                 "... where a match counts only within this many pixels of the descriptor: the scene stands still (0: anywhere, as the thesis)");
     f.add_double("sift-contrast", &options.recognize.sift.contrast_threshold,
                  "SIFT's contrast threshold, learning and recognition (OpenCV's default 0.04; lower finds more on small labels)");
     f.add_double("view-expiry", &options.view_expiry_s, "drop views not committed within SECONDS of message time");

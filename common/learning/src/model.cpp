@@ -15,7 +15,7 @@ int ObjectModel::descriptor_count() const {
 }
 
 std::vector<std::vector<bool>> background_descriptors(const std::vector<Features>& views, double ratio,
-                                                      int background_matches) {
+                                                      int background_matches, double static_px) {
   std::vector<std::vector<int>> matched_views(views.size());
   for (size_t i = 0; i < views.size(); ++i) matched_views[i].assign(views[i].size(), 0);
   for (size_t j = 0; j < views.size(); ++j) {
@@ -23,8 +23,11 @@ std::vector<std::vector<bool>> background_descriptors(const std::vector<Features
     matcher.add(views[j].descriptors);
     for (size_t i = 0; i < views.size(); ++i) {
       if (i == j) continue;
-      for (const cv::DMatch& m : detail::ratio_matches(matcher, views[i].descriptors, views[j].size(), ratio))
+      for (const cv::DMatch& m : detail::ratio_matches(matcher, views[i].descriptors, views[j].size(), ratio)) {
+        const cv::Point2f shift = views[i].keypoints[m.queryIdx].pt - views[j].keypoints[m.trainIdx].pt;
+        if (static_px > 0 && shift.dot(shift) > static_px * static_px) continue;  // it moved: the object
         ++matched_views[i][m.queryIdx];
+      }
     }
   }
   std::vector<std::vector<bool>> background(views.size());
@@ -51,7 +54,7 @@ ObjectModel learn_object(const ObjectInfo& info, const std::vector<TrainingImage
     counts.outside_box += all.size() - boxed.back().size();
     if (progress) progress(static_cast<int>(v) + 1, static_cast<int>(images.size()));
   }
-  const auto background = background_descriptors(boxed, params.ratio, params.background_matches);
+  const auto background = background_descriptors(boxed, params.ratio, params.background_matches, params.background_static_px);
   ObjectModel model;
   model.info = info;
   for (size_t v = 0; v < images.size(); ++v) {

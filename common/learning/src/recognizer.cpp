@@ -104,8 +104,20 @@ std::vector<cv::DMatch> one_per_point(std::vector<cv::DMatch> matches, const Fea
   return out;
 }
 
-// A homography is tried only with this many matches: fewer fit it too easily.
+// A homography is tried only with this many matches, an affine map with this many: fewer fit them
+// too easily.
 constexpr int kHomographyMinMatches = 10;
+constexpr int kAffineMinMatches = 6;
+// An affine map's linear part: kept unless mirrored, or squashing one direction over this many
+// times more than the other (a surface seen at up to ~80 degrees of tilt).
+constexpr double kMaxAnisotropy = 6;
+
+bool plausible_view_map(const cv::Mat& linear) {
+  cv::Mat singular;
+  cv::SVD::compute(linear, singular, cv::SVD::NO_UV);
+  const double s_max = singular.at<double>(0), s_min = singular.at<double>(1);
+  return cv::determinant(linear) > 0 && s_min > 1e-3 && s_max / s_min <= kMaxAnisotropy;
+}
 
 std::vector<cv::DMatch> inliers_of(const std::vector<cv::DMatch>& matches, const std::vector<uchar>& mask) {
   std::vector<cv::DMatch> out;
@@ -119,7 +131,7 @@ std::vector<cv::DMatch> inliers_of(const std::vector<cv::DMatch>& matches, const
 // fix it). The matches that fixed the mapping agree with it by construction, so a set counts only
 // when `min_support` more matches agree; otherwise none are verified.
 std::vector<cv::DMatch> geometric_inliers(const std::vector<cv::DMatch>& matches, const Features& query,
-                                          const Features& view, double ransac_px, int min_support) {
+                                          const Features& view, double ransac_px, int min_support, bool affine) {
   if (matches.size() < 3) return {};
   std::vector<cv::Point2f> from, to;
   for (const auto& m : matches) {
@@ -134,6 +146,16 @@ std::vector<cv::DMatch> geometric_inliers(const std::vector<cv::DMatch>& matches
   if (!cv::estimateAffinePartial2D(from, to, mask, cv::RANSAC, ransac_px, similarity_iterations, 0.995).empty()) {
     auto inliers = inliers_of(matches, mask);
     if (static_cast<int>(inliers.size()) >= 2 + min_support) best = std::move(inliers);
+  }
+  // A label seen at another tilt (a bottle lying down, seen from above) is foreshortened along one
+  // direction: an affine map (3 matches fix it) explains it where a similarity cannot. Mirrored or
+  // nearly collapsed maps are no view of a surface.
+  if (affine && static_cast<int>(matches.size()) >= kAffineMinMatches) {
+    const cv::Mat a = cv::estimateAffine2D(from, to, mask, cv::RANSAC, ransac_px, 2000, 0.995);
+    if (!a.empty() && plausible_view_map(a(cv::Rect(0, 0, 2, 2)))) {
+      auto inliers = inliers_of(matches, mask);
+      if (static_cast<int>(inliers.size()) >= 3 + min_support && inliers.size() > best.size()) best = std::move(inliers);
+    }
   }
   if (static_cast<int>(matches.size()) >= kHomographyMinMatches) {
     const cv::Mat h = cv::findHomography(from, to, cv::RANSAC, ransac_px, mask, 2000, 0.995);
@@ -288,7 +310,8 @@ Recognition Recognizer::recognize(const Features& query) const {
       if (static_cast<int>(matches.size()) <= score.verified_matches) continue;
       const Features& features = entry->model->views[view].features;
       const std::vector<cv::DMatch> kept =
-          params_.geometric_check ? geometric_inliers(matches, query, features, params_.ransac_px, params_.min_support)
+          params_.geometric_check ? geometric_inliers(matches, query, features, params_.ransac_px, params_.min_support,
+                                                      params_.affine_check)
                                   : matches;
       if (static_cast<int>(kept.size()) > score.verified_matches) {
         score.verified_matches = static_cast<int>(kept.size());

@@ -46,6 +46,11 @@ struct LearnParams {
   double box_margin = 0.25;   // of the box's size, each side
   double ratio = 0.6;         // Lowe's ratio between views (thesis: N = 0.6)
   int background_matches = 3; // a descriptor matching this many other views' descriptors is background
+  // ... where a match counts only when the two keypoints lie within this many pixels of each other:
+  // the scene behind the object stands still in the image while the object turns, so a descriptor
+  // found again elsewhere is the object's label seen one or two turn steps on, not background.
+  // 0 or less: any match counts (the thesis' rule as published).
+  double background_static_px = 4;
   SiftParams sift;            // as the recognizer's, so that both find the same keypoints
 };
 
@@ -56,12 +61,16 @@ struct LearnStats {
   int kept = 0;
 };
 
-// For every view's descriptors: true when it is background by the thesis' rule (sec. 7.3.3). An
-// object descriptor stays visible for one turn step either way, so it matches at most the previous
-// and the next view; one that matches (Lowe's ratio test) descriptors of `background_matches` or
-// more other views belongs to the static scene behind the object.
+// For every view's descriptors: true when it is background by the thesis' rule (sec. 7.3.3). The
+// thesis reasons that an object descriptor stays visible for one turn step either way, so it matches
+// at most the previous and the next view; one that matches (Lowe's ratio test) descriptors of
+// `background_matches` or more other views belongs to the static scene behind the object. A label
+// facing the camera stays recognisable over several 30-degree steps, though, and that rule prunes
+// exactly the object's most stable features; with `static_px` > 0 a match counts only when the
+// matched keypoint lies within `static_px` pixels of the descriptor's own (the scene does not move,
+// the turning object does).
 std::vector<std::vector<bool>> background_descriptors(const std::vector<Features>& views, double ratio,
-                                                      int background_matches);
+                                                      int background_matches, double static_px = 0);
 
 // Detects, prunes (box, then across views) and keeps the images. Throws std::invalid_argument
 // naming the view when an image is empty or not 8-bit, and when no views are given.

@@ -26,6 +26,7 @@ struct RecognizeParams {
   int min_matches = 3;          // the best object needs this many verified matches (thesis: 3)
   bool geometric_check = true;  // RANSAC similarity or homography per training view
   int min_support = 2;          // matches agreeing with a mapping beyond those that fixed it
+  bool affine_check = true;     // also an affine map (foreshortening), from 6 matches
   double ransac_px = 6.0;       // reprojection error an inlier may have, pixels
   MatcherKind matcher = MatcherKind::SharedFlann;  // fastest at every database size measured
   // SharedFlann only: neighbours fetched per query descriptor over the whole database (enough that
