@@ -385,6 +385,53 @@ TEST(LearningRecognizer, GeometricCheckRejectsMatchesThatAgreeOnlyInDescriptor) 
   EXPECT_GT(exact.scores[0].verified_matches, 0.6 * model->views[2].features.size());
 }
 
+// `count` features of `view`, at least 25 px apart (each a separate piece of evidence), their
+// positions moved by `map`: a query seeing the training view through that mapping.
+Features spread_features_mapped(const Features& view, const cv::Matx23d& map, int count) {
+  Features out;
+  out.descriptors.create(0, 128, CV_32F);
+  for (int i = 0; i < view.size() && out.size() < count; ++i) {
+    const cv::Point2f p = view.keypoints[i].pt;
+    bool apart = true;
+    for (const auto& k : out.keypoints) apart = apart && cv::norm(k.pt - p) >= 25;
+    if (!apart) continue;
+    cv::KeyPoint moved = view.keypoints[i];
+    moved.pt = cv::Point2f(static_cast<float>(map(0, 0) * p.x + map(0, 1) * p.y + map(0, 2)),
+                           static_cast<float>(map(1, 0) * p.x + map(1, 1) * p.y + map(1, 2)));
+    out.keypoints.push_back(moved);
+    out.descriptors.push_back(view.descriptors.row(i));
+  }
+  return out;
+}
+
+// A label seen tilted away (a bottle lying down) is squashed along one direction: too few matches
+// for a homography, and a similarity explains only some of them; an affine map explains them all.
+// A mirrored or collapsed mapping is still no view of a surface.
+TEST(LearningRecognizer, AnAffineCheckVerifiesAForeshortenedViewButNoMirrorOrCollapse) {
+  const auto model = learned("red", 10, 20);
+  const Features& view = model->views[2].features;
+  const double c = std::cos(0.5), s = std::sin(0.5);
+  auto squashed_by = [&](double sx) {  // rotate 0.5 rad, then squash x by sx, then shift
+    return cv::Matx23d(sx * c, -sx * s, 200, s, c, 40);
+  };
+  RecognizeParams similarity_only;
+  similarity_only.affine_check = false;
+  Recognizer with, without(similarity_only);
+  with.add(model);
+  without.add(model);
+  const Features foreshortened = spread_features_mapped(view, squashed_by(0.45), 8);
+  ASSERT_EQ(foreshortened.size(), 8);
+  const Recognition affine = with.recognize(foreshortened), similarity = without.recognize(foreshortened);
+  EXPECT_GE(affine.scores[0].verified_matches, 7);
+  EXPECT_LT(similarity.scores[0].verified_matches, affine.scores[0].verified_matches);
+  // Mirrored, or squashed tenfold: the affine map is refused, nothing beyond the similarity's.
+  for (double sx : {-0.8, 0.1}) {
+    const Features implausible = spread_features_mapped(view, squashed_by(sx), 8);
+    EXPECT_EQ(with.recognize(implausible).scores[0].verified_matches,
+              without.recognize(implausible).scores[0].verified_matches) << "squash " << sx;
+  }
+}
+
 TEST(LearningRecognizer, AddingANameAgainReplacesTheModel) {
   Recognizer recognizer;
   recognizer.add(learned("cup", 10, 20));
