@@ -587,10 +587,18 @@ int main(int argc, char** argv) {
   flags.add_double("ratio", &o.recognize.ratio, "Lowe's ratio in recognition");
   flags.add_double("ransac-px", &o.recognize.ransac_px, "the geometric check's inlier distance, pixels");
   flags.add_int("min-support", &o.recognize.min_support, "matches agreeing with a mapping beyond those that fixed it");
+  std::string root_sift = o.recognize.root_sift ? "on" : "off";
+  flags.add_string("root-sift", &root_sift, "on|off: match RootSIFT descriptors (Hellinger distance)");
+  flags.add_double("sift-contrast", &o.recognize.sift.contrast_threshold,
+                   "SIFT's contrast threshold in recognition and, with --relearn, in learning");
   try {
     if (!flags.parse(argc, argv)) return 0;
     if (affine != "on" && affine != "off") throw FlagError("--affine-check must be on or off");
     o.recognize.affine_check = affine == "on";
+    if (root_sift != "on" && root_sift != "off") throw FlagError("--root-sift must be on or off");
+    o.recognize.root_sift = root_sift == "on";
+    o.learn.sift = o.recognize.sift;  // as the learner: both find the same keypoints
+    o.learn.ratio = o.recognize.ratio;
     if (o.runs.empty() || o.scenes.empty() || o.test_images.empty()) throw FlagError("--runs, --scenes and --test-images are required");
     if (!(o.tolerance_mm > 0)) throw FlagError("--tolerance-mm must be positive");
     return run(o);

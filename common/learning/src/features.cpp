@@ -3,6 +3,7 @@
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <cmath>
 #include <stdexcept>
 
 namespace nudge::learning {
@@ -28,6 +29,21 @@ Features detect_features(const cv::Mat& image, const SiftParams& params) {
   sift->detectAndCompute(grey, cv::noArray(), features.keypoints, features.descriptors);
   if (features.descriptors.empty()) features.descriptors.create(0, 128, CV_32F);
   return features;
+}
+
+cv::Mat root_sift(const cv::Mat& descriptors) {
+  if (descriptors.empty()) return descriptors.clone();
+  if (descriptors.type() != CV_32F) throw std::invalid_argument("root_sift: descriptors are not CV_32F");
+  cv::Mat out(descriptors.size(), CV_32F);
+  for (int r = 0; r < descriptors.rows; ++r) {
+    const float* in = descriptors.ptr<float>(r);
+    float* o = out.ptr<float>(r);
+    double sum = 0;
+    for (int c = 0; c < descriptors.cols; ++c) sum += std::abs(in[c]);
+    const double scale = sum > 0 ? 1.0 / sum : 0.0;
+    for (int c = 0; c < descriptors.cols; ++c) o[c] = static_cast<float>(std::sqrt(std::abs(in[c]) * scale));
+  }
+  return out;
 }
 
 cv::Rect generous_box(const cv::Rect& box, double margin, cv::Size image_size) {

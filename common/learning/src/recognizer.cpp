@@ -50,6 +50,9 @@ struct Recognizer::SharedIndex {
 
 namespace {
 
+// The descriptors as they are matched: RootSIFT (features.hpp) unless switched off.
+cv::Mat matching_descriptors(const cv::Mat& sift, bool root) { return root ? root_sift(sift) : sift; }
+
 cv::Ptr<cv::DescriptorMatcher> make_matcher(MatcherKind kind) {
   if (kind == MatcherKind::BruteForce) return cv::makePtr<cv::BFMatcher>(cv::NORM_L2);
   // Randomised k-d trees: 4 trees, 32 leaves checked (Lowe's and OpenCV's usual setting for SIFT).
@@ -200,7 +203,7 @@ void Recognizer::add(std::shared_ptr<const ObjectModel> model) {
       entry->row_view.push_back(static_cast<int>(v));
       entry->row_index.push_back(k);
     }
-    if (!f.descriptors.empty() && !shared_) all.push_back(f.descriptors);
+    if (!f.descriptors.empty() && !shared_) all.push_back(matching_descriptors(f.descriptors, params_.root_sift));
   }
   if (all.rows >= 2 && !shared_) {
     entry->matcher = make_matcher(params_.matcher);
@@ -235,7 +238,8 @@ void Recognizer::build_index() const {
   if (!shared_->stale) return;
   std::vector<detail::IndexedObject> objects(entries_.size());
   for (size_t i = 0; i < entries_.size(); ++i) {
-    for (const auto& view : entries_[i]->model->views) objects[i].view_descriptors.push_back(view.features.descriptors);
+    for (const auto& view : entries_[i]->model->views)
+      objects[i].view_descriptors.push_back(matching_descriptors(view.features.descriptors, params_.root_sift));
     objects[i].row_view = &entries_[i]->row_view;
   }
   shared_->index.build(objects);
@@ -243,18 +247,18 @@ void Recognizer::build_index() const {
 }
 
 // Per entry, the query descriptors passing its ratio test, trainIdx the row in the entry's stack.
-std::vector<std::vector<cv::DMatch>> Recognizer::ratio_matches_per_object(const Features& query) const {
+std::vector<std::vector<cv::DMatch>> Recognizer::ratio_matches_per_object(const cv::Mat& query) const {
   if (shared_) {
     build_index();
     detail::IndexSearch search;
     search.neighbours = params_.shared_neighbours;
     search.checks = params_.shared_checks;
     search.ratio = params_.ratio;
-    return shared_->index.ratio_matches(query.descriptors, search);
+    return shared_->index.ratio_matches(query, search);
   }
   std::vector<std::vector<cv::DMatch>> out;
   for (const auto& entry : entries_) {
-    out.push_back(entry->matcher ? view_ratio_matches(*entry->matcher, entry->row_view, query.descriptors, params_.ratio)
+    out.push_back(entry->matcher ? view_ratio_matches(*entry->matcher, entry->row_view, query, params_.ratio)
                                  : std::vector<cv::DMatch>{});
   }
   return out;
@@ -285,7 +289,8 @@ Recognition Recognizer::recognize(const Features& query) const {
   Stopwatch watch;
   Recognition result;
   result.query = query;
-  const std::vector<std::vector<cv::DMatch>> object_matches = ratio_matches_per_object(query);
+  const std::vector<std::vector<cv::DMatch>> object_matches =
+      ratio_matches_per_object(matching_descriptors(query.descriptors, params_.root_sift));
   for (size_t e = 0; e < entries_.size(); ++e) {
     const auto& entry = entries_[e];
     ObjectScore score;

@@ -71,6 +71,28 @@ TEST(LearningFeatures, ALowerContrastThresholdFindsMoreOnAFaintTextureAndBadSett
   EXPECT_THROW(detect_features(faint, bad), std::invalid_argument);
 }
 
+TEST(LearningFeatures, RootSiftRowsAreUnitLengthAndTheirDistanceIsHellinger) {
+  const Features f = detect_features(synthetic::random_texture(kImage, 7));
+  ASSERT_GT(f.size(), 50);
+  const cv::Mat root = root_sift(f.descriptors);
+  ASSERT_EQ(root.size(), f.descriptors.size());
+  auto histogram = [&](int row) {  // the SIFT row as a distribution
+    cv::Mat h = f.descriptors.row(row) / cv::sum(f.descriptors.row(row))[0];
+    return h;
+  };
+  for (int i = 0; i + 1 < 50; ++i) {
+    EXPECT_NEAR(cv::norm(root.row(i)), 1.0, 1e-5);
+    // |sqrt p - sqrt q|^2 = 2 - 2 * (Bhattacharyya coefficient of p and q)
+    cv::Mat product;
+    cv::sqrt(histogram(i).mul(histogram(i + 1)), product);
+    const double distance = cv::norm(root.row(i), root.row(i + 1));
+    EXPECT_NEAR(distance * distance, 2 - 2 * cv::sum(product)[0], 1e-4);
+  }
+  EXPECT_EQ(cv::countNonZero(root_sift(cv::Mat::zeros(1, 128, CV_32F))), 0);
+  EXPECT_TRUE(root_sift(cv::Mat(0, 128, CV_32F)).empty());
+  EXPECT_THROW(root_sift(cv::Mat::ones(1, 128, CV_8U)), std::invalid_argument);
+}
+
 TEST(LearningFeatures, GenerousBoxGrowsAndClips) {
   EXPECT_EQ(generous_box({100, 100, 40, 80}, 0.25, {640, 480}), cv::Rect(90, 80, 60, 120));
   EXPECT_EQ(generous_box({0, 0, 40, 80}, 0.5, {640, 480}), cv::Rect(0, 0, 60, 120));
@@ -170,6 +192,22 @@ TEST(LearningRecognizer, FindsTheRightObjectAndViewInANewScene) {
   EXPECT_GE(r.best_score()->verified_matches, 15);
   for (const auto& s : r.scores) {
     if (s.name != "blue") { EXPECT_LT(s.verified_matches, r.best_score()->verified_matches / 3); }
+  }
+}
+
+TEST(LearningRecognizer, FindsTheObjectMatchingRootSiftOrPlainSift) {
+  const cv::Mat scene = synthetic::place_in_scene(object_face(11, 7), synthetic::random_texture({640, 480}, 99), 15,
+                                                  0.8, {300, 250});
+  for (bool root : {true, false}) {
+    RecognizeParams params;
+    params.root_sift = root;
+    Recognizer recognizer(params);
+    recognizer.add(learned("red", 10, 20));
+    recognizer.add(learned("blue", 11, 20));
+    const Recognition r = recognizer.recognize(scene);
+    ASSERT_TRUE(r.recognised()) << "root_sift " << root << ": " << r.reason;
+    EXPECT_EQ(r.best_score()->name, "blue") << "root_sift " << root;
+    EXPECT_GE(r.best_score()->verified_matches, 15) << "root_sift " << root;
   }
 }
 

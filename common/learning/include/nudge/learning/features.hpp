@@ -30,6 +30,12 @@ struct SiftParams {
 // non-8-bit image, or settings SIFT refuses (a threshold not positive, fewer than 1 layer).
 Features detect_features(const cv::Mat& image, const SiftParams& params = {});
 
+// RootSIFT (Arandjelovic & Zisserman, CVPR 2012): each descriptor row L1-normalised and square-
+// rooted, so that the Euclidean distance between two rows is the Hellinger distance between their
+// gradient histograms and a few large bins no longer dominate it. Rows come out with unit L2 norm
+// (an all-zero row stays zero). Recognition matches these; the database keeps plain SIFT.
+cv::Mat root_sift(const cv::Mat& descriptors);
+
 // The box grown by `margin` times its width and height on every side (the thesis' "generous" box,
 // allowing for the tilt and shift of an imperfect grasp), clipped to the image.
 cv::Rect generous_box(const cv::Rect& box, double margin, cv::Size image_size);

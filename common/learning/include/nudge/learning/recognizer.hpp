@@ -27,6 +27,7 @@ struct RecognizeParams {
   bool geometric_check = true;  // RANSAC similarity or homography per training view
   int min_support = 2;          // matches agreeing with a mapping beyond those that fixed it
   bool affine_check = true;     // also an affine map (foreshortening), from 6 matches
+  bool root_sift = true;        // match RootSIFT (Hellinger distance) rather than raw SIFT descriptors
   double ransac_px = 6.0;       // reprojection error an inlier may have, pixels
   MatcherKind matcher = MatcherKind::SharedFlann;  // fastest at every database size measured
   // SharedFlann only: neighbours fetched per query descriptor over the whole database (enough that
@@ -87,7 +88,7 @@ class Recognizer {
  private:
   struct Entry;
   struct SharedIndex;
-  std::vector<std::vector<cv::DMatch>> ratio_matches_per_object(const Features& query) const;
+  std::vector<std::vector<cv::DMatch>> ratio_matches_per_object(const cv::Mat& query_descriptors) const;
   RecognizeParams params_;
   std::vector<std::unique_ptr<Entry>> entries_;
   std::unique_ptr<SharedIndex> shared_;  // SharedFlann only
