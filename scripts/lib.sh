@@ -154,6 +154,8 @@ nudge_in_private_network() {
 # (nudge-triangulation --candidate-line-tilt 2): objects' lines lean 0-1 deg (a degraded one up
 # to 4), lines between two objects 2.5-5 deg; re-chosen on 33 recorded development runs
 # (docs/supervisor.md, nudge-exp-survey-line-tilt: 2 and 3 deg keep as many real candidates).
+# A survey that leaves nothing to nudge is asked once more at 5 deg before the run ends
+# (nudge-supervisor --wide-survey-tilt 5): a label can lean a lone bottle's line past 2 deg.
 nudge_run_loop() {
   local bin=$1 scene=$2 calibration=$3 workspace=$4 out=$5 run=$6
   shift 6
@@ -190,6 +192,7 @@ nudge_run_loop() {
       survey=(--survey-lines 8) ;;
     plain)
       triangulation_flags=', "--candidate-line-tilt", "2"'
+      survey=(--wide-survey-tilt 5)
       if [ "${NUDGE_LOOP_REACH:-1}" = 1 ]; then
         symmetry_flags='"--lines", "20", "--reach-calibration", "'"$calibration"'", "--reach-inner-radius", "0.10", "--reach-keep", "5"'
       fi ;;

@@ -373,6 +373,7 @@ class Shell {
     m.utime = now_;
     m.frames = r.frames;
     m.lines_per_image = r.lines;
+    m.max_line_tilt_deg = r.max_line_tilt_deg;
     for (const Eigen::Vector3d& place : r.explored) {
       const Eigen::Vector3d p = scene_.world_to_table(Eigen::Vector3d(place.x(), place.y(), 0.0));
       m.explored.push_back({p.x(), p.y(), 0.0});  // on the table
@@ -556,6 +557,8 @@ void add_flags(Flags& f, Options& o) {
              "plot) while the settled AXES decide");
   f.add_int("survey-frames", &o.config.survey_frames, "stereo pairs per candidate survey (thesis 25)");
   f.add_int("survey-lines", &o.config.survey_lines, "lines per image in a survey (thesis 3)");
+  f.add_double("wide-survey-tilt", &o.config.wide_survey_tilt_deg,
+               "a survey leaving nothing to nudge is asked again with lines up to DEG from upright before the run ends (0: never)");
   f.add_int("max-attempts", &o.config.max_attempts, "nudges per run");
   f.add_double("settle", &o.config.settle_s, "after the nudge, wait this long for the object to rest, s");
   f.add_double("max-settle", &o.config.max_settle_s,
@@ -617,6 +620,8 @@ int main(int argc, char** argv) {
     if (opt.require.empty()) opt.require = std::string("camera,symmetry,triangulation,arm") + (opt.clock == "sim" ? ",world" : "");
     if (!(opt.service_timeout_s > 0)) throw FlagError("--service-timeout must be > 0");
     if (!(opt.config.learn_timeout_s > 0)) throw FlagError("--learn-timeout must be > 0");
+    if (!(opt.config.wide_survey_tilt_deg >= 0 && opt.config.wide_survey_tilt_deg <= 90))
+      throw FlagError("--wide-survey-tilt must be in [0, 90] degrees");
     if (!(opt.config.learn_max_wait_s >= opt.config.learn_timeout_s)) throw FlagError("--learn-max-wait must be >= --learn-timeout");
     if (!(opt.nudge_speed_scale >= 0.01 && opt.nudge_speed_scale <= 1)) throw FlagError("--nudge-speed must lie in [0.01, 1]");
     if (opt.learn == "on") opt.config.learn = sv::Config::Learn::On;

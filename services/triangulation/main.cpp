@@ -147,6 +147,12 @@ class Triangulation {
     geo::LocationParams params = opt_.locations;
     if (request.frames > 0) params.frames = request.frames;
     if (request.lines_per_image > 0) params.lines_per_image = request.lines_per_image;
+    if (request.max_line_tilt_deg > 0) {
+      if (!(request.max_line_tilt_deg <= 90))
+        throw std::runtime_error("max_line_tilt_deg " + std::to_string(request.max_line_tilt_deg) +
+                                 " is not in (0, 90]; request ignored");
+      params.max_line_tilt_deg = request.max_line_tilt_deg;
+    }
     for (int i = 0; i < request.num_explored; ++i) {
       const Eigen::Vector3d place(request.explored[i][0], request.explored[i][1], request.explored[i][2]);
       if (!place.allFinite()) throw std::runtime_error("explored place " + std::to_string(i) + " is not finite; request ignored");
@@ -157,7 +163,9 @@ class Triangulation {
     request_utime_ = request.utime;
     stale_pairs_ = 0;
     log::info() << "candidates requested: gathering " << params.frames << " stereo pairs, " << params.lines_per_image
-                << " lines per image" << (params.explored.empty() ? std::string()
+                << " lines per image"
+                << (params.max_line_tilt_deg > 0 ? ", within " + std::to_string(params.max_line_tilt_deg) + " deg of upright" : std::string())
+                << (params.explored.empty() ? std::string()
                                           : ", leaving out the lines of " + std::to_string(params.explored.size()) + " explored object(s)");
   }
 

@@ -179,12 +179,14 @@ int right_order(int frame, int k) { return (k + frame) % 3; }
 // frames before it arrive late, as from a lagging pipeline).
 // `explored`: places sent with the request (table frame).
 void write_input_log(const Scene& scene, const std::string& path, int64_t request_utime = kStart - 1,
-                     int request_frames = 20, const std::vector<Eigen::Vector3d>& explored = {}) {
+                     int request_frames = 20, const std::vector<Eigen::Vector3d>& explored = {},
+                     double max_line_tilt_deg = 0) {
   LogWriter log(path);
   nudge::candidates_request_t request;
   request.utime = request_utime;
   request.frames = request_frames;
   request.lines_per_image = 3;
+  request.max_line_tilt_deg = max_line_tilt_deg;
   for (const Eigen::Vector3d& place : explored) request.explored.push_back({place.x(), place.y(), place.z()});
   request.num_explored = static_cast<int32_t>(request.explored.size());
   log.raw(request.utime, "CANDIDATES_REQUEST", encode(request));
@@ -381,6 +383,25 @@ TEST(TriangulationService, AnExploredObjectsLinesAreNotPaired) {
   ASSERT_EQ(c.num_candidates, 1);
   EXPECT_LT((frame.to_camera(Eigen::Vector3d(c.position[0][0], c.position[0][1], c.position[0][2])) - ring[1]->base_right).norm(), 1e-3);
   EXPECT_NE(service.err.find("leaving out the lines of 1 explored object(s)"), std::string::npos) << service.err;
+}
+
+// A request may widen (or narrow) the survey's line tilt for itself: the supervisor's second look.
+// A tilt outside (0, 90] degrees is refused by name and nothing is gathered for it.
+TEST(TriangulationService, ARequestCarriesItsOwnLineTilt) {
+  const Scene scene;
+  ServiceRun wide("wide_tilt");
+  geo::save_rig(scene.rig, wide.rig);
+  write_input_log(scene, wide.in, kStart - 1, 20, {}, 5.0);
+  const std::string flags = table_flags(scene) + " --candidate-line-tilt 2";
+  ASSERT_EQ(wide(flags), 0) << wide.command(flags) << "\n" << wide.err;
+  expect_axes_and_candidates(scene, read_output(wide.out), wide.err);
+  EXPECT_NE(wide.err.find("within 5.0"), std::string::npos) << wide.err;
+  ServiceRun bad("bad_tilt");
+  geo::save_rig(scene.rig, bad.rig);
+  write_input_log(scene, bad.in, kStart - 1, 20, {}, 120.0);
+  ASSERT_EQ(bad(flags), 0) << bad.command(flags) << "\n" << bad.err;
+  EXPECT_TRUE(read_output(bad.out).candidates.empty());
+  EXPECT_NE(bad.err.find("max_line_tilt_deg 120"), std::string::npos) << bad.err;
 }
 
 TEST(TriangulationService, TableAndArmBaseCanComeFromTheCalibrationFile) {

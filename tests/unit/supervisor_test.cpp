@@ -91,6 +91,17 @@ sv::Segmentation mask_of_difference(const cv::Mat& before, const cv::Mat& after,
   return s;
 }
 
+// `line` turned by `degrees` about the middle of its support segment (a line a label leans).
+nudge::symmetry::Line leaning(const nudge::symmetry::Line& line, double degrees, cv::Size size) {
+  const cv::Point2d middle = 0.5 * (line.seg1 + line.seg2), d = line.seg2 - line.seg1;
+  const double turn = degrees * M_PI / 180;
+  const cv::Point2d turned(d.x * std::cos(turn) - d.y * std::sin(turn), d.x * std::sin(turn) + d.y * std::cos(turn));
+  nudge::symmetry::Line out = sv::line_through(middle - 0.5 * turned, middle + 0.5 * turned, size);
+  out.seg1 = middle - 0.5 * turned;
+  out.seg2 = middle + 0.5 * turned;
+  return out;
+}
+
 template <typename T>
 std::vector<T> outputs_of(const std::vector<sv::Output>& outputs) {
   std::vector<T> found;
@@ -444,6 +455,48 @@ TEST_F(SupervisorTest, NoCandidateAtAllEndsTheRunWithItsReason) {
   start_with(s, {});
   EXPECT_EQ(s.state(), sv::State::Done);
   EXPECT_EQ(s.summary().end_reason, "no candidate found on the table");
+}
+
+// A survey that leaves nothing to nudge is asked once more, with survey lines further from
+// upright, before the run ends (a lone bottle whose label leans its line past the service's 2 deg);
+// what the second look finds is nudged.
+TEST_F(SupervisorTest, AnEmptySurveyIsAskedOnceMoreWithWiderLinesBeforeTheRunEnds) {
+  sv::Config config;
+  config.wide_survey_tilt_deg = 5;
+  for (bool found_later : {false, true}) {
+    sv::Supervisor s = make(config);
+    s.start(now_, 100);
+    s.on_services({}, now_);
+    const auto first = outputs_of<sv::CandidatesRequest>(s.take_outputs());
+    ASSERT_EQ(first.size(), 1u);
+    EXPECT_EQ(first[0].max_line_tilt_deg, 0) << "the first survey is the service's own";
+    const auto second = outputs_of<sv::CandidatesRequest>(answer_survey(s, {}));
+    ASSERT_EQ(s.state(), sv::State::FindCandidates) << s.report().reason;
+    ASSERT_EQ(second.size(), 1u);
+    EXPECT_EQ(second[0].max_line_tilt_deg, 5);
+    EXPECT_NE(s.report().reason.find("no candidate found on the table: a second look"), std::string::npos)
+        << s.report().reason;
+    EXPECT_NE(s.report().reason.find("up to 5 deg from upright"), std::string::npos) << s.report().reason;
+    if (found_later) {
+      // Both cameras saw the object's lines leaning 4 deg about its middle: too far for a
+      // survey's agreement (3 deg), near enough for the second look's.
+      const Eigen::Vector3d object(0.28, -0.05, 0);
+      for (int i = 0; i < 10; ++i)
+        for (bool left : {true, false}) {
+          const auto axis = left ? scene_.left_axis_line(object, 0.25, {640, 480}) : scene_.right_axis_line(object, 0.25, {640, 480});
+          ASSERT_TRUE(axis);
+          s.on_lines(left, {leaning(*axis, 4.0, {640, 480})}, now_ + kSecond / 10, now_ + kSecond / 5);
+        }
+      answer_survey(s, {object});
+      EXPECT_NE(s.state(), sv::State::Done) << s.summary().end_reason;
+      EXPECT_EQ(s.summary().attempts, 1);
+    } else {
+      answer_survey(s, {});
+      EXPECT_EQ(s.state(), sv::State::Done);
+      EXPECT_EQ(s.summary().end_reason, "no candidate found on the table");
+      EXPECT_EQ(s.summary().surveys, 2) << "one second look, not more";
+    }
+  }
 }
 
 TEST_F(SupervisorTest, EveryCandidateOutOfReachIsReportedNotNudged) {

@@ -132,17 +132,21 @@ void Supervisor::finish(State state, const std::string& reason, int64_t now) {
 
 // ---- the loop ----
 
-void Supervisor::survey(int64_t now, const std::string& why) {
+void Supervisor::survey(int64_t now, const std::string& why, double max_line_tilt_deg) {
   if (summary_.attempts >= config_.max_attempts) {
     finish(State::Done, "attempt limit reached (" + std::to_string(config_.max_attempts) + " nudges)", now);
     return;
   }
   ++summary_.surveys;
   request_time_ = now;
+  wide_survey_ = max_line_tilt_deg > 0;
   for (auto& lines : survey_lines_) lines.clear();
+  char wide[64] = "";
+  if (wide_survey_) std::snprintf(wide, sizeof wide, ", lines up to %.0f deg from upright", max_line_tilt_deg);
   enter(State::FindCandidates, now,
-        (why.empty() ? std::string() : why + "; ") + "surveying: candidates from " + std::to_string(config_.survey_frames) + " stereo pairs");
-  outputs_.push_back(CandidatesRequest{config_.survey_frames, config_.survey_lines, standing_});
+        (why.empty() ? std::string() : why + "; ") + "surveying: candidates from " + std::to_string(config_.survey_frames) +
+            " stereo pairs" + wide);
+  outputs_.push_back(CandidatesRequest{config_.survey_frames, config_.survey_lines, standing_, max_line_tilt_deg});
 }
 
 void Supervisor::choose(int64_t now) {
@@ -161,6 +165,10 @@ void Supervisor::choose(int64_t now) {
     const bool any_new = std::any_of(choice.rejected.begin(), choice.rejected.end(),
                                      [](const Rejection& r) { return r.reason != "already explored"; });
     if (any_new) why += " (" + choice.rejected.back().reason + ")";
+    if (!wide_survey_ && config_.wide_survey_tilt_deg > 0) {
+      survey(now, why + ": a second look", config_.wide_survey_tilt_deg);
+      return;
+    }
     finish(State::Done, why, now);
     return;
   }
@@ -930,7 +938,17 @@ void Supervisor::on_lines(bool left, const std::vector<symmetry::Line>& lines, i
 }
 
 double Supervisor::stereo_agreement(const Candidate& candidate) const {
-  const double max_angle = config_.agreement_angle_deg * M_PI / 180;
+  // The second, wider look paired lines leaning up to wide_survey_tilt_deg: one of those agrees
+  // with the candidate's predicted axis when it leans no more and passes within the offset of the
+  // axis' middle (its R about the image centre moves with the lean, however close it passes).
+  const double max_angle =
+      (wide_survey_ ? std::max(config_.agreement_angle_deg, config_.wide_survey_tilt_deg) : config_.agreement_angle_deg) * M_PI / 180;
+  auto agree = [&](const symmetry::Line& line, const symmetry::Line& predicted) {
+    if (!wide_survey_) return lines_agree(line, predicted, max_angle, config_.agreement_offset_px);
+    const cv::Point2d middle = 0.5 * (predicted.seg1 + predicted.seg2);
+    return std::abs(symmetry::line_difference(line, predicted).theta) <= max_angle &&
+           std::abs(signed_distance(line, middle, config_.frame_size)) <= config_.agreement_offset_px;
+  };
   double agreement = 1.0;
   for (int camera = 0; camera < 2; ++camera) {
     const auto& messages = survey_lines_[camera];
@@ -940,9 +958,7 @@ double Supervisor::stereo_agreement(const Candidate& candidate) const {
     if (!predicted) return 0.0;
     int seen = 0;
     for (const auto& lines : messages)
-      seen += std::any_of(lines.begin(), lines.end(), [&](const symmetry::Line& line) {
-        return lines_agree(line, *predicted, max_angle, config_.agreement_offset_px);
-      });
+      seen += std::any_of(lines.begin(), lines.end(), [&](const symmetry::Line& line) { return agree(line, *predicted); });
     agreement = std::min(agreement, static_cast<double>(seen) / messages.size());
   }
   return agreement;

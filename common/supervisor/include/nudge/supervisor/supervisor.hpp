@@ -44,6 +44,12 @@ const char* to_string(State state);
 struct Config {
   int survey_frames = 25;            // stereo pairs per candidate request (thesis 6.2)
   int survey_lines = 3;              // lines per image (3 x 3 pairings)
+  // A survey that leaves nothing to nudge is asked once more with survey lines up to this many
+  // degrees from the image of an upright axis (CANDIDATES_REQUEST.max_line_tilt_deg) before the
+  // run ends: a triangulation service that pairs only near-upright lines (--candidate-line-tilt 2
+  // against phantoms between objects) loses an object whose line a label or clutter leans a few
+  // degrees. 0: no second look (one survey, as the thesis).
+  double wide_survey_tilt_deg = 0;
   int max_attempts = 12;             // nudges per run
   double services_timeout_s = 60;    // for every required service's first heartbeat
   double candidates_timeout_s = 60;  // task-clock seconds for a CANDIDATES answer
@@ -189,6 +195,7 @@ using SegmentFunction = std::function<Segmentation(const cv::Mat& before, const 
 struct CandidatesRequest {
   int frames = 25, lines = 3;
   std::vector<Eigen::Vector3d> explored;
+  double max_line_tilt_deg = 0;  // > 0: this survey's line tilt (the second look); 0: the service's
 };
 struct SnapshotRequest { bool both = false; };  // both cameras (learning: the left segmentation too)
 // Learning (thesis ch. 7). Grasp/Place: the tool point `height` above the table over `position`.
@@ -345,7 +352,7 @@ class Supervisor {
 
  private:
   void enter(State state, int64_t now, const std::string& reason);
-  void survey(int64_t now, const std::string& why = "");
+  void survey(int64_t now, const std::string& why = "", double max_line_tilt_deg = 0);
   void choose(int64_t now);
   void request_still(State state, int64_t now, const std::string& note = "");
   void ask_for_still(int64_t now, bool first);
@@ -377,6 +384,7 @@ class Supervisor {
   std::string after_home_;  // why the survey after homing happens
   std::vector<Candidate> candidates_;
   std::vector<Eigen::Vector3d> explored_, phantoms_, empty_;
+  bool wide_survey_ = false;  // the survey under way is the second, wider look
   std::vector<Eigen::Vector3d> standing_;  // explored objects where they stand now (CandidatesRequest::explored)
   // The segmented objects where they came to rest (they stand there now), with their masks.
   struct Rested {
