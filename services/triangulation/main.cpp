@@ -147,7 +147,7 @@ class Triangulation {
     geo::LocationParams params = opt_.locations;
     if (request.frames > 0) params.frames = request.frames;
     if (request.lines_per_image > 0) params.lines_per_image = request.lines_per_image;
-    if (request.max_line_tilt_deg > 0) {
+    if (!(request.max_line_tilt_deg <= 0)) {  // positive, or NaN: refused below, not ignored
       if (!(request.max_line_tilt_deg <= 90))
         throw std::runtime_error("max_line_tilt_deg " + std::to_string(request.max_line_tilt_deg) +
                                  " is not in (0, 90]; request ignored");

@@ -24,7 +24,7 @@ std::string matcher_name(MatcherKind kind);
 struct RecognizeParams {
   double ratio = 0.6;           // d1 < ratio * d2 (thesis: N = 0.6)
   int min_matches = 3;          // the best object needs this many verified matches (thesis: 3)
-  bool geometric_check = true;  // RANSAC similarity or homography per training view
+  bool geometric_check = true;  // RANSAC similarity, affine map or homography per training view
   int min_support = 2;          // matches agreeing with a mapping beyond those that fixed it
   bool affine_check = true;     // also an affine map (foreshortening), from 6 matches
   bool root_sift = true;        // match RootSIFT (Hellinger distance) rather than raw SIFT descriptors
