@@ -1,10 +1,26 @@
 #include "nudge/supervisor/line_search.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "nudge/symmetry/line.hpp"
 
 namespace nudge::supervisor {
+namespace {
+
+// Whether `line`'s support reaches down to the predicted axis' foot (predicted.seg1; seg2 its top):
+// its end furthest along the axis from the top is at most `slack` of the axis' length short of the
+// foot. True for a prediction without a span.
+bool reaches_foot(const symmetry::Line& line, const symmetry::Line& predicted, double slack) {
+  const cv::Point2d top_to_foot = predicted.seg1 - predicted.seg2;
+  const double length = cv::norm(top_to_foot);
+  if (length < 1) return true;
+  const cv::Point2d down = top_to_foot / length;
+  const double reach = std::max((line.seg1 - predicted.seg2).dot(down), (line.seg2 - predicted.seg2).dot(down));
+  return reach >= (1 - slack) * length;
+}
+
+}  // namespace
 
 std::optional<symmetry::Line> find_line_near(const cv::Mat& image, const symmetry::Line& predicted,
                                              const LineSearchParams& params) {
@@ -27,12 +43,16 @@ std::optional<symmetry::Line> find_line_near(const cv::Mat& image, const symmetr
   symmetry::Detector detector(p, edges);
   const symmetry::Result result = detector.detect(image);
   std::optional<symmetry::Line> best;
+  bool best_reaches = false;
   double best_offset = params.window_px;
   for (const symmetry::Line& line : result.lines) {
     // In the form nearer the prediction: (R, theta) equals (-R, theta +- 180 deg).
     const double offset = std::abs(symmetry::line_difference(line, predicted).r);
-    if (offset <= best_offset) {
+    if (offset > params.window_px) continue;
+    const bool reaches = reaches_foot(line, predicted, params.foot_slack);
+    if (!best || (reaches && !best_reaches) || (reaches == best_reaches && offset <= best_offset)) {
       best_offset = offset;
+      best_reaches = reaches;
       best = line;
     }
   }
