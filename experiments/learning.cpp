@@ -40,6 +40,7 @@
 #include "nudge/learning/match_truth.hpp"
 #include "nudge/learning/recognizer.hpp"
 #include "nudge/learning/synthetic.hpp"
+#include "nudge/sim/objects.hpp"
 #include "nudge/sim/scene.hpp"
 #include "nudge/sim/state_sync.hpp"
 #include "nudge/sim/world.hpp"
@@ -118,6 +119,7 @@ struct Judged {
   std::string image, target, variant, label, bottle;  // bottle: what the label is (a learned bottle)
   int verified = 0, good = 0, bad = 0, best_view = -1;
   int most_ratio_matches = 0, most_verified = 0;  // over every object, recognised or not (why not: how near)
+  int label_pixels = -1;  // the target's label pixels in sight (-1: no target, or it has no label)
   std::vector<double> distances_m;
   learning::Recognition recognition;
 };
@@ -218,7 +220,30 @@ TrainingTruth render_training_views(const Run& run, const fs::path& scene_file, 
   return truth;
 }
 
+// How much of the target's label the test image shows: its pixels whose object-frame height lies in
+// the label's band. The bottles' bodies are plain; their labels carry nearly all of their SIFT
+// features, so an image showing little label has little to be recognised by.
+// `bottles`: the learned bottles' specs by name (the training scenes' first objects).
+int label_pixels_in_sight(const TestImage& t, const std::map<std::string, sim::ObjectSpec>& bottles) {
+  const auto found = bottles.find(t.target);
+  if (found == bottles.end() || found->second.label.file.empty() || t.surface.type() != CV_32FC3 ||
+      t.mask.type() != CV_8U || t.mask.size() != t.surface.size())
+    return -1;
+  const sim::ObjectSpec& target = found->second;
+  auto [bottom, top] = sim::default_label_band(target.kind);
+  if (target.label.bottom >= 0) bottom = target.label.bottom;
+  if (target.label.top >= 0) top = target.label.top;
+  int pixels = 0;
+  for (int y = 0; y < t.mask.rows; ++y)
+    for (int x = 0; x < t.mask.cols; ++x) {
+      const float z = t.surface.at<cv::Vec3f>(y, x)[2];
+      if (t.mask.at<uchar>(y, x) == 1 && z >= bottom && z <= top) ++pixels;
+    }
+  return pixels;
+}
+
 Judged recognise_and_judge(const learning::Recognizer& recognizer, const TestImage& t,
+                           const std::map<std::string, sim::ObjectSpec>& bottles,
                            const std::map<std::string, std::string>& bottle_of,
                            std::map<std::string, TrainingTruth>& training, double tolerance_m) {
   Judged j;
@@ -226,6 +251,7 @@ Judged recognise_and_judge(const learning::Recognizer& recognizer, const TestIma
   j.target = t.target;
   j.variant = variant_name(t.variant);
   j.recognition = recognizer.recognize(t.colour);
+  j.label_pixels = label_pixels_in_sight(t, bottles);
   for (const learning::ObjectScore& score : j.recognition.scores) {
     j.most_ratio_matches = std::max(j.most_ratio_matches, score.ratio_matches);
     j.most_verified = std::max(j.most_verified, score.verified_matches);
@@ -433,11 +459,15 @@ std::string markdown_report(const Options& o, const std::vector<Run>& runs, cons
     if (const ThesisRow* t = thesis_row(r.bottle)) md << "4, " << t->good << " / " << t->bad;
     md << " |\n";
   }
-  md << "\n## Every image\n\n| image | recognised as | verified matches | good | bad | most ratio-test / verified matches of any object |\n"
-     << "|---|---|---|---|---|---|\n";
+  md << "\n## Every image\n\n| image | recognised as | verified matches | good | bad | most ratio-test / verified matches of any object | label pixels in sight |\n"
+     << "|---|---|---|---|---|---|---|\n";
   for (const Judged& x : judged)
     md << "| " << x.image << " | " << (x.label.empty() ? "nothing (" + x.recognition.reason + ")" : x.bottle) << " | "
-       << x.verified << " | " << x.good << " | " << x.bad << " | " << x.most_ratio_matches << " / " << x.most_verified << " |\n";
+       << x.verified << " | " << x.good << " | " << x.bad << " | " << x.most_ratio_matches << " / " << x.most_verified << " | "
+       << (x.label_pixels < 0 ? std::string("–") : std::to_string(x.label_pixels)) << " |\n";
+  md << "\n`label pixels in sight`: the target's pixels in the test image whose height on the bottle lies in its "
+        "label's band (the bodies are plain: the labels carry nearly all of the bottles' SIFT features), from the "
+        "simulator's surface render of the image.\n";
   md << "\n**Good and bad matches.** A verified match (the recognised object's best training view, after the RANSAC "
         "check) is good when the test image's keypoint and the training view's keypoint show the same surface point "
         "of the same object: both within one pixel of that object's pixels, their object-frame coordinates within "
@@ -496,7 +526,12 @@ int run(const Options& o) {
   std::sort(scene_files.begin(), scene_files.end());
   if (scene_files.empty()) throw std::runtime_error(o.scenes + ": no train*.yaml scenes");
   std::vector<Run> runs;
-  for (const fs::path& f : scene_files) runs.push_back(read_run(o.runs, f));
+  std::map<std::string, sim::ObjectSpec> bottles;
+  for (const fs::path& f : scene_files) {
+    runs.push_back(read_run(o.runs, f));
+    const sim::ObjectSpec bottle = sim::load_scene(f.string()).objects.at(0);
+    bottles[bottle.name] = bottle;
+  }
 
   const learning::ObjectDatabase db(o.runs + "/objects");
   learning::LoadReport loaded = db.load_all(o.relearn);
@@ -524,7 +559,7 @@ int run(const Options& o) {
   nudge::Progress progress("nudge-exp-learning", static_cast<int>(images.size()));
   for (const TestImage& t : images) {
     progress.step(t.name);
-    judged.push_back(recognise_and_judge(recognizer, t, bottle_of, training, o.tolerance_mm / 1e3));
+    judged.push_back(recognise_and_judge(recognizer, t, bottles, bottle_of, training, o.tolerance_mm / 1e3));
     const Judged& x = judged.back();
     progress.note(x.image + ": " + (x.label.empty() ? "nothing (" + x.recognition.reason + ")" : x.bottle) + ", " +
                   std::to_string(x.good) + " good / " + std::to_string(x.bad) + " bad");
