@@ -40,7 +40,6 @@
 #include "nudge/learning/match_truth.hpp"
 #include "nudge/learning/recognizer.hpp"
 #include "nudge/learning/synthetic.hpp"
-#include "nudge/sim/objects.hpp"
 #include "nudge/sim/scene.hpp"
 #include "nudge/sim/state_sync.hpp"
 #include "nudge/sim/world.hpp"
@@ -103,6 +102,7 @@ std::shared_ptr<const learning::ObjectModel> relearned(const learning::ObjectMod
 // One training scene's run, as its summary tells it.
 struct Run {
   std::string scene, bottle;          // train1_white_bottle, white_bottle
+  sim::ObjectSpec bottle_spec;        // the training scene's first object
   fs::path folder;                    // runs/<scene>/<scene>
   std::string learned_name;           // in the database; "" when not learned
   std::string why_not;                // what happened instead
@@ -141,7 +141,8 @@ std::string attempt_story(const nlohmann::json& a) {
 Run read_run(const fs::path& runs, const fs::path& scene_file) {
   Run run;
   run.scene = scene_file.stem().string();
-  run.bottle = sim::load_scene(scene_file.string()).objects.at(0).name;
+  run.bottle_spec = sim::load_scene(scene_file.string()).objects.at(0);
+  run.bottle = run.bottle_spec.name;
   run.folder = runs / run.scene / run.scene;
   const fs::path summary_file = run.folder / "summary.json";
   if (!fs::exists(summary_file)) {
@@ -226,20 +227,13 @@ TrainingTruth render_training_views(const Run& run, const fs::path& scene_file, 
 // `bottles`: the learned bottles' specs by name (the training scenes' first objects).
 int label_pixels_in_sight(const TestImage& t, const std::map<std::string, sim::ObjectSpec>& bottles) {
   const auto found = bottles.find(t.target);
-  if (found == bottles.end() || found->second.label.file.empty() || t.surface.type() != CV_32FC3 ||
+  if (found == bottles.end() || !found->second.label.present() || t.surface.type() != CV_32FC3 ||
       t.mask.type() != CV_8U || t.mask.size() != t.surface.size())
     return -1;
-  const sim::ObjectSpec& target = found->second;
-  auto [bottom, top] = sim::default_label_band(target.kind);
-  if (target.label.bottom >= 0) bottom = target.label.bottom;
-  if (target.label.top >= 0) top = target.label.top;
-  int pixels = 0;
-  for (int y = 0; y < t.mask.rows; ++y)
-    for (int x = 0; x < t.mask.cols; ++x) {
-      const float z = t.surface.at<cv::Vec3f>(y, x)[2];
-      if (t.mask.at<uchar>(y, x) == 1 && z >= bottom && z <= top) ++pixels;
-    }
-  return pixels;
+  const auto [bottom, top] = sim::label_band(found->second);
+  cv::Mat height;
+  cv::extractChannel(t.surface, height, 2);
+  return cv::countNonZero((t.mask == 1) & (height >= bottom) & (height <= top));
 }
 
 Judged recognise_and_judge(const learning::Recognizer& recognizer, const TestImage& t,
@@ -529,8 +523,7 @@ int run(const Options& o) {
   std::map<std::string, sim::ObjectSpec> bottles;
   for (const fs::path& f : scene_files) {
     runs.push_back(read_run(o.runs, f));
-    const sim::ObjectSpec bottle = sim::load_scene(f.string()).objects.at(0);
-    bottles[bottle.name] = bottle;
+    bottles[runs.back().bottle] = runs.back().bottle_spec;
   }
 
   const learning::ObjectDatabase db(o.runs + "/objects");

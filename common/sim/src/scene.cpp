@@ -265,12 +265,17 @@ ObjectModel model_of(const ObjectSpec& spec, int segments) {
                           ? mesh_object(read_mesh_file(spec.mesh.file), spec.mesh.scale, spec.mesh.rotation)
                           : make_object(spec.kind, segments);
   if (spec.label.present()) {
-    auto band = default_label_band(spec.kind);
-    if (spec.label.bottom >= 0) band.first = spec.label.bottom;
-    if (spec.label.top >= 0) band.second = spec.label.top;
-    model.label = label_sleeve(model, band.first, band.second, segments);
+    const auto [bottom, top] = label_band(spec);
+    model.label = label_sleeve(model, bottom, top, segments);
   }
   return model;
+}
+
+std::pair<double, double> label_band(const ObjectSpec& spec) {
+  auto band = default_label_band(spec.kind);
+  if (spec.label.bottom >= 0) band.first = spec.label.bottom;
+  if (spec.label.top >= 0) band.second = spec.label.top;
+  return band;
 }
 
 Scene default_scene() {

@@ -16,6 +16,7 @@
 #include <cstdint>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace nudge::sim {
@@ -144,6 +145,11 @@ struct Scene {
 // MeshFileError (mesh_file.hpp) with the reason; validate() turns those into SceneErrors naming
 // the field.
 ObjectModel model_of(const ObjectSpec& spec, int segments = 48);
+
+// The heights above the base [bottom, top] a label covers: the spec's, or its kind's default band
+// where the spec leaves them negative (default_label_band()). Throws std::invalid_argument for a
+// kind with no place for a label.
+std::pair<double, double> label_band(const ObjectSpec& spec);
 
 // Defaults for the table and backdrop: light wood-coloured table, plain off-white wall.
 Scene default_scene();
