@@ -23,6 +23,7 @@
 #include "nudge/flags.hpp"
 #include "nudge/progress.hpp"
 #include "nudge/timing.hpp"
+#include "nudge/geometry/axis_appearance.hpp"
 #include "nudge/geometry/interesting_locations.hpp"
 #include "nudge/geometry/table_texture.hpp"
 #include "nudge/geometry/upright.hpp"
@@ -83,12 +84,16 @@ struct AfterOptions {
   double appearance_weight = 1, band_weight = 0.5, min_appearance = 0, colour_tolerance = 90, band_gap = 8, verify_suppress = 4;
   int candidate_lines = 8;
   bool stereo_check = true, colour_edges = true;
-  double min_overlap = 0.3, max_foot = 0.08;
+  double min_overlap = 0.2, max_foot = 0.08;  // third round: 0.3 without the stereo appearance
   bool refine = false;
   double refine_max = 4;
   double upright = 2;  // second round: only peaks that can be upright axes are verified
   bool snap = false;
   double min_fraction = 0.03;
+  double min_agreement = 0.5;  // stereo appearance along the axis (0: off); fourth round
+  double agreement_tolerance = 60;
+  int agreement_window = 1;
+  double agreement_waived = 0.7;
 };
 
 Pipeline after_issue14(const AfterOptions& o) {
@@ -120,6 +125,10 @@ Pipeline after_issue14(const AfterOptions& o) {
   p.locations.min_height_overlap = o.min_overlap;
   p.locations.max_foot_height_m = o.max_foot;
   p.locations.qt.min_fraction = o.min_fraction;
+  p.locations.min_axis_colour_agreement = o.min_agreement;
+  p.locations.appearance.colour_tolerance = o.agreement_tolerance;
+  p.locations.appearance.window_px = o.agreement_window;
+  p.locations.appearance_waived_at_overlap = o.agreement_waived;
   return p;
 }
 
@@ -139,6 +148,16 @@ struct LineLoss {
 struct CandidateLoss {
   int candidate = 0, never_both = 0, no_intersect = 0, not_clustered = 0;
 };
+// What became of the pairing of an object's own left and right lines, per object-frame in both
+// cameras' lines (--diagnose): one line ranked beyond the lines paired, the axis refused (tilt,
+// range, workspace ring, triangulation), its table hit further than 25 mm from the object, the
+// stereo check's height overlap or foot, another pairing taking one of its lines first, or an
+// intersect near the object.
+struct PairLoss {
+  int ranked_beyond = 0, tilt = 0, range = 0, ring = 0, triangulation = 0, hit_far = 0, overlap = 0, foot = 0,
+      taken = 0, near = 0;
+  std::vector<double> hit_mm;  // the valid pairings' hit distance from the object
+};
 
 struct SceneResult {
   std::string name;
@@ -146,6 +165,7 @@ struct SceneResult {
   std::array<CameraCount, 2> cameras;
   LineLoss line_loss;
   CandidateLoss candidate_loss;
+  PairLoss pair_loss;
   double pair_ms = 0;  // both cameras' detection and the pair's candidate intersects, summed over frames
   int candidates = 0, object_candidates = 0, duplicate_candidates = 0, objects_without = 0, phantom_candidates = 0;
   cv::Mat picture;
@@ -320,6 +340,45 @@ void diagnose_line(const sym::Detector& detector, const Detection& detection, co
   ++loss->no_peak;
 }
 
+int first_match(const std::vector<sym::Line>& lines, const sim::ImageLine& truth, int width, int height) {
+  for (size_t k = 0; k < lines.size(); ++k)
+    if (matches(lines[k], truth, width, height)) return static_cast<int>(k);
+  return -1;
+}
+
+// PairLoss of one object-frame: `il`, `ir` index the object's lines in `left`, `right`; `axes` are
+// the pairings the finder kept for the frame; `object_xy` the object's place (world frame).
+void diagnose_pairing(const geo::StereoRig& rig, const geo::Plane& table, const geo::AxisFilter& filter,
+                      const geo::LocationParams& params, const std::vector<sym::Line>& left,
+                      const std::vector<sym::Line>& right, int il, int ir, const std::vector<geo::PairedAxis>& axes,
+                      const sim::CameraModel& right_camera, const Eigen::Vector2d& object_xy, PairLoss* loss) {
+  if (il >= params.lines_per_image || ir >= params.lines_per_image) return void(++loss->ranked_beyond);
+  const geo::PairingResult one = geo::triangulate_pairings(rig, {left[il]}, {right[ir]}, &table, filter);
+  if (one.axes.empty()) {
+    const std::string why = one.rejections.empty() ? "" : one.rejections.front();
+    if (why.find("tilted") != std::string::npos) return void(++loss->tilt);
+    if (why.find("from the camera") != std::string::npos) return void(++loss->range);
+    if (why.find("arm base") != std::string::npos) return void(++loss->ring);
+    return void(++loss->triangulation);
+  }
+  const Eigen::Vector3d hit = right_camera.R.transpose() * (one.axes.front().hit->point - right_camera.t);
+  const double distance = (hit.head<2>() - object_xy).norm();
+  loss->hit_mm.push_back(1000 * distance);
+  if (distance > kCandidateRadiusM) return void(++loss->hit_far);
+  if (params.stereo_check) {
+    geo::LocationParams any_foot = params;
+    any_foot.max_foot_height_m = 1e3;
+    geo::PairingResult single = one;
+    single.axes.front().left_index = il;
+    single.axes.front().right_index = ir;
+    if (geo::consistent_pairings(rig, left, right, single, table, any_foot).empty()) return void(++loss->overlap);
+    if (geo::consistent_pairings(rig, left, right, single, table, params).empty()) return void(++loss->foot);
+  }
+  for (const geo::PairedAxis& a : axes)
+    if (a.left_index == il && a.right_index == ir) return void(++loss->near);
+  ++loss->taken;
+}
+
 void draw_frame(const cv::Mat& image, const std::vector<sym::Line>& lines, const std::vector<sim::ImageLine>& truth,
                 const std::vector<Eigen::Vector2d>& candidates, const std::vector<bool>& candidate_is_object,
                 cv::Mat* out) {
@@ -335,8 +394,52 @@ void draw_frame(const cv::Mat& image, const std::vector<sym::Line>& lines, const
   *out = canvas;
 }
 
+// --dump-pairings: every valid pairing of a frame's paired lines, one CSV row each, with its
+// stereo-check numbers and what it is (to design the pairing rule).
+void dump_pairings(const geo::StereoRig& rig, const geo::Plane& table, const geo::LocationFinder& finder,
+                   const geo::LocationParams& params, const std::array<std::vector<sym::Line>, 2>& lines,
+                   const std::array<std::vector<sim::ImageLine>, 2>& truth, const sim::World& world,
+                   const sim::StereoImages& images, const std::string& scene, int frame, std::ofstream* out) {
+  const sim::CameraModel& right = world.camera(1);
+  const geo::PairingResult result = geo::triangulate_pairings(rig, lines[0], lines[1], &table, finder.axis_filter(),
+                                                              {}, params.lines_per_image);
+  auto object_of = [&](int c, const sym::Line& line) {
+    for (int i = 0; i < world.num_objects(); ++i)
+      if (truth[c][i].valid && matches(line, truth[c][i], 640, 480)) return i;
+    return -1;
+  };
+  for (const geo::PairedAxis& a : result.axes) {
+    const auto l = geo::support_heights(rig, geo::Side::Left, lines[0][a.left_index], a.axis, *a.hit, table);
+    const auto r = geo::support_heights(rig, geo::Side::Right, lines[1][a.right_index], a.axis, *a.hit, table);
+    if (!l || !r) continue;
+    const Eigen::Vector3d hit = right.R.transpose() * (a.hit->point - right.t);
+    int nearest = -1;
+    double best = 1e9;
+    for (int i = 0; i < world.num_objects(); ++i) {
+      const double d = (hit.head<2>() - world.object(i).position.head<2>()).norm();
+      if (d < best) best = d, nearest = i;
+    }
+    const auto tl = geo::upright_tilt_deg(rig, geo::Side::Left, table, lines[0][a.left_index]);
+    const auto tr = geo::upright_tilt_deg(rig, geo::Side::Right, table, lines[1][a.right_index]);
+    auto agreement = [&](double top, double tolerance) {
+      geo::AxisAppearanceParams ap;
+      ap.colour_tolerance = tolerance;
+      const auto g = geo::axis_colour_agreement(rig, images.colour[0], images.colour[1], a.axis, a.hit->point, table,
+                                                std::clamp(top, 0.04, 0.30), ap);
+      return g ? *g : -1.0;
+    };
+    const double top = std::min(l->high, r->high);
+    *out << agreement(top, 60) << "," << agreement(top, 30) << "," << agreement(0.08, 60) << ",";
+    *out << scene << "," << frame << "," << a.left_index << "," << a.right_index << ","
+         << object_of(0, lines[0][a.left_index]) << "," << object_of(1, lines[1][a.right_index]) << "," << nearest
+         << "," << best * 1000 << "," << l->low << "," << l->high << "," << r->low << "," << r->high << ","
+         << a.hit->tilt_deg << "," << (tl ? *tl : -1) << "," << (tr ? *tr : -1) << ","
+         << lines[0][a.left_index].votes << "," << lines[1][a.right_index].votes << "\n";
+  }
+}
+
 SceneResult run_scene(const std::string& file, const Pipeline& pipeline, int frames, bool picture, bool diagnose,
-                      std::ofstream* dump = nullptr) {
+                      std::ofstream* dump = nullptr, std::ofstream* pair_dump = nullptr) {
   SceneResult result;
   result.name = fs::path(file).stem().string();
   sim::World world(sim::load_scene(file));
@@ -409,8 +512,19 @@ SceneResult run_scene(const std::string& file, const Pipeline& pipeline, int fra
       first_image = images.colour[0];
     }
     for (int i = 0; i < world.num_objects(); ++i) frames_in_both[i] += in_lines[0][i] && in_lines[1][i];
+    if (pair_dump) dump_pairings(rig, table, finder, locations, lines, truth, world, images, result.name, f, pair_dump);
+    if (diagnose) {
+      const std::vector<geo::PairedAxis> axes = finder.frame_axes(lines[0], lines[1], images.colour[0], images.colour[1]);
+      for (int i = 0; i < world.num_objects(); ++i) {
+        if (!in_lines[0][i] || !in_lines[1][i]) continue;
+        const int il = first_match(lines[0], truth[0][i], images.colour[0].cols, images.colour[0].rows);
+        const int ir = first_match(lines[1], truth[1][i], images.colour[1].cols, images.colour[1].rows);
+        diagnose_pairing(rig, table, finder.axis_filter(), locations, lines[0], lines[1], il, ir, axes, right,
+                         world.object(i).position.head<2>(), &result.pair_loss);
+      }
+    }
     nudge::Stopwatch watch;
-    finder.add_frame(lines[0], lines[1]);
+    finder.add_frame(lines[0], lines[1], images.colour[0], images.colour[1]);
     result.pair_ms += watch.elapsed_ms();
   }
 
@@ -500,6 +614,27 @@ std::string fixed(double v, int digits = 3) {
 
 LineLoss total_line_loss(const std::vector<SceneResult>& rs);
 CandidateLoss total_candidate_loss(const std::vector<SceneResult>& rs);
+
+std::string pair_loss_text(const std::vector<SceneResult>& results) {
+  PairLoss t;
+  for (const SceneResult& r : results) {
+    const PairLoss& p = r.pair_loss;
+    t.ranked_beyond += p.ranked_beyond, t.tilt += p.tilt, t.range += p.range, t.ring += p.ring;
+    t.triangulation += p.triangulation, t.hit_far += p.hit_far, t.overlap += p.overlap, t.foot += p.foot;
+    t.taken += p.taken, t.near += p.near;
+    t.hit_mm.insert(t.hit_mm.end(), p.hit_mm.begin(), p.hit_mm.end());
+  }
+  std::sort(t.hit_mm.begin(), t.hit_mm.end());
+  auto quantile = [&](double q) { return t.hit_mm.empty() ? 0.0 : t.hit_mm[static_cast<size_t>(q * (t.hit_mm.size() - 1))]; };
+  std::ostringstream s;
+  s << "object-frames in both cameras' lines: a line ranked beyond the lines paired " << t.ranked_beyond
+    << ", axis tilted " << t.tilt << ", out of range " << t.range << ", outside the ring " << t.ring
+    << ", no triangulation " << t.triangulation << ", hit > 25 mm away " << t.hit_far << ", height overlap "
+    << t.overlap << ", foot above the table " << t.foot << ", a line taken by another pairing " << t.taken
+    << ", intersect near " << t.near << "; hit distance mm p50 " << quantile(0.5) << " p75 " << quantile(0.75)
+    << " p90 " << quantile(0.9);
+  return s.str();
+}
 
 std::string losses_text(const std::vector<SceneResult>& results) {
   const LineLoss l = total_line_loss(results);
@@ -680,6 +815,9 @@ void write_report(const Results& results, int frames, int dev_frames, const Afte
      << o.upright << " deg of an upright axis' image verified, " << o.keep << " kept" << (o.snap ? ", snapped upright" : "")
      << "; " << o.candidate_lines << " lines per image to CANDIDATES"
      << (o.stereo_check ? ", stereo check (overlap " + fixed(o.min_overlap, 2) + ", foot " + fixed(o.max_foot, 2) + " m)" : ", no stereo check")
+     << (o.min_agreement > 0 ? ", stereo appearance along the axis (agreement " + fixed(o.min_agreement, 2) + ", tolerance " +
+                                   fixed(o.agreement_tolerance, 0) + ", waived at overlap " + fixed(o.agreement_waived, 2) + ")"
+                             : "")
      << ", QT min fraction " << fixed(o.min_fraction, 2) << " (docs/clutter.md).\n\n"
      << "## Where objects are lost (development family, seeds 1-40, " << dev_frames << " stereo pairs per scene)\n\n"
      << "Per visible object and camera frame: its axis among the lines; among the accumulator's peaks but dropped by the "
@@ -714,7 +852,7 @@ int main(int argc, char** argv) {
   int frames = 25, dev_frames = 2;
   bool no_write = false, skip_before = false, diagnose = false;
   int seed_min = 0, seed_max = 1 << 30;
-  std::string pictures, dump_file;
+  std::string pictures, dump_file, pair_dump_file;
   AfterOptions after_options;
   std::vector<double> canny;
   nudge::Flags flags("nudge-exp-clutter", "Symmetry lines and candidates on busy tables (issue 14).");
@@ -725,6 +863,7 @@ int main(int argc, char** argv) {
   flags.add_bool("no-write", &no_write, "print only; write no result files");
   flags.add_string("pictures", &pictures, "also write each scene's picture (after) to this directory");
   flags.add_string("dump", &dump_file, "write every accumulator peak's features and truth to this CSV (tuning)");
+  flags.add_string("dump-pairings", &pair_dump_file, "write every valid pairing's stereo-check numbers and truth to this CSV (tuning)");
   flags.add_bool("diagnose", &diagnose, "print where each missed object was lost (stage by stage)");
   flags.add_int("seed-min", &seed_min, "only scenes whose seed (file name's number) is at least this");
   flags.add_int("seed-max", &seed_max, "only scenes whose seed is at most this");
@@ -755,6 +894,10 @@ int main(int argc, char** argv) {
   flags.add_double("min-overlap", &a.min_overlap, "after: stereo check, least overlap / union of the heights");
   flags.add_double("max-foot", &a.max_foot, "after: stereo check, lowest support end at most this far from the table, m");
   flags.add_int("candidate-lines", &a.candidate_lines, "after: lines per image paired for CANDIDATES");
+  flags.add_double("min-agreement", &a.min_agreement, "after: least share of an axis' heights where both images agree (0: off)");
+  flags.add_int("agreement-window", &a.agreement_window, "after: half-size of the colour window of the stereo appearance check, px");
+  flags.add_double("agreement-waived", &a.agreement_waived, "after: support overlap at which the stereo appearance check is waived (> 1: never)");
+  flags.add_double("agreement-tolerance", &a.agreement_tolerance, "after: L1 BGR tolerance of the stereo appearance check");
   flags.add_double("min-fraction", &a.min_fraction, "after: smallest QT cluster, share of all intersects");
   try {
     if (!flags.parse(argc, argv)) return 0;
@@ -788,6 +931,12 @@ int main(int argc, char** argv) {
     dump.open(dump_file);
     dump << "scene,frame,camera,rank,votes,pairs,band_share,appearance,band_len,rows,smooth,polarity,r,theta,label,tilt\n";
   }
+  std::ofstream pair_dump;
+  if (!pair_dump_file.empty()) {
+    pair_dump.open(pair_dump_file);
+    pair_dump << "agree60,agree30,agree_fixed,scene,frame,il,ir,left_object,right_object,nearest,hit_mm,left_low,left_high,right_low,right_high,"
+                 "axis_tilt,left_tilt,right_tilt,left_votes,right_votes\n";
+  }
   std::map<std::string, std::vector<std::string>> files_of;
   int steps = 0;
   for (const std::string& family : sets) {
@@ -815,7 +964,8 @@ int main(int argc, char** argv) {
         progress.step(pipeline.name + " " + fs::path(file).stem().string());
         results[family][pipeline.name].push_back(
             run_scene(file, pipeline, breakdown_only ? dev_frames : frames, pipeline.name == "after" && !breakdown_only,
-                      diagnose || breakdown_only, dump.is_open() && pipeline.name == "after" ? &dump : nullptr));
+                      diagnose || breakdown_only, dump.is_open() && pipeline.name == "after" ? &dump : nullptr,
+                      pair_dump.is_open() && pipeline.name == "after" ? &pair_dump : nullptr));
         const SceneResult& r = results[family][pipeline.name].back();
         if (!pictures.empty() && !r.picture.empty()) cv::imwrite(pictures + "/" + r.name + ".png", r.picture);
         std::ostringstream detail;
@@ -829,6 +979,7 @@ int main(int argc, char** argv) {
       }
       progress.note(family + " " + pipeline.name + ": " + summary_json(summarise(results[family][pipeline.name])));
       if (diagnose || breakdown_only) progress.note(family + " " + pipeline.name + " losses: " + losses_text(results[family][pipeline.name]));
+      if (diagnose) progress.note(family + " " + pipeline.name + " pairings: " + pair_loss_text(results[family][pipeline.name]));
     }
   }
   progress.finish(set + " scenes, " + std::to_string(pipelines.size()) + " pipeline(s)");

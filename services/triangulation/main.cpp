@@ -2,6 +2,8 @@
 // candidate object locations on the table (sec. 6.2).
 //   SYMMETRY_LEFT + SYMMETRY_RIGHT (paired by utime) -> AXES (axes_t), every stereo pair
 //   CANDIDATES_REQUEST (candidates_request_t) -> gather N pairs -> CANDIDATES (candidates_t), once
+//   with --stereo-appearance also CAMERA_LEFT + CAMERA_RIGHT (image_t, the lines' images, found by
+//   utime): a pairing counts for CANDIDATES only where both images agree along its axis
 // With a table plane, positions are in the table frame (z up along the table normal, origin at the
 // arm base's foot on the table, else below the right camera; x = the right camera's x projected
 // onto the table). Without one, AXES are in the right camera's frame with NaN table points.
@@ -9,13 +11,16 @@
 // file's optional `table_plane` / `arm_base` fields (see nudge/geometry/workspace.hpp); the
 // workspace ring around the arm base from --workspace FILE (robot::Workspace, the arm's), with
 // --ring-inner / --ring-outer as overrides.
+#include <array>
 #include <cmath>
+#include <deque>
 #include <limits>
 #include <optional>
 
 #include "nudge/axes_t.hpp"
 #include "nudge/bus/axes_convert.hpp"
 #include "nudge/bus/channels.hpp"
+#include "nudge/bus/image.hpp"
 #include "nudge/bus/service.hpp"
 #include "nudge/bus/symmetry_convert.hpp"
 #include "nudge/candidates_request_t.hpp"
@@ -23,6 +28,7 @@
 #include "nudge/geometry/interesting_locations.hpp"
 #include "nudge/geometry/stereo_pairing.hpp"
 #include "nudge/geometry/workspace.hpp"
+#include "nudge/image_t.hpp"
 #include "nudge/log.hpp"
 #include "nudge/robot/workspace_flags.hpp"
 #include "nudge/symmetry_lines_t.hpp"
@@ -35,6 +41,8 @@ namespace {
 struct Options {
   std::string calibration, left_channel = bus::channel::SYMMETRY_LEFT,
               right_channel = bus::channel::SYMMETRY_RIGHT;
+  // With --stereo-appearance: the images the lines were found in (paired with them by utime).
+  std::string left_image_channel = bus::channel::CAMERA_LEFT, right_image_channel = bus::channel::CAMERA_RIGHT;
   std::vector<double> table_plane, arm_base;
   int lines = 0, buffer = 16;
   geo::AxisFilter filter;             // AXES: thesis ch. 4 (15 deg, within reach)
@@ -85,6 +93,13 @@ class Triangulation {
     });
     subs.subscribe<candidates_request_t>(bus::channel::CANDIDATES_REQUEST,
                                          [this](const candidates_request_t& m, const std::string&) { on_request(m); });
+    if (opt_.locations.min_axis_colour_agreement <= 0) return;
+    subs.subscribe<image_t>(opt_.left_image_channel, [this](const image_t& m, const std::string& ch) {
+      on_image(geo::Side::Left, m, ch);
+    });
+    subs.subscribe<image_t>(opt_.right_image_channel, [this](const image_t& m, const std::string& ch) {
+      on_image(geo::Side::Right, m, ch);
+    });
   }
 
  private:
@@ -105,6 +120,27 @@ class Triangulation {
                    << " has non-finite values; its pairings are skipped";
     }
     return lines;
+  }
+
+  // The stereo appearance check compares the images the lines were found in: the last few of
+  // each camera are kept, to be found by the lines' utime.
+  void on_image(geo::Side side, const image_t& msg, const std::string& channel) {
+    const geo::Camera& camera = side == geo::Side::Left ? rig_.left : rig_.right;
+    cv::Mat image = bus::to_mat(msg);  // throws naming the image: counted and skipped by the bus
+    if (image.cols != camera.width || image.rows != camera.height)
+      throw std::runtime_error(channel + " utime " + std::to_string(msg.utime) + ": image " +
+                               std::to_string(image.cols) + "x" + std::to_string(image.rows) +
+                               " but the calibration is for " + std::to_string(camera.width) + "x" +
+                               std::to_string(camera.height));
+    auto& kept = images_[side == geo::Side::Left ? 0 : 1];
+    kept.emplace_back(msg.utime, std::move(image));
+    while (static_cast<int>(kept.size()) > opt_.buffer) kept.pop_front();
+  }
+
+  const cv::Mat* image_at(geo::Side side, int64_t utime) const {
+    for (const auto& [t, image] : images_[side == geo::Side::Left ? 0 : 1])
+      if (t == utime) return &image;
+    return nullptr;
   }
 
   void on_lines(geo::Side side, const symmetry_lines_t& msg, const std::string& channel) {
@@ -170,7 +206,19 @@ class Triangulation {
   }
 
   void gather(int64_t utime, const Lines& left, const Lines& right) {
-    finder_->add_frame(left, right);
+    if (opt_.locations.min_axis_colour_agreement > 0) {
+      const cv::Mat *left_image = image_at(geo::Side::Left, utime), *right_image = image_at(geo::Side::Right, utime);
+      if (!left_image || !right_image) {
+        ++frames_without_images_;
+        log::warn() << "utime " << utime << ": no " << (left_image ? opt_.right_image_channel : opt_.left_image_channel)
+                    << " image of the lines' moment for the stereo appearance check; the pair is not gathered ("
+                    << frames_without_images_ << " so far)";
+        return;
+      }
+      finder_->add_frame(left, right, *left_image, *right_image);
+    } else {
+      finder_->add_frame(left, right);
+    }
     if (!finder_->complete()) return;
     candidates_t msg;
     msg.utime = utime;
@@ -201,6 +249,8 @@ class Triangulation {
   int64_t pairs_ = 0;
   int64_t request_utime_ = 0;  // the candidates request's: pairs taken before it are not gathered
   int64_t stale_pairs_ = 0;    // such pairs since the request
+  int64_t frames_without_images_ = 0;  // pairs not gathered: their images never came
+  std::array<std::deque<std::pair<int64_t, cv::Mat>>, 2> images_;  // left, right: (utime, image)
 };
 
 void add_flags(Flags& f, Options& o) {
@@ -232,6 +282,16 @@ void add_flags(Flags& f, Options& o) {
                "CANDIDATES with --stereo-check: least overlap / union of the two lines' heights");
   f.add_double("max-foot-height", &o.locations.max_foot_height_m,
                "CANDIDATES with --stereo-check: lowest support end at most this far from the table, m");
+  f.add_double("stereo-appearance", &o.locations.min_axis_colour_agreement,
+               "CANDIDATES: pair a left and a right line only if both cameras' images show the same colour at "
+               "this share of the heights along the axis (0: off; needs the camera images, docs/clutter.md)");
+  f.add_double("appearance-tolerance", &o.locations.appearance.colour_tolerance,
+               "CANDIDATES with --stereo-appearance: L1 BGR difference (0-765) of the same colour");
+  f.add_double("appearance-waived-at-overlap", &o.locations.appearance_waived_at_overlap,
+               "CANDIDATES with --stereo-appearance: support segments overlapping this much need no appearance "
+               "check (above 1: never waived)");
+  f.add_string("left-image-channel", &o.left_image_channel, "with --stereo-appearance: the left camera's images");
+  f.add_string("right-image-channel", &o.right_image_channel, "with --stereo-appearance: the right camera's images");
 }
 
 void check(const Options& o) {

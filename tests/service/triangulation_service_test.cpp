@@ -9,6 +9,7 @@
 #include <Eigen/Geometry>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>  // after Eigen, as OpenCV requires
+#include <opencv2/imgproc.hpp>
 
 #include <array>
 #include <cmath>
@@ -20,6 +21,7 @@
 
 #include "nudge/axes_t.hpp"
 #include "nudge/bus/channels.hpp"
+#include "nudge/bus/image.hpp"
 #include "nudge/bus/symmetry_convert.hpp"
 #include "nudge/candidates_request_t.hpp"
 #include "nudge/candidates_t.hpp"
@@ -509,4 +511,90 @@ TEST(TriangulationService, WithTheStereoCheckAxesPairEachLineOnce) {
       EXPECT_TRUE(found) << scene.objects[k].name << " at utime " << utime;
     }
   }
+}
+
+namespace {
+
+// Each object painted as a 24 px wide band of its own colour along its axis' image, on grey: the
+// pictures the lines were found in. `right_b` is object B's colour in the right image.
+cv::Mat painted(const Scene& scene, bool left, const cv::Scalar& right_b) {
+  const cv::Scalar colours[3] = {{40, 40, 200}, {40, 200, 40}, {200, 40, 40}};
+  cv::Mat image(kHeight, kWidth, CV_8UC3, cv::Scalar::all(128));
+  for (int k = 0; k < 3; ++k) {
+    const sym::Line& line = left ? scene.objects[k].left : scene.objects[k].right;
+    cv::line(image, line.seg1, line.seg2, k == 1 && !left ? right_b : colours[k], 24);
+  }
+  return image;
+}
+
+// The scene's log with each frame's images before its lines, as the camera and symmetry services
+// publish them.
+void write_log_with_images(const Scene& scene, const std::string& path, const cv::Scalar& right_b) {
+  LogWriter log(path);
+  nudge::candidates_request_t request;
+  request.utime = kStart - 1;
+  request.frames = 10;
+  request.lines_per_image = 3;
+  request.max_line_tilt_deg = 0;
+  request.num_explored = 0;
+  log.raw(request.utime, "CANDIDATES_REQUEST", encode(request));
+  const cv::Mat left_image = painted(scene, true, {}), right_image = painted(scene, false, right_b);
+  for (int f = 0; f < 12; ++f) {
+    const int64_t utime = kStart + f * kPeriod;
+    std::vector<sym::Line> left, right;
+    for (const Object& o : scene.objects) left.push_back(o.left), right.push_back(o.right);
+    log.raw(utime, "CAMERA_LEFT", encode(nudge::bus::to_message(left_image, nudge::image_t::FORMAT_BGR8, utime, f, "left")));
+    log.raw(utime + 1, "CAMERA_RIGHT",
+            encode(nudge::bus::to_message(right_image, nudge::image_t::FORMAT_BGR8, utime, f, "right")));
+    log.raw(utime + 10, "SYMMETRY_LEFT", encode(lines_message(left, utime, "left")));
+    log.raw(utime + 11, "SYMMETRY_RIGHT", encode(lines_message(right, utime, "right")));
+  }
+}
+
+bool candidate_near(const Scene& scene, const nudge::candidates_t& c, const Eigen::Vector3d& base_right) {
+  const auto p = table_plane_in_right(scene.rig);
+  geo::Plane table;
+  table.normal = Eigen::Vector3d(p[0], p[1], p[2]);
+  table.offset = p[3];
+  const geo::TableFrame frame(table, scene.arm_base_right);
+  for (int i = 0; i < c.num_candidates; ++i)
+    if ((frame.to_camera(Eigen::Vector3d(c.position[i][0], c.position[i][1], c.position[i][2])) - base_right).norm() < 1e-3)
+      return true;
+  return false;
+}
+
+}  // namespace
+
+// --stereo-appearance takes the camera images the lines were found in: an object both cameras see
+// in its colour is a candidate; one whose right image shows another colour along its axis (as when
+// the right line is another object's) is not; without images no pair is gathered, and it says so.
+TEST(TriangulationService, WithTheStereoAppearanceBothImagesMustAgreeAlongTheAxis) {
+  const Scene scene;
+  ServiceRun service("stereo_appearance");
+  geo::save_rig(scene.rig, service.rig);
+  const std::string flags = table_flags(scene) + " --stereo-appearance 0.5 --appearance-waived-at-overlap 2";
+
+  write_log_with_images(scene, service.in, {40, 200, 40});  // B green in both
+  ASSERT_EQ(service(flags), 0) << service.err;
+  Output same = read_output(service.out);
+  ASSERT_EQ(same.candidates.size(), 1u) << service.err;
+  EXPECT_TRUE(candidate_near(scene, same.candidates[0], scene.objects[0].base_right));
+  EXPECT_TRUE(candidate_near(scene, same.candidates[0], scene.objects[1].base_right));
+
+  write_log_with_images(scene, service.in, {200, 40, 200});  // B magenta on the right
+  ASSERT_EQ(service(flags), 0) << service.err;
+  Output differ = read_output(service.out);
+  ASSERT_EQ(differ.candidates.size(), 1u) << service.err;
+  EXPECT_TRUE(candidate_near(scene, differ.candidates[0], scene.objects[0].base_right));
+  EXPECT_FALSE(candidate_near(scene, differ.candidates[0], scene.objects[1].base_right));
+  // The overlap of the two support segments (here the whole axis in both) can waive the check.
+  ASSERT_EQ(service(table_flags(scene) + " --stereo-appearance 0.5"), 0) << service.err;
+  Output waived = read_output(service.out);
+  ASSERT_EQ(waived.candidates.size(), 1u) << service.err;
+  EXPECT_TRUE(candidate_near(scene, waived.candidates[0], scene.objects[1].base_right));
+
+  write_input_log(scene, service.in);  // lines only
+  ASSERT_EQ(service(flags), 0) << service.err;
+  EXPECT_TRUE(read_output(service.out).candidates.empty());
+  EXPECT_NE(service.err.find("no CAMERA_LEFT image"), std::string::npos) << service.err;
 }

@@ -12,6 +12,7 @@
 #include <random>
 #include <sstream>
 
+#include "nudge/geometry/axis_appearance.hpp"
 #include "nudge/geometry/interesting_locations.hpp"
 #include "nudge/geometry/plane.hpp"
 #include "nudge/geometry/qt_cluster.hpp"
@@ -1115,4 +1116,102 @@ TEST(GeometryTableTexture, BadImagesAndParametersAreNamed) {
   // Grey images work as BGR ones do.
   cv::Mat grey(warp.size(), CV_8UC1, cv::Scalar(100));
   EXPECT_EQ(table_texture_mask(grey, grey, warp).size(), warp.size());
+}
+
+namespace {
+
+// The card's axis (right camera frame), its image line in one camera of the scene, and the scene's
+// pictures with the right camera's card painted another colour: what a pairing of one object's
+// left line with another object's right line looks like along the axis.
+Segment3 card_axis(const CardScene& scene) { return {scene.foot, scene.foot + scene.height * scene.up}; }
+
+sym::Line card_line(const CardScene& scene, Side side) {
+  std::vector<cv::Point2d> pixels;
+  for (int i = 0; i <= 30; ++i) {
+    const Eigen::Vector3d p = scene.foot + (scene.height * i / 30.0) * scene.up;
+    const Eigen::Vector2d q = side == Side::Left ? scene.rig.left.project(scene.rig.R.transpose() * (p - scene.rig.T))
+                                                 : scene.rig.right.project(p);
+    pixels.emplace_back(q.x(), q.y());
+  }
+  const Camera& camera = side == Side::Left ? scene.rig.left : scene.rig.right;
+  return fit_line(pixels, camera.width, camera.height);
+}
+
+cv::Mat repainted_card(const std::pair<cv::Mat, cv::Mat>& picture) {
+  cv::Mat image = picture.first.clone();
+  image.setTo(cv::Scalar(40, 40, 200), picture.second == 1);
+  return image;
+}
+
+}  // namespace
+
+// Both cameras see the card along its own axis; with the right camera's card another colour (the
+// right line another object's) they see different things at every height.
+TEST(GeometryAxisAppearance, BothCamerasSeeTheObjectAlongItsAxisAndNotAlongAPhantoms) {
+  const CardScene scene;
+  const auto left = scene.render(Side::Left, 4), right = scene.render(Side::Right);
+  const Segment3 axis = card_axis(scene);
+  const auto same = axis_colour_agreement(scene.rig, left.first, right.first, axis, scene.foot, scene.table, 0.14);
+  ASSERT_TRUE(same.ok()) << same.reason();
+  EXPECT_GE(*same, 0.95);
+  const auto phantom =
+      axis_colour_agreement(scene.rig, left.first, repainted_card(right), axis, scene.foot, scene.table, 0.14);
+  ASSERT_TRUE(phantom.ok()) << phantom.reason();
+  EXPECT_LE(*phantom, 0.05);
+  // Grey images are compared as grey.
+  cv::Mat left_grey, right_grey;
+  cv::cvtColor(left.first, left_grey, cv::COLOR_BGR2GRAY);
+  cv::cvtColor(right.first, right_grey, cv::COLOR_BGR2GRAY);
+  EXPECT_GE(axis_colour_agreement(scene.rig, left_grey, right_grey, axis, scene.foot, scene.table, 0.14).value(), 0.95);
+}
+
+TEST(GeometryAxisAppearance, BadImagesHeightsAndParametersAreNamed) {
+  const CardScene scene;
+  const auto left = scene.render(Side::Left), right = scene.render(Side::Right);
+  const Segment3 axis = card_axis(scene);
+  try {
+    axis_colour_agreement(scene.rig, cv::Mat(480, 640, CV_8UC3), right.first, axis, scene.foot, scene.table, 0.1);
+    FAIL() << "a left image of the wrong size was taken";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("left image"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(axis_colour_agreement(scene.rig, left.first, cv::Mat(), axis, scene.foot, scene.table, 0.1),
+               std::invalid_argument);
+  // Below the first height looked at there is nothing to compare: no verdict, not a pass.
+  const auto too_low = axis_colour_agreement(scene.rig, left.first, right.first, axis, scene.foot, scene.table, 0.005);
+  ASSERT_FALSE(too_low.ok());
+  EXPECT_NE(too_low.reason().find("heights"), std::string::npos) << too_low.reason();
+  AxisAppearanceParams bad;
+  bad.step_m = 0;
+  EXPECT_THROW(axis_colour_agreement(scene.rig, left.first, right.first, axis, scene.foot, scene.table, 0.1, bad),
+               std::invalid_argument);
+}
+
+// With min_axis_colour_agreement the finder takes the frame's images and keeps the card's pairing
+// only where both cameras see the card; without images it refuses to guess.
+TEST(GeometryAxisAppearance, LocationFinderDropsPairingsTheImagesDisagreeOn) {
+  const CardScene scene;
+  const auto left = scene.render(Side::Left), right = scene.render(Side::Right);
+  const std::vector<sym::Line> left_lines = {card_line(scene, Side::Left)}, right_lines = {card_line(scene, Side::Right)};
+  LocationParams params;
+  params.frames = 1;
+  params.min_axis_colour_agreement = 0.5;
+  params.appearance_waived_at_overlap = 2;  // never: the two support segments cover the same heights
+  LocationFinder finder(scene.rig, scene.table, std::nullopt, params);
+  EXPECT_THROW(finder.add_frame(left_lines, right_lines), std::invalid_argument);
+  EXPECT_EQ(finder.frame_axes(left_lines, right_lines, left.first, right.first).size(), 1u);
+  EXPECT_TRUE(finder.frame_axes(left_lines, right_lines, left.first, repainted_card(right)).empty());
+  EXPECT_EQ(finder.add_frame(left_lines, right_lines, left.first, right.first), 1);
+  ASSERT_EQ(finder.intersect_points().size(), 1u);
+  EXPECT_LT((finder.intersect_points()[0] - scene.foot).norm(), 0.01);
+  // Support segments that agree as well as these (the whole card in both images) say "one object"
+  // by themselves: the appearance is not asked.
+  params.appearance_waived_at_overlap = 0.7;
+  const LocationFinder waived(scene.rig, scene.table, std::nullopt, params);
+  EXPECT_EQ(waived.frame_axes(left_lines, right_lines, left.first, repainted_card(right)).size(), 1u);
+  params.appearance_waived_at_overlap = -1;
+  EXPECT_THROW(LocationFinder(scene.rig, scene.table, std::nullopt, params), std::invalid_argument);
+  params.appearance_waived_at_overlap = 0.7;
+  params.min_axis_colour_agreement = 1.5;
+  EXPECT_THROW(LocationFinder(scene.rig, scene.table, std::nullopt, params), std::invalid_argument);
 }

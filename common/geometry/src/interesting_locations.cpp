@@ -99,6 +99,13 @@ void validate(const LocationParams& p) {
     throw std::invalid_argument("location parameter min_height_overlap must be in [0, 1]");
   if (!(p.max_foot_height_m > 0)) throw std::invalid_argument("location parameter max_foot_height_m must be > 0");
   if (!(p.explored_line_px > 0)) throw std::invalid_argument("location parameter explored_line_px must be > 0");
+  if (!(p.min_axis_colour_agreement >= 0 && p.min_axis_colour_agreement <= 1))
+    throw std::invalid_argument("location parameter min_axis_colour_agreement must be in [0, 1]");
+  if (!(p.appearance_waived_at_overlap >= 0))
+    throw std::invalid_argument("location parameter appearance_waived_at_overlap must be >= 0 (above 1: never waived)");
+  if (!(p.appearance_min_top_m > 0 && p.appearance_max_top_m >= p.appearance_min_top_m))
+    throw std::invalid_argument("location parameters need 0 < appearance_min_top_m <= appearance_max_top_m");
+  validate(p.appearance);
   if (!(p.max_line_tilt_deg >= 0 && p.max_line_tilt_deg <= 90))
     throw std::invalid_argument("location parameter max_line_tilt_deg must be in [0, 90]");
   for (const Eigen::Vector3d& place : p.explored)
@@ -156,6 +163,12 @@ Outcome<HeightRange> support_heights(const StereoRig& rig, Side side, const symm
   return Outcome<HeightRange>::success({std::min(h[0], h[1]), std::max(h[0], h[1])});
 }
 
+double height_overlap(const HeightRange& a, const HeightRange& b) {
+  const double overlap = std::min(a.high, b.high) - std::max(a.low, b.low);
+  const double span = std::max(a.high, b.high) - std::min(a.low, b.low);
+  return span > 0 ? std::max(0.0, overlap) / span : 0.0;
+}
+
 std::vector<PairedAxis> consistent_pairings(const StereoRig& rig, const std::vector<symmetry::Line>& left,
                                             const std::vector<symmetry::Line>& right, const PairingResult& result,
                                             const Plane& table, const LocationParams& params) {
@@ -170,9 +183,7 @@ std::vector<PairedAxis> consistent_pairings(const StereoRig& rig, const std::vec
     const auto l = support_heights(rig, Side::Left, left[a.left_index], a.axis, *a.hit, table);
     const auto r = support_heights(rig, Side::Right, right[a.right_index], a.axis, *a.hit, table);
     if (!l || !r) continue;
-    const double overlap = std::min(l->high, r->high) - std::max(l->low, r->low);
-    const double span = std::max(l->high, r->high) - std::min(l->low, r->low);
-    const double share = span > 0 ? std::max(0.0, overlap) / span : 0.0;
+    const double share = height_overlap(*l, *r);
     const bool on_table = std::fabs(std::min(l->low, r->low)) <= params.max_foot_height_m;
     if (share >= params.min_height_overlap && on_table) scored.push_back({share, i});
   }
@@ -217,12 +228,49 @@ std::vector<symmetry::Line> LocationFinder::survey_lines(Side side, const std::v
   return kept;
 }
 
-int LocationFinder::add_frame(const std::vector<symmetry::Line>& all_left, const std::vector<symmetry::Line>& all_right) {
+PairingResult appearance_consistent(const StereoRig& rig, const std::vector<symmetry::Line>& left,
+                                    const std::vector<symmetry::Line>& right, const PairingResult& result,
+                                    const Plane& table, const cv::Mat& left_image, const cv::Mat& right_image,
+                                    const LocationParams& params) {
+  if (params.min_axis_colour_agreement <= 0) return result;
+  PairingResult kept = result;
+  kept.axes.clear();
+  for (const PairedAxis& a : result.axes) {
+    if (!a.hit) continue;
+    // Up to the lower support top: above an object's top both cameras see what stands behind it.
+    double top = params.appearance_max_top_m;
+    const auto l = support_heights(rig, Side::Left, left[a.left_index], a.axis, *a.hit, table);
+    const auto r = support_heights(rig, Side::Right, right[a.right_index], a.axis, *a.hit, table);
+    if (l && r) {
+      if (height_overlap(*l, *r) >= params.appearance_waived_at_overlap) {
+        kept.axes.push_back(a);
+        continue;
+      }
+      top = std::min(l->high, r->high);
+    }
+    top = std::clamp(top, params.appearance_min_top_m, params.appearance_max_top_m);
+    const Outcome<double> agreement =
+        axis_colour_agreement(rig, left_image, right_image, a.axis, a.hit->point, table, top, params.appearance);
+    if (agreement && *agreement >= params.min_axis_colour_agreement) kept.axes.push_back(a);
+  }
+  return kept;
+}
+
+std::vector<PairedAxis> LocationFinder::frame_axes(const std::vector<symmetry::Line>& all_left,
+                                                   const std::vector<symmetry::Line>& all_right,
+                                                   const cv::Mat& left_image, const cv::Mat& right_image) const {
+  const bool appearance = params_.min_axis_colour_agreement > 0;
+  if (appearance && (left_image.empty() || right_image.empty()))
+    throw std::invalid_argument("location finder: min_axis_colour_agreement needs the frame's two images");
   const std::vector<symmetry::Line> left = survey_lines(Side::Left, all_left), right = survey_lines(Side::Right, all_right);
-  const PairingResult result =
-      triangulate_pairings(rig_, left, right, &table_, filter_, triangulation_, params_.lines_per_image);
-  const std::vector<PairedAxis> axes =
-      params_.stereo_check ? consistent_pairings(rig_, left, right, result, table_, params_) : result.axes;
+  PairingResult result = triangulate_pairings(rig_, left, right, &table_, filter_, triangulation_, params_.lines_per_image);
+  if (appearance) result = appearance_consistent(rig_, left, right, result, table_, left_image, right_image, params_);
+  return params_.stereo_check ? consistent_pairings(rig_, left, right, result, table_, params_) : result.axes;
+}
+
+int LocationFinder::add_frame(const std::vector<symmetry::Line>& all_left, const std::vector<symmetry::Line>& all_right,
+                              const cv::Mat& left_image, const cv::Mat& right_image) {
+  const std::vector<PairedAxis> axes = frame_axes(all_left, all_right, left_image, right_image);
   for (const PairedAxis& axis : axes) points_.push_back(axis.hit->point);
   ++frames_;
   return static_cast<int>(axes.size());

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "nudge/geometry/axis_appearance.hpp"
 #include "nudge/geometry/plane.hpp"
 #include "nudge/geometry/qt_cluster.hpp"
 #include "nudge/geometry/stereo_pairing.hpp"
@@ -73,6 +74,18 @@ struct LocationParams {
   bool stereo_check = false;
   double min_height_overlap = 0.3;
   double max_foot_height_m = 0.08;
+  // Stereo appearance (issue 14), off at 0: with the frame's images given to add_frame, a pairing
+  // counts only if the two cameras show the same colour at no less than this share of the heights
+  // along its axis (axis_colour_agreement, up to the lower of the two support segments' tops,
+  // clamped to [appearance_min_top_m, appearance_max_top_m]). Checked before the stereo check
+  // pairs each line once, so a phantom does not take an object's line.
+  double min_axis_colour_agreement = 0;
+  double appearance_min_top_m = 0.04, appearance_max_top_m = 0.30;
+  // Two support segments covering the same heights (overlap / union at least this) already say
+  // "one object": such a pairing needs no appearance check. A finely patterned object looks
+  // different to the two cameras (they see its surface ~1 cm apart) but its outline does not.
+  double appearance_waived_at_overlap = 0.7;
+  AxisAppearanceParams appearance;
   // Beyond the thesis (one object per scene): objects already explored that still stand on the
   // table (right camera frame, on it). Their lines are the strongest in every later survey and
   // would crowd out the objects still to find, so a line that is the image of an upright axis at
@@ -104,6 +117,15 @@ struct HeightRange {
 };
 Outcome<HeightRange> support_heights(const StereoRig& rig, Side side, const symmetry::Line& line,
                                      const Segment3& axis, const TableHit& hit, const Plane& table);
+// Overlap / union of two height ranges, in [0, 1] (0 when they do not overlap).
+double height_overlap(const HeightRange& a, const HeightRange& b);
+
+// The pairings of `result` whose two images agree along the axis (min_axis_colour_agreement of
+// `params`); all of them when it is 0.
+PairingResult appearance_consistent(const StereoRig& rig, const std::vector<symmetry::Line>& left,
+                                    const std::vector<symmetry::Line>& right, const PairingResult& result,
+                                    const Plane& table, const cv::Mat& left_image, const cv::Mat& right_image,
+                                    const LocationParams& params);
 
 // The pairings of `result` (triangulate_pairings with a table) that pass the stereo check of
 // `params`, each line used once, most consistent first.
@@ -123,13 +145,22 @@ class LocationFinder {
   LocationFinder(const StereoRig& rig, const Plane& table, const std::optional<Eigen::Vector3d>& arm_base,
                  LocationParams params = {}, TriangulationParams triangulation = {});
 
+  // The pairings one stereo pair's lines (strongest first) give, as add_frame counts them: the
+  // indices are into the lines left after survey_lines (the lines given, when nothing is explored
+  // and max_line_tilt_deg is 0).
+  // With images (the ones the lines were found in), min_axis_colour_agreement applies.
+  std::vector<PairedAxis> frame_axes(const std::vector<symmetry::Line>& left, const std::vector<symmetry::Line>& right,
+                                     const cv::Mat& left_image = {}, const cv::Mat& right_image = {}) const;
   // Adds one stereo pair's lines (strongest first); returns how many intersects it contributed.
-  int add_frame(const std::vector<symmetry::Line>& left, const std::vector<symmetry::Line>& right);
+  // With min_axis_colour_agreement > 0 the images are needed (std::invalid_argument without them).
+  int add_frame(const std::vector<symmetry::Line>& left, const std::vector<symmetry::Line>& right,
+                const cv::Mat& left_image = {}, const cv::Mat& right_image = {});
   bool complete() const { return frames_ >= params_.frames; }
   int frames() const { return frames_; }
   int intersects() const { return static_cast<int>(points_.size()); }
   // The table intersects gathered so far (right camera frame), in the order they were added.
   const std::vector<Eigen::Vector3d>& intersect_points() const { return points_; }
+  const AxisFilter& axis_filter() const { return filter_; }
   // QT clusters of the intersects gathered so far, largest first.
   std::vector<Location> locations() const;
   void reset();
