@@ -560,6 +560,8 @@ void add_flags(Flags& f, Options& o) {
   f.add_double("wide-survey-tilt", &o.config.wide_survey_tilt_deg,
                "a survey leaving nothing to nudge is asked again with lines up to DEG from upright before the run ends (0: never)");
   f.add_int("max-attempts", &o.config.max_attempts, "nudges per run");
+  f.add_int("segmentation-retries", &o.config.segmentation_retries,
+            "a push that moved something but gave no segmentation: nudge the object again from its rest, this many times");
   f.add_double("settle", &o.config.settle_s, "after the nudge, wait this long for the object to rest, s");
   f.add_double("max-settle", &o.config.max_settle_s,
                "with too few settled axes near the push line, settle on up to this long after the nudge, s");

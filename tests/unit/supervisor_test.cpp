@@ -1169,6 +1169,54 @@ TEST_F(SupervisorTest, AFailedSegmentationsRestIsNoObjectToLeaveOut) {
   EXPECT_EQ(s.state(), sv::State::SnapshotBefore) << s.report().reason;
 }
 
+// A push that moves the object but gives no segmentation leaves its rest to be nudged again, once
+// (Config::segmentation_retries): a second failure there leaves the new rest explored. With no
+// retries the first rest is explored at once (held-out h11: a clear bottle's lopsided first mask).
+TEST_F(SupervisorTest, AnObjectWhoseSegmentationFailedIsNudgedAgainFromItsRestOnce) {
+  auto failing = [](const cv::Mat&, const cv::Mat&, const auto&, const auto&) {
+    sv::Segmentation nothing;
+    nothing.error = "segmentation empty";
+    return nothing;
+  };
+  for (const int retries : {1, 0}) {
+    SCOPED_TRACE("segmentation_retries " + std::to_string(retries));
+    sv::Config config;
+    config.segmentation_retries = retries;
+    sv::Supervisor s(config, scene_, sv::ArmSetup{}, failing);
+    const Eigen::Vector3d object(0.28, -0.05, 0);
+    const Eigen::Vector3d rest = nudge_and_park(s, object);
+    s.on_right_still(draw_scene(scene_, {1280, 960}, {rest}), now_, now_);
+    const auto first = outputs_of<sv::AttemptEnded>(s.take_outputs());
+    ASSERT_EQ(first.at(0).attempt->outcome, sv::Outcome::SegmentationFailed);
+    answer_survey(s, {rest});
+    if (retries == 0) {
+      EXPECT_EQ(s.state(), sv::State::Done) << s.report().reason;
+      EXPECT_EQ(s.summary().rejections.count("already explored"), 1u);
+      continue;
+    }
+    EXPECT_NE(first.at(0).attempt->reason.find("nudged again"), std::string::npos) << first.at(0).attempt->reason;
+    ASSERT_EQ(s.state(), sv::State::SnapshotBefore) << s.report().reason;
+    EXPECT_LT((s.report().target - rest).norm(), 1e-9);
+    // The second push, from the rest, fails too: its rest is explored.
+    s.on_right_still(draw_scene(scene_, {1280, 960}, {rest}), now_, now_);
+    const sv::NudgeCommand nudge = outputs_of<sv::NudgeCommand>(s.take_outputs()).at(0);
+    const Eigen::Vector3d second_rest = rest + 0.03 * nudge.direction;
+    play_nudge(s, nudge.seq, rest, second_rest);
+    settle_with_axes(s, {second_rest});
+    park(s);
+    s.on_right_still(draw_scene(scene_, {1280, 960}, {second_rest}), now_, now_);
+    const auto second = outputs_of<sv::AttemptEnded>(s.take_outputs());
+    ASSERT_EQ(second.at(0).attempt->outcome, sv::Outcome::SegmentationFailed);
+    EXPECT_EQ(second.at(0).attempt->reason.find("nudged again"), std::string::npos) << second.at(0).attempt->reason;
+    answer_survey(s, {second_rest});
+    EXPECT_EQ(s.state(), sv::State::Done) << s.report().reason;
+    EXPECT_EQ(s.summary().rejections.count("already explored"), 1u);
+  }
+  sv::Config bad;
+  bad.segmentation_retries = -1;
+  EXPECT_THROW(sv::Supervisor(bad, scene_, sv::ArmSetup{}, failing), std::invalid_argument);
+}
+
 // A striped object's other lines pair into candidates off its axis at other depths: one whose line
 // in the right camera runs through the segmented object's mask is that object (development s06:
 // the striped bottle nudged twice), one beside it is not.

@@ -88,6 +88,7 @@ Supervisor::Supervisor(Config config, SceneGeometry scene, ArmSetup arm, Segment
     throw std::invalid_argument("supervisor: views and view_step_deg must be positive");
   if (!(config_.settle_s >= 0 && config_.max_settle_s >= config_.settle_s))
     throw std::invalid_argument("supervisor: settle_s must be >= 0 and max_settle_s >= settle_s");
+  if (config_.segmentation_retries < 0) throw std::invalid_argument("supervisor: segmentation_retries must be >= 0");
   joints_ = arm_.home();
 }
 
@@ -641,10 +642,12 @@ void Supervisor::end_attempt(Outcome outcome, const std::string& reason, int64_t
     if (a.rest) phantoms_.push_back(*a.rest);
     else empty_.push_back(a.target.position);
   } else if (outcome != Outcome::Aborted && outcome != Outcome::SnapshotLost) {
-    explored_.push_back(a.target.position);
-    for (const Candidate& c : a.candidates)  // the same object seen at another depth
-      if ((c.position - a.target.position).head<2>().norm() < config_.targets.same_object_radius) explored_.push_back(c.position);
-    if (a.rest) explored_.push_back(*a.rest);
+    if (!retry_from_rest(a)) {
+      explored_.push_back(a.target.position);
+      for (const Candidate& c : a.candidates)  // the same object seen at another depth
+        if ((c.position - a.target.position).head<2>().norm() < config_.targets.same_object_radius) explored_.push_back(c.position);
+      if (a.rest) explored_.push_back(*a.rest);
+    }
     if (a.rest && outcome == Outcome::Segmented) {
       // Only a segmented object is known to stand at its rest. Another outcome's rest may be the
       // phantom's axes seen again after a push that barely moved a neighbour; leaving its lines
@@ -671,6 +674,23 @@ void Supervisor::end_attempt(Outcome outcome, const std::string& reason, int64_t
   // The arm has moved: park it before looking again.
   nudge_seq_ = 0;
   park(now, why + "; parking the arm");
+}
+
+// Whether a failed segmentation's object is to be nudged again: it moved, so it stands near its
+// rest (a push of a few cm leaves it within same_object_radius of where it was, so neither place
+// is explored), and it has failed fewer than segmentation_retries times. The failures are counted
+// at both places, so a rest estimated in the wrong place cannot restart the count.
+bool Supervisor::retry_from_rest(Attempt& a) {
+  if (a.outcome != Outcome::SegmentationFailed || !a.rest) return false;
+  int failures = 1;
+  for (const auto& [place, count] : retries_)
+    if ((place - a.target.position).head<2>().norm() < config_.targets.same_object_radius)
+      failures = std::max(failures, count + 1);
+  if (failures > config_.segmentation_retries) return false;
+  retries_.emplace_back(a.target.position, failures);
+  retries_.emplace_back(*a.rest, failures);
+  a.reason += "; its rest will be nudged again";
+  return true;
 }
 
 int64_t Supervisor::awaited_arm_seq() const {

@@ -126,6 +126,11 @@ struct Config {
   // Chosen on the development runs of 2026-11-25: every correct mask 0.79 or more, the wrong ones
   // (a piece of a cup, a neighbour's edge) 0.32-0.81.
   double min_mask_mirror_agreement = 0.7;
+  // A push that moved something but gave no segmentation (a mask too small, lopsided or empty)
+  // leaves the place it pushed from explored; where the object came to rest is nudged again, up to
+  // this many times for one object (a nudge from the new place is a new view of it; held-out h11:
+  // a clear bottle's first push gave a lopsided mask, and its new place then counted as explored).
+  int segmentation_retries = 1;
   double min_object_radius_m = 0.025, min_object_height_m = 0.06;
   // Rows watched for motion: from the table to this height. The object's foot moves when it is
   // pushed; the arm's links, higher up, may pass beyond the line in the image, the pad never does.
@@ -384,6 +389,9 @@ class Supervisor {
   std::string after_home_;  // why the survey after homing happens
   std::vector<Candidate> candidates_;
   std::vector<Eigen::Vector3d> explored_, phantoms_, empty_;
+  // Rests of failed segmentations left to be nudged again (Config::segmentation_retries), each
+  // with how many failed attempts led there.
+  std::vector<std::pair<Eigen::Vector3d, int>> retries_;
   bool wide_survey_ = false;  // the survey under way is the second, wider look
   std::vector<Eigen::Vector3d> standing_;  // explored objects where they stand now (CandidatesRequest::explored)
   // The segmented objects where they came to rest (they stand there now), with their masks.
@@ -394,6 +402,7 @@ class Supervisor {
   };
   std::vector<Rested> rested_;
   std::vector<Eigen::Vector3d> explored_with_ray_mates() const;
+  bool retry_from_rest(Attempt& attempt);
   // The smallest object expected standing at a foot, as the right still shows it (px; 0 x 0 when
   // it cannot be projected).
   cv::Size2d smallest_object_image(const Eigen::Vector3d& foot) const;
