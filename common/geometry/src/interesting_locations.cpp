@@ -251,7 +251,14 @@ PairingResult appearance_consistent(const StereoRig& rig, const std::vector<symm
     top = std::clamp(top, params.appearance_min_top_m, params.appearance_max_top_m);
     const Outcome<double> agreement =
         axis_colour_agreement(rig, left_image, right_image, a.axis, a.hit->point, table, top, params.appearance);
-    if (agreement && *agreement >= params.min_axis_colour_agreement) kept.axes.push_back(a);
+    if (agreement && *agreement >= params.min_axis_colour_agreement) {
+      kept.axes.push_back(a);
+      continue;
+    }
+    kept.rejections.push_back(pairing_name(a.left_index, a.right_index) + ": " +
+                              (agreement ? "the two images agree along the axis at " + std::to_string(*agreement) +
+                                               " of its heights (min " + std::to_string(params.min_axis_colour_agreement) + ")"
+                                         : agreement.reason()));
   }
   return kept;
 }
