@@ -346,6 +346,9 @@ int first_match(const std::vector<sym::Line>& lines, const sim::ImageLine& truth
   return -1;
 }
 
+// A point of the right camera's frame in the world's.
+Eigen::Vector3d in_world(const sim::CameraModel& right, const Eigen::Vector3d& p) { return right.R.transpose() * (p - right.t); }
+
 // PairLoss of one object-frame: `il`, `ir` index the object's lines in `left`, `right`; `axes` are
 // the pairings the finder kept for the frame; `object_xy` the object's place (world frame).
 void diagnose_pairing(const geo::StereoRig& rig, const geo::Plane& table, const geo::AxisFilter& filter,
@@ -361,7 +364,7 @@ void diagnose_pairing(const geo::StereoRig& rig, const geo::Plane& table, const 
     if (why.find("arm base") != std::string::npos) return void(++loss->ring);
     return void(++loss->triangulation);
   }
-  const Eigen::Vector3d hit = right_camera.R.transpose() * (one.axes.front().hit->point - right_camera.t);
+  const Eigen::Vector3d hit = in_world(right_camera, one.axes.front().hit->point);
   const double distance = (hit.head<2>() - object_xy).norm();
   loss->hit_mm.push_back(1000 * distance);
   if (distance > kCandidateRadiusM) return void(++loss->hit_far);
@@ -405,14 +408,14 @@ void dump_pairings(const geo::StereoRig& rig, const geo::Plane& table, const geo
                                                               {}, params.lines_per_image);
   auto object_of = [&](int c, const sym::Line& line) {
     for (int i = 0; i < world.num_objects(); ++i)
-      if (truth[c][i].valid && matches(line, truth[c][i], 640, 480)) return i;
+      if (truth[c][i].valid && matches(line, truth[c][i], images.colour[c].cols, images.colour[c].rows)) return i;
     return -1;
   };
   for (const geo::PairedAxis& a : result.axes) {
     const auto l = geo::support_heights(rig, geo::Side::Left, lines[0][a.left_index], a.axis, *a.hit, table);
     const auto r = geo::support_heights(rig, geo::Side::Right, lines[1][a.right_index], a.axis, *a.hit, table);
     if (!l || !r) continue;
-    const Eigen::Vector3d hit = right.R.transpose() * (a.hit->point - right.t);
+    const Eigen::Vector3d hit = in_world(right, a.hit->point);
     int nearest = -1;
     double best = 1e9;
     for (int i = 0; i < world.num_objects(); ++i) {
@@ -533,7 +536,7 @@ SceneResult run_scene(const std::string& file, const Pipeline& pipeline, int fra
   std::vector<Eigen::Vector2d> drawn;
   std::vector<bool> drawn_is_object;
   for (const geo::Location& location : finder.locations()) {
-    const Eigen::Vector3d p = right.R.transpose() * (location.position - right.t);
+    const Eigen::Vector3d p = in_world(right, location.position);
     ++result.candidates;
     int nearest = -1;
     double best = kCandidateRadiusM;
@@ -557,7 +560,7 @@ SceneResult run_scene(const std::string& file, const Pipeline& pipeline, int fra
   for (int i = 0; i < world.num_objects(); ++i) {
     int near = 0;
     for (const Eigen::Vector3d& hit : finder.intersect_points()) {
-      const Eigen::Vector3d p = right.R.transpose() * (hit - right.t);
+      const Eigen::Vector3d p = in_world(right, hit);
       near += (p.head<2>() - world.object(i).position.head<2>()).norm() <= kCandidateRadiusM;
     }
     CandidateLoss& loss = result.candidate_loss;

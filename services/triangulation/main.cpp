@@ -122,9 +122,11 @@ class Triangulation {
     return lines;
   }
 
-  // The stereo appearance check compares the images the lines were found in: the last few of
-  // each camera are kept, to be found by the lines' utime.
+  // The stereo appearance check compares the images the lines were found in: while a candidates
+  // request gathers, the last few of each camera are kept, to be found by the lines' utime (between
+  // surveys nothing reads them, so they are not decoded).
   void on_image(geo::Side side, const image_t& msg, const std::string& channel) {
+    if (!finder_) return;
     const geo::Camera& camera = side == geo::Side::Left ? rig_.left : rig_.right;
     cv::Mat image = bus::to_mat(msg);  // throws naming the image: counted and skipped by the bus
     if (image.cols != camera.width || image.rows != camera.height)
