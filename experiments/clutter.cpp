@@ -82,6 +82,7 @@ struct AfterOptions {
   int candidates = 80, suppress = 4, keep = 12;  // first round: 20 peaks, 8 kept
   bool verify = true;
   double appearance_weight = 1, band_weight = 0.5, min_appearance = 0, colour_tolerance = 90, band_gap = 8, verify_suppress = 4;
+  double support_gap = 16;  // fifth round: bands joined across gaps up to this into the support (0: the band alone)
   int candidate_lines = 8;
   bool stereo_check = true, colour_edges = true;
   double min_overlap = 0.2, max_foot = 0.08;  // third round: 0.3 without the stereo appearance
@@ -89,11 +90,11 @@ struct AfterOptions {
   double refine_max = 4;
   double upright = 2;  // second round: only peaks that can be upright axes are verified
   bool snap = false;
-  double min_fraction = 0.03;
-  double min_agreement = 0.5;  // stereo appearance along the axis (0: off); fourth round
+  double min_fraction = 0.05;  // fifth round (0.03 before)
+  double min_agreement = 0.6;  // stereo appearance along the axis (0: off); fourth round 0.5, fifth 0.6
   double agreement_tolerance = 60;
   int agreement_window = 1;
-  double agreement_waived = 0.7;
+  double agreement_waived = 0.85;  // fourth round 0.7
 };
 
 Pipeline after_issue14(const AfterOptions& o) {
@@ -115,6 +116,7 @@ Pipeline after_issue14(const AfterOptions& o) {
   p.verify.min_appearance = o.min_appearance;
   p.verify.colour_tolerance = o.colour_tolerance;
   p.verify.band_gap_px = o.band_gap;
+  p.verify.support_gap_px = o.support_gap;
   p.verify.suppress_px = o.verify_suppress;
   p.verify.refine = o.refine;
   p.upright_max_deg = o.upright;
@@ -816,6 +818,7 @@ void write_report(const Results& results, int frames, int dev_frames, const Afte
         "candidate per scene.\n\n"
      << "\"after\": " << o.candidates << " accumulator peaks (suppression " << o.suppress << "), only those within "
      << o.upright << " deg of an upright axis' image verified, " << o.keep << " kept" << (o.snap ? ", snapped upright" : "")
+     << (o.support_gap > o.band_gap ? ", support segments joined across gaps up to " + fixed(o.support_gap, 0) + " px" : "")
      << "; " << o.candidate_lines << " lines per image to CANDIDATES"
      << (o.stereo_check ? ", stereo check (overlap " + fixed(o.min_overlap, 2) + ", foot " + fixed(o.max_foot, 2) + " m)" : ", no stereo check")
      << (o.min_agreement > 0 ? ", stereo appearance along the axis (agreement " + fixed(o.min_agreement, 2) + ", tolerance " +
@@ -891,6 +894,7 @@ int main(int argc, char** argv) {
   flags.add_double("min-appearance", &a.min_appearance, "after: drop lines below this appearance agreement");
   flags.add_double("colour-tolerance", &a.colour_tolerance, "after: L1 BGR tolerance of mirrored samples");
   flags.add_double("band-gap", &a.band_gap, "after: gap that splits bands along a line, px");
+  flags.add_double("support-gap", &a.support_gap, "after: gaps up to this join bands into a line's support segment, px (0: the largest band alone)");
   flags.add_double("verify-suppress", &a.verify_suppress, "after: verified lines closer than this (px, and 3 deg) to a better one are dropped");
   flags.add_double("colour-edges", &colour_flag, "after: 1 = Canny on the colour image, 0 = on grey");
   flags.add_double("stereo-check", &stereo_flag, "after: 1 = pair lines only when their support heights agree, 0 = off");

@@ -122,8 +122,15 @@ Segmented score(const cv::Mat& mask, const Truth& truth, int objects) {
   return s;
 }
 
+// An attempt's still, or an empty image when the attempt ended before taking it (no warning:
+// attempts that ended early are normal).
+cv::Mat still_of(const fs::path& attempt_dir, const char* name) {
+  const fs::path path = attempt_dir / name;
+  return fs::exists(path) ? cv::imread(path.string()) : cv::Mat();
+}
+
 cv::Mat gallery_row(const fs::path& attempt_dir, const cv::Mat& mask) {
-  cv::Mat before = cv::imread((attempt_dir / "before.png").string()), after = cv::imread((attempt_dir / "after.png").string());
+  cv::Mat before = still_of(attempt_dir, "before.png"), after = still_of(attempt_dir, "after.png");
   if (before.empty() || after.empty()) return {};
   cv::Mat overlay = after.clone();
   overlay.setTo(cv::Scalar(0, 200, 0), mask);
@@ -194,7 +201,7 @@ double time_motion_segmentation(const std::vector<fs::path>& attempt_dirs) {
       }
       return l;
     };
-    const cv::Mat before = cv::imread((dir / "before.png").string()), after = cv::imread((dir / "after.png").string());
+    const cv::Mat before = still_of(dir, "before.png"), after = still_of(dir, "after.png");
     if (before.empty() || after.empty() || json.find("\"line_after\":{") == std::string::npos) continue;
     const symmetry::Line lb = line("line_before"), la = line("line_after");
     for (int repeat = 0; repeat < 5; ++repeat) {

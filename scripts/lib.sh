@@ -141,7 +141,9 @@ nudge_in_private_network() {
 #     the edges, stereo-checked candidates and AXES: far fewer phantoms, but on the held-out scenes
 #     it segmented fewer objects than "plain";
 #   "busy": the busy-table pipeline of docs/clutter.md ("verified" with colour edges, blur 2,
-#     Dmin 8, Dmax 90, and no column mask).
+#     Dmin 8, Dmax 90, support segments joined across 16 px gaps, no column mask; candidates
+#     stereo-checked at 0.2 overlap, both images agreeing along the axis (0.6, waived at 0.85
+#     overlap), QT clusters of at least 5 % of the intersects).
 # NUDGE_LOOP_COLUMN_MASK=1 adds the column mask to "plain" and "busy" ("verified" has it).
 # NUDGE_LOOP_TABLE_TEXTURE (1, the default; 0: off) leaves the table's own texture out of the
 # edges (nudge-symmetry --table-texture-calibration: where the two cameras agree through the
@@ -187,8 +189,9 @@ nudge_run_loop() {
       survey=(--survey-lines 8)
       column_mask=1 ;;
     busy)
-      symmetry_flags="$verified"', "--colour-edges", "--blur", "2", "--dmin", "8", "--dmax", "90"'
-      triangulation_flags=', "--stereo-check", "--cluster-min-fraction", "0.03"'
+      symmetry_flags="$verified"', "--colour-edges", "--blur", "2", "--dmin", "8", "--dmax", "90", "--support-gap", "16"'
+      triangulation_flags=', "--stereo-check", "--min-height-overlap", "0.2", "--stereo-appearance", "0.6",
+                             "--appearance-waived-at-overlap", "0.85", "--cluster-min-fraction", "0.05"'
       survey=(--survey-lines 8) ;;
     plain)
       triangulation_flags=', "--candidate-line-tilt", "2"'

@@ -43,6 +43,8 @@ int main(int argc, char** argv) {
     f.add_int("verify", &verify, "busy tables: verify the --lines peaks (local support, mirrored colour) and publish the best N; 0: off");
     f.add_double("appearance-tolerance", &options.verify_params.colour_tolerance,
                  "with --verify: L1 BGR difference under which mirrored colour samples agree");
+    f.add_double("support-gap", &options.verify_params.support_gap_px,
+                 "with --verify: gaps up to this many px join bands into a line's support segment (0: the largest band alone)");
     std::string upright_calibration;
     std::vector<double> upright_table;
     double upright_tilt = 2;

@@ -28,10 +28,15 @@ struct Band {
   double lo = 0, hi = 0;
   int pairs = 0;
   std::vector<cv::Point2d> midpoints;  // of the band's pairs
+  // The support: the band and the runs beyond it joined across gaps up to support_gap (the
+  // band itself when that gap is no wider than the band's).
+  std::vector<cv::Point2d> support;
 };
 
-// The largest run of pair midpoints along the line with no gap wider than `gap`.
-Band largest_band(const std::vector<double>& along, const std::vector<cv::Point2d>& midpoints, double gap) {
+// The largest run of pair midpoints along the line with no gap wider than `gap`, and its support
+// (the same run grown across gaps up to `support_gap`).
+Band largest_band(const std::vector<double>& along, const std::vector<cv::Point2d>& midpoints, double gap,
+                  double support_gap) {
   Band best;
   if (along.empty()) return best;
   std::vector<size_t> order(along.size());
@@ -42,12 +47,18 @@ Band largest_band(const std::vector<double>& along, const std::vector<cv::Point2
     if (i < order.size() && along[order[i]] - along[order[i - 1]] <= gap) continue;
     const int count = static_cast<int>(i - start);
     if (count > best.pairs) {
-      best = {along[order[start]], along[order[i - 1]], count, {}};
+      best = {along[order[start]], along[order[i - 1]], count, {}, {}};
       best_start = start;
     }
     start = i;
   }
-  for (size_t i = best_start; i < best_start + static_cast<size_t>(best.pairs); ++i) best.midpoints.push_back(midpoints[order[i]]);
+  const size_t best_end = best_start + static_cast<size_t>(best.pairs);  // one past the band
+  for (size_t i = best_start; i < best_end; ++i) best.midpoints.push_back(midpoints[order[i]]);
+  size_t lo = best_start, hi = best_end;
+  const double join = std::max(gap, support_gap);
+  while (lo > 0 && along[order[lo]] - along[order[lo - 1]] <= join) --lo;
+  while (hi < order.size() && along[order[hi]] - along[order[hi - 1]] <= join) ++hi;
+  for (size_t i = lo; i < hi; ++i) best.support.push_back(midpoints[order[i]]);
   return best;
 }
 
@@ -79,7 +90,7 @@ LineEvidence evidence_of(const std::vector<VotingPair>& pairs, const cv::Mat& bg
       ++samples;
     }
   }
-  Band band = largest_band(along, midpoints, params.band_gap_px);
+  Band band = largest_band(along, midpoints, params.band_gap_px, params.support_gap_px);
   e.band_share = static_cast<double>(band.pairs) / e.pairs;
   e.appearance = static_cast<double>(agree) / samples;
   e.score = line.votes * std::pow(e.band_share, params.band_weight) * std::pow(e.appearance, params.appearance_weight);
@@ -135,6 +146,7 @@ void validate(const VerifyParams& p) {
   };
   require(p.keep >= 0 && p.keep <= 1000, "verify parameter keep must be in [0, 1000]");
   require(p.band_gap_px > 0, "verify parameter band_gap_px must be > 0");
+  require(p.support_gap_px >= 0, "verify parameter support_gap_px must be >= 0");
   require(p.colour_tolerance >= 0 && p.colour_tolerance <= 765, "verify parameter colour_tolerance must be in [0, 765]");
   require(p.min_appearance >= 0 && p.min_appearance <= 1, "verify parameter min_appearance must be in [0, 1]");
   require(p.appearance_weight >= 0 && p.appearance_weight <= 10, "verify parameter appearance_weight must be in [0, 10]");
@@ -165,12 +177,12 @@ std::vector<Line> verify_lines(const Detector& detector, const EdgeSet& edges, c
   for (size_t i = 0; i < lines.size(); ++i) {
     Band band;
     found[i] = evidence_of(detector.voting_pairs(edges, lines[i]), bgr, lines[i], params, &band);
-    if (band.pairs > 0) {  // the support segment: the object's band, not stray pairs along the line
+    if (band.pairs > 0) {  // the support segment: the object's band (and what support_gap_px joins to it), not stray pairs along the line
       scored[i] = refined(lines[i], band, params, bgr.cols, bgr.rows);
       const cv::Point2d normal(std::cos(scored[i].theta), std::sin(scored[i].theta)), dir(-normal.y, normal.x);
       const cv::Point2d pivot = centre + scored[i].r * normal;
       double lo = 1e300, hi = -1e300;
-      for (const cv::Point2d& m : band.midpoints) {
+      for (const cv::Point2d& m : band.support) {
         lo = std::min(lo, (m - centre).dot(dir));
         hi = std::max(hi, (m - centre).dot(dir));
       }

@@ -96,6 +96,35 @@ TEST(SymmetryVerify, RanksTheObjectAboveThePhantomAndTrimsItsSupport) {
   EXPECT_EQ(sym::verify_lines(d.detector, d.edges, image, d.lines, params).size(), 2u);
 }
 
+// The pale object's outline broken for 20 rows (a stretch against a background of its own
+// colour): the support segment is its larger fragment, unless support_gap_px joins the two.
+TEST(SymmetryVerify, TheSupportGapJoinsABrokenOutline) {
+  cv::Mat image = busy_image();
+  const cv::Rect hidden(50, 130, 40, 20);
+  for (int x = hidden.x; x < hidden.x + hidden.width; ++x)
+    image(cv::Rect(x, hidden.y, 1, hidden.height)).setTo(cv::Scalar::all(20 + (x * 200) / kWidth));
+  const Detection d = detect(image);
+  sym::VerifyParams params;
+  params.keep = 20;
+  auto support_of_object = [&](double support_gap) {
+    params.support_gap_px = support_gap;
+    const sym::Line* object = nullptr;
+    const std::vector<sym::Line> verified = sym::verify_lines(d.detector, d.edges, image, d.lines, params);
+    object = line_at(verified, 69.5);
+    EXPECT_NE(object, nullptr);
+    return object ? cv::Vec2d(std::min(object->seg1.y, object->seg2.y), std::max(object->seg1.y, object->seg2.y))
+                  : cv::Vec2d(0, 0);
+  };
+  const cv::Vec2d fragment = support_of_object(0);
+  EXPECT_NEAR(fragment[0], 60, 6);   // the upper fragment, rows 60..129, is the larger
+  EXPECT_NEAR(fragment[1], 130, 6);
+  const cv::Vec2d whole = support_of_object(30);
+  EXPECT_NEAR(whole[0], 60, 6);
+  EXPECT_NEAR(whole[1], 199, 6);
+  params.support_gap_px = -1;
+  EXPECT_THROW(sym::validate(params), std::invalid_argument);
+}
+
 TEST(SymmetryVerify, RefusesBadInput) {
   const cv::Mat image = busy_image();
   const Detection d = detect(image);

@@ -22,6 +22,11 @@ namespace nudge::symmetry {
 struct VerifyParams {
   int keep = 8;                  // lines returned, best score first
   double band_gap_px = 8;        // pairs further apart along the line start a new band
+  // The support segment (Line::seg1/seg2, which the stereo check compares between the cameras) is
+  // the largest band grown across gaps up to this: an object whose outline is broken (a stretch
+  // against a background of its own colour, a label) keeps its whole height rather than its
+  // largest fragment. At most band_gap_px: the band alone.
+  double support_gap_px = 0;
   double colour_tolerance = 90;  // L1 BGR difference (0-765) below which mirrored samples agree
   double min_appearance = 0.0;   // drop lines whose appearance agreement is below this (0-1)
   // score = votes x band share ^ band_weight x appearance ^ appearance_weight
@@ -59,7 +64,7 @@ LineEvidence line_evidence(const Detector& detector, const EdgeSet& edges, const
 std::optional<Line> fit_line(const std::vector<cv::Point2d>& points, int width, int height);
 
 // Scores every line and returns the best `params.keep`, best first; each line's support segment
-// becomes the extent of its largest band (with params.refine the line is first refitted to it). Throws std::invalid_argument if image and edges differ in size.
+// becomes the extent of its largest band, grown across gaps up to params.support_gap_px (with params.refine the line is first refitted to it). Throws std::invalid_argument if image and edges differ in size.
 std::vector<Line> verify_lines(const Detector& detector, const EdgeSet& edges, const cv::Mat& image,
                                const std::vector<Line>& lines, const VerifyParams& params = {},
                                std::vector<LineEvidence>* evidence = nullptr);
