@@ -79,7 +79,7 @@ Pipeline before_issue14() {
 // Issue 14's pipeline (docs/clutter.md): every value below was chosen on the development family.
 struct AfterOptions {
   double dmin = 8, dmax = 90, blur = 2.0, canny_low = 30, canny_high = 90;
-  int candidates = 80, suppress = 4, keep = 12;  // first round: 20 peaks, 8 kept
+  int candidates = 80, suppress = 3, keep = 12;  // first round: 20 peaks, 8 kept; suppression 4 until the fifth round
   bool verify = true;
   double appearance_weight = 1, band_weight = 0.5, min_appearance = 0, colour_tolerance = 90, band_gap = 8, verify_suppress = 4;
   double support_gap = 16;  // fifth round: bands joined across gaps up to this into the support (0: the band alone)

@@ -141,7 +141,7 @@ nudge_in_private_network() {
 #     the edges, stereo-checked candidates and AXES: far fewer phantoms, but on the held-out scenes
 #     it segmented fewer objects than "plain";
 #   "busy": the busy-table pipeline of docs/clutter.md ("verified" with colour edges, blur 2,
-#     Dmin 8, Dmax 90, support segments joined across 16 px gaps, no column mask; candidates
+#     Dmin 8, Dmax 90, the accumulator's suppression 3 px and 3 deg, support segments joined across 16 px gaps, no column mask; candidates
 #     stereo-checked at 0.2 overlap, both images agreeing along the axis (0.6, waived at 0.85
 #     overlap), QT clusters of at least 5 % of the intersects).
 # NUDGE_LOOP_COLUMN_MASK=1 adds the column mask to "plain" and "busy" ("verified" has it).
@@ -180,7 +180,10 @@ nudge_run_loop() {
   local arm_watchdog=
   [ -n "${NUDGE_LOOP_ARM_WATCHDOG:-}" ] && arm_watchdog=", \"--supervisor-timeout\", \"$NUDGE_LOOP_ARM_WATCHDOG\""
   local symmetry_flags='"--lines", "5"' triangulation_flags= survey=() column_mask=${NUDGE_LOOP_COLUMN_MASK:-0}
-  local verified='"--lines", "80", "--suppress-r", "4", "--suppress-theta", "4", "--verify", "12",
+  # The accumulator's suppression: 4 px and 4 deg for "verified", 3 for "busy" (docs/clutter.md, fifth round).
+  local suppression=4
+  [ "${NUDGE_LOOP_TABLE:-plain}" = busy ] && suppression=3
+  local verified='"--lines", "80", "--suppress-r", "'$suppression'", "--suppress-theta", "'$suppression'", "--verify", "12",
                   "--upright-calibration", "'"$calibration"'"'
   case "${NUDGE_LOOP_TABLE:-plain}" in
     verified)
