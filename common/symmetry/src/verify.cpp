@@ -25,7 +25,6 @@ int l1(const cv::Vec3b& a, const cv::Vec3b& b) {
 }
 
 struct Band {
-  double lo = 0, hi = 0;
   int pairs = 0;
   std::vector<cv::Point2d> midpoints;  // of the band's pairs
   // The support: the band and the runs beyond it joined across gaps up to support_gap (the
@@ -47,7 +46,7 @@ Band largest_band(const std::vector<double>& along, const std::vector<cv::Point2
     if (i < order.size() && along[order[i]] - along[order[i - 1]] <= gap) continue;
     const int count = static_cast<int>(i - start);
     if (count > best.pairs) {
-      best = {along[order[start]], along[order[i - 1]], count, {}, {}};
+      best.pairs = count;
       best_start = start;
     }
     start = i;
