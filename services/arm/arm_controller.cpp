@@ -55,6 +55,7 @@ robot::Command to_command(const arm_command_t& m, robot::CommandKind kind) {
   c.approach_height = m.approach_height;
   c.start_distance = m.start_distance;
   c.stop_distance = m.stop_distance;
+  c.object_height = m.object_height;
   c.angle = m.angle;
   c.speed_scale = m.speed_scale;
   return c;

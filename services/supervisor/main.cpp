@@ -405,6 +405,7 @@ class Shell {
     m.height = opt_.arm.nudge.push_height;
     m.start_distance = opt_.arm.nudge.start_distance;
     m.stop_distance = opt_.arm.nudge.stop_distance;
+    m.object_height = c.object_height;  // 0: the arm's own (the tallest object expected)
     publish(bus::channel::ARM_COMMAND, m);
   }
   void handle(const sv::HomeCommand& c) {
@@ -582,6 +583,14 @@ void add_flags(Flags& f, Options& o) {
   f.add_double("nudge-timeout", &o.config.nudge_timeout_s, "for the arm to finish a nudge, s of the task clock");
   f.add_double("nudge-speed", &o.nudge_speed_scale, "nudges at this fraction of the arm's joint speed limits (0.01-1)");
   f.add_double("object-radius", &o.config.targets.object_radius, "largest expected object radius (push clearance), m");
+  f.add_double("shortest-height-limit", &o.config.targets.shortest_height_limit,
+               "a push whose arm would pass too near the tallest expected object is still chosen when it clears an object "
+               "at least this tall, m; the object's height is then measured in the before still (0: never)");
+  f.add_double("max-push-turn", &o.config.targets.max_push_turn_deg,
+               "when neither push across the camera's view plans, pushes turned off it up to this are tried, deg (0: across only)");
+  f.add_double("push-turn-step", &o.config.targets.push_turn_step_deg, "the turned pushes' step, deg");
+  f.add_double("height-margin", &o.config.height.margin_m,
+               "added to the object's measured height before the arm is told to clear it, m");
   f.add_string("learn", &o.learn,
                "learning by interaction (thesis ch. 7: recognise before nudging; grasp, turn, learn, put back after a "
                "segmentation): on, off, or auto (while the learner's heartbeat is heard)");

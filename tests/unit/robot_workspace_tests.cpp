@@ -326,6 +326,24 @@ TEST(PlanCommand, OutOfRingNudgeIsRefusedWithItsReason) {
   EXPECT_FALSE(contains(again.reason, "workspace ring")) << again.reason;
 }
 
+TEST(PlanCommand, ANudgeClearsTheObjectHeightItIsGivenOrTheTallestExpected) {
+  PlannerConfig config = planner_config(Workspace{});
+  config.nudge.tool_tilt = 0;  // the thesis' straight-down tool: its wrist rides beside the object
+  const JointVector home = home_joints(config);
+  Command tall = nudge_at({0.26, 0.045, 0.0}, {0.0, -1.0, 0.0});
+  const MotionPlan refused = plan_command(config, tall, home);
+  EXPECT_FALSE(refused.ok());
+  EXPECT_FALSE(refused.malformed);
+  EXPECT_TRUE(contains(refused.reason, "forearm or wrist")) << refused.reason;
+  Command cup = tall;
+  cup.object_height = 0.08;  // measured: the wrist passes above it
+  EXPECT_TRUE(plan_command(config, cup, home).ok());
+  Command negative = tall;
+  negative.object_height = -0.1;
+  const MotionPlan bad = plan_command(config, negative, home);
+  EXPECT_TRUE(bad.malformed);
+}
+
 TEST(PlanCommand, MalformedCommandsAreRefusedAsMalformed) {
   const PlannerConfig config = planner_config(Workspace{});
   const JointVector home = home_joints(config);

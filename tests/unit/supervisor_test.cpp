@@ -379,6 +379,162 @@ TEST(Targets, NearestTheCameraFirstAndEveryPassOverHasAReason) {
   EXPECT_NE(around.rejected[0].reason.find("the pad would touch the explored object at"), std::string::npos) << around.rejected[0].reason;
 }
 
+// The thesis' straight-down tool (no lean): its wrist rides beside the pushed object, so some
+// pushes clear a cup but not the tallest object expected.
+sv::ArmSetup straight_down_arm() {
+  sv::ArmSetup arm;
+  arm.nudge.tool_tilt = 0;
+  return arm;
+}
+// Such a place: a 0.25 m object there is struck by the wrist, a 0.08 m one is not.
+const Eigen::Vector3d kWristNearTallObject(0.26, 0.045, 0);
+
+TEST(Targets, APushTooNearTheTallestObjectIsChosenForTheTallestObjectItClears) {
+  const sv::SceneGeometry scene = make_scene();
+  const sv::ArmSetup arm = straight_down_arm();
+  const std::vector<sv::Candidate> candidates = {{0, kWristNearTallObject, 9}};
+  const auto choice = sv::choose_target(candidates, {}, scene.right_camera_in_world(), arm, arm_state_joints(), sv::TargetParams{});
+  ASSERT_TRUE(choice.found);
+  EXPECT_GE(choice.height_limit, sv::TargetParams{}.shortest_height_limit);
+  EXPECT_LT(choice.height_limit, arm.nudge.object_height);
+  // The tallest it clears, to within the bisection's step: a centimetre more is refused.
+  nudge::robot::NudgeParams taller = arm.nudge;
+  taller.object_height = choice.height_limit + 2 * sv::TargetParams{}.height_limit_step;
+  EXPECT_FALSE(nudge::robot::plan_nudge(arm.model, arm.safety_config(), arm.point_to_base(kWristNearTallObject),
+                                        arm.direction_to_base(choice.direction), taller, arm_state_joints())
+                   .ok());
+  // Without such pushes it is passed over with the arm's reason.
+  sv::TargetParams never;
+  never.shortest_height_limit = 0;
+  const auto refused = sv::choose_target(candidates, {}, scene.right_camera_in_world(), arm, arm_state_joints(), never);
+  EXPECT_FALSE(refused.found);
+  ASSERT_EQ(refused.rejected.size(), 1u);
+  EXPECT_NE(refused.rejected[0].reason.find("forearm or wrist"), std::string::npos) << refused.rejected[0].reason;
+  // With the lean the same place clears the tallest object: no limit.
+  const auto leaned = sv::choose_target(candidates, {}, scene.right_camera_in_world(), sv::ArmSetup{}, arm_state_joints(),
+                                        sv::TargetParams{});
+  ASSERT_TRUE(leaned.found);
+  EXPECT_EQ(leaned.height_limit, 0.0);
+}
+
+TEST(Targets, APlaceNeitherPushAcrossTheViewReachesIsPushedTurnedOffIt) {
+  const sv::SceneGeometry scene = make_scene();
+  const sv::ArmSetup arm;
+  sv::TargetParams across_only;
+  across_only.max_push_turn_deg = 0;
+  // Over the workspace ring, the places the arm pushes only turned off across the view.
+  int turned = 0;
+  for (double radius = 0.16; radius <= 0.34; radius += 0.03)
+    for (double bearing = -90; bearing <= 90; bearing += 15) {
+      const double b = bearing * M_PI / 180;
+      const std::vector<sv::Candidate> candidates = {{0, Eigen::Vector3d(radius * std::cos(b), radius * std::sin(b), 0), 9}};
+      const auto thesis = sv::choose_target(candidates, {}, scene.right_camera_in_world(), arm, arm_state_joints(), across_only);
+      if (thesis.found) continue;
+      const auto choice = sv::choose_target(candidates, {}, scene.right_camera_in_world(), arm, arm_state_joints(), sv::TargetParams{});
+      if (!choice.found) {
+        EXPECT_NE(choice.rejected.at(0).reason.find("pushes turned up to 40 deg off across the view: none planned"), std::string::npos)
+            << choice.rejected[0].reason;
+        continue;
+      }
+      ++turned;
+      // Turned by a multiple of the step, no further than the limit, and saying so.
+      const Eigen::Vector3d ray = (candidates[0].position - scene.right_camera_in_world()).normalized();
+      const double off_deg = std::asin(std::abs(choice.direction.dot(Eigen::Vector3d(ray.x(), ray.y(), 0).normalized()))) * 180 / M_PI;
+      EXPECT_NEAR(off_deg, choice.push_turn_deg, 1e-6);
+      EXPECT_TRUE(choice.push_turn_deg == 20 || choice.push_turn_deg == 40) << choice.push_turn_deg;
+      EXPECT_NE(choice.note.find("deg off across the view"), std::string::npos) << choice.note;
+      EXPECT_TRUE(choice.plan.ok());
+    }
+  EXPECT_GT(turned, 0);
+}
+
+TEST(ObjectHeight, TheRayIsReadWhereItPassesOverTheAxis) {
+  const sv::SceneGeometry scene = make_scene();
+  const Eigen::Vector3d foot(0.28, -0.05, 0);
+  for (const cv::Size size : {cv::Size(640, 480), cv::Size(1280, 960)})
+    for (double height : {0.0, 0.06, 0.12, 0.2}) {
+      const auto pixel = scene.project_right(foot + Eigen::Vector3d(0, 0, height), size);
+      ASSERT_TRUE(pixel);
+      const auto read = sv::ray_height_over(scene, foot, *pixel, size);
+      ASSERT_TRUE(read);
+      EXPECT_NEAR(*read, height, 1e-6) << size << " " << height;
+    }
+  // A point of the rim behind the axis (a top seen from above) reads higher: the error is safe.
+  Eigen::Vector3d behind = foot - scene.right_camera_in_world();
+  behind.z() = 0;
+  const Eigen::Vector3d rim = foot + 0.03 * behind.normalized() + Eigen::Vector3d(0, 0, 0.12);
+  const auto read = sv::ray_height_over(scene, foot, *scene.project_right(rim, {1280, 960}), {1280, 960});
+  ASSERT_TRUE(read);
+  EXPECT_GT(*read, 0.12 + 0.01);
+}
+
+TEST(ObjectHeight, TheTopOfTheSymmetricOutlineInTheStillIsTheObjectsHeight) {
+  const sv::SceneGeometry scene = make_scene();
+  const cv::Size size(1280, 960);
+  for (const Eigen::Vector3d& foot : {Eigen::Vector3d(0.28, -0.05, 0), Eigen::Vector3d(0.22, 0.12, 0)}) {
+    const cv::Mat still = draw_scene(scene, size, {foot});  // 0.12 m tall
+    const auto line = sv::find_line_near(still, *scene.right_axis_line(foot, 0.25, size));
+    ASSERT_TRUE(line);
+    const auto height = sv::measure_object_height(scene, still, *line, foot);
+    ASSERT_TRUE(height);
+    EXPECT_NEAR(*height, 0.12, 0.006) << foot.transpose();
+  }
+  // Nothing symmetric there: no height.
+  const Eigen::Vector3d foot(0.28, -0.05, 0);
+  const cv::Mat empty = draw_scene(scene, size, {});
+  EXPECT_FALSE(sv::measure_object_height(scene, empty, *scene.right_axis_line(foot, 0.25, size), foot));
+  sv::HeightParams bad;
+  bad.margin_m = -0.01;
+  EXPECT_THROW(sv::validate(bad), std::invalid_argument);
+}
+
+// Where the arm with its leaning tool clears an object only up to about 0.15 m (behind the base,
+// at the ring's edge: the lean cannot take the wrist far enough off the object).
+const Eigen::Vector3d kLeanedWristNearTallObject(-0.04, 0.28, 0);
+
+TEST_F(SupervisorTest, APushClearingOnlyAShortObjectIsMadeWhenTheStillMeasuresItShorter) {
+  const auto choice = sv::choose_target({{0, kLeanedWristNearTallObject, 9}}, {}, scene_.right_camera_in_world(), sv::ArmSetup{},
+                                        arm_state_joints(), sv::TargetParams{});
+  ASSERT_TRUE(choice.found);
+  ASSERT_GT(choice.height_limit, 0.135);  // the drawn object, 0.12 m, and a margin of 5 mm fit under it
+  sv::Config config;
+  config.height.margin_m = 0.005;
+  sv::Supervisor s(config, scene_, sv::ArmSetup{}, mask_of_difference);
+  start_with(s, {kLeanedWristNearTallObject});
+  s.on_right_still(draw_scene(scene_, {1280, 960}, {kLeanedWristNearTallObject}), now_, now_);
+  const auto nudges = outputs_of<sv::NudgeCommand>(s.take_outputs());
+  ASSERT_EQ(nudges.size(), 1u) << s.report().reason;
+  // The drawn object is 0.12 m tall; the arm is told that plus the margin.
+  EXPECT_NEAR(nudges[0].object_height, 0.12 + config.height.margin_m, 0.006);
+  // A push that clears any object leaves the arm's default.
+  sv::Supervisor leaned = make();
+  EXPECT_EQ(nudge_command_for(leaned, Eigen::Vector3d(0.28, -0.05, 0)).object_height, 0.0);
+}
+
+TEST_F(SupervisorTest, APushClearingOnlyAShortObjectIsRefusedWhenTheStillMeasuresItTaller) {
+  sv::Config config;
+  config.height.margin_m = 0.2;  // as if the object were 0.32 m tall
+  sv::Supervisor s(config, scene_, straight_down_arm(), mask_of_difference);
+  start_with(s, {kWristNearTallObject});
+  s.on_right_still(draw_scene(scene_, {1280, 960}, {kWristNearTallObject}), now_, now_);
+  auto out = s.take_outputs();
+  EXPECT_TRUE(outputs_of<sv::NudgeCommand>(out).empty());
+  auto ended = outputs_of<sv::AttemptEnded>(out);
+  ASSERT_EQ(ended.size(), 1u);
+  EXPECT_EQ(ended[0].attempt->outcome, sv::Outcome::Refused);
+  EXPECT_NE(ended[0].attempt->reason.find("the push clears only an object"), std::string::npos) << ended[0].attempt->reason;
+  ASSERT_TRUE(ended[0].attempt->measured_height);
+  EXPECT_NEAR(*ended[0].attempt->measured_height, 0.12, 0.006);
+  // Not measured at all (nothing symmetric where it stands): refused too, with its reason.
+  sv::Supervisor blind(sv::Config{}, scene_, straight_down_arm(), mask_of_difference);
+  start_with(blind, {kWristNearTallObject});
+  blind.on_right_still(draw_scene(scene_, {1280, 960}, {}), now_, now_);
+  ended = outputs_of<sv::AttemptEnded>(blind.take_outputs());
+  ASSERT_EQ(ended.size(), 1u);
+  EXPECT_EQ(ended[0].attempt->outcome, sv::Outcome::Refused);
+  EXPECT_NE(ended[0].attempt->reason.find("height was not measured"), std::string::npos) << ended[0].attempt->reason;
+}
+
 TEST_F(SupervisorTest, SegmentsTheObjectThenFindsNothingLeftToNudge) {
   sv::Config with_trackers;
   with_trackers.track = true;

@@ -105,7 +105,8 @@ struct Planning {
     if (!override_with(command.height, &params.push_height) ||
         !override_with(command.approach_height, &params.approach_height) ||
         !override_with(command.start_distance, &params.start_distance) ||
-        !override_with(command.stop_distance, &params.stop_distance)) {
+        !override_with(command.stop_distance, &params.stop_distance) ||
+        !override_with(command.object_height, &params.object_height)) {
       return malformed("heights and distances must be finite and not negative");
     }
     if (!command.target_position.allFinite() || !command.direction.allFinite()) {

@@ -54,13 +54,6 @@ class LargestBlob {
   int label_ = 0;
 };
 
-// The still's pixel at the calibration's resolution (the inverse of scene.cpp's scaling).
-Eigen::Vector2d to_calibration(const geometry::Camera& camera, const cv::Point2d& pixel, cv::Size size) {
-  const double sx = static_cast<double>(camera.width) / size.width;
-  const double sy = static_cast<double>(camera.height) / size.height;
-  return {sx * (pixel.x + 0.5) - 0.5, sy * (pixel.y + 0.5) - 0.5};
-}
-
 }  // namespace
 
 std::optional<MaskOnLine> read_mask_on_line(const cv::Mat& mask, const symmetry::Line& line) {

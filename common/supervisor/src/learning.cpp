@@ -63,6 +63,8 @@ void Supervisor::before_lines() {
   Attempt& a = *attempt_;
   if (const auto right = scene_.right_axis_line(a.target.position, config_.object_height_m, config_.still_size))
     a.before_line = find_line_near(a.before, *right, config_.line_search);
+  if (a.height_limit > 0 && a.before_line)
+    a.measured_height = measure_object_height(scene_, a.before, *a.before_line, a.target.position, config_.height);
   if (!a.learn) return;
   if (const auto left = scene_.left_axis_line(a.target.position, config_.object_height_m, config_.still_size))
     a.before_line_left = find_line_near(a.before_left, *left, config_.line_search);

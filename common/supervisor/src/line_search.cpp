@@ -27,8 +27,8 @@ std::optional<symmetry::Line> find_line_near(const cv::Mat& image, const symmetr
   if (image.empty()) return std::nullopt;
   const double scale = image.cols / 640.0;  // the detector's thesis distances are for 640x480
   symmetry::Params p;
-  p.dmin = 25 * scale;
-  p.dmax = 250 * scale;
+  p.dmin = params.min_pair_width_px * scale;
+  p.dmax = params.max_pair_width_px * scale;
   const double theta_deg = predicted.theta * 180 / M_PI;
   p.theta_min_deg = theta_deg - params.window_deg;
   p.theta_max_deg = theta_deg + params.window_deg;

@@ -150,6 +150,18 @@ std::string attempt_json(const Attempt& a) {
   } else {
     j.raw("null");
   }
+  // A push that cleared only an object of height_limit: the object's measured height and what the
+  // arm was told (0 when it was not pushed).
+  if (a.height_limit > 0) {
+    j.field("height_limit_m", a.height_limit);
+    j.key("measured_height_m");
+    if (a.measured_height) {
+      j.value(*a.measured_height);
+    } else {
+      j.raw("null");
+    }
+    j.field("pushed_object_height_m", a.pushed_object_height);
+  }
   if (a.rest_from_mask) write_point(j, "rest_from_mask", *a.rest_from_mask);
   if (a.rest_from_axes) write_point(j, "rest_from_axes", *a.rest_from_axes);
   j.field("motion_frames", a.motion_frames).field("motion_blocks", a.motion_blocks);

@@ -78,6 +78,12 @@ std::optional<symmetry::Line> SceneGeometry::left_axis_line(const Eigen::Vector3
   return axis_line(project_left(on_table(foot, 0), size), project_left(on_table(foot, height), size), size);
 }
 
+Eigen::Vector2d to_calibration(const geometry::Camera& camera, const cv::Point2d& pixel, cv::Size size) {
+  const double sx = static_cast<double>(camera.width) / size.width;
+  const double sy = static_cast<double>(camera.height) / size.height;
+  return {sx * (pixel.x + 0.5) - 0.5, sy * (pixel.y + 0.5) - 0.5};
+}
+
 bool lines_agree(const symmetry::Line& detected, const symmetry::Line& predicted, double max_angle, double max_offset) {
   // wrapped: (R, theta) is (-R, theta -+ pi)
   const symmetry::LineDifference d = symmetry::line_difference(detected, predicted);

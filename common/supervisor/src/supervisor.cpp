@@ -89,6 +89,7 @@ Supervisor::Supervisor(Config config, SceneGeometry scene, ArmSetup arm, Segment
   if (!(config_.settle_s >= 0 && config_.max_settle_s >= config_.settle_s))
     throw std::invalid_argument("supervisor: settle_s must be >= 0 and max_settle_s >= settle_s");
   if (config_.segmentation_retries < 0) throw std::invalid_argument("supervisor: segmentation_retries must be >= 0");
+  validate(config_.height);
   joints_ = arm_.home();
 }
 
@@ -179,6 +180,7 @@ void Supervisor::choose(int64_t now) {
   attempt_->target = choice.target;
   attempt_->direction = choice.direction;
   attempt_->plan = choice.plan;
+  attempt_->height_limit = choice.height_limit;
   attempt_->candidates = candidates_;
   attempt_->rejected = choice.rejected;
   attempt_->started = now;
@@ -297,7 +299,30 @@ std::string Supervisor::still_requests_text() const {
          seconds_text(config_.snapshot_timeout_s) + ")";
 }
 
+// A push that clears only objects up to a height (TargetChoice::height_limit): the height to tell
+// the arm, or nothing when the object measures taller or was not measured (the attempt has then
+// ended with the reason).
+std::optional<double> Supervisor::height_to_clear(int64_t now) {
+  Attempt& a = *attempt_;
+  if (a.height_limit <= 0) return 0.0;  // the arm's default: the tallest object expected
+  const std::string limit = std::to_string(std::lround(a.height_limit * 1e3)) + " mm tall";
+  if (!a.measured_height) {
+    end_attempt(Outcome::Refused, "the push clears only an object " + limit + ", and the object's height was not measured in the still", now);
+    return std::nullopt;
+  }
+  const double needed = *a.measured_height + config_.height.margin_m;
+  if (needed > a.height_limit) {
+    end_attempt(Outcome::Refused, "the object measures " + std::to_string(std::lround(*a.measured_height * 1e3)) +
+                                      " mm tall in the still; the push clears only an object " + limit, now);
+    return std::nullopt;
+  }
+  a.pushed_object_height = needed;
+  return needed;
+}
+
 void Supervisor::start_nudge(int64_t now) {
+  const std::optional<double> object_height = height_to_clear(now);
+  if (!object_height) return;
   const Attempt& a = *attempt_;
   const auto line = scene_.right_axis_line(a.target.position, config_.object_height_m, config_.frame_size);
   const auto foot = scene_.project_right(a.target.position, config_.frame_size);
@@ -321,7 +346,7 @@ void Supervisor::start_nudge(int64_t now) {
   }
   nudge_seq_ = next_seq_++;
   enter(State::Nudge, now, "nudging candidate " + std::to_string(a.target.index) + " at " + millimetres(a.target.position));
-  outputs_.push_back(NudgeCommand{nudge_seq_, a.target.position, a.direction});
+  outputs_.push_back(NudgeCommand{nudge_seq_, a.target.position, a.direction, *object_height});
 }
 
 void Supervisor::verify(int64_t now) {

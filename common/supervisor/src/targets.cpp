@@ -3,8 +3,12 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <numeric>
+#include <optional>
+#include <string>
+#include <utility>
 
 namespace nudge::supervisor {
 
@@ -91,8 +95,79 @@ std::vector<Obstacle> obstacles_to(const Candidate& c, const std::vector<Candida
   return obstacles;
 }
 
+// A push of `c` along `direction` planned with the arm's links clearing an object `height` tall:
+// the robot library's plan, and the whole command as the arm service will plan it from where the
+// arm is (the move to P0 included): a target it would refuse is not chosen.
+struct PushPlan {
+  robot::NudgePlan plan;
+  std::string problem;  // empty when both plan
+  bool ok() const { return problem.empty(); }
+};
+PushPlan plan_push(const Candidate& c, const Eigen::Vector3d& direction_base, const Eigen::Vector3d& direction,
+                   const ArmSetup& arm, const robot::JointVector& seed, double height) {
+  robot::NudgeParams nudge = arm.nudge;
+  nudge.object_height = height;
+  PushPlan push;
+  push.plan = robot::plan_nudge(arm.model, arm.safety_config(), arm.point_to_base(c.position), direction_base, nudge, seed);
+  if (!push.plan.ok()) {
+    push.problem = "out of reach: " + push.plan.reason;
+    return push;
+  }
+  robot::Command command;
+  command.kind = robot::CommandKind::Nudge;
+  command.target_position = c.position;
+  command.direction = horizontal(direction).normalized();
+  command.object_height = height;
+  const robot::MotionPlan arm_plan = robot::plan_command(arm.planner(), command, seed);
+  if (!arm_plan.ok()) push.problem = "the arm would refuse: " + arm_plan.reason;
+  return push;
+}
+
+// The tallest object a push that does not clear the tallest expected (arm.nudge.object_height)
+// still clears, down to params.shortest_height_limit, bisected to params.height_limit_step (a
+// shorter object only leaves more room), and the push planned for it; nothing when it clears not
+// even that (a push refused for reach or joint limits is refused at every height).
+std::optional<std::pair<double, PushPlan>> push_for_shorter_object(const Candidate& c, const Eigen::Vector3d& direction_base,
+                                                                   const Eigen::Vector3d& direction, const ArmSetup& arm,
+                                                                   const robot::JointVector& seed, const TargetParams& params) {
+  const double tallest = arm.nudge.object_height;
+  if (!(params.shortest_height_limit > 0) || tallest <= params.shortest_height_limit) return std::nullopt;
+  PushPlan low = plan_push(c, direction_base, direction, arm, seed, params.shortest_height_limit);
+  if (!low.ok()) return std::nullopt;
+  double clears = params.shortest_height_limit, refused = tallest;
+  while (refused - clears > params.height_limit_step) {
+    const double middle = 0.5 * (clears + refused);
+    PushPlan tried = plan_push(c, direction_base, direction, arm, seed, middle);
+    if (tried.ok()) {
+      clears = middle;
+      low = std::move(tried);
+    } else {
+      refused = middle;
+    }
+  }
+  return std::make_pair(clears, std::move(low));
+}
+
+// The horizontal push directions tried for a target (base frame): the two across the camera's view
+// (thesis), then each turned by push_turn_step_deg, 2 push_turn_step_deg, ... up to
+// max_push_turn_deg towards and away from the camera, in that order; with the angle turned.
+std::vector<std::pair<Eigen::Vector3d, double>> push_directions(const Eigen::Vector3d& camera_base, const Eigen::Vector3d& target_base,
+                                                                const TargetParams& params) {
+  const auto across = robot::directions_across_view(camera_base, target_base);
+  std::vector<std::pair<Eigen::Vector3d, double>> out = {{across[0], 0.0}, {across[1], 0.0}};
+  if (!(params.push_turn_step_deg > 0)) return out;
+  // Below 90 deg: a push along the ray moves the object in depth only, which no camera sees as motion.
+  for (double turn = params.push_turn_step_deg; turn <= params.max_push_turn_deg + 1e-9 && turn < 90; turn += params.push_turn_step_deg)
+    for (const Eigen::Vector3d& d : across)
+      for (double sign : {1.0, -1.0})
+        out.emplace_back(Eigen::AngleAxisd(sign * turn * M_PI / 180, Eigen::Vector3d::UnitZ()) * d, turn);
+  return out;
+}
+
 // One pass over the candidates in camera order. With `strict`, a push that may touch another
-// candidate is refused; otherwise it is taken and noted.
+// candidate is refused; otherwise it is taken and noted. Per candidate, the first push (in
+// push_directions' order) that clears the tallest object expected is taken; when none does, the
+// one that clears the tallest shorter object (TargetChoice::height_limit).
 TargetChoice choose_pass(const std::vector<Candidate>& candidates, const std::vector<size_t>& order, const History& history,
                          const Eigen::Vector3d& camera_base, const ArmSetup& arm, const robot::JointVector& seed,
                          const TargetParams& params, bool strict) {
@@ -109,11 +184,33 @@ TargetChoice choose_pass(const std::vector<Candidate>& candidates, const std::ve
       reject("not seen upright by both cameras (a stereo mismatch)");
       continue;
     }
-    std::string why_not;
+    std::string why_not;  // the two pushes across the view: their reasons in full
+    int turned_refused = 0;
+    struct Refused {
+      Eigen::Vector3d direction_base, direction;
+      double turn;
+      PushConflict conflict;
+    };
+    std::vector<Refused> too_near;  // planned only for a shorter object, perhaps
+    auto taken = [&](const Eigen::Vector3d& direction, double turn, const PushConflict& conflict, PushPlan push, double limit) {
+      TargetChoice t = choice;
+      t.found = true;
+      t.target = c;
+      t.direction = horizontal(direction).normalized();
+      t.plan = std::move(push.plan);
+      t.height_limit = limit;
+      t.push_turn_deg = turn;
+      if (conflict) t.note = "no clear push left: " + conflict.reason;
+      if (turn > 0) t.note += std::string(t.note.empty() ? "" : "; ") + "pushed " + std::to_string(std::lround(turn)) + " deg off across the view";
+      return t;
+    };
     const std::vector<Obstacle> obstacles = obstacles_to(c, candidates, history, params);
-    for (const Eigen::Vector3d& direction_base :
-         robot::directions_across_view(camera_base, arm.point_to_base(c.position))) {
+    for (const auto& [direction_base, turn] : push_directions(camera_base, arm.point_to_base(c.position), params)) {
       const Eigen::Vector3d direction = arm.direction_to_world(direction_base);
+      auto refuse = [&](const std::string& problem) {
+        if (turn > 0) ++turned_refused;
+        else why_not += std::string(why_not.empty() ? "" : "; the other way: ") + problem;
+      };
       PushConflict conflict;
       for (const Obstacle& other : obstacles) {
         PushConflict found = push_conflict(c.position, direction, other.place, arm, params, other.what);
@@ -121,33 +218,23 @@ TargetChoice choose_pass(const std::vector<Candidate>& candidates, const std::ve
         if (conflict.kind == PushConflict::Kind::Pad) break;
       }
       if (conflict && (strict || conflict.kind == PushConflict::Kind::Pad)) {
-        why_not += std::string(why_not.empty() ? "" : "; the other way: ") + conflict.reason;
+        refuse(conflict.reason);
         continue;
       }
-      robot::NudgePlan plan =
-          robot::plan_nudge(arm.model, arm.safety_config(), arm.point_to_base(c.position), direction_base, arm.nudge, seed);
-      if (!plan.ok()) {
-        why_not += std::string(why_not.empty() ? "" : "; the other way: ") + "out of reach: " + plan.reason;
-        continue;
-      }
-      // The whole command as the arm service will plan it from where the arm is (the move to P0
-      // included): a target it would refuse is not chosen.
-      robot::Command command;
-      command.kind = robot::CommandKind::Nudge;
-      command.target_position = c.position;
-      command.direction = horizontal(direction).normalized();
-      const robot::MotionPlan arm_plan = robot::plan_command(arm.planner(), command, seed);
-      if (!arm_plan.ok()) {
-        why_not += std::string(why_not.empty() ? "" : "; the other way: ") + "the arm would refuse: " + arm_plan.reason;
-        continue;
-      }
-      choice.found = true;
-      choice.target = c;
-      choice.direction = horizontal(direction).normalized();
-      choice.plan = std::move(plan);
-      if (conflict) choice.note = "no clear push left: " + conflict.reason;
-      return choice;
+      PushPlan push = plan_push(c, direction_base, direction, arm, seed, arm.nudge.object_height);
+      if (push.ok()) return taken(direction, turn, conflict, std::move(push), 0.0);
+      refuse(push.problem);
+      too_near.push_back({direction_base, direction, turn, conflict});
     }
+    std::optional<TargetChoice> limited;
+    for (const Refused& r : too_near) {
+      auto shorter = push_for_shorter_object(c, r.direction_base, r.direction, arm, seed, params);
+      if (shorter && (!limited || shorter->first > limited->height_limit))
+        limited = taken(r.direction, r.turn, r.conflict, std::move(shorter->second), shorter->first);
+    }
+    if (limited) return *limited;
+    if (turned_refused > 0)
+      why_not += "; pushes turned up to " + std::to_string(std::lround(params.max_push_turn_deg)) + " deg off across the view: none planned";
     reject(why_not);
   }
   return choice;

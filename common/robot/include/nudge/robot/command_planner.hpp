@@ -59,6 +59,7 @@ struct Command {
   double approach_height = 0;   // Nudge P0 (0: default)
   double start_distance = 0;    // Nudge Dmax (0: default)
   double stop_distance = 0;     // Nudge Dmin (0: default)
+  double object_height = 0;     // Nudge: the pushed object's height the links clear (0: default)
   double angle = 0;             // RotateWrist, radians
   double speed_scale = 0;       // fraction of the joint speed limits (0: default)
 };

@@ -22,6 +22,8 @@ struct LineSearchParams {
   double window_px = 30;     // largest |R - R_predicted| accepted, at the still's resolution
   int lines = 5;             // peaks examined
   double mirror_tolerance_deg = 15;  // mirror-consistent pairs (docs: clutter and texture)
+  // The edge pairs' widths, px at 640x480 (scaled to the still's): the thesis' Dmin and Dmax.
+  double min_pair_width_px = 25, max_pair_width_px = 250;
   // A line reaches the foot when its support ends at most this fraction of the predicted axis'
   // length above the predicted foot (the axis is drawn up to the tallest object's height, so
   // 0.3 of it is a few centimetres of a short cup's height at most).

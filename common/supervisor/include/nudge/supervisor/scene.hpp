@@ -54,6 +54,10 @@ class SceneGeometry {
   geometry::RigidTransform arm_to_right_;
 };
 
+// A pixel of an image of `size` at the calibration's resolution (the inverse of the scaling of
+// project_right and project_left): the stills are the same camera at another resolution.
+Eigen::Vector2d to_calibration(const geometry::Camera& camera, const cv::Point2d& pixel, cv::Size size);
+
 // Whether a detected line is the predicted one: angles within `max_angle` (radians) and R within
 // `max_offset` px, comparing (R, theta) in the form nearer the prediction.
 bool lines_agree(const symmetry::Line& detected, const symmetry::Line& predicted, double max_angle, double max_offset);

@@ -27,6 +27,7 @@
 #include "nudge/supervisor/grasp.hpp"
 #include "nudge/supervisor/line_search.hpp"
 #include "nudge/supervisor/motion_watch.hpp"
+#include "nudge/supervisor/object_height.hpp"
 #include "nudge/supervisor/scene.hpp"
 #include "nudge/supervisor/targets.hpp"
 #include "nudge/tracking/tracker.hpp"
@@ -153,6 +154,10 @@ struct Config {
   bool track_trace = false;
   tracking::TrackerParams tracker;
   LineSearchParams line_search;
+  // A push that clears only objects up to some height (TargetChoice::height_limit) is made only
+  // when the object measures lower in the before still, plus height.margin_m; the arm is told
+  // that height (object_height.hpp).
+  HeightParams height;
 
   // ---- learning by interaction (thesis ch. 7) ----
   // Off: segmentation only (ch. 6). On: recognise before nudging, grasp, turn and learn every
@@ -210,7 +215,8 @@ struct RotateCommand { int64_t seq = 0; double angle = 0; };  // radians, relati
 struct RecognizeRequest { int64_t seq = 0; cv::Rect roi; cv::Mat image; };
 struct LearnView { int index = 0; double angle = 0; cv::Rect box; cv::Mat image; int64_t utime = 0; std::string object_key; };
 struct LearnCommit { int64_t seq = 0; std::string object_key; int views = 0; double height = 0, radius = 0; };
-struct NudgeCommand { int64_t seq = 0; Eigen::Vector3d target, direction; };
+// object_height: the pushed object's height the arm's links must clear, m; 0: the arm's default.
+struct NudgeCommand { int64_t seq = 0; Eigen::Vector3d target, direction; double object_height = 0; };
 struct StopCommand { int64_t seq = 0; std::string reason; };
 // The arm parks at its home pose (COMMAND_HOME) after a nudge, before the next survey: at the end
 // of a nudge it stands above the table, where its links' symmetry lines would crowd the survey.
@@ -233,6 +239,11 @@ struct Attempt {
   Candidate target;
   Eigen::Vector3d direction = Eigen::Vector3d::UnitX();
   robot::NudgePlan plan;
+  // The push clears only an object this tall (0: any expected object); then the object's height
+  // as measured in the before still, and what the arm was told (measured + margin).
+  double height_limit = 0;
+  std::optional<double> measured_height;
+  double pushed_object_height = 0;
   std::vector<Candidate> candidates;       // the survey it was chosen from
   std::vector<Rejection> rejected;         // candidates passed over for it
   Outcome outcome = Outcome::Aborted;
@@ -365,6 +376,7 @@ class Supervisor {
   bool trackers_decide() const;
   std::string still_requests_text() const;
   void start_nudge(int64_t now);
+  std::optional<double> height_to_clear(int64_t now);
   void verify(int64_t now);
   void segment(int64_t now);
   void end_attempt(Outcome outcome, const std::string& reason, int64_t now);

@@ -55,6 +55,18 @@ struct TargetParams {
   // segmentations (h06, hm1); but a transparent bottle was seen in only 4% (second set, h11), so
   // only the never-seen are passed over.
   double min_nudge_agreement = 0.01;
+  // A push whose arm would come too near an object as tall as the tallest expected
+  // (robot::NudgeParams::object_height) may still clear the object that stands there: the choice
+  // then carries the tallest object it clears (to within height_limit_step), down to this, and the
+  // object's height must be measured before the push (object_height.hpp). 0: no such pushes.
+  double shortest_height_limit = 0.08;
+  double height_limit_step = 0.005;
+  // When neither push across the camera's view (thesis) plans, pushes turned off it by multiples
+  // of push_turn_step_deg up to max_push_turn_deg are tried: the object still moves across the
+  // view by cos(turn) of the push, and a place the arm reaches one way only (joint 3's limit, the
+  // workspace ring) may be pushed. 0: across the view only.
+  double max_push_turn_deg = 40;
+  double push_turn_step_deg = 20;
 };
 
 struct Candidate {
@@ -80,6 +92,10 @@ struct TargetChoice {
   robot::NudgePlan plan;                                  // base frame (for pictures and checks)
   std::vector<Rejection> rejected;                        // every candidate passed over, and why
   std::string note;  // set when the push was accepted although it may touch another candidate
+  // 0: the push clears the tallest object expected. Otherwise it clears only an object this tall
+  // (m above the table): the object must be measured no taller before it is pushed.
+  double height_limit = 0;
+  double push_turn_deg = 0;  // how far the push is turned off across the camera's view
 };
 
 // "(x, y) mm" of a world point, for reasons.

@@ -1,0 +1,51 @@
+#pragma once
+// How tall a candidate stands, from the right camera's still before the nudge. The arm's planner
+// keeps the forearm and wrist clear of the pushed object; not knowing the object, it assumes the
+// tallest one expected (robot::NudgeParams::object_height, 0.25 m), and near the workspace ring's
+// edge that refuses pushes a 0.20 m bottle leaves room for. Measured, the push can clear the object
+// it meets rather than the tallest one there might be.
+//
+// The measurement is built to err high: the top is the highest edge pair symmetric about the
+// object's line (with pairs narrow enough for a bottle's neck and cap), and the ray through it is
+// read where it passes above the object's axis, which for a top seen from above is the rear rim
+// (r tan(theta) higher than the top). Symmetric clutter above the object raises it further. Only
+// an object whose top has no edge pair at all (a clear cap against a clear background) reads low,
+// which the margin the supervisor adds is for.
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include <optional>
+
+#include "nudge/supervisor/scene.hpp"
+#include "nudge/symmetry/detector.hpp"
+
+namespace nudge::supervisor {
+
+struct HeightParams {
+  // Narrowest edge pair counted, px at 640x480 (the still's are scaled): a bottle's cap, 25 mm
+  // across at 0.7 m, is 20 px there; the survey's 25 px leaves it out.
+  double min_pair_width_px = 6;
+  double max_pair_width_px = 250;  // at 640x480, as the survey's
+  double window_deg = 2;           // the line searched within +- this of the object's line
+  double window_px = 4;            // ... and this far of it (at 640x480)
+  double margin_m = 0.02;          // added to the measured top before the arm is told
+};
+
+// Throws std::invalid_argument naming the parameter.
+void validate(const HeightParams& params);
+
+// The height above the table at which the right camera's ray through `pixel` (at image `size`)
+// passes over the vertical through `foot` (world; the ray's point nearest it seen from above).
+// Nothing when the pixel does not map to a ray or the ray runs parallel to the vertical.
+std::optional<double> ray_height_over(const SceneGeometry& scene, const Eigen::Vector3d& foot, const cv::Point2d& pixel,
+                                      cv::Size size);
+
+// The object's height in the right still: the top of the edge pairs symmetric about
+// `object_line` (its line in the still, e.g. find_line_near's), read over the vertical through
+// `foot`, and never below the top of `object_line`'s own support. Nothing when no line near
+// `object_line` is found or its top does not map to a height.
+std::optional<double> measure_object_height(const SceneGeometry& scene, const cv::Mat& right_still,
+                                            const symmetry::Line& object_line, const Eigen::Vector3d& foot,
+                                            const HeightParams& params = {});
+
+}  // namespace nudge::supervisor
