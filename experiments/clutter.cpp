@@ -16,6 +16,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <tuple>
 #include <sstream>
@@ -360,10 +361,23 @@ void diagnose_pairing(const geo::StereoRig& rig, const geo::Plane& table, const 
   if (il >= params.lines_per_image || ir >= params.lines_per_image) return void(++loss->ranked_beyond);
   const geo::PairingResult one = geo::triangulate_pairings(rig, {left[il]}, {right[ir]}, &table, filter);
   if (one.axes.empty()) {
-    const std::string why = one.rejections.empty() ? "" : one.rejections.front();
-    if (why.find("tilted") != std::string::npos) return void(++loss->tilt);
-    if (why.find("from the camera") != std::string::npos) return void(++loss->range);
-    if (why.find("arm base") != std::string::npos) return void(++loss->ring);
+    // Which of the filter's tests refuses it: each applied alone to the unfiltered axis.
+    geo::AxisFilter none;
+    none.max_tilt_deg = 90;
+    none.max_range_m = std::numeric_limits<double>::infinity();
+    none.ring_centre.reset();
+    const geo::PairingResult unfiltered = geo::triangulate_pairings(rig, {left[il]}, {right[ir]}, &table, none);
+    if (unfiltered.axes.empty()) return void(++loss->triangulation);
+    const geo::Segment3& axis = unfiltered.axes.front().axis;
+    geo::AxisFilter tilt = none, range = none, ring = none;
+    tilt.max_tilt_deg = filter.max_tilt_deg;
+    range.max_range_m = filter.max_range_m;
+    ring.ring_centre = filter.ring_centre;
+    ring.ring_inner_m = filter.ring_inner_m;
+    ring.ring_outer_m = filter.ring_outer_m;
+    if (!geo::check_axis(axis, table, tilt)) return void(++loss->tilt);
+    if (!geo::check_axis(axis, table, range)) return void(++loss->range);
+    if (!geo::check_axis(axis, table, ring)) return void(++loss->ring);
     return void(++loss->triangulation);
   }
   const Eigen::Vector3d hit = in_world(right_camera, one.axes.front().hit->point);

@@ -169,6 +169,29 @@ double height_overlap(const HeightRange& a, const HeightRange& b) {
   return span > 0 ? std::max(0.0, overlap) / span : 0.0;
 }
 
+namespace {
+
+// A pairing's two support height ranges: those it carries, else computed now (nothing when either
+// line's is not found).
+std::optional<std::pair<HeightRange, HeightRange>> pairing_support(const StereoRig& rig, const std::vector<symmetry::Line>& left,
+                                                                   const std::vector<symmetry::Line>& right, const PairedAxis& a,
+                                                                   const Plane& table) {
+  if (a.support) return a.support;
+  if (!a.hit) return std::nullopt;
+  const auto l = support_heights(rig, Side::Left, left[a.left_index], a.axis, *a.hit, table);
+  const auto r = support_heights(rig, Side::Right, right[a.right_index], a.axis, *a.hit, table);
+  if (!l || !r) return std::nullopt;
+  return std::make_pair(*l, *r);
+}
+
+}  // namespace
+
+PairingResult with_support_heights(const StereoRig& rig, const std::vector<symmetry::Line>& left,
+                                   const std::vector<symmetry::Line>& right, PairingResult result, const Plane& table) {
+  for (PairedAxis& a : result.axes) a.support = pairing_support(rig, left, right, a, table);
+  return result;
+}
+
 std::vector<PairedAxis> consistent_pairings(const StereoRig& rig, const std::vector<symmetry::Line>& left,
                                             const std::vector<symmetry::Line>& right, const PairingResult& result,
                                             const Plane& table, const LocationParams& params) {
@@ -179,12 +202,11 @@ std::vector<PairedAxis> consistent_pairings(const StereoRig& rig, const std::vec
   std::vector<Scored> scored;
   for (size_t i = 0; i < result.axes.size(); ++i) {
     const PairedAxis& a = result.axes[i];
-    if (!a.hit) continue;
-    const auto l = support_heights(rig, Side::Left, left[a.left_index], a.axis, *a.hit, table);
-    const auto r = support_heights(rig, Side::Right, right[a.right_index], a.axis, *a.hit, table);
-    if (!l || !r) continue;
-    const double share = height_overlap(*l, *r);
-    const bool on_table = std::fabs(std::min(l->low, r->low)) <= params.max_foot_height_m;
+    const auto support = pairing_support(rig, left, right, a, table);
+    if (!support) continue;
+    const auto& [l, r] = *support;
+    const double share = height_overlap(l, r);
+    const bool on_table = std::fabs(std::min(l.low, r.low)) <= params.max_foot_height_m;
     if (share >= params.min_height_overlap && on_table) scored.push_back({share, i});
   }
   std::stable_sort(scored.begin(), scored.end(), [](const Scored& a, const Scored& b) { return a.overlap > b.overlap; });
@@ -239,14 +261,13 @@ PairingResult appearance_consistent(const StereoRig& rig, const std::vector<symm
     if (!a.hit) continue;
     // Up to the lower support top: above an object's top both cameras see what stands behind it.
     double top = params.appearance_max_top_m;
-    const auto l = support_heights(rig, Side::Left, left[a.left_index], a.axis, *a.hit, table);
-    const auto r = support_heights(rig, Side::Right, right[a.right_index], a.axis, *a.hit, table);
-    if (l && r) {
-      if (height_overlap(*l, *r) >= params.appearance_waived_at_overlap) {
+    if (const auto support = pairing_support(rig, left, right, a, table)) {
+      const auto& [l, r] = *support;
+      if (height_overlap(l, r) >= params.appearance_waived_at_overlap) {
         kept.axes.push_back(a);
         continue;
       }
-      top = std::min(l->high, r->high);
+      top = std::min(l.high, r.high);
     }
     top = std::clamp(top, params.appearance_min_top_m, params.appearance_max_top_m);
     const Outcome<double> agreement =
@@ -271,6 +292,7 @@ std::vector<PairedAxis> LocationFinder::frame_axes(const std::vector<symmetry::L
     throw std::invalid_argument("location finder: min_axis_colour_agreement needs the frame's two images");
   const std::vector<symmetry::Line> left = survey_lines(Side::Left, all_left), right = survey_lines(Side::Right, all_right);
   PairingResult result = triangulate_pairings(rig_, left, right, &table_, filter_, triangulation_, params_.lines_per_image);
+  if (appearance && params_.stereo_check) result = with_support_heights(rig_, left, right, std::move(result), table_);  // once for both
   if (appearance) result = appearance_consistent(rig_, left, right, result, table_, left_image, right_image, params_);
   return params_.stereo_check ? consistent_pairings(rig_, left, right, result, table_, params_) : result.axes;
 }

@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 
 #include <optional>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -19,11 +20,20 @@
 
 namespace nudge::geometry {
 
+// The heights above the table (along the axis, from its table hit) that a line's support segment
+// (Line::seg1..seg2) covers: where the camera rays through its ends pass closest to the axis.
+struct HeightRange {
+  double low = 0, high = 0;
+};
+
 // One left x right pairing that gave a valid axis.
 struct PairedAxis {
   int left_index = 0, right_index = 0;  // into the lines passed in
   Segment3 axis;                        // right camera frame
   std::optional<TableHit> hit;          // set when a table plane was given
+  // The left and the right line's support_heights on the axis, once computed (with_support_heights):
+  // the stereo appearance and the stereo check both read them.
+  std::optional<std::pair<HeightRange, HeightRange>> support;
 };
 
 struct PairingResult {
@@ -110,15 +120,13 @@ bool is_image_of_upright_axis(const StereoRig& rig, Side side, const Plane& tabl
 // Throws std::invalid_argument naming the offending parameter.
 void validate(const LocationParams& params);
 
-// The heights above the table (along the axis, from its table hit) that a line's support segment
-// (Line::seg1..seg2) covers: where the camera rays through its ends pass closest to the axis.
-struct HeightRange {
-  double low = 0, high = 0;
-};
 Outcome<HeightRange> support_heights(const StereoRig& rig, Side side, const symmetry::Line& line,
                                      const Segment3& axis, const TableHit& hit, const Plane& table);
 // Overlap / union of two height ranges, in [0, 1] (0 when they do not overlap).
 double height_overlap(const HeightRange& a, const HeightRange& b);
+// `result` with every pairing's PairedAxis::support set where both lines' support heights are found.
+PairingResult with_support_heights(const StereoRig& rig, const std::vector<symmetry::Line>& left,
+                                   const std::vector<symmetry::Line>& right, PairingResult result, const Plane& table);
 
 // The pairings of `result` whose two images agree along the axis (min_axis_colour_agreement of
 // `params`); all of them when it is 0.
