@@ -135,7 +135,8 @@ std::optional<std::pair<double, PushPlan>> push_for_shorter_object(const Candida
   PushPlan low = plan_push(c, direction_base, direction, arm, seed, params.shortest_height_limit);
   if (!low.ok()) return std::nullopt;
   double clears = params.shortest_height_limit, refused = tallest;
-  while (refused - clears > params.height_limit_step) {
+  const double step = std::max(params.height_limit_step, 1e-4);  // a step of 0 or less would never end
+  while (refused - clears > step) {
     const double middle = 0.5 * (clears + refused);
     PushPlan tried = plan_push(c, direction_base, direction, arm, seed, middle);
     if (tried.ok()) {
