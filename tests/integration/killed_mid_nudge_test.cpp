@@ -170,7 +170,7 @@ TEST_P(KilledMidNudge, SupervisorPausesStopsTheArmAndResumesSafely) {
 
   // Every service the supervisor needs (its --require set with --clock sim). The learner is needed
   // only by a run that learns: it joins the run (and --require) when it is the one killed.
-  const nudge::test::LoopSetup setup{dir, kScene, kCalibration};
+  const nudge::test::LoopSetup setup{dir, kScene, kCalibration, nudge::test::kPrivateLcmUrl, {}};
   LoopServices services(setup);
   std::vector<std::string> extra;
   if (victim == "learner") extra.push_back("learner");
