@@ -607,6 +607,8 @@ int main(int argc, char** argv) {
   flags.add_string("name", &o.name, "result name (docs/results/NAME.*)");
   flags.add_string("set", &o.set, "the test images' set: eval (reported) or dev (tuning; nudge-exp-learning-scenes --set dev)");
   flags.add_bool("relearn", &o.relearn, "learn every stored object again from its stored views with today's learning");
+  std::string axis_tilts = learning::axis_tilts_text(o.learn.axis_tilts);
+  flags.add_string("axis-tilts", &axis_tilts, "--relearn: simulated tilts along the held object's axis, comma-separated (none: off)");
   flags.add_int("background-matches", &o.learn.background_matches, "--relearn: other views a background descriptor matches");
   flags.add_double("background-static-px", &o.learn.background_static_px,
                    "--relearn: a match counts towards background only within this many pixels (0: anywhere)");
@@ -625,6 +627,11 @@ int main(int argc, char** argv) {
     o.recognize.affine_check = affine == "on";
     if (root_sift != "on" && root_sift != "off") throw FlagError("--root-sift must be on or off");
     o.recognize.root_sift = root_sift == "on";
+    try {
+      o.learn.axis_tilts = learning::axis_tilts_from_text(axis_tilts);
+    } catch (const std::invalid_argument& e) {
+      throw FlagError(std::string("--axis-tilts: ") + e.what());
+    }
     o.learn.sift = o.recognize.sift;  // as the learner: both find the same keypoints
     o.learn.ratio = o.recognize.ratio;
     if (o.runs.empty() || o.scenes.empty() || o.test_images.empty()) throw FlagError("--runs, --scenes and --test-images are required");

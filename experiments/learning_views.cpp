@@ -44,6 +44,8 @@ constexpr int kViews = 12;
 
 struct Options {
   std::string test_images;
+  std::string set = "eval";
+  std::string axis_tilts;  // the learner's simulated tilts along the axis (LearnParams::axis_tilts)
   std::string tilts = "0,30";
   std::string name = "learning_views";
 };
@@ -158,14 +160,15 @@ std::string json_report(const std::vector<std::string>& sets, const std::vector<
   return j.str();
 }
 
-std::string markdown_report(const std::vector<std::string>& sets, const std::vector<Score>& scores, const std::vector<TestImage>& images) {
+std::string markdown_report(const Options& o, const std::vector<std::string>& sets, const std::vector<Score>& scores, const std::vector<TestImage>& images) {
   std::ostringstream md;
   md << "# What the learned views lack (issue 11)\n\n"
      << "`nudge-exp-learning-views`: each of the seven bottles learned again from 12 simulator renders of it alone on its "
         "training scene's table, turned about its axis in 30 deg steps, its top tilted away from the right camera by the "
         "angle of the row (the label seen that much more from above) (1280x960 stills, the box from the render's mask, the learner's pruning and defaults); then the "
-        "experiment's 38 test images (`nudge-exp-learning-scenes --set eval`) recognised with the learner's defaults. "
+        "experiment's 38 test images (`nudge-exp-learning-scenes --set " << o.set << "`) recognised with the learner's defaults. "
         "The chain's own figures (views held in the gripper) are in `learning.md`.\n\n"
+     << (o.axis_tilts.empty() ? std::string() : "Each view also learned squeezed along the bottle's axis (the learner's `--axis-tilts " + o.axis_tilts + "`).\n\n")
      << machine_description() << ", " << today() << ".\n\n";
   md << "| views | correct of 28 | plain | cluttered | orientation | occluded | wrong | false of 10 | descriptors |\n"
      << "|---|---|---|---|---|---|---|---|---|\n";
@@ -191,7 +194,9 @@ std::string markdown_report(const std::vector<std::string>& sets, const std::vec
 
 int run(const Options& o) {
   const std::vector<double> tilts = parse_tilts(o.tilts);
-  const std::vector<TestImage> images = read_test_images(o.test_images, "eval");
+  learning::LearnParams learn;
+  learn.axis_tilts = learning::axis_tilts_from_text(o.axis_tilts);
+  const std::vector<TestImage> images = read_test_images(o.test_images, o.set);
   const std::vector<sim::ObjectSpec> bottles = learning_bottles();
   nudge::Progress progress("nudge-exp-learning-views", static_cast<int>(bottles.size() * tilts.size()));
   std::vector<std::vector<std::shared_ptr<const learning::ObjectModel>>> per_tilt(tilts.size());
@@ -204,7 +209,7 @@ int run(const Options& o) {
       learning::ObjectInfo info;
       info.name = bottles[b].name;
       std::vector<learning::TrainingImage> views = turntable_views(scene, tilts[t]);
-      per_tilt[t].push_back(std::make_shared<learning::ObjectModel>(learning::learn_object(info, views)));
+      per_tilt[t].push_back(std::make_shared<learning::ObjectModel>(learning::learn_object(info, views, learn)));
       every_view.insert(every_view.end(), views.begin(), views.end());
     }
     if (tilts.size() > 1) {
@@ -230,7 +235,7 @@ int run(const Options& o) {
     scores.push_back(score(all_tilts, images));
   }
   write_result(o.name + ".json", json_report(sets, scores));
-  write_result(o.name + ".md", markdown_report(sets, scores, images));
+  write_result(o.name + ".md", markdown_report(o, sets, scores, images));
   std::string summary;
   for (size_t i = 0; i < sets.size(); ++i)
     summary += (i ? "; " : "") + sets[i] + ": " + std::to_string(correct_of_learned(scores[i])) + " of 28";
@@ -245,7 +250,9 @@ int main(int argc, char** argv) {
   Flags flags("nudge-exp-learning-views",
               "Learn the seven bottles from unobstructed turntable renders at several tilts and recognise the learning "
               "experiment's test images (issue 11's diagnosis).");
-  flags.add_string("test-images", &o.test_images, "nudge-exp-learning-scenes --set eval's output folder");
+  flags.add_string("test-images", &o.test_images, "nudge-exp-learning-scenes' output folder (of --set)");
+  flags.add_string("set", &o.set, "the test images' set: eval (the report's) or dev (to try settings on)");
+  flags.add_string("axis-tilts", &o.axis_tilts, "the learner's simulated tilts along the bottle's axis, comma-separated (none: off)");
   flags.add_string("tilts", &o.tilts, "comma-separated tilts of the bottle's top away from the right camera, deg (0: upright)");
   flags.add_string("name", &o.name, "result name (docs/results/NAME.*)");
   try {

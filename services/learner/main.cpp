@@ -25,6 +25,9 @@ int main(int argc, char** argv) {
                  "... where a match counts only within this many pixels of the descriptor: the scene stands still (0: anywhere, as the thesis)");
     f.add_double("sift-contrast", &options.recognize.sift.contrast_threshold,
                  "SIFT's contrast threshold, learning and recognition (OpenCV's default 0.04; lower finds more on small labels)");
+    std::string axis_tilts = learning::axis_tilts_text(options.learn.axis_tilts);
+    f.add_string("axis-tilts", &axis_tilts,
+                 "also learn each view squeezed along the held object's axis by these simulated tilts (1/cos: 2 = 60 deg), comma-separated; none: off");
     f.add_double("view-expiry", &options.view_expiry_s, "drop views not committed within SECONDS of message time");
     if (!service.parse(argc, argv)) return 0;
     if (options.db_dir.empty()) throw FlagError("--db DIR is required");
@@ -36,6 +39,11 @@ int main(int argc, char** argv) {
     if (options.recognize.ratio <= 0 || options.recognize.ratio > 1) throw FlagError("--ratio must be in (0, 1]");
     if (options.recognize.min_matches < 1) throw FlagError("--min-matches must be >= 1");
     if (options.learn.background_matches < 1) throw FlagError("--background-matches must be >= 1");
+    try {
+      options.learn.axis_tilts = learning::axis_tilts_from_text(axis_tilts);
+    } catch (const std::invalid_argument& e) {
+      throw FlagError(std::string("--axis-tilts: ") + e.what());
+    }
     if (options.view_expiry_s <= 0) throw FlagError("--view-expiry must be > 0");
     if (!(options.recognize.sift.contrast_threshold > 0)) throw FlagError("--sift-contrast must be > 0");
     options.learn.ratio = options.recognize.ratio;

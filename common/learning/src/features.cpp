@@ -3,7 +3,9 @@
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <string>
 #include <stdexcept>
 
 namespace nudge::learning {
@@ -29,6 +31,36 @@ Features detect_features(const cv::Mat& image, const SiftParams& params) {
   sift->detectAndCompute(grey, cv::noArray(), features.keypoints, features.descriptors);
   if (features.descriptors.empty()) features.descriptors.create(0, 128, CV_32F);
   return features;
+}
+
+Features detect_features_tilted(const cv::Mat& image, double tilt, const SiftParams& params, const cv::Rect& roi) {
+  if (!(tilt >= 1)) throw std::invalid_argument("SIFT: simulated tilt " + std::to_string(tilt) + " is below 1");
+  if (image.empty()) throw std::invalid_argument("SIFT: empty image");
+  const cv::Rect area = roi.empty() ? cv::Rect(0, 0, image.cols, image.rows) : roi & cv::Rect(0, 0, image.cols, image.rows);
+  if (area.empty()) {  // the roi lies outside the image: nothing of it to see
+    Features none;
+    none.descriptors.create(0, 128, CV_32F);
+    return none;
+  }
+  const int squeezed_rows = std::max(1, static_cast<int>(std::lround(area.height / tilt)));
+  cv::Mat squeezed;
+  cv::resize(image(area), squeezed, cv::Size(area.width, squeezed_rows), 0, 0, cv::INTER_AREA);
+  Features features = detect_features(squeezed, params);
+  const float y_scale = static_cast<float>(area.height) / static_cast<float>(squeezed_rows);
+  for (cv::KeyPoint& k : features.keypoints) {
+    k.pt.x += static_cast<float>(area.x);
+    k.pt.y = k.pt.y * y_scale + static_cast<float>(area.y);
+  }
+  return features;
+}
+
+Features concatenate(const Features& a, const Features& b) {
+  Features out;
+  out.keypoints = a.keypoints;
+  out.keypoints.insert(out.keypoints.end(), b.keypoints.begin(), b.keypoints.end());
+  cv::vconcat(a.descriptors.empty() ? cv::Mat(0, 128, CV_32F) : a.descriptors,
+              b.descriptors.empty() ? cv::Mat(0, 128, CV_32F) : b.descriptors, out.descriptors);
+  return out;
 }
 
 cv::Mat root_sift(const cv::Mat& descriptors) {

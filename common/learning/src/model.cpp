@@ -2,7 +2,9 @@
 
 #include <opencv2/features2d.hpp>
 
+#include <sstream>
 #include <stdexcept>
+#include <string>
 
 #include "ratio_match.hpp"
 
@@ -12,6 +14,31 @@ int ObjectModel::descriptor_count() const {
   int n = 0;
   for (const auto& view : views) n += view.features.size();
   return n;
+}
+
+std::vector<double> axis_tilts_from_text(const std::string& text) {
+  std::vector<double> tilts;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    size_t used = 0;
+    double tilt = 0;
+    try {
+      tilt = std::stod(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (item.empty() || used != item.size() || !(tilt >= 1 && tilt <= 8))
+      throw std::invalid_argument("simulated tilt '" + item + "' is no number in [1, 8]");
+    tilts.push_back(tilt);
+  }
+  return tilts;
+}
+
+std::string axis_tilts_text(const std::vector<double>& tilts) {
+  std::ostringstream out;
+  for (size_t i = 0; i < tilts.size(); ++i) out << (i ? "," : "") << tilts[i];
+  return out.str();
 }
 
 std::vector<std::vector<bool>> background_descriptors(const std::vector<Features>& views, double ratio,
@@ -41,14 +68,17 @@ std::vector<std::vector<bool>> background_descriptors(const std::vector<Features
 ObjectModel learn_object(const ObjectInfo& info, const std::vector<TrainingImage>& images, const LearnParams& params,
                          LearnStats* stats, const LearnProgress& progress) {
   if (images.empty()) throw std::invalid_argument("object " + info.name + ": no training views");
+  for (double tilt : params.axis_tilts)
+    if (!(tilt >= 1)) throw std::invalid_argument("object " + info.name + ": simulated tilt " + std::to_string(tilt) + " is below 1");
   LearnStats counts;
   std::vector<Features> boxed;
   for (size_t v = 0; v < images.size(); ++v) {
     const TrainingImage& t = images[v];
     if (t.image.empty() || t.image.depth() != CV_8U)
       throw std::invalid_argument("object " + info.name + ": view " + std::to_string(v) + " is empty or not 8-bit");
-    const Features all = detect_features(t.image, params.sift);
+    Features all = detect_features(t.image, params.sift);
     const cv::Rect box = t.box.empty() ? cv::Rect() : generous_box(t.box, params.box_margin, t.image.size());
+    for (double tilt : params.axis_tilts) all = concatenate(all, detect_features_tilted(t.image, tilt, params.sift, box));
     boxed.push_back(features_inside(all, box));
     counts.detected += all.size();
     counts.outside_box += all.size() - boxed.back().size();

@@ -30,6 +30,18 @@ struct SiftParams {
 // non-8-bit image, or settings SIFT refuses (a threshold not positive, fewer than 1 layer).
 Features detect_features(const cv::Mat& image, const SiftParams& params = {});
 
+// SIFT of the image as a camera would see it tilted away about the image's horizontal axis
+// (ASIFT's simulated tilt, Morel & Yu 2009, in one direction): the image (only `roi` of it, when
+// given) squeezed vertically by `tilt` (1/cos of the tilt angle: 2 is 60 deg), area-averaged so
+// that the squeeze does not alias, then SIFT; keypoints mapped back into the image's coordinates
+// (y times the squeeze; size and angle as detected). SIFT copes with about 40 deg of foreshortening
+// by itself; this finds the keypoints of a surface seen more obliquely than that (a held bottle's
+// label, its axis vertical in the image, as it looks when the bottle lies pointing at a camera).
+// Throws std::invalid_argument for a tilt below 1 and as detect_features does.
+Features detect_features_tilted(const cv::Mat& image, double tilt, const SiftParams& params = {},
+                                const cv::Rect& roi = {});
+// The keypoints and descriptors of `b` after those of `a`.
+Features concatenate(const Features& a, const Features& b);
 // RootSIFT (Arandjelovic & Zisserman, CVPR 2012): each descriptor row L1-normalised and square-
 // rooted, so that the Euclidean distance between two rows is the Hellinger distance between their
 // gradient histograms and a few large bins no longer dominate it. Rows come out with unit L2 norm

@@ -52,7 +52,19 @@ struct LearnParams {
   // 0 or less: any match counts (the thesis' rule as published).
   double background_static_px = 4;
   SiftParams sift;            // as the recognizer's, so that both find the same keypoints
+  // Each view's box also seen squeezed vertically by these simulated tilts (detect_features_tilted;
+  // each >= 1, none: the views as taken). The arm holds the object upright, so its training views
+  // show the label side-on; an object lying pointing towards the camera shows it squeezed along
+  // its axis, beyond what SIFT matches by itself. The squeezed views' features join their view's
+  // before the pruning, in the view's own coordinates.
+  std::vector<double> axis_tilts;
 };
+
+// "1.5,2" -> {1.5, 2}; "" -> none. Throws std::invalid_argument naming the item that is no number
+// or below 1.
+std::vector<double> axis_tilts_from_text(const std::string& text);
+// The inverse: {1.5, 2} -> "1.5,2".
+std::string axis_tilts_text(const std::vector<double>& tilts);
 
 struct LearnStats {
   int detected = 0;            // SIFT keypoints in every view
