@@ -18,6 +18,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <iomanip>
 #include <filesystem>
@@ -92,8 +94,10 @@ std::shared_ptr<const learning::ObjectModel> relearned(const learning::ObjectMod
     images.push_back({v.image, v.box, v.wrist_angle});
   }
   learning::LearnStats stats;
+  const auto start = std::chrono::steady_clock::now();
   auto model = std::make_shared<learning::ObjectModel>(learning::learn_object(stored.info, images, params, &stats));
-  std::cerr << "relearned " << stored.info.name << ": " << stats.detected << " detected, " << stats.outside_box
+  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  std::cerr << "relearned " << stored.info.name << " in " << std::lround(ms) << " ms: " << stats.detected << " detected, " << stats.outside_box
             << " outside the box, " << stats.background << " background, " << stats.kept << " kept (stored: "
             << stored.descriptor_count() << ")\n";
   return model;
@@ -608,7 +612,7 @@ int main(int argc, char** argv) {
   flags.add_string("set", &o.set, "the test images' set: eval (reported) or dev (tuning; nudge-exp-learning-scenes --set dev)");
   flags.add_bool("relearn", &o.relearn, "learn every stored object again from its stored views with today's learning");
   std::string axis_tilts = learning::axis_tilts_text(o.learn.axis_tilts);
-  flags.add_string("axis-tilts", &axis_tilts, "--relearn: simulated tilts along the held object's axis, comma-separated (none: off)");
+  flags.add_string("axis-tilts", &axis_tilts, "--relearn: simulated tilts along the held object's axis, comma-separated (\"\": none)");
   flags.add_int("background-matches", &o.learn.background_matches, "--relearn: other views a background descriptor matches");
   flags.add_double("background-static-px", &o.learn.background_static_px,
                    "--relearn: a match counts towards background only within this many pixels (0: anywhere)");

@@ -163,7 +163,9 @@ bool compose(TestImage& t, const sim::ObjectSpec& target) {
     case TestVariant::Cluttered: extra = 3 + draw.pick(2); break;
     case TestVariant::Orientation:
       t.lying = true;
-      t.lying_yaw = draw.uniform(-60, 60) * kDeg + (draw.pick(2) ? M_PI : 0.0);  // across the view, either way
+      // Within 60 deg of pointing along the view (the rig looks along -x), either end first: the
+      // label is seen squeezed along the bottle's axis, up to end-on.
+      t.lying_yaw = draw.uniform(-60, 60) * kDeg + (draw.pick(2) ? M_PI : 0.0);
       t.lying_roll = draw.uniform(0, 2 * M_PI);
       extra = 1;
       break;

@@ -45,7 +45,7 @@ constexpr int kViews = 12;
 struct Options {
   std::string test_images;
   std::string set = "eval";
-  std::string axis_tilts;  // the learner's simulated tilts along the axis (LearnParams::axis_tilts)
+  std::string axis_tilts = nudge::learning::axis_tilts_text(nudge::learning::LearnParams{}.axis_tilts);  // the learner's
   std::string tilts = "0,30";
   std::string name = "learning_views";
 };
@@ -252,7 +252,7 @@ int main(int argc, char** argv) {
               "experiment's test images (issue 11's diagnosis).");
   flags.add_string("test-images", &o.test_images, "nudge-exp-learning-scenes' output folder (of --set)");
   flags.add_string("set", &o.set, "the test images' set: eval (the report's) or dev (to try settings on)");
-  flags.add_string("axis-tilts", &o.axis_tilts, "the learner's simulated tilts along the bottle's axis, comma-separated (none: off)");
+  flags.add_string("axis-tilts", &o.axis_tilts, "the learner's simulated tilts along the bottle's axis, comma-separated (empty: none)");
   flags.add_string("tilts", &o.tilts, "comma-separated tilts of the bottle's top away from the right camera, deg (0: upright)");
   flags.add_string("name", &o.name, "result name (docs/results/NAME.*)");
   try {

@@ -27,7 +27,7 @@ int main(int argc, char** argv) {
                  "SIFT's contrast threshold, learning and recognition (OpenCV's default 0.04; lower finds more on small labels)");
     std::string axis_tilts = learning::axis_tilts_text(options.learn.axis_tilts);
     f.add_string("axis-tilts", &axis_tilts,
-                 "also learn each view squeezed along the held object's axis by these simulated tilts (1/cos: 2 = 60 deg), comma-separated; none: off");
+                 "also learn each view squeezed along the held object's axis by these simulated tilts (1/cos: 2 = 60 deg), comma-separated; \"\": none");
     f.add_double("view-expiry", &options.view_expiry_s, "drop views not committed within SECONDS of message time");
     if (!service.parse(argc, argv)) return 0;
     if (options.db_dir.empty()) throw FlagError("--db DIR is required");

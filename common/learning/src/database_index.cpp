@@ -17,7 +17,7 @@ void DatabaseIndex::build(const std::vector<IndexedObject>& objects) {
   descriptors_.create(total, 128, CV_32F);
   row_object_.resize(total);
   row_local_.resize(total);
-  row_view_.resize(total);
+  row_group_.resize(total);
   int row = 0;
   for (size_t o = 0; o < objects.size(); ++o) {
     if (object_rows_[o] == 0) continue;
@@ -28,7 +28,7 @@ void DatabaseIndex::build(const std::vector<IndexedObject>& objects) {
       for (int k = 0; k < d.rows; ++k, ++row, ++local) {
         row_object_[row] = static_cast<int>(o);
         row_local_[row] = local;
-        row_view_[row] = (*objects[o].row_view)[local];
+        row_group_[row] = (*objects[o].row_group)[local];
       }
     }
   }
@@ -81,7 +81,7 @@ std::vector<std::vector<cv::DMatch>> DatabaseIndex::ratio_matches(const cv::Mat&
       if (it->count >= kObjectNeighbours) continue;
       ++it->count;
       it->last = d;
-      if (it->same_view < 0 && row_view_[row] == row_view_[it->nearest_row]) it->same_view = d;
+      if (it->same_view < 0 && row_group_[row] == row_group_[it->nearest_row]) it->same_view = d;
     }
     for (const ObjectNeighbours& n : seen) {
       float second;

@@ -14,10 +14,12 @@ namespace nudge::learning::detail {
 // shared indexes, so both decide alike.
 constexpr int kObjectNeighbours = 4;
 
-// One object as the index sees it: its views' descriptors stacked, and the view of each row.
+// One object as the index sees it: its views' descriptors stacked, and the ratio-test group of each row.
 struct IndexedObject {
   std::vector<cv::Mat> view_descriptors;  // CV_32F, 128 wide; empty views allowed
-  const std::vector<int>* row_view = nullptr;
+  // Each row's ratio-test group: its view, told apart by the simulated tilt it was found at (the
+  // Recognizer's row_group).
+  const std::vector<int>* row_group = nullptr;
 };
 
 struct IndexSearch {
@@ -39,7 +41,7 @@ class DatabaseIndex {
 
  private:
   cv::Mat descriptors_;                   // the index points into it: kept alive with it
-  std::vector<int> row_object_, row_local_, row_view_;
+  std::vector<int> row_object_, row_local_, row_group_;
   std::vector<int> object_rows_;          // rows per object (0 for one left out)
   std::unique_ptr<cv::flann::Index> index_;
 };

@@ -50,9 +50,12 @@ Features detect_features_tilted(const cv::Mat& image, double tilt, const SiftPar
   for (cv::KeyPoint& k : features.keypoints) {
     k.pt.x += static_cast<float>(area.x);
     k.pt.y = k.pt.y * y_scale + static_cast<float>(area.y);
+    k.class_id = tilt_layer_id(tilt);
   }
   return features;
 }
+
+int tilt_layer_id(double tilt) { return tilt > 1 ? static_cast<int>(std::lround(tilt * 100)) : -1; }
 
 Features concatenate(const Features& a, const Features& b) {
   Features out;

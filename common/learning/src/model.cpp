@@ -71,31 +71,41 @@ ObjectModel learn_object(const ObjectInfo& info, const std::vector<TrainingImage
   for (double tilt : params.axis_tilts)
     if (!(tilt >= 1)) throw std::invalid_argument("object " + info.name + ": simulated tilt " + std::to_string(tilt) + " is below 1");
   LearnStats counts;
-  std::vector<Features> boxed;
+  // layers[0][v]: view v's features as taken; layers[l][v]: as seen squeezed by axis_tilts[l - 1].
+  // Each layer is pruned on its own: a squeezed view is compared with the other views squeezed
+  // alike (its own copy of a point in another layer would pass for its second neighbour).
+  std::vector<std::vector<Features>> layers(1 + params.axis_tilts.size(), std::vector<Features>(images.size()));
   for (size_t v = 0; v < images.size(); ++v) {
     const TrainingImage& t = images[v];
     if (t.image.empty() || t.image.depth() != CV_8U)
       throw std::invalid_argument("object " + info.name + ": view " + std::to_string(v) + " is empty or not 8-bit");
-    Features all = detect_features(t.image, params.sift);
     const cv::Rect box = t.box.empty() ? cv::Rect() : generous_box(t.box, params.box_margin, t.image.size());
-    for (double tilt : params.axis_tilts) all = concatenate(all, detect_features_tilted(t.image, tilt, params.sift, box));
-    boxed.push_back(features_inside(all, box));
-    counts.detected += all.size();
-    counts.outside_box += all.size() - boxed.back().size();
+    for (size_t l = 0; l < layers.size(); ++l) {
+      const Features all = l == 0 ? detect_features(t.image, params.sift)
+                                  : detect_features_tilted(t.image, params.axis_tilts[l - 1], params.sift, box);
+      layers[l][v] = features_inside(all, box);
+      counts.detected += all.size();
+      counts.outside_box += all.size() - layers[l][v].size();
+    }
     if (progress) progress(static_cast<int>(v) + 1, static_cast<int>(images.size()));
   }
-  const auto background = background_descriptors(boxed, params.ratio, params.background_matches, params.background_static_px);
+  std::vector<std::vector<std::vector<bool>>> background;
+  for (const auto& layer : layers)
+    background.push_back(background_descriptors(layer, params.ratio, params.background_matches, params.background_static_px));
   ObjectModel model;
   model.info = info;
   for (size_t v = 0; v < images.size(); ++v) {
-    std::vector<bool> keep(background[v].size());
-    for (size_t k = 0; k < keep.size(); ++k) keep[k] = !background[v][k];
     ModelView view;
-    view.features = select_features(boxed[v], keep);
+    for (size_t l = 0; l < layers.size(); ++l) {
+      std::vector<bool> keep(background[l][v].size());
+      for (size_t k = 0; k < keep.size(); ++k) keep[k] = !background[l][v][k];
+      const Features kept = select_features(layers[l][v], keep);
+      counts.background += layers[l][v].size() - kept.size();
+      view.features = l == 0 ? kept : concatenate(view.features, kept);
+    }
     view.box = images[v].box;
     view.wrist_angle = images[v].wrist_angle;
     view.image = images[v].image;
-    counts.background += boxed[v].size() - view.features.size();
     counts.kept += view.features.size();
     model.views.push_back(std::move(view));
   }

@@ -36,6 +36,10 @@ std::string matcher_name(MatcherKind kind) {
 struct Recognizer::Entry {
   std::shared_ptr<const ObjectModel> model;
   std::vector<int> row_view, row_index;
+  // The ratio test's group of each row: its view, and within the view the simulated tilt it was
+  // found at (LearnParams::axis_tilts), so that a point's squeezed copy is not its own second
+  // neighbour.
+  std::vector<int> row_group;
   cv::Ptr<cv::DescriptorMatcher> matcher;  // null for a set of < 2 descriptors, and for SharedFlann
 };
 
@@ -63,12 +67,12 @@ cv::Ptr<cv::DescriptorMatcher> make_matcher(MatcherKind kind) {
 // Neighbours looked at per query descriptor (see view_ratio_matches).
 constexpr int kNeighbours = detail::kObjectNeighbours;
 
-// Lowe's ratio test within one training view. Neighbouring views show the same surface point, so
+// Lowe's ratio test within one training view (row_group: the view, and the simulated tilt within it). Neighbouring views show the same surface point, so
 // over the object's whole set (as the thesis matched) the second neighbour is often the same point
 // one turn step on, failing a true match. Here d2 is the nearest neighbour in the same view as the
 // nearest one; when none of the kNeighbours nearest is, the last of them stands in for it (the
 // true d2 is no smaller, so the test is only stricter).
-std::vector<cv::DMatch> view_ratio_matches(cv::DescriptorMatcher& matcher, const std::vector<int>& row_view,
+std::vector<cv::DMatch> view_ratio_matches(cv::DescriptorMatcher& matcher, const std::vector<int>& row_group,
                                            const cv::Mat& query, double ratio) {
   std::vector<cv::DMatch> out;
   if (query.empty()) return out;
@@ -79,7 +83,7 @@ std::vector<cv::DMatch> view_ratio_matches(cv::DescriptorMatcher& matcher, const
     const cv::DMatch& nearest = neighbours[0];
     float second = neighbours.back().distance;
     for (size_t i = 1; i < neighbours.size(); ++i) {
-      if (row_view[neighbours[i].trainIdx] == row_view[nearest.trainIdx]) {
+      if (row_group[neighbours[i].trainIdx] == row_group[nearest.trainIdx]) {
         second = neighbours[i].distance;
         break;
       }
@@ -190,6 +194,7 @@ Recognizer& Recognizer::operator=(Recognizer&&) noexcept = default;
 void Recognizer::add(std::shared_ptr<const ObjectModel> model) {
   auto entry = std::make_unique<Entry>();
   cv::Mat all(0, 128, CV_32F);
+  int next_group = 0;
   for (size_t v = 0; v < model->views.size(); ++v) {
     const Features& f = model->views[v].features;
     if (!f.descriptors.empty() && (f.descriptors.type() != CV_32F || f.descriptors.cols != 128))
@@ -199,9 +204,13 @@ void Recognizer::add(std::shared_ptr<const ObjectModel> model) {
       throw std::invalid_argument("object '" + model->info.name + "' view " + std::to_string(v) + ": " +
                                   std::to_string(f.size()) + " keypoints but " + std::to_string(f.descriptors.rows) +
                                   " descriptors");
+    std::map<int, int> group_of_layer;  // class_id -> ratio-test group, within this view
     for (int k = 0; k < f.size(); ++k) {
       entry->row_view.push_back(static_cast<int>(v));
       entry->row_index.push_back(k);
+      auto [it, fresh] = group_of_layer.emplace(f.keypoints[k].class_id, 0);
+      if (fresh) it->second = next_group++;
+      entry->row_group.push_back(it->second);
     }
     if (!f.descriptors.empty() && !shared_) all.push_back(matching_descriptors(f.descriptors, params_.root_sift));
   }
@@ -240,7 +249,7 @@ void Recognizer::build_index() const {
   for (size_t i = 0; i < entries_.size(); ++i) {
     for (const auto& view : entries_[i]->model->views)
       objects[i].view_descriptors.push_back(matching_descriptors(view.features.descriptors, params_.root_sift));
-    objects[i].row_view = &entries_[i]->row_view;
+    objects[i].row_group = &entries_[i]->row_group;
   }
   shared_->index.build(objects);
   shared_->stale = false;
@@ -258,7 +267,7 @@ std::vector<std::vector<cv::DMatch>> Recognizer::ratio_matches_per_object(const 
   }
   std::vector<std::vector<cv::DMatch>> out;
   for (const auto& entry : entries_) {
-    out.push_back(entry->matcher ? view_ratio_matches(*entry->matcher, entry->row_view, query, params_.ratio)
+    out.push_back(entry->matcher ? view_ratio_matches(*entry->matcher, entry->row_group, query, params_.ratio)
                                  : std::vector<cv::DMatch>{});
   }
   return out;

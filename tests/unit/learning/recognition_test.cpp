@@ -507,7 +507,10 @@ TEST(LearningFeatures, TiltedDetectionSqueezesTheRegionAndMapsKeypointsBack) {
   const Features tilted = detect_features_tilted(image, 2.0, {}, kBox);
   ASSERT_GT(tilted.size(), 20);
   EXPECT_EQ(tilted.descriptors.rows, tilted.size());
-  for (const auto& k : tilted.keypoints) EXPECT_TRUE(cv::Rect2f(kBox).contains(k.pt)) << k.pt;
+  for (const auto& k : tilted.keypoints) {
+    EXPECT_TRUE(cv::Rect2f(kBox).contains(k.pt)) << k.pt;
+    EXPECT_EQ(k.class_id, tilt_layer_id(2.0));  // told apart from plain SIFT's (-1) in the ratio test
+  }
   // Spread over the whole region's height, not only its upper half (the squeezed image's rows).
   float lowest = 0;
   for (const auto& k : tilted.keypoints) lowest = std::max(lowest, k.pt.y);
@@ -527,14 +530,16 @@ TEST(LearningRecognizer, ALabelSqueezedAlongTheAxisIsFoundWhenLearnedWithSimulat
   const cv::Mat surface = synthetic::random_texture(kSurface, 11);
   const cv::Mat background = synthetic::random_texture(kImage, 12);
   const auto views = synthetic::turntable_views(surface, background, kBox, 12);
-  LearnParams with_tilts;
+  LearnParams none, with_tilts, defaults;
+  none.axis_tilts = {};
   with_tilts.axis_tilts = {1.7, 2.5};
   ObjectInfo info;
   info.name = "lying";
   LearnStats plain_stats, tilted_stats;
-  Recognizer plain, tilted;
-  plain.add(std::make_shared<ObjectModel>(learn_object(info, views, {}, &plain_stats)));
+  Recognizer plain, tilted, by_default;
+  plain.add(std::make_shared<ObjectModel>(learn_object(info, views, none, &plain_stats)));
   tilted.add(std::make_shared<ObjectModel>(learn_object(info, views, with_tilts, &tilted_stats)));
+  by_default.add(std::make_shared<ObjectModel>(learn_object(info, views, defaults)));
   EXPECT_GT(tilted_stats.kept, plain_stats.kept);
   EXPECT_EQ(tilted_stats.detected, tilted_stats.outside_box + tilted_stats.background + tilted_stats.kept);
 
@@ -548,5 +553,58 @@ TEST(LearningRecognizer, ALabelSqueezedAlongTheAxisIsFoundWhenLearnedWithSimulat
   EXPECT_GE(after.scores[0].verified_matches, 10);
   EXPECT_GE(after.scores[0].verified_matches, 2 * before.scores[0].verified_matches + 5)
       << "without simulated tilts " << before.scores[0].verified_matches;
+  // The default tilts (2 and 3) bracket this squeeze: found too, with more than the plain views.
+  const Recognition default_tilts = by_default.recognize(scene);
+  EXPECT_TRUE(default_tilts.recognised());
+  EXPECT_GT(default_tilts.scores[0].verified_matches, before.scores[0].verified_matches);
+
+  // Seen side-on, as taken: the squeezed copies cost nothing. Each copy is its own group in the
+  // ratio test; in its view's group a point's squeezed copy would be its second neighbour.
+  cv::Mat upright_scene = synthetic::random_texture({500, 400}, 14);
+  label.copyTo(upright_scene(cv::Rect(cv::Point(200, 100), label.size())));
+  const int plain_upright = plain.recognize(upright_scene).scores[0].verified_matches;
+  ASSERT_GE(plain_upright, 20);
+  EXPECT_GE(tilted.recognize(upright_scene).scores[0].verified_matches, 0.9 * plain_upright);
   EXPECT_THROW(learn_object(info, views, [] { LearnParams p; p.axis_tilts = {0.5}; return p; }()), std::invalid_argument);
+}
+
+// A view learned with simulated tilts holds a point's squeezed copy next to the point itself. In
+// one ratio-test group the copy would be the point's second neighbour and fail every true match;
+// the copy's own class_id (tilt_layer_id) puts it in a group of its own.
+TEST(LearningRecognizer, ASqueezedCopyOfAPointIsNotItsSecondNeighbour) {
+  const auto learned_model = learned("red", 10, 20);
+  Features plain;  // view 2's features as taken (plain SIFT: class_id -1)
+  const Features& view2 = learned_model->views[2].features;
+  std::vector<bool> is_plain(view2.size());
+  for (int i = 0; i < view2.size(); ++i) is_plain[i] = view2.keypoints[i].class_id == -1;
+  plain = select_features(view2, is_plain);
+  ASSERT_GE(plain.size(), 30);
+  cv::RNG rng(5);
+  auto noisy = [&](const cv::Mat& d) {
+    cv::Mat noise(d.size(), CV_32F);
+    rng.fill(noise, cv::RNG::NORMAL, 0, 4);
+    return cv::Mat(d + noise);
+  };
+  Features copies = plain;  // as a squeezed layer would hold them: near, not equal
+  copies.descriptors = noisy(plain.descriptors);
+  for (auto& k : copies.keypoints) k.class_id = tilt_layer_id(2.0);
+  Features query = spread_features_mapped(plain, cv::Matx23d(1, 0, 30, 0, 1, 20), 8);
+  ASSERT_EQ(query.size(), 8);
+  query.descriptors = noisy(query.descriptors);
+  for (MatcherKind kind : {MatcherKind::SharedFlann, MatcherKind::BruteForce}) {
+    RecognizeParams params;
+    params.matcher = kind;
+    auto recognise_with = [&](int copy_class) {
+      Features copies_as = copies;
+      for (auto& k : copies_as.keypoints) k.class_id = copy_class;
+      auto model = std::make_shared<ObjectModel>();
+      model->info.name = "red";
+      model->views.push_back({concatenate(plain, copies_as), {}, 0, {}});
+      Recognizer recognizer(params);
+      recognizer.add(model);
+      return recognizer.recognize(query).scores[0].verified_matches;
+    };
+    EXPECT_GE(recognise_with(tilt_layer_id(2.0)), 7) << matcher_name(kind);
+    EXPECT_LT(recognise_with(-1), 4) << matcher_name(kind) << ": the copies in the points' own group";
+  }
 }

@@ -37,9 +37,13 @@ Features detect_features(const cv::Mat& image, const SiftParams& params = {});
 // (y times the squeeze; size and angle as detected). SIFT copes with about 40 deg of foreshortening
 // by itself; this finds the keypoints of a surface seen more obliquely than that (a held bottle's
 // label, its axis vertical in the image, as it looks when the bottle lies pointing at a camera).
+// Each keypoint's class_id is tilt_layer_id(tilt), so that the recognizer's ratio test can tell a
+// point's squeezed copy from another point (plain SIFT leaves class_id at -1).
 // Throws std::invalid_argument for a tilt below 1 and as detect_features does.
 Features detect_features_tilted(const cv::Mat& image, double tilt, const SiftParams& params = {},
                                 const cv::Rect& roi = {});
+// The class_id of keypoints found at a simulated tilt: the tilt in hundredths; -1 for tilt 1.
+int tilt_layer_id(double tilt);
 // The keypoints and descriptors of `b` after those of `a`.
 Features concatenate(const Features& a, const Features& b);
 // RootSIFT (Arandjelovic & Zisserman, CVPR 2012): each descriptor row L1-normalised and square-
