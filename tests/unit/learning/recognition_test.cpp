@@ -530,16 +530,17 @@ TEST(LearningRecognizer, ALabelSqueezedAlongTheAxisIsFoundWhenLearnedWithSimulat
   const cv::Mat surface = synthetic::random_texture(kSurface, 11);
   const cv::Mat background = synthetic::random_texture(kImage, 12);
   const auto views = synthetic::turntable_views(surface, background, kBox, 12);
-  LearnParams none, with_tilts, defaults;
+  LearnParams none, with_tilts, bracketing;
   none.axis_tilts = {};
   with_tilts.axis_tilts = {1.7, 2.5};
+  bracketing.axis_tilts = {2, 3};
   ObjectInfo info;
   info.name = "lying";
   LearnStats plain_stats, tilted_stats;
   Recognizer plain, tilted, by_default;
   plain.add(std::make_shared<ObjectModel>(learn_object(info, views, none, &plain_stats)));
   tilted.add(std::make_shared<ObjectModel>(learn_object(info, views, with_tilts, &tilted_stats)));
-  by_default.add(std::make_shared<ObjectModel>(learn_object(info, views, defaults)));
+  by_default.add(std::make_shared<ObjectModel>(learn_object(info, views, bracketing)));
   EXPECT_GT(tilted_stats.kept, plain_stats.kept);
   EXPECT_EQ(tilted_stats.detected, tilted_stats.outside_box + tilted_stats.background + tilted_stats.kept);
 
@@ -553,7 +554,7 @@ TEST(LearningRecognizer, ALabelSqueezedAlongTheAxisIsFoundWhenLearnedWithSimulat
   EXPECT_GE(after.scores[0].verified_matches, 10);
   EXPECT_GE(after.scores[0].verified_matches, 2 * before.scores[0].verified_matches + 5)
       << "without simulated tilts " << before.scores[0].verified_matches;
-  // The default tilts (2 and 3) bracket this squeeze: found too, with more than the plain views.
+  // Tilts of 2 and 3 bracket this squeeze: found too, with more than the plain views.
   const Recognition default_tilts = by_default.recognize(scene);
   EXPECT_TRUE(default_tilts.recognised());
   EXPECT_GT(default_tilts.scores[0].verified_matches, before.scores[0].verified_matches);

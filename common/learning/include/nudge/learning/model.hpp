@@ -56,11 +56,10 @@ struct LearnParams {
   // each >= 1, none: the views as taken). The arm holds the object upright, so its training views
   // show the label side-on; an object lying pointing towards the camera shows it squeezed along
   // its axis, beyond what SIFT matches by itself. The squeezed views' features join their view's
-  // before the pruning, in the view's own coordinates. 2 and 3 (60 and 71 deg; ASIFT samples tilts
-  // about 1.4 apart, SIFT matching about 40 deg of tilt by itself): on the learning experiment's
-  // tuning images (docs/learning.md) lying bottles 3 -> 5 of 7, 22 -> 24 of 28 in all, no false
-  // recognition; 1.8 times the descriptors.
-  std::vector<double> axis_tilts = {2, 3};
+  // before the pruning, in the view's own coordinates. Off by default: 2 and 3 (60 and 71 deg) took
+  // the tuning images from 22 to 24 of 28 but the evaluation images of two chain runs from 19 to
+  // 19 and 17 (docs/learning.md), at 1.8 times the descriptors.
+  std::vector<double> axis_tilts;
 };
 
 // "1.5,2" -> {1.5, 2}; "" -> none. Throws std::invalid_argument naming the item that is no number
