@@ -52,17 +52,9 @@ struct Options {
 
 std::vector<double> parse_tilts(const std::string& text) {
   std::vector<double> tilts;
-  std::stringstream in(text);
-  std::string item;
-  while (std::getline(in, item, ',')) {
-    size_t used = 0;
-    double tilt = 0;
-    try {
-      tilt = std::stod(item, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used != item.size() || !(tilt >= -60 && tilt <= 60)) throw FlagError("--tilts: '" + item + "' is no angle in [-60, 60] deg");
+  for (const std::string& item : nudge::split_list(text)) {
+    const double tilt = nudge::parse_double(item, "--tilts");
+    if (!(tilt >= -60 && tilt <= 60)) throw FlagError("--tilts: '" + item + "' is no angle in [-60, 60] deg");
     tilts.push_back(tilt);
   }
   if (tilts.empty()) throw FlagError("--tilts: no angle");
