@@ -67,8 +67,10 @@ void BM_GraspPlanAfterNudge(benchmark::State& state) {
   const sv::SegmentFunction segment = sv::motion_segmentation({}, false);
   const sv::ArmSetup arm;
   // The before stills' lines are found before the nudge (Supervisor: when the stills arrive).
+  sv::LineSearchParams search;
+  search.crop_to_prediction = state.range(1) != 0;
   std::optional<nudge::symmetry::Line> before_lines[2];
-  for (int c = 0; c < 2; ++c) before_lines[c] = sv::find_line_near(cameras[c].before, *cameras[c].predicted_before);
+  for (int c = 0; c < 2; ++c) before_lines[c] = sv::find_line_near(cameras[c].before, *cameras[c].predicted_before, search);
   const sv::SegmentFunction segment_left = sv::motion_segmentation({}, false);  // the left's own, as the shell sets it
   const bool parallel = state.range(0) != 0;
   double grasp_height = 0;
@@ -78,7 +80,7 @@ void BM_GraspPlanAfterNudge(benchmark::State& state) {
     auto camera_top = [&](int c) {
       const Camera& cam = cameras[c];
       auto line_before = before_lines[c];
-      auto line_after = sv::find_line_near(cam.after, *cam.predicted_after);
+      auto line_after = sv::find_line_near(cam.after, *cam.predicted_after, search);
       if (!line_before) line_before = cam.predicted_before;
       if (!line_after) line_after = cam.predicted_after;
       const sv::Segmentation s = (c == 0 ? segment_left : segment)(cam.before, cam.after, *line_before, *line_after);
@@ -109,7 +111,9 @@ void BM_GraspPlanAfterNudge(benchmark::State& state) {
   }
   state.counters["grasp_height_mm"] = grasp_height * 1e3;  // a wrong plan shows here
 }
-BENCHMARK(BM_GraspPlanAfterNudge)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->MinTime(2.0)->UseRealTime();
+// Args: the left camera on a second thread (1) or after the right (0); the line searches in the band
+// about the prediction (1, as the supervisor does) or in the whole still (0).
+BENCHMARK(BM_GraspPlanAfterNudge)->Args({0, 1})->Args({1, 1})->Args({1, 0})->Unit(benchmark::kMillisecond)->MinTime(2.0)->UseRealTime();
 
 // Its parts: one line search in a still, one motion segmentation.
 void BM_LineSearchInStill(benchmark::State& state) {
@@ -118,9 +122,14 @@ void BM_LineSearchInStill(benchmark::State& state) {
   const Eigen::Vector3d foot(0.25, 0.01, 0);
   const cv::Mat still = draw(scene, foot, false);
   const auto predicted = scene.right_axis_line(foot, kHeight, kStill);
-  for (auto _ : state) benchmark::DoNotOptimize(sv::find_line_near(still, *predicted));
+  sv::LineSearchParams params;
+  params.crop_to_prediction = state.range(0) != 0;
+  for (auto _ : state) benchmark::DoNotOptimize(sv::find_line_near(still, *predicted, params));
+  state.counters["searched_share"] =
+      params.crop_to_prediction ? static_cast<double>(sv::search_region(still.size(), *predicted, params).area()) / still.total() : 1.0;
 }
-BENCHMARK(BM_LineSearchInStill)->Unit(benchmark::kMillisecond);
+// Arg: the band about the prediction searched (1, as the supervisor does) or the whole still (0).
+BENCHMARK(BM_LineSearchInStill)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond);
 
 void BM_MotionSegmentationOfStills(benchmark::State& state) {
   cv::setNumThreads(0);

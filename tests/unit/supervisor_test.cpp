@@ -2001,6 +2001,56 @@ TEST(LineSearch, TakesTheLineThatStandsOnThePredictedFootOverANearerOneEndingAbo
   EXPECT_NEAR(scene.found_x(*nearest), scene.column_x, 3.0);
 }
 
+// An object 20 px and 5 deg off its predicted axis, near the still's edge, and a symmetric object far
+// away: the search in the band about the prediction finds the object's line, as the search of the
+// whole still does, in the whole still's coordinates.
+TEST(LineSearch, TheSearchOfTheBandAboutThePredictionFindsTheLineTheWholeStillShows) {
+  cv::Mat still(960, 1280, CV_8UC3, cv::Scalar(150, 150, 150));
+  const double theta = 5 * M_PI / 180;
+  const cv::Point2d centre(1000, 500), along(-std::sin(theta), std::cos(theta)), across(std::cos(theta), std::sin(theta));
+  std::vector<cv::Point> outline;
+  for (const cv::Point2d& corner : {centre - 200 * along - 60 * across, centre - 200 * along + 60 * across,
+                                    centre + 200 * along + 60 * across, centre + 200 * along - 60 * across})
+    outline.emplace_back(cvRound(corner.x), cvRound(corner.y));
+  cv::fillConvexPoly(still, outline, cv::Scalar(40, 60, 80));
+  cv::rectangle(still, cv::Rect(200, 250, 140, 420), cv::Scalar(230, 230, 230), cv::FILLED);
+  const cv::Point2d foot(980, 720), top(980, 280);
+  nudge::symmetry::Line predicted = sv::line_through(foot, top, still.size());
+  predicted.seg1 = foot;
+  predicted.seg2 = top;
+  sv::LineSearchParams params;
+  const cv::Rect region = sv::search_region(still.size(), predicted, params);
+  EXPECT_LT(region.area(), still.size().area() / 2);
+  EXPECT_TRUE(region.contains(cv::Point(cvRound(centre.x), cvRound(centre.y))));
+  const auto cropped = sv::find_line_near(still, predicted, params);
+  params.crop_to_prediction = false;
+  const auto whole = sv::find_line_near(still, predicted, params);
+  ASSERT_TRUE(cropped);
+  ASSERT_TRUE(whole);
+  const cv::Point2d image_centre((still.cols - 1) / 2.0, (still.rows - 1) / 2.0);
+  const auto distance = [&](const nudge::symmetry::Line& line) {
+    return std::abs((centre - image_centre).dot(cv::Point2d(std::cos(line.theta), std::sin(line.theta))) - line.r);
+  };
+  EXPECT_LT(distance(*cropped), 1.5);
+  EXPECT_NEAR(cropped->theta, theta, 0.5 * M_PI / 180);
+  EXPECT_NEAR(cropped->r, whole->r, 0.5);
+  EXPECT_NEAR(cropped->theta, whole->theta, 0.2 * M_PI / 180);
+  EXPECT_LT(cv::norm(cropped->seg1 - whole->seg1) + cv::norm(cropped->seg2 - whole->seg2), 4.0);
+}
+
+// A prediction without a span, or one off the still: the whole still, or nothing to search.
+TEST(LineSearch, TheBandIsTheWholeStillWithoutASpanAndEmptyOffIt) {
+  const cv::Size size(1280, 960);
+  nudge::symmetry::Line spanless = sv::line_through({640, 700}, {640, 300}, size);
+  spanless.seg1 = spanless.seg2 = {640, 500};
+  EXPECT_EQ(sv::search_region(size, spanless), cv::Rect(0, 0, 1280, 960));
+  nudge::symmetry::Line off = sv::line_through({5000, 700}, {5000, 300}, size);
+  off.seg1 = {5000, 700};
+  off.seg2 = {5000, 300};
+  EXPECT_TRUE(sv::search_region(size, off).empty());
+  EXPECT_FALSE(sv::find_line_near(cv::Mat(size, CV_8UC3, cv::Scalar::all(100)), off));
+}
+
 TEST(LineSearch, TakesTheNearestLineWhenNoneReachesTheFoot) {
   const ColumnAndBottle scene(/*with_bottle=*/false);
   const auto found = sv::find_line_near(scene.still, scene.predicted(true), scene.params);

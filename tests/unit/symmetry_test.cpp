@@ -1120,6 +1120,60 @@ TEST(LineDifference, OfLinesMatchesTheirParameters) {
   EXPECT_NEAR(d.theta, -5 * kDeg, 1e-12);
 }
 
+// A line found in part of an image is the same line in the whole image's coordinates: points of the
+// region's line, shifted by the region's corner, lie on the whole image's line.
+TEST(LineFromRegion, PointsOfTheRegionsLineLieOnTheWholeImagesLine) {
+  const cv::Size whole(1280, 960);
+  const cv::Rect region(700, 120, 401, 613);
+  Line in_region;
+  in_region.r = -37.5;
+  in_region.theta = 7 * kDeg;
+  in_region.seg1 = {180, 40};
+  in_region.seg2 = {150, 560};
+  const Line mapped = line_from_region(in_region, region, whole);
+  EXPECT_DOUBLE_EQ(mapped.theta, in_region.theta);
+  const cv::Point2d normal(std::cos(in_region.theta), std::sin(in_region.theta)), along(-normal.y, normal.x);
+  const cv::Point2d region_centre((region.width - 1) / 2.0, (region.height - 1) / 2.0);
+  const cv::Point2d whole_centre((whole.width - 1) / 2.0, (whole.height - 1) / 2.0);
+  for (double t : {-300.0, 0.0, 250.0}) {
+    const cv::Point2d p = region_centre + in_region.r * normal + t * along + cv::Point2d(region.x, region.y);
+    EXPECT_NEAR((p - whole_centre).dot(normal), mapped.r, 1e-9) << t;
+  }
+  EXPECT_EQ(mapped.seg1, cv::Point2d(880, 160));
+  EXPECT_EQ(mapped.seg2, cv::Point2d(850, 680));
+  // Its border ends are the whole image's: on the line, on the border.
+  for (const cv::Point2d& end : {mapped.end1, mapped.end2}) {
+    EXPECT_NEAR((end - whole_centre).dot(normal), mapped.r, 1e-6);
+    EXPECT_TRUE(std::min({end.x, end.y, whole.width - 1 - end.x, whole.height - 1 - end.y}) < 1e-6);
+  }
+}
+
+// Detected in a crop and mapped back, or detected in the whole image: the same line.
+TEST(LineFromRegion, DetectionInACropAgreesWithDetectionInTheWholeImage) {
+  cv::Mat image = blank(640, 480, 200);
+  const cv::Point centre(420, 250);
+  cv::ellipse(image, centre, cv::Size(40, 110), 6, 0, 360, cv::Scalar(40), cv::FILLED);
+  cv::rectangle(image, cv::Rect(60, 100, 80, 200), cv::Scalar(90), cv::FILLED);  // another object, outside the crop
+  Params p;
+  p.theta_min_deg = -20;
+  p.theta_max_deg = 20;
+  Detector detector(p);
+  const Result whole = detector.detect(image);
+  const cv::Rect crop(300, 100, 240, 300);
+  const Result part = detector.detect(image(crop));
+  ASSERT_FALSE(whole.lines.empty());
+  ASSERT_FALSE(part.lines.empty());
+  const Line mapped = line_from_region(part.lines[0], crop, image.size());
+  const Line& same = *std::min_element(whole.lines.begin(), whole.lines.end(), [&](const Line& a, const Line& b) {
+    return r_diff(a, mapped.r, mapped.theta) < r_diff(b, mapped.r, mapped.theta);
+  });
+  EXPECT_LT(r_diff(same, mapped.r, mapped.theta), 0.5);
+  EXPECT_LT(angle_diff_deg(same.theta, mapped.theta), 0.2);
+  // And it is the ellipse's axis.
+  const cv::Point2d c(centre.x - (image.cols - 1) / 2.0, centre.y - (image.rows - 1) / 2.0);
+  EXPECT_NEAR(c.dot(cv::Point2d(std::cos(mapped.theta), std::sin(mapped.theta))), mapped.r, 1.5);
+}
+
 // The robot's own body left out: the masked edge pixels go with their orientations, the rest keep
 // their order; a mask of another size is refused.
 TEST(SymmetryEdges, RemoveEdgesDropsTheMaskedPixelsWithTheirOrientations) {

@@ -22,6 +22,35 @@ bool reaches_foot(const symmetry::Line& line, const symmetry::Line& predicted, d
 
 }  // namespace
 
+cv::Rect search_region(const cv::Size& size, const symmetry::Line& predicted, const LineSearchParams& params) {
+  const cv::Rect whole(0, 0, size.width, size.height);
+  const cv::Point2d axis = predicted.seg2 - predicted.seg1;
+  const double length = cv::norm(axis);
+  if (length < 1) return whole;
+  const cv::Point2d along = axis / length;
+  const cv::Point2d across(-along.y, along.x);
+  const double scale = size.width / 640.0;
+  const double half_pair = 0.5 * params.max_pair_width_px * scale;
+  const double window = params.window_deg * M_PI / 180;
+  // A line within the windows passes within window_px + 2 sin(window / 2) |p - centre| of a point p
+  // of the predicted line (the normals differ by at most the angle window); its pairs reach
+  // half_pair across it and half_pair sin(window) along the predicted axis.
+  const cv::Point2d centre((size.width - 1) / 2.0, (size.height - 1) / 2.0);
+  const double farthest = std::max(cv::norm(predicted.seg1 - centre), cv::norm(predicted.seg2 - centre)) + params.window_px;
+  const double half_width = params.window_px + 2 * std::sin(window / 2) * farthest + half_pair + 2;  // 2: Sobel's reach
+  const double half_length = 0.5 * length + params.window_px + half_pair * std::sin(window) + 2;
+  const cv::Point2d middle = 0.5 * (predicted.seg1 + predicted.seg2);
+  double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
+  for (int a : {-1, 1})
+    for (int b : {-1, 1}) {
+      const cv::Point2d corner = middle + a * half_length * along + b * half_width * across;
+      x0 = std::min(x0, corner.x), y0 = std::min(y0, corner.y), x1 = std::max(x1, corner.x), y1 = std::max(y1, corner.y);
+    }
+  const cv::Rect band(cv::Point(static_cast<int>(std::floor(x0)), static_cast<int>(std::floor(y0))),
+                      cv::Point(static_cast<int>(std::ceil(x1)) + 1, static_cast<int>(std::ceil(y1)) + 1));
+  return band & whole;
+}
+
 std::optional<symmetry::Line> find_line_near(const cv::Mat& image, const symmetry::Line& predicted,
                                              const LineSearchParams& params) {
   if (image.empty()) return std::nullopt;
@@ -41,11 +70,15 @@ std::optional<symmetry::Line> find_line_near(const cv::Mat& image, const symmetr
   symmetry::EdgeParams edges;
   edges.gradients = params.mirror_tolerance_deg > 0;
   symmetry::Detector detector(p, edges);
-  const symmetry::Result result = detector.detect(image);
+  const cv::Rect region = params.crop_to_prediction ? search_region(image.size(), predicted, params)
+                                                    : cv::Rect(0, 0, image.cols, image.rows);
+  if (region.width < 2 || region.height < 2) return std::nullopt;  // the predicted axis lies outside the still
+  const symmetry::Result result = detector.detect(image(region));
   std::optional<symmetry::Line> best;
   bool best_reaches = false;
   double best_offset = params.window_px;
-  for (const symmetry::Line& line : result.lines) {
+  for (const symmetry::Line& found : result.lines) {
+    const symmetry::Line line = symmetry::line_from_region(found, region, image.size());
     // In the form nearer the prediction: (R, theta) equals (-R, theta +- 180 deg).
     const double offset = std::abs(symmetry::line_difference(line, predicted).r);
     if (offset > params.window_px) continue;

@@ -38,4 +38,17 @@ LineDifference line_difference(double r, double theta, double reference_r, doubl
   return {(odd ? -r : r) - reference_r, d_theta};
 }
 
+Line line_from_region(const Line& line, const cv::Rect& region, const cv::Size& whole) {
+  Line out = line;
+  const cv::Point2d offset(region.x, region.y);
+  const cv::Point2d region_centre((region.width - 1) / 2.0, (region.height - 1) / 2.0);
+  const cv::Point2d whole_centre((whole.width - 1) / 2.0, (whole.height - 1) / 2.0);
+  const cv::Point2d normal(std::cos(line.theta), std::sin(line.theta));
+  out.r = line.r + normal.dot(offset + region_centre - whole_centre);
+  out.seg1 = line.seg1 + offset;
+  out.seg2 = line.seg2 + offset;
+  border_endpoints(out.r, out.theta, whole.width, whole.height, &out.end1, &out.end2);
+  return out;
+}
+
 }  // namespace nudge::symmetry

@@ -87,7 +87,9 @@ TEST(SymmetryVerify, RanksTheObjectAboveThePhantomAndTrimsItsSupport) {
     if (std::fabs(verified[i].theta) < 0.02 && std::fabs(x_of(verified[i]) - 215) < 1.5 && phantom_rank < 0) phantom_rank = i;
   }
   ASSERT_GE(object_rank, 0);
-  if (phantom_rank >= 0) EXPECT_LT(object_rank, phantom_rank);
+  if (phantom_rank >= 0) {
+    EXPECT_LT(object_rank, phantom_rank);
+  }
   // The object's support is its own height (rows 60..199), not the whole image column.
   const sym::Line& object = verified[object_rank];
   EXPECT_NEAR(std::min(object.seg1.y, object.seg2.y), 60, 6);

@@ -28,7 +28,19 @@ struct LineSearchParams {
   // length above the predicted foot (the axis is drawn up to the tallest object's height, so
   // 0.3 of it is a few centimetres of a short cup's height at most).
   double foot_slack = 0.3;
+  // Run the detector only on the part of the still that the accepted lines' edge pairs can lie in
+  // (search_region): the windows above, the pair widths and the predicted axis' span. The lines
+  // found are the same lines (in the whole still's coordinates); the still's other edges are
+  // neither detected nor voted with, which was most of the search's time in a 1280x960 still.
+  bool crop_to_prediction = true;
 };
+
+// The part of a `size` image a search for lines near `predicted` needs: the band about the predicted
+// axis' span (seg1 to seg2, lengthened by params.window_px at both ends) that holds every edge pair of
+// a line within the windows, widths up to max_pair_width_px (scaled to the image's width). The whole
+// image for a prediction without a span.
+cv::Rect search_region(const cv::Size& size, const symmetry::Line& predicted, const LineSearchParams& params = {});
+
 
 // The detected line nearest the prediction within the windows, of those that reach the predicted
 // foot when any does, or nothing. The prediction's seg1 is its foot on the table and seg2 its top

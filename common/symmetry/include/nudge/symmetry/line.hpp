@@ -22,6 +22,11 @@ struct Line {
 // twice, when it misses the image).
 void border_endpoints(double r, double theta, int width, int height, cv::Point2d* p1, cv::Point2d* p2);
 
+// `line`, detected in the part `region` of a `whole` image, in the whole image's coordinates: R about
+// the whole image's centre, end1/end2 on its border, seg1/seg2 shifted. The discrete peak's bins
+// stay the region's.
+Line line_from_region(const Line& line, const cv::Rect& region, const cv::Size& whole);
+
 // line - reference, in (R px, theta rad), with the line taken in whichever of its forms
 // (R + 0, theta + k 180 deg, R negated for odd k) is nearest the reference in theta: theta in
 // (-90, 90] deg, so lines either side of the +-90 deg wrap come out a few degrees apart.
