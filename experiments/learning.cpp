@@ -427,7 +427,13 @@ std::string markdown_report(const Options& o, const std::vector<Run>& runs, cons
      << learning::SiftParams{}.contrast_threshold << ", " << timing.matcher << "). The test images are the right camera's "
      << test_size.width << "x" << test_size.height << (test_size.width > 640 ? " high-resolution stills (as the robot "
         "takes them to look closely and learn; the 640x480 video frames of the same scenes show the bottles at a third "
-        "of the training views' scale, docs/learning.md)" : " video frames") << ".\n\n"
+        "of the training views' scale, docs/learning.md)" : " video frames") << ". "
+     << (o.relearn ? "Every object relearned from its stored views with today's learning (`--relearn`; simulated axis tilts: " +
+                         (o.learn.axis_tilts.empty() ? std::string("none") : learning::axis_tilts_text(o.learn.axis_tilts)) + ")"
+                   : std::string("The database as the runs stored it"))
+     << "; features learned at simulated tilts, where the models have any, matched "
+     << (o.recognize.tilts_as_fallback ? "only when the views as taken recognise nothing" : "with the others, in one pass")
+     << ".\n\n"
      << machine_description() << ", " << today() << ".\n\n"
      << "| | here | thesis |\n|---|---|---|\n"
      << "| objects learned | " << t.objects_learned << " of " << runs.size() << " | 7 of 7 |\n"
@@ -623,6 +629,9 @@ int main(int argc, char** argv) {
   flags.add_int("min-support", &o.recognize.min_support, "matches agreeing with a mapping beyond those that fixed it");
   std::string root_sift = o.recognize.root_sift ? "on" : "off";
   flags.add_string("root-sift", &root_sift, "on|off: match RootSIFT descriptors (Hellinger distance)");
+  std::string tilts_as_fallback = o.recognize.tilts_as_fallback ? "on" : "off";
+  flags.add_string("tilts-as-fallback", &tilts_as_fallback,
+                   "on|off: the simulated tilts' features matched only when the views as taken recognise nothing");
   flags.add_double("sift-contrast", &o.recognize.sift.contrast_threshold,
                    "SIFT's contrast threshold in recognition and, with --relearn, in learning");
   try {
@@ -631,6 +640,8 @@ int main(int argc, char** argv) {
     o.recognize.affine_check = affine == "on";
     if (root_sift != "on" && root_sift != "off") throw FlagError("--root-sift must be on or off");
     o.recognize.root_sift = root_sift == "on";
+    if (tilts_as_fallback != "on" && tilts_as_fallback != "off") throw FlagError("--tilts-as-fallback must be on or off");
+    o.recognize.tilts_as_fallback = tilts_as_fallback == "on";
     try {
       o.learn.axis_tilts = learning::axis_tilts_from_text(axis_tilts);
     } catch (const std::invalid_argument& e) {

@@ -48,6 +48,7 @@ struct Options {
   std::string axis_tilts = nudge::learning::axis_tilts_text(nudge::learning::LearnParams{}.axis_tilts);  // the learner's
   std::string tilts = "0,30";
   std::string name = "learning_views";
+  std::string tilts_as_fallback = nudge::learning::RecognizeParams{}.tilts_as_fallback ? "on" : "off";  // the learner's
 };
 
 std::vector<double> parse_tilts(const std::string& text) {
@@ -103,8 +104,9 @@ struct Score {
   std::vector<std::string> answers;    // per test image
 };
 
-Score score(const std::vector<std::shared_ptr<const learning::ObjectModel>>& models, const std::vector<TestImage>& images) {
-  learning::Recognizer recognizer;
+Score score(const std::vector<std::shared_ptr<const learning::ObjectModel>>& models, const std::vector<TestImage>& images,
+            const learning::RecognizeParams& params) {
+  learning::Recognizer recognizer(params);
   Score s;
   for (const auto& m : models) {
     recognizer.add(m);
@@ -188,6 +190,8 @@ int run(const Options& o) {
   const std::vector<double> tilts = parse_tilts(o.tilts);
   learning::LearnParams learn;
   learn.axis_tilts = learning::axis_tilts_from_text(o.axis_tilts);
+  learning::RecognizeParams recognize;
+  recognize.tilts_as_fallback = o.tilts_as_fallback == "on";
   const std::vector<TestImage> images = read_test_images(o.test_images, o.set);
   const std::vector<sim::ObjectSpec> bottles = learning_bottles();
   nudge::Progress progress("nudge-exp-learning-views", static_cast<int>(bottles.size() * tilts.size()));
@@ -220,11 +224,11 @@ int run(const Options& o) {
   std::vector<Score> scores;
   for (size_t t = 0; t < tilts.size(); ++t) {
     sets.push_back("tilted " + std::to_string(std::lround(tilts[t])) + " deg");
-    scores.push_back(score(per_tilt[t], images));
+    scores.push_back(score(per_tilt[t], images, recognize));
   }
   if (!all_tilts.empty()) {
     sets.push_back("all tilts together");
-    scores.push_back(score(all_tilts, images));
+    scores.push_back(score(all_tilts, images, recognize));
   }
   write_result(o.name + ".json", json_report(sets, scores));
   write_result(o.name + ".md", markdown_report(o, sets, scores, images));
@@ -245,11 +249,14 @@ int main(int argc, char** argv) {
   flags.add_string("test-images", &o.test_images, "nudge-exp-learning-scenes' output folder (of --set)");
   flags.add_string("set", &o.set, "the test images' set: eval (the report's) or dev (to try settings on)");
   flags.add_string("axis-tilts", &o.axis_tilts, "the learner's simulated tilts along the bottle's axis, comma-separated (empty: none)");
+  flags.add_string("tilts-as-fallback", &o.tilts_as_fallback,
+                   "on|off: the simulated tilts' features matched only when the views as taken recognise nothing (the learner's --tilts-as-fallback)");
   flags.add_string("tilts", &o.tilts, "comma-separated tilts of the bottle's top away from the right camera, deg (0: upright)");
   flags.add_string("name", &o.name, "result name (docs/results/NAME.*)");
   try {
     if (!flags.parse(argc, argv)) return 0;
     if (o.test_images.empty()) throw FlagError("--test-images is required");
+    if (o.tilts_as_fallback != "on" && o.tilts_as_fallback != "off") throw FlagError("--tilts-as-fallback must be on or off");
     return run(o);
   } catch (const FlagError& e) {
     std::cerr << "nudge-exp-learning-views: " << e.what() << "\n" << flags.help();

@@ -28,6 +28,9 @@ int main(int argc, char** argv) {
     std::string axis_tilts = learning::axis_tilts_text(options.learn.axis_tilts);
     f.add_string("axis-tilts", &axis_tilts,
                  "also learn each view squeezed along the held object's axis by these simulated tilts (1/cos: 2 = 60 deg), comma-separated; \"\": none");
+    std::string tilts_as_fallback = options.recognize.tilts_as_fallback ? "on" : "off";
+    f.add_string("tilts-as-fallback", &tilts_as_fallback,
+                 "on|off: the features learned at --axis-tilts matched only when the views as taken recognise nothing");
     f.add_double("view-expiry", &options.view_expiry_s, "drop views not committed within SECONDS of message time");
     if (!service.parse(argc, argv)) return 0;
     if (options.db_dir.empty()) throw FlagError("--db DIR is required");
@@ -44,6 +47,8 @@ int main(int argc, char** argv) {
     } catch (const std::invalid_argument& e) {
       throw FlagError(std::string("--axis-tilts: ") + e.what());
     }
+    if (tilts_as_fallback != "on" && tilts_as_fallback != "off") throw FlagError("--tilts-as-fallback must be on or off");
+    options.recognize.tilts_as_fallback = tilts_as_fallback == "on";
     if (options.view_expiry_s <= 0) throw FlagError("--view-expiry must be > 0");
     if (!(options.recognize.sift.contrast_threshold > 0)) throw FlagError("--sift-contrast must be > 0");
     options.learn.ratio = options.recognize.ratio;

@@ -113,12 +113,14 @@ int main(int argc, char** argv) {
       symmetry_service::Options::Upright upright;
       try {
         upright.rig = geometry::load_rig(upright_calibration);
-        std::optional<geometry::Plane> table = geometry::load_workspace(upright_calibration).table;
-        if (!upright_table.empty())
-          table = geometry::plane_from_coefficients(
+        if (!upright_table.empty()) {
+          upright.table = geometry::plane_from_coefficients(
               Eigen::Vector4d(upright_table[0], upright_table[1], upright_table[2], upright_table[3]));
-        if (!table) throw std::invalid_argument(upright_calibration + " has no table_plane; give --upright-table");
-        upright.table = *table;
+        } else {
+          const std::optional<geometry::Plane> table = geometry::load_workspace(upright_calibration).table;
+          if (!table) throw std::invalid_argument(upright_calibration + " has no table_plane; give --upright-table");
+          upright.table = *table;
+        }
         for (const auto& channel : options.inputs) symmetry_service::side_of_channel(channel);
       } catch (const std::exception& e) {
         throw FlagError(std::string("--upright-calibration: ") + e.what());

@@ -41,6 +41,10 @@ struct Recognizer::Entry {
   // neighbour.
   std::vector<int> row_group;
   cv::Ptr<cv::DescriptorMatcher> matcher;  // null for a set of < 2 descriptors, and for SharedFlann
+  // Views' features found at simulated tilts (at_simulated_tilt): the model without them, and for
+  // each of its views the index of each of its features in the model's view. Null without any.
+  std::shared_ptr<const ObjectModel> untilted;
+  std::vector<std::vector<int>> untilted_index;
 };
 
 // SharedFlann: the index over every entry's descriptors, rebuilt after the entries change. Built
@@ -175,6 +179,34 @@ std::vector<cv::DMatch> geometric_inliers(const std::vector<cv::DMatch>& matches
   return best;
 }
 
+// `model` without the features found at simulated tilts, and per view the index of each feature kept
+// in the model's own view; null when it has none.
+std::shared_ptr<const ObjectModel> without_tilts(const ObjectModel& model, std::vector<std::vector<int>>* index) {
+  bool any = false;
+  for (const auto& view : model.views)
+    any = any || std::any_of(view.features.keypoints.begin(), view.features.keypoints.end(), at_simulated_tilt);
+  if (!any) return nullptr;
+  auto out = std::make_shared<ObjectModel>();
+  out->info = model.info;
+  index->assign(model.views.size(), {});
+  for (size_t v = 0; v < model.views.size(); ++v) {
+    const ModelView& view = model.views[v];
+    ModelView kept;
+    kept.box = view.box;
+    kept.wrist_angle = view.wrist_angle;
+    kept.image = view.image;
+    kept.features.descriptors.create(0, 128, CV_32F);
+    for (int k = 0; k < view.features.size(); ++k) {
+      if (at_simulated_tilt(view.features.keypoints[k])) continue;
+      kept.features.keypoints.push_back(view.features.keypoints[k]);
+      kept.features.descriptors.push_back(view.features.descriptors.row(k));
+      (*index)[v].push_back(k);
+    }
+    out->views.push_back(std::move(kept));
+  }
+  return out;
+}
+
 }  // namespace
 
 Recognizer::Recognizer(const RecognizeParams& params)
@@ -219,15 +251,45 @@ void Recognizer::add(std::shared_ptr<const ObjectModel> model) {
     entry->matcher->add(all);
     entry->matcher->train();  // builds FLANN's trees now, not on the first query
   }
+  if (params_.tilts_as_fallback) entry->untilted = without_tilts(*model, &entry->untilted_index);
   entry->model = std::move(model);
   if (shared_) shared_->stale = true;
-  for (auto& e : entries_) {
-    if (e->model->info.name == entry->model->info.name) {
-      e = std::move(entry);
-      return;
-    }
+  const Entry& added = *entry;
+  auto same = std::find_if(entries_.begin(), entries_.end(),
+                           [&](const auto& e) { return e->model->info.name == added.model->info.name; });
+  if (same != entries_.end())
+    *same = std::move(entry);
+  else
+    entries_.push_back(std::move(entry));
+  update_untilted(added);
+}
+
+void Recognizer::update_untilted(const Entry& added) {
+  const bool any_tilted = std::any_of(entries_.begin(), entries_.end(), [](const auto& e) { return e->untilted != nullptr; });
+  if (!any_tilted) {
+    untilted_.reset();
+    return;
   }
-  entries_.push_back(std::move(entry));
+  if (untilted_ && untilted_->size() + 1 >= size()) {  // one model added or replaced, the others there
+    untilted_->add(added.untilted ? added.untilted : added.model);
+    return;
+  }
+  // The first model with tilted features (or after a removal): every model, in the same order.
+  RecognizeParams plain = params_;
+  plain.tilts_as_fallback = false;
+  untilted_ = std::make_unique<Recognizer>(plain);
+  for (const auto& e : entries_) untilted_->add(e->untilted ? e->untilted : e->model);
+}
+
+// The untilted pass's matches, trainIdx into the untilted view's features: into the model's own.
+void Recognizer::remap_untilted(Recognition* result) const {
+  for (ObjectScore& score : result->scores) {
+    if (score.best_view < 0) continue;
+    const auto entry = std::find_if(entries_.begin(), entries_.end(), [&](const auto& e) { return e->model->info.name == score.name; });
+    if (entry == entries_.end() || !(*entry)->untilted) continue;
+    const std::vector<int>& index = (*entry)->untilted_index[score.best_view];
+    for (cv::DMatch& m : score.matches) m.trainIdx = index[m.trainIdx];
+  }
 }
 
 bool Recognizer::remove(const std::string& name) {
@@ -235,6 +297,8 @@ bool Recognizer::remove(const std::string& name) {
     if ((*it)->model->info.name == name) {
       entries_.erase(it);
       if (shared_) shared_->stale = true;
+      if (untilted_) untilted_->remove(name);
+      if (std::none_of(entries_.begin(), entries_.end(), [](const auto& e) { return e->untilted != nullptr; })) untilted_.reset();
       return true;
     }
   }
@@ -242,6 +306,7 @@ bool Recognizer::remove(const std::string& name) {
 }
 
 void Recognizer::build_index() const {
+  if (untilted_) untilted_->build_index();
   if (!shared_) return;
   std::lock_guard<std::mutex> lock(shared_->mutex);
   if (!shared_->stale) return;
@@ -295,6 +360,21 @@ Recognition Recognizer::recognize(const cv::Mat& image, const cv::Rect& roi) con
 }
 
 Recognition Recognizer::recognize(const Features& query) const {
+  Stopwatch watch;
+  if (untilted_) {
+    Recognition untilted = untilted_->recognize(query);
+    if (untilted.recognised()) {
+      remap_untilted(&untilted);
+      untilted.elapsed_ms = watch.elapsed_ms();
+      return untilted;
+    }
+  }
+  Recognition result = recognize_all_features(query);
+  result.elapsed_ms = watch.elapsed_ms();
+  return result;
+}
+
+Recognition Recognizer::recognize_all_features(const Features& query) const {
   Stopwatch watch;
   Recognition result;
   result.query = query;

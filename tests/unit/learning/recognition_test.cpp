@@ -537,7 +537,10 @@ TEST(LearningRecognizer, ALabelSqueezedAlongTheAxisIsFoundWhenLearnedWithSimulat
   ObjectInfo info;
   info.name = "lying";
   LearnStats plain_stats, tilted_stats;
-  Recognizer plain, tilted, by_default;
+  // One pass over every feature: what the simulated tilts add, when they are searched.
+  RecognizeParams one_pass;
+  one_pass.tilts_as_fallback = false;
+  Recognizer plain, tilted(one_pass), by_default(one_pass);
   plain.add(std::make_shared<ObjectModel>(learn_object(info, views, none, &plain_stats)));
   tilted.add(std::make_shared<ObjectModel>(learn_object(info, views, with_tilts, &tilted_stats)));
   by_default.add(std::make_shared<ObjectModel>(learn_object(info, views, bracketing)));
@@ -569,6 +572,79 @@ TEST(LearningRecognizer, ALabelSqueezedAlongTheAxisIsFoundWhenLearnedWithSimulat
   EXPECT_THROW(learn_object(info, views, [] { LearnParams p; p.axis_tilts = {0.5}; return p; }()), std::invalid_argument);
 }
 
+// The features found at simulated tilts are a second pass (RecognizeParams::tilts_as_fallback): a
+// query the views as taken recognise is recognised exactly as without them; one they do not, a
+// label squeezed past what SIFT matches, is searched again with them. The matches name the model's
+// own features, and removing or replacing models keeps both passes in step.
+TEST(LearningRecognizer, SimulatedTiltsAreSearchedOnlyWhenTheViewsAsTakenRecogniseNothing) {
+  const cv::Mat surface = synthetic::random_texture(kSurface, 11);
+  const cv::Mat background = synthetic::random_texture(kImage, 12);
+  const auto views = synthetic::turntable_views(surface, background, kBox, 12);
+  LearnParams none, tilts;
+  tilts.axis_tilts = {2, 3};
+  ObjectInfo info;
+  info.name = "lying";
+  const auto plain_model = std::make_shared<ObjectModel>(learn_object(info, views, none));
+  const auto tilted_model = std::make_shared<ObjectModel>(learn_object(info, views, tilts));
+  // Exhaustive matching, so that the two passes' answers can be compared exactly (FLANN's trees are
+  // random: two indexes of the same descriptors differ a little).
+  RecognizeParams exhaustive;
+  exhaustive.matcher = MatcherKind::BruteForce;
+  Recognizer plain(exhaustive), fallback(exhaustive);
+  plain.add(plain_model);
+  fallback.add(tilted_model);
+
+  const cv::Mat label = views[4].image(kBox);
+  cv::Mat upright_scene = synthetic::random_texture({500, 400}, 14);
+  label.copyTo(upright_scene(cv::Rect(cv::Point(200, 100), label.size())));
+  const Recognition as_taken = plain.recognize(upright_scene), first_pass = fallback.recognize(upright_scene);
+  ASSERT_TRUE(as_taken.recognised());
+  ASSERT_TRUE(first_pass.recognised());
+  EXPECT_EQ(first_pass.scores[0].verified_matches, as_taken.scores[0].verified_matches);
+  EXPECT_EQ(first_pass.scores[0].best_view, as_taken.scores[0].best_view);
+  const Features& view = tilted_model->views[first_pass.scores[0].best_view].features;
+  for (const cv::DMatch& m : first_pass.scores[0].matches) {
+    ASSERT_LT(m.trainIdx, view.size());
+    EXPECT_FALSE(at_simulated_tilt(view.keypoints[m.trainIdx]));
+  }
+
+  cv::Mat squeezed, lying;
+  cv::resize(label, squeezed, cv::Size(label.cols, label.rows / 3), 0, 0, cv::INTER_AREA);
+  cv::rotate(squeezed, lying, cv::ROTATE_90_CLOCKWISE);
+  cv::Mat lying_scene = synthetic::random_texture({500, 400}, 13);
+  lying.copyTo(lying_scene(cv::Rect(cv::Point(150, 150), lying.size())));
+  ASSERT_FALSE(plain.recognize(lying_scene).recognised()) << "the test needs a squeeze the views as taken miss";
+  const Recognition second_pass = fallback.recognize(lying_scene);
+  ASSERT_TRUE(second_pass.recognised()) << second_pass.reason;
+  const Features& tilted_view = tilted_model->views[second_pass.scores[0].best_view].features;
+  int tilted_matches = 0;
+  for (const cv::DMatch& m : second_pass.scores[0].matches) {
+    ASSERT_LT(m.trainIdx, tilted_view.size());
+    tilted_matches += at_simulated_tilt(tilted_view.keypoints[m.trainIdx]);
+  }
+  EXPECT_GT(tilted_matches, 0);
+  // The shared index (the learner's default) takes the same two passes.
+  Recognizer shared;
+  shared.add(tilted_model);
+  EXPECT_TRUE(shared.recognize(upright_scene).recognised());
+  const Recognition shared_second = shared.recognize(lying_scene);
+  ASSERT_TRUE(shared_second.recognised()) << shared_second.reason;
+  for (const cv::DMatch& m : shared_second.scores[0].matches)
+    EXPECT_LT(m.trainIdx, tilted_model->views[shared_second.scores[0].best_view].features.size());
+
+  // Another object beside it, then the tilted model replaced by the plain one: no second pass.
+  const auto other = std::make_shared<ObjectModel>(
+      learn_object([] { ObjectInfo o; o.name = "other"; return o; }(),
+                   synthetic::turntable_views(synthetic::random_texture(kSurface, 21), background, kBox, 12), tilts));
+  fallback.add(other);
+  EXPECT_EQ(fallback.recognize(upright_scene).scores[0].verified_matches, as_taken.scores[0].verified_matches);
+  EXPECT_TRUE(fallback.recognize(lying_scene).recognised());
+  fallback.remove("other");
+  fallback.add(plain_model);
+  EXPECT_FALSE(fallback.recognize(lying_scene).recognised());
+  EXPECT_EQ(fallback.recognize(upright_scene).scores[0].verified_matches, as_taken.scores[0].verified_matches);
+}
+
 // A view learned with simulated tilts holds a point's squeezed copy next to the point itself. In
 // one ratio-test group the copy would be the point's second neighbour and fail every true match;
 // the copy's own class_id (tilt_layer_id) puts it in a group of its own.
@@ -595,6 +671,7 @@ TEST(LearningRecognizer, ASqueezedCopyOfAPointIsNotItsSecondNeighbour) {
   for (MatcherKind kind : {MatcherKind::SharedFlann, MatcherKind::BruteForce}) {
     RecognizeParams params;
     params.matcher = kind;
+    params.tilts_as_fallback = false;  // the copies searched with the points, in one pass
     auto recognise_with = [&](int copy_class) {
       Features copies_as = copies;
       for (auto& k : copies_as.keypoints) k.class_id = copy_class;

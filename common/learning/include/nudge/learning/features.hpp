@@ -44,6 +44,8 @@ Features detect_features_tilted(const cv::Mat& image, double tilt, const SiftPar
                                 const cv::Rect& roi = {});
 // The class_id of keypoints found at a simulated tilt: the tilt in hundredths; -1 for tilt 1.
 int tilt_layer_id(double tilt);
+// Whether a keypoint was found at a simulated tilt (its class_id is a tilt layer's, >= 100).
+inline bool at_simulated_tilt(const cv::KeyPoint& k) { return k.class_id >= 100; }
 // The keypoints and descriptors of `b` after those of `a`.
 Features concatenate(const Features& a, const Features& b);
 // RootSIFT (Arandjelovic & Zisserman, CVPR 2012): each descriptor row L1-normalised and square-

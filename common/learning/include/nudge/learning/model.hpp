@@ -56,10 +56,11 @@ struct LearnParams {
   // each >= 1, none: the views as taken). The arm holds the object upright, so its training views
   // show the label side-on; an object lying pointing towards the camera shows it squeezed along
   // its axis, beyond what SIFT matches by itself. The squeezed views' features join their view's
-  // before the pruning, in the view's own coordinates. Off by default: 2 and 3 (60 and 71 deg) took
-  // the tuning images from 22 to 24 of 28 but the evaluation images of two chain runs from 19 to
-  // 19 and 17 (docs/learning.md), at 1.8 times the descriptors.
-  std::vector<double> axis_tilts;
+  // before the pruning, in the view's own coordinates. 2 and 3 (60 and 71 deg) take the tuning
+  // images from 22 to 24 of 28 at 1.8 times the descriptors. Matched in one pass with the views as
+  // taken they lost evaluation images that had few matches (docs/learning.md); the recognizer
+  // matches them only when the views as taken recognise nothing (RecognizeParams::tilts_as_fallback).
+  std::vector<double> axis_tilts = {2, 3};
 };
 
 // "1.5,2" -> {1.5, 2}; "" -> none. Throws std::invalid_argument naming the item that is no number

@@ -35,6 +35,11 @@ struct RecognizeParams {
   int shared_neighbours = 16;
   int shared_checks = 64;
   SiftParams sift;              // of the query image (recognize(image, roi)); as the learner's
+  // Features the learner found at simulated tilts (LearnParams::axis_tilts) are matched only when
+  // the views as taken recognise nothing: a second pass over every feature. A query the views as
+  // taken recognise is then recognised exactly as without the tilts; their squeezed copies
+  // neither crowd its neighbours nor its ratio test. false: one pass over every feature.
+  bool tilts_as_fallback = true;
 };
 
 // How one object scored against the query.
@@ -89,9 +94,14 @@ class Recognizer {
   struct Entry;
   struct SharedIndex;
   std::vector<std::vector<cv::DMatch>> ratio_matches_per_object(const cv::Mat& query_descriptors) const;
+  Recognition recognize_all_features(const Features& query) const;
+  // tilts_as_fallback: the models without their tilted features, kept while any model has them.
+  void update_untilted(const Entry& added);
+  void remap_untilted(Recognition* result) const;
   RecognizeParams params_;
   std::vector<std::unique_ptr<Entry>> entries_;
   std::unique_ptr<SharedIndex> shared_;  // SharedFlann only
+  std::unique_ptr<Recognizer> untilted_;
 };
 
 // Thesis fig. 7.10: the query image above the best training view, the verified matches as red
