@@ -729,7 +729,9 @@ TEST(Tracker, KeepsTheTrackOfAnObjectThatRestsAndMovesOn) {
       cv::Mat img = static_scene(640, 480);
       draw_bottle(img, truth(i), 1.0);
       s = tracker.feed(img, i * kFramePeriodUs);
-      if (i == kStop) ASSERT_EQ(s.status, TrackStatus::Tracking) << s.reason;
+      if (i == kStop) {
+        ASSERT_EQ(s.status, TrackStatus::Tracking) << s.reason;
+      }
       if (i <= kStop) continue;
       lost |= s.status == TrackStatus::Lost;
       resting = std::max(resting, s.resting_frames);
