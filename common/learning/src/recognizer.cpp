@@ -190,18 +190,13 @@ std::shared_ptr<const ObjectModel> without_tilts(const ObjectModel& model, std::
   out->info = model.info;
   index->assign(model.views.size(), {});
   for (size_t v = 0; v < model.views.size(); ++v) {
-    const ModelView& view = model.views[v];
-    ModelView kept;
-    kept.box = view.box;
-    kept.wrist_angle = view.wrist_angle;
-    kept.image = view.image;
-    kept.features.descriptors.create(0, 128, CV_32F);
-    for (int k = 0; k < view.features.size(); ++k) {
-      if (at_simulated_tilt(view.features.keypoints[k])) continue;
-      kept.features.keypoints.push_back(view.features.keypoints[k]);
-      kept.features.descriptors.push_back(view.features.descriptors.row(k));
-      (*index)[v].push_back(k);
+    ModelView kept = model.views[v];  // box, angle and image shared; the features replaced below
+    std::vector<bool> as_taken(kept.features.size());
+    for (int k = 0; k < kept.features.size(); ++k) {
+      as_taken[k] = !at_simulated_tilt(kept.features.keypoints[k]);
+      if (as_taken[k]) (*index)[v].push_back(k);
     }
+    kept.features = select_features(kept.features, as_taken);
     out->views.push_back(std::move(kept));
   }
   return out;
@@ -270,11 +265,11 @@ void Recognizer::update_untilted(const Entry& added) {
     untilted_.reset();
     return;
   }
-  if (untilted_ && untilted_->size() + 1 >= size()) {  // one model added or replaced, the others there
+  if (untilted_) {  // it holds every other model already (add and remove keep it in step)
     untilted_->add(added.untilted ? added.untilted : added.model);
     return;
   }
-  // The first model with tilted features (or after a removal): every model, in the same order.
+  // The first model with tilted features: every model, in the same order.
   RecognizeParams plain = params_;
   plain.tilts_as_fallback = false;
   untilted_ = std::make_unique<Recognizer>(plain);
