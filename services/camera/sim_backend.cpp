@@ -3,6 +3,8 @@
 // drawn and published on CAMERA_LEFT / CAMERA_RIGHT with the state's (simulated) utime.
 #include "sim_backend.hpp"
 
+#include <algorithm>
+#include <functional>
 #include <optional>
 #include <random>
 #include <vector>
@@ -16,6 +18,7 @@
 #include "nudge/sim/world.hpp"
 #include "nudge/sim_state_t.hpp"
 #include "nudge/snapshot_request_t.hpp"
+#include "nudge/timing.hpp"
 #include "nudge/bus/sim_convert.hpp"
 
 namespace nudge::camera_service {
@@ -25,6 +28,11 @@ namespace {
 constexpr const char* kChannels[2] = {bus::channel::CAMERA_LEFT, bus::channel::CAMERA_RIGHT};
 constexpr const char* kSnapshotChannels[2] = {bus::channel::SNAPSHOT_LEFT, bus::channel::SNAPSHOT_RIGHT};
 constexpr const char* kCameraNames[2] = {"left", "right"};
+// A still waits at most this long without a new state (wall time) for a state at or after its
+// request's time, then shows the newest state there is.
+constexpr int64_t kNoStateUs = 500000;
+// A request stamped this far beyond the newest state is on another clock (wall time).
+constexpr int64_t kOtherClockUs = 5000000;
 
 }  // namespace
 
@@ -50,6 +58,7 @@ int run_sim_camera(bus::Service& service, const SimOptions& options) {
   int64_t snapshot_ids[2] = {0, 0};
   std::optional<int64_t> last_state_utime;
   std::optional<sim::PoseSnapshot> previous;
+  std::function<void()> on_state_rendered;  // answers the stills the new state is due for (below)
   // One camera's frame: sharp, or the mean of renders spread over the interval since the last
   // state (motion blur), with the sensor noise added once, seeded by scene seed and frame.
   auto render = [&](int camera, const sim::PoseSnapshot& poses) {
@@ -78,28 +87,65 @@ int run_sim_camera(bus::Service& service, const SimOptions& options) {
     previous = poses;
     if (blur) sim::apply_poses(world, poses);  // snapshots show the state itself
     ++frame_id;
+    on_state_rendered();
     if (options.count > 0 && frame_id >= options.count) service.request_stop();
   });
+  // Stills (CAMERA_SNAPSHOT_REQUEST). A still shows a state at or after the request's time (the
+  // requester's simulated clock): the requester saw that state, and a still of an earlier one may
+  // show the arm before it parked. The camera handles its input in order, so when a request comes
+  // it has often drawn only the state before the one the requester saw; the request then waits
+  // for the next state (stills of the state before were refused as "taken before we asked", and a
+  // loaded camera lost every still of an attempt that way). Repeated requests fold into one.
+  std::optional<int64_t> pending[2];  // per camera: the still must show a state at or after this
+  int64_t last_state_wall = 0;
+  auto take_still = [&](int c, const char* why) {
+    if (why) log::warn() << kCameraNames[c] << " still: " << why << "; it shows the newest state, " << *last_state_utime;
+    service.publish(kSnapshotChannels[c], bus::to_message(world.render_snapshot(c), options.snapshot_format, *last_state_utime,
+                                                          snapshot_ids[c]++, kCameraNames[c], options.jpeg_quality));
+    pending[c].reset();
+  };
+  // Answers the stills whose time the newest state has reached.
+  auto answer_due = [&]() {
+    for (int c = 0; c < 2; ++c)
+      if (pending[c] && last_state_utime && *last_state_utime >= *pending[c]) take_still(c, nullptr);
+  };
+  on_state_rendered = [&]() {
+    last_state_wall = wall_utime();
+    answer_due();
+  };
   if (options.snapshots) {
     service.subscriptions().subscribe<snapshot_request_t>(
         bus::channel::CAMERA_SNAPSHOT_REQUEST, [&](const snapshot_request_t& request, const std::string&) {
           if (!last_state_utime) throw std::runtime_error("no SIM_STATE rendered yet: nothing to snapshot");
           if (request.cameras < snapshot_request_t::CAMERAS_BOTH || request.cameras > snapshot_request_t::CAMERAS_RIGHT)
             throw std::invalid_argument("snapshot request: unknown cameras value " + std::to_string(request.cameras));
+          // A time far beyond the newest state is another clock's (a wall-clock requester): now.
+          const bool other_clock = request.utime - *last_state_utime > kOtherClockUs;
           for (int c = 0; c < 2; ++c) {
             const int8_t this_camera = c == 0 ? snapshot_request_t::CAMERAS_LEFT : snapshot_request_t::CAMERAS_RIGHT;
             if (request.cameras != snapshot_request_t::CAMERAS_BOTH && request.cameras != this_camera) continue;
-            service.publish(kSnapshotChannels[c],
-                            bus::to_message(world.render_snapshot(c), options.snapshot_format, *last_state_utime,
-                                            snapshot_ids[c]++, kCameraNames[c], options.jpeg_quality));
+            const int64_t due = other_clock ? *last_state_utime : request.utime;
+            pending[c] = pending[c] ? std::max(*pending[c], due) : due;
           }
+          answer_due();
         });
   }
   // One pair per world state (README; the integration tests count them): SIM_STATE keeps LCM's
   // queue of 30 whatever --queue says, so a camera that falls behind renders its backlog late
   // instead of skipping states (docs/reliability.md, "Soak").
   service.subscriptions().set_stream_queue_capacity(30);
-  return service.run();
+  // No state for a while (the world paused or stopped, or the input ended): a waiting still shows
+  // the newest state there is.
+  auto answer_stale = [&](const char* why) {
+    for (int c = 0; c < 2; ++c)
+      if (pending[c] && last_state_utime) take_still(c, why);
+  };
+  const int code = service.run([&]() -> int {
+    if (wall_utime() - last_state_wall > kNoStateUs) answer_stale("no state at or after the request's time came");
+    return 20;
+  });
+  answer_stale("the camera stopped before a state at or after the request's time came");
+  return code;
 }
 
 }  // namespace nudge::camera_service

@@ -86,10 +86,13 @@ TEST(WorldCamera, EveryStateBecomesAStereoPairWhoseBottleAxisTheDetectorFinds) {
     const auto state = decode<nudge::sim_state_t>(e);
     states[state.utime] = state;
     if (states.size() == 10) {
+      // Stamped just after the 10th state (the requester's clock had passed it): the still must
+      // wait for the 11th, not show the 10th, which the camera drew last.
       nudge::snapshot_request_t request;
-      request.utime = e.timestamp;
+      request.utime = state.utime + 1;
       request.cameras = nudge::snapshot_request_t::CAMERAS_BOTH;
       camera_input.push_back({e.timestamp + 1, channel::CAMERA_SNAPSHOT_REQUEST, encode(request)});
+      camera_input.push_back({e.timestamp + 2, channel::CAMERA_SNAPSHOT_REQUEST, encode(request)});  // asked again
     }
     if (states.size() == 5) {  // a state of another scene: reported, counted, no frames
       nudge::sim_state_t other = state;
@@ -99,6 +102,12 @@ TEST(WorldCamera, EveryStateBecomesAStereoPairWhoseBottleAxisTheDetectorFinds) {
     }
   }
   ASSERT_EQ(states.size(), 26u) << "25 Hz over 1 s of simulated time, plus the state at t = 0";
+  {  // a right still asked for after the last state: no later state comes, the input ends
+    nudge::snapshot_request_t request;
+    request.utime = states.rbegin()->first + 1;
+    request.cameras = nudge::snapshot_request_t::CAMERAS_RIGHT;
+    camera_input.push_back({camera_input.back().timestamp + 1, channel::CAMERA_SNAPSHOT_REQUEST, encode(request)});
+  }
   EXPECT_EQ(states.begin()->first, 0);
   EXPECT_EQ(states.rbegin()->first, 1000000);
   write_log(camera_in, camera_input);
@@ -124,11 +133,17 @@ TEST(WorldCamera, EveryStateBecomesAStereoPairWhoseBottleAxisTheDetectorFinds) {
     EXPECT_EQ(left[utime].cols, 640);
     EXPECT_EQ(left[utime].rows, 480);
   }
-  ASSERT_EQ(snapshots.size(), 2u) << "one still pair for the one request";
-  for (const auto& s : snapshots) {
+  ASSERT_EQ(snapshots.size(), 3u) << "one still pair for the request asked twice, one right still at the end";
+  for (size_t i = 0; i < snapshots.size(); ++i) {
+    const auto& s = snapshots[i];
     EXPECT_EQ(s.width, 1280);
     EXPECT_EQ(s.height, 960);
-    EXPECT_EQ(s.utime, std::next(states.begin(), 9)->first) << "the still shows the latest state";
+    if (i < 2) {
+      EXPECT_EQ(s.utime, std::next(states.begin(), 10)->first) << "the still shows the first state at or after the request";
+    } else {
+      EXPECT_EQ(s.camera, "right");
+      EXPECT_EQ(s.utime, states.rbegin()->first) << "with no later state, the newest there is";
+    }
   }
 
   // Thesis parameters for upright objects in 640x480 frames.

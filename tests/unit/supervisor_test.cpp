@@ -925,6 +925,27 @@ TEST_F(SupervisorTest, ASnapshotThatNeverComesEndsTheAttemptAfterItsTimeout) {
   EXPECT_THROW(s.on_right_still(cv::Mat(480, 640, CV_8UC3), now_, now_), std::invalid_argument);  // wrong size: named
 }
 
+// A candidate whose before still never came is tried once more (the still says nothing about the
+// candidate: a busy camera lost it); lost a second time, it is passed over so that a camera that
+// never answers cannot loop the run.
+TEST_F(SupervisorTest, ACandidateWhoseBeforeStillWasLostIsTriedOnceMore) {
+  sv::Supervisor s = make();
+  const Eigen::Vector3d object(0.28, -0.05, 0);
+  start_with(s, {object});
+  ASSERT_EQ(s.state(), sv::State::SnapshotBefore);
+  s.on_time(now_ += 11 * kSecond);
+  ASSERT_EQ(outputs_of<sv::AttemptEnded>(s.take_outputs()).size(), 1u);
+  answer_survey(s, {object + Eigen::Vector3d(0.003, 0, 0)});  // the same object, seen again
+  EXPECT_EQ(s.state(), sv::State::SnapshotBefore) << "tried again";
+  s.on_time(now_ += 11 * kSecond);
+  const auto second = outputs_of<sv::AttemptEnded>(s.take_outputs());
+  ASSERT_EQ(second.size(), 1u);
+  EXPECT_EQ(second[0].attempt->outcome, sv::Outcome::SnapshotLost);
+  answer_survey(s, {object});
+  EXPECT_EQ(s.state(), sv::State::Done) << "lost twice: passed over";
+  EXPECT_EQ(s.summary().attempts, 2);
+}
+
 // A still lost on the way (a dropped UDP fragment loses the whole 3.7 MB message) is asked for
 // again every snapshot_retry_s until the step's timeout; the answer to a later request is taken.
 TEST_F(SupervisorTest, AStillThatDoesNotComeIsAskedForAgainUntilTheTimeout) {

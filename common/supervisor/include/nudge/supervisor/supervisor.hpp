@@ -401,6 +401,8 @@ class Supervisor {
   std::string after_home_;  // why the survey after homing happens
   std::vector<Candidate> candidates_;
   std::vector<Eigen::Vector3d> explored_, phantoms_, empty_;
+  // Candidates whose before still was lost once: tried again once, then passed over.
+  std::vector<Eigen::Vector3d> still_lost_;
   // Rests of failed segmentations left to be nudged again (Config::segmentation_retries), each
   // with how many failed attempts led there.
   std::vector<std::pair<Eigen::Vector3d, int>> retries_;
