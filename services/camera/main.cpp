@@ -55,6 +55,9 @@ int main(int argc, char** argv) {
     camera_service::SimOptions sim;
     f.add_string("scene", &sim.scene_file, "--source sim: the world service's scene file");
     f.add_double("noise", &sim.noise_sigma, "--source sim: Gaussian pixel noise sigma (-1: the scene's)");
+    f.add_int("max-lag-ms", &sim.max_lag_ms,
+              "--source sim: a state that waited longer in the input queue is not drawn, its frame counted missed "
+              "(a camera slower than the world stays current; 0: draw every state)");
     f.add_int("motion-blur", &sim.motion_blur,
               "--source sim: renders averaged over the interval since the last state (0: sharp)");
     f.add_bool("snapshots", &sim.snapshots,
@@ -65,6 +68,7 @@ int main(int argc, char** argv) {
                  "segment better (motion segmentation takes the largest change over the colour channels)");
     if (!service.parse(argc, argv)) return 0;
     if (rate < 0) throw FlagError("--rate must be >= 0");
+    if (sim.max_lag_ms < 0) throw FlagError("--max-lag-ms must be >= 0");
     if (count < 0) throw FlagError("--count must be >= 0");
     const int8_t pixel_format = bus::format_from_name(format);
     if (source_spec == "sim") {

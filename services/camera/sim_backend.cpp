@@ -1,6 +1,8 @@
 // Renders every SIM_STATE with a World of its own built from the same scene: objects and the
 // pusher are teleported to the state's poses (physics never runs here), then both cameras are
-// drawn and published on CAMERA_LEFT / CAMERA_RIGHT with the state's (simulated) utime.
+// drawn and published on CAMERA_LEFT / CAMERA_RIGHT with the state's (simulated) utime. States
+// that waited in the input queue longer than --max-lag-ms are skipped (a slow camera stays
+// current instead of lagging seconds behind the world).
 #include "sim_backend.hpp"
 
 #include <algorithm>
@@ -75,7 +77,19 @@ int run_sim_camera(bus::Service& service, const SimOptions& options) {
     exposure.convertTo(out, CV_8UC3);
     return out;
   };
-  service.subscriptions().subscribe<sim_state_t>(bus::channel::SIM_STATE, [&](const sim_state_t& state, const std::string&) {
+  int64_t skipped = 0;
+  service.subscriptions().subscribe_timed<sim_state_t>(bus::channel::SIM_STATE, [&](const sim_state_t& state, const std::string&,
+                                                                                    int64_t receive_utime) {
+    // A state that waited in the queue past the lag limit is not drawn: a camera that cannot draw
+    // every state shows the newest ones rather than falling further behind (its frame id is used
+    // up, so the gap is seen downstream as a missed frame).
+    if (options.max_lag_ms > 0 && wall_utime() - receive_utime > options.max_lag_ms * 1000) {
+      if (skipped++ % 50 == 0)
+        log::warn() << "state " << state.utime << " waited " << (wall_utime() - receive_utime) / 1000
+                    << " ms (over --max-lag-ms): not drawn; " << skipped << " skipped so far";
+      ++frame_id;
+      return;
+    }
     const sim::PoseSnapshot poses = bus::poses_of(state);
     sim::apply_poses(world, poses);  // throws naming the object: counted, skipped
     last_state_utime = state.utime;
@@ -145,6 +159,7 @@ int run_sim_camera(bus::Service& service, const SimOptions& options) {
     return 20;
   });
   answer_stale("the camera stopped before a state at or after the request's time came");
+  if (skipped > 0) log::info() << skipped << " states not drawn: they waited past --max-lag-ms";
   return code;
 }
 
