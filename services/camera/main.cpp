@@ -24,7 +24,7 @@ struct Stream {
 
 #ifdef NUDGE_CAMERA_SIM
 constexpr const char* kSimUsage =
-    "Simulation: --source sim --scene FILE renders every SIM_STATE as a stereo pair.";
+    "Simulation: --source sim --scene FILE renders every SIM_STATE as a stereo pair (unless it waited past --max-lag-ms).";
 #else
 constexpr const char* kSimUsage =
     "Simulation (--source sim): not in this build, which has no simulator (MuJoCo/OSMesa).";

@@ -6,7 +6,6 @@
 #include "sim_backend.hpp"
 
 #include <algorithm>
-#include <functional>
 #include <optional>
 #include <random>
 #include <vector>
@@ -60,7 +59,6 @@ int run_sim_camera(bus::Service& service, const SimOptions& options) {
   int64_t snapshot_ids[2] = {0, 0};
   std::optional<int64_t> last_state_utime;
   std::optional<sim::PoseSnapshot> previous;
-  std::function<void()> on_state_rendered;  // answers the stills the new state is due for (below)
   // One camera's frame: sharp, or the mean of renders spread over the interval since the last
   // state (motion blur), with the sensor noise added once, seeded by scene seed and frame.
   auto render = [&](int camera, const sim::PoseSnapshot& poses) {
@@ -76,6 +74,25 @@ int run_sim_camera(bus::Service& service, const SimOptions& options) {
     cv::Mat out;
     exposure.convertTo(out, CV_8UC3);
     return out;
+  };
+  // Stills (CAMERA_SNAPSHOT_REQUEST). A still shows a state at or after the request's time (the
+  // requester's simulated clock): the requester saw that state, and a still of an earlier one may
+  // show the arm before it parked. The camera handles its input in order, so when a request comes
+  // it has often drawn only the state before the one the requester saw; the request then waits
+  // for the next state (stills of the state before were refused as "taken before we asked", and a
+  // loaded camera lost every still of an attempt that way). Repeated requests fold into one.
+  std::optional<int64_t> pending[2];  // per camera: the still must show a state at or after this
+  int64_t last_state_wall = 0;
+  auto take_still = [&](int c, const char* why) {
+    if (why) log::warn() << kCameraNames[c] << " still: " << why << "; it shows the newest state, " << *last_state_utime;
+    service.publish(kSnapshotChannels[c], bus::to_message(world.render_snapshot(c), options.snapshot_format, *last_state_utime,
+                                                          snapshot_ids[c]++, kCameraNames[c], options.jpeg_quality));
+    pending[c].reset();
+  };
+  // Answers the stills whose time the newest state has reached.
+  auto answer_due = [&]() {
+    for (int c = 0; c < 2; ++c)
+      if (pending[c] && last_state_utime && *last_state_utime >= *pending[c]) take_still(c, nullptr);
   };
   int64_t skipped = 0;
   service.subscriptions().subscribe_timed<sim_state_t>(bus::channel::SIM_STATE, [&](const sim_state_t& state, const std::string&,
@@ -101,32 +118,10 @@ int run_sim_camera(bus::Service& service, const SimOptions& options) {
     previous = poses;
     if (blur) sim::apply_poses(world, poses);  // snapshots show the state itself
     ++frame_id;
-    on_state_rendered();
-    if (options.count > 0 && frame_id >= options.count) service.request_stop();
-  });
-  // Stills (CAMERA_SNAPSHOT_REQUEST). A still shows a state at or after the request's time (the
-  // requester's simulated clock): the requester saw that state, and a still of an earlier one may
-  // show the arm before it parked. The camera handles its input in order, so when a request comes
-  // it has often drawn only the state before the one the requester saw; the request then waits
-  // for the next state (stills of the state before were refused as "taken before we asked", and a
-  // loaded camera lost every still of an attempt that way). Repeated requests fold into one.
-  std::optional<int64_t> pending[2];  // per camera: the still must show a state at or after this
-  int64_t last_state_wall = 0;
-  auto take_still = [&](int c, const char* why) {
-    if (why) log::warn() << kCameraNames[c] << " still: " << why << "; it shows the newest state, " << *last_state_utime;
-    service.publish(kSnapshotChannels[c], bus::to_message(world.render_snapshot(c), options.snapshot_format, *last_state_utime,
-                                                          snapshot_ids[c]++, kCameraNames[c], options.jpeg_quality));
-    pending[c].reset();
-  };
-  // Answers the stills whose time the newest state has reached.
-  auto answer_due = [&]() {
-    for (int c = 0; c < 2; ++c)
-      if (pending[c] && last_state_utime && *last_state_utime >= *pending[c]) take_still(c, nullptr);
-  };
-  on_state_rendered = [&]() {
     last_state_wall = wall_utime();
     answer_due();
-  };
+    if (options.count > 0 && frame_id >= options.count) service.request_stop();
+  });
   if (options.snapshots) {
     service.subscriptions().subscribe<snapshot_request_t>(
         bus::channel::CAMERA_SNAPSHOT_REQUEST, [&](const snapshot_request_t& request, const std::string&) {
@@ -144,9 +139,10 @@ int run_sim_camera(bus::Service& service, const SimOptions& options) {
           answer_due();
         });
   }
-  // One pair per world state (README; the integration tests count them): SIM_STATE keeps LCM's
-  // queue of 30 whatever --queue says, so a camera that falls behind renders its backlog late
-  // instead of skipping states (docs/reliability.md, "Soak").
+  // One pair per world state (README; the integration tests count them, with --max-lag-ms 0):
+  // SIM_STATE keeps LCM's queue of 30 whatever --queue says, so a camera that falls behind draws
+  // its backlog up to --max-lag-ms late instead of losing states to a short queue
+  // (docs/reliability.md, "Soak").
   service.subscriptions().set_stream_queue_capacity(30);
   // No state for a while (the world paused or stopped, or the input ended): a waiting still shows
   // the newest state there is.

@@ -11,7 +11,7 @@ set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 bin=${1:?usage: camera_lag.sh BIN_DIR SCENE}
 scene=${2:?usage: camera_lag.sh BIN_DIR SCENE}
-rate=250 seconds=3 limit_ms=40
+rate=500 seconds=2 limit_ms=40
 
 nudge_test_in_private_network "$@"
 nudge_test_work_dir
@@ -65,7 +65,7 @@ def p90(values):
 
 every_states, every_frames = read(sys.argv[1])
 states, frames = read(sys.argv[2])
-assert len(states) > 300 and len(every_states) > 300, f"the world published {len(states)} / {len(every_states)} states"
+assert len(states) > 500 and len(every_states) > 500, f"the world published {len(states)} / {len(every_states)} states"
 assert len(frames) > 20, f"the limited camera drew {len(frames)} frames"
 every, limited = lags_ms(every_states, every_frames), lags_ms(states, frames)
 print(f"every state: {len(every_frames)} of {len(every_states)} drawn, lag p90 {p90(every):.0f} ms; "
