@@ -57,7 +57,8 @@ int main(int argc, char** argv) {
     f.add_double("noise", &sim.noise_sigma, "--source sim: Gaussian pixel noise sigma (-1: the scene's)");
     f.add_int("max-lag-ms", &sim.max_lag_ms,
               "--source sim: a state that waited longer in the input queue is not drawn, its frame counted missed "
-              "(a camera slower than the world stays current; 0: draw every state)");
+              "(a camera slower than the world stays current; 0: draw every state, the supervisor's frame counts "
+              "assume it)");
     f.add_int("motion-blur", &sim.motion_blur,
               "--source sim: renders averaged over the interval since the last state (0: sharp)");
     f.add_bool("snapshots", &sim.snapshots,

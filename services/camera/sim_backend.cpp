@@ -1,7 +1,7 @@
 // Renders every SIM_STATE with a World of its own built from the same scene: objects and the
 // pusher are teleported to the state's poses (physics never runs here), then both cameras are
-// drawn and published on CAMERA_LEFT / CAMERA_RIGHT with the state's (simulated) utime. States
-// that waited in the input queue longer than --max-lag-ms are skipped (a slow camera stays
+// drawn and published on CAMERA_LEFT / CAMERA_RIGHT with the state's (simulated) utime. With
+// --max-lag-ms, states that waited in the input queue longer are skipped (a slow camera stays
 // current instead of lagging seconds behind the world).
 #include "sim_backend.hpp"
 
@@ -139,7 +139,7 @@ int run_sim_camera(bus::Service& service, const SimOptions& options) {
           answer_due();
         });
   }
-  // One pair per world state (README; the integration tests count them, with --max-lag-ms 0):
+  // One pair per world state (README; the integration tests count them) unless --max-lag-ms:
   // SIM_STATE keeps LCM's queue of 30 whatever --queue says, so a camera that falls behind draws
   // its backlog up to --max-lag-ms late instead of losing states to a short queue
   // (docs/reliability.md, "Soak").

@@ -15,7 +15,7 @@ struct SimOptions {
   int8_t snapshot_format = 0;  // and of the stills
   int jpeg_quality = 90;
   int count = 0;            // stop after this many stereo pairs; 0 = no limit
-  int max_lag_ms = 500;      // states that waited longer in the input queue are not drawn (0: all are)
+  int max_lag_ms = 0;        // > 0: states that waited longer in the input queue are not drawn
   int motion_blur = 0;      // > 1: average this many renders across the interval since the last
                             // state (the shutter open for the whole frame); 0 or 1: sharp
 };

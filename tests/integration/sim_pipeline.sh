@@ -25,7 +25,7 @@ url=$NUDGE_TEST_URL
 sym=$!
 "$bin/nudge-monitor" --lcm-url "$url" --truth --expect-frames "$frames" --allow-missing 1 --timeout 45 2>"$work/monitor.log" &
 mon=$!
-"$bin/nudge-camera" --lcm-url "$url" --source sim --scene "$scene" --max-lag-ms 0 2>"$work/camera.log" &  # every state drawn
+"$bin/nudge-camera" --lcm-url "$url" --source sim --scene "$scene" --max-lag-ms 0 2>"$work/camera.log" &  # every state drawn (the default)
 cam=$!
 # Every subscriber listens before the first state: wait until each has started (the camera
 # builds its World first), each within 30 s.
