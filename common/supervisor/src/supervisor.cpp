@@ -687,11 +687,7 @@ void Supervisor::end_attempt(Outcome outcome, const std::string& reason, int64_t
   if (outcome == Outcome::SnapshotLost && a.before.empty()) {
     // A still lost to a busy camera or the network says nothing about the candidate: it is tried
     // once more. Lost again, it is passed over (a camera that never answers must not loop the run).
-    const double radius = config_.targets.same_object_radius;
-    const bool lost_before = std::any_of(still_lost_.begin(), still_lost_.end(), [&](const Eigen::Vector3d& p) {
-      return (p - a.target.position).head<2>().norm() < radius;
-    });
-    if (lost_before) explored_.push_back(a.target.position);
+    if (near_any(a.target.position, still_lost_, config_.targets.same_object_radius)) explored_.push_back(a.target.position);
     else still_lost_.push_back(a.target.position);
   }
   outputs_.push_back(AttemptEnded{std::shared_ptr<const Attempt>(attempt_.release())});

@@ -64,11 +64,11 @@ PushConflict push_conflict(const Eigen::Vector3d& target, const Eigen::Vector3d&
   return {};
 }
 
-namespace {
-
 bool near_any(const Eigen::Vector3d& p, const std::vector<Eigen::Vector3d>& places, double radius) {
   return std::any_of(places.begin(), places.end(), [&](const Eigen::Vector3d& e) { return horizontal(e - p).norm() < radius; });
 }
+
+namespace {
 
 struct Obstacle {
   Eigen::Vector3d place;

@@ -138,4 +138,7 @@ PushConflict push_conflict(const Eigen::Vector3d& target, const Eigen::Vector3d&
                            const Eigen::Vector3d& other, const ArmSetup& arm, const TargetParams& params,
                            const std::string& what = "candidate");
 
+// Whether `p` lies within `radius` of any of `places`, on the table (heights ignored).
+bool near_any(const Eigen::Vector3d& p, const std::vector<Eigen::Vector3d>& places, double radius);
+
 }  // namespace nudge::supervisor
