@@ -62,6 +62,7 @@ struct Options {
   // A gentle push: tall objects (bottles) tip when the pad meets them at the arm's usual speed.
   double nudge_speed_scale = 0.25;
   bool keep_running = false;
+  std::string line_pick = "strongest";  // strongest, nearest (LineSearchParams::strongest)
   std::string learn = "auto";      // on, off, auto (while the learner's heartbeat is heard)
   std::string learner = "learner"; // the learner service's heartbeat name
   sv::Config config;
@@ -575,6 +576,13 @@ void add_flags(Flags& f, Options& o) {
                "candidates that both cameras show upright in a smaller share of the survey's frames are not nudged (0: all are)");
   f.add_double("min-mask-share", &o.config.min_mask_share,
                "a mask smaller than this share of the smallest object's image at the rest (its pixels, rows or mean width) is no segmentation (0: any)");
+  f.add_double("after-line-lean-window", &o.config.line_search.lean_window_deg,
+               "the after still's object line is looked for first within this many deg of the before line's lean carried to "
+               "the rest (0: only about the upright prediction)");
+  f.add_int("still-lines", &o.config.line_search.lines,
+            "symmetry peaks examined in a still's search for the object's line (the prediction's windows keep the nearby ones)");
+  f.add_string("line-pick", &o.line_pick,
+               "of the lines near a still's predicted object line: the strongest (most votes) or the nearest");
   f.add_double("min-mask-mirror", &o.config.min_mask_mirror_agreement,
                "a mask that agrees less with its own mirror image about the object's line (IoU) is no segmentation (0: any)");
   f.add_double("snapshot-timeout", &o.config.snapshot_timeout_s, "for a still, s of the task clock");
@@ -635,6 +643,12 @@ int main(int argc, char** argv) {
       throw FlagError("--wide-survey-tilt must be in [0, 90] degrees");
     if (!(opt.config.learn_max_wait_s >= opt.config.learn_timeout_s)) throw FlagError("--learn-max-wait must be >= --learn-timeout");
     if (!(opt.nudge_speed_scale >= 0.01 && opt.nudge_speed_scale <= 1)) throw FlagError("--nudge-speed must lie in [0.01, 1]");
+    if (opt.line_pick != "strongest" && opt.line_pick != "nearest")
+      throw FlagError("--line-pick: strongest or nearest, not '" + opt.line_pick + "'");
+    opt.config.line_search.strongest = opt.line_pick == "strongest";
+    if (opt.config.line_search.lines < 1 || opt.config.line_search.lines > 100) throw FlagError("--still-lines must lie in [1, 100]");
+    if (!(opt.config.line_search.lean_window_deg >= 0 && opt.config.line_search.lean_window_deg <= 90))
+      throw FlagError("--after-line-lean-window must lie in [0, 90] deg");
     if (opt.learn == "on") opt.config.learn = sv::Config::Learn::On;
     else if (opt.learn == "off") opt.config.learn = sv::Config::Learn::Off;
     else if (opt.learn == "auto") opt.config.learn = sv::Config::Learn::Auto;

@@ -2072,6 +2072,89 @@ TEST(LineSearch, TheBandIsTheWholeStillWithoutASpanAndEmptyOffIt) {
   EXPECT_FALSE(sv::find_line_near(cv::Mat(size, CV_8UC3, cv::Scalar::all(100)), off));
 }
 
+// A dark bottle 25 px beside the prediction and, at the prediction, a short faint pair of stripes
+// (an object's edge paired with something behind it): the nearest line is the stripes', the
+// strongest the bottle's.
+TEST(LineSearch, TheStrongestPickTakesTheBottleOverAFaintPairAtThePrediction) {
+  cv::Mat still(960, 1280, CV_8UC3, cv::Scalar(128, 128, 128));
+  cv::rectangle(still, cv::Point(560, 240), cv::Point(670, 540), cv::Scalar(50, 60, 70), cv::FILLED);
+  for (int x : {600, 680}) cv::line(still, cv::Point(x, 590), cv::Point(x, 660), cv::Scalar(170, 170, 170), 3);
+  const nudge::symmetry::Line predicted = sv::line_through({640, 700}, {640, 240}, still.size());  // no span
+  const auto x_at = [&](const nudge::symmetry::Line& line, double row) {
+    const cv::Point2d centre((still.cols - 1) / 2.0, (still.rows - 1) / 2.0);
+    return centre.x + (line.r - (row - centre.y) * std::sin(line.theta)) / std::cos(line.theta);
+  };
+  sv::LineSearchParams params;
+  params.strongest = false;
+  const auto nearest = sv::find_line_near(still, predicted, params);
+  ASSERT_TRUE(nearest);
+  EXPECT_NEAR(x_at(*nearest, 620), 640, 3.0);
+  params.strongest = true;  // the default
+  const auto strongest = sv::find_line_near(still, predicted, params);
+  ASSERT_TRUE(strongest);
+  EXPECT_NEAR(x_at(*strongest, 400), 615, 3.0);
+  EXPECT_GT(strongest->votes, 2 * nearest->votes);
+}
+
+TEST(LineSearch, APredictionTurnedAboutItsFootKeepsTheFootAndTurnsTheAngle) {
+  const cv::Size size(1280, 960);
+  nudge::symmetry::Line upright = sv::line_through({700, 600}, {690, 250}, size);
+  upright.seg1 = {700, 600};
+  upright.seg2 = {690, 250};
+  for (double degrees : {-5.0, 3.0}) {
+    const nudge::symmetry::Line turned = sv::turned_about_foot(upright, degrees * M_PI / 180, size);
+    EXPECT_NEAR(nudge::symmetry::line_difference(turned, upright).theta * 180 / M_PI, degrees, 1e-6);
+    EXPECT_EQ(turned.seg1, upright.seg1);
+    EXPECT_NEAR(cv::norm(turned.seg2 - turned.seg1), cv::norm(upright.seg2 - upright.seg1), 1e-6);
+    EXPECT_NEAR(sv::signed_distance(turned, turned.seg1, size), 0, 1e-6);
+    EXPECT_NEAR(sv::signed_distance(turned, turned.seg2, size), 0, 1e-6);
+  }
+}
+
+// A bottle that leans 5 deg in the before still and in the after one, where a taller upright pair of
+// stripes stands on it at the upright prediction of the rest (as the arm's base column's outline
+// behind a clear bottle): the strongest line about the upright prediction is the stripes', the
+// strongest about the before line's lean carried over is the bottle's.
+TEST(LineSearch, TheMovedObjectsLineKeepsTheLeanItHadBeforeTheNudge) {
+  const cv::Size size(1280, 960);
+  const double lean = 5 * M_PI / 180;
+  const auto leaning_bottle = [&](cv::Mat& still, cv::Point2d foot) {
+    const cv::Point2d up(std::sin(lean), -std::cos(lean)), across(std::cos(lean), std::sin(lean));
+    std::vector<cv::Point> outline;
+    for (const cv::Point2d& corner : {foot - 55 * across, foot + 55 * across, foot + 55 * across + 320 * up, foot - 55 * across + 320 * up})
+      outline.emplace_back(cvRound(corner.x), cvRound(corner.y));
+    cv::fillConvexPoly(still, outline, cv::Scalar(50, 60, 70));
+  };
+  const auto upright_at = [&](cv::Point2d foot) {
+    nudge::symmetry::Line line = sv::line_through(foot, foot + cv::Point2d(0, -320), size);
+    line.seg1 = foot;
+    line.seg2 = foot + cv::Point2d(0, -320);
+    return line;
+  };
+  cv::Mat before(size, CV_8UC3, cv::Scalar(128, 128, 128)), after = before.clone();
+  leaning_bottle(before, {500, 600});
+  leaning_bottle(after, {640, 600});
+  for (int x : {628, 708}) cv::line(after, cv::Point(x, 150), cv::Point(x, 600), cv::Scalar(200, 200, 200), 3);
+  sv::LineSearchParams params;  // the defaults: the strongest line, a lean window of 2 deg
+  const nudge::symmetry::Line predicted_before = upright_at({500, 600}), predicted_after = upright_at({668, 600});
+  const auto before_line = sv::find_line_near(before, predicted_before, params);
+  ASSERT_TRUE(before_line);
+  EXPECT_NEAR(before_line->theta, lean, 1 * M_PI / 180);
+  const auto moved = sv::find_moved_line(after, predicted_after, predicted_before, before_line, params);
+  ASSERT_TRUE(moved);
+  EXPECT_NEAR(moved->theta, lean, 1 * M_PI / 180);
+  EXPECT_NEAR(sv::signed_distance(*moved, {640, 600}, size), 0, 3.0);  // through the bottle's foot
+  // Without the lean, or without a before line: the stripes' upright line.
+  for (const bool knows_before : {true, false}) {
+    params.lean_window_deg = knows_before ? 0 : 2;
+    const auto upright = sv::find_moved_line(after, predicted_after, predicted_before,
+                                             knows_before ? before_line : std::nullopt, params);
+    ASSERT_TRUE(upright);
+    EXPECT_NEAR(upright->theta, 0, 1 * M_PI / 180) << knows_before;
+    EXPECT_NEAR(sv::signed_distance(*upright, {668, 400}, size), 0, 3.0) << knows_before;
+  }
+}
+
 TEST(LineSearch, TakesTheNearestLineWhenNoneReachesTheFoot) {
   const ColumnAndBottle scene(/*with_bottle=*/false);
   const auto found = sv::find_line_near(scene.still, scene.predicted(true), scene.params);

@@ -102,7 +102,7 @@ void Supervisor::segment_left(Attempt& a) const {
   const auto predicted_after = scene_.left_axis_line(*a.rest, config_.object_height_m, config_.still_size);
   if (!predicted_before || !predicted_after) return;
   if (!a.before_line_left) a.before_line_left = find_line_near(a.before_left, *predicted_before, config_.line_search);
-  a.after_line_left = find_line_near(a.after_left, *predicted_after, config_.line_search);
+  a.after_line_left = find_moved_line(a.after_left, *predicted_after, *predicted_before, a.before_line_left, config_.line_search);
   if (!a.before_line_left) a.before_line_left = predicted_before;
   if (!a.after_line_left) a.after_line_left = predicted_after;
   const SegmentFunction& segment = segment_left_ ? segment_left_ : segment_;

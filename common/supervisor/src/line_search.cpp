@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "nudge/supervisor/scene.hpp"
 #include "nudge/symmetry/line.hpp"
 
 namespace nudge::supervisor {
@@ -77,19 +78,47 @@ std::optional<symmetry::Line> find_line_near(const cv::Mat& image, const symmetr
   std::optional<symmetry::Line> best;
   bool best_reaches = false;
   double best_offset = params.window_px;
+  double best_votes = 0;
   for (const symmetry::Line& found : result.lines) {
     const symmetry::Line line = symmetry::line_from_region(found, region, image.size());
     // In the form nearer the prediction: (R, theta) equals (-R, theta +- 180 deg).
     const double offset = std::abs(symmetry::line_difference(line, predicted).r);
     if (offset > params.window_px) continue;
     const bool reaches = reaches_foot(line, predicted, params.foot_slack);
-    if (!best || (reaches && !best_reaches) || (reaches == best_reaches && offset <= best_offset)) {
+    const bool preferred = params.strongest ? line.votes > best_votes : offset <= best_offset;
+    if (!best || (reaches && !best_reaches) || (reaches == best_reaches && preferred)) {
+      best_votes = line.votes;
       best_offset = offset;
       best_reaches = reaches;
       best = line;
     }
   }
   return best;
+}
+
+symmetry::Line turned_about_foot(const symmetry::Line& predicted, double angle, const cv::Size& size) {
+  const cv::Point2d span = predicted.seg2 - predicted.seg1;
+  const double c = std::cos(angle), s = std::sin(angle);
+  // The line's direction (-sin theta, cos theta) turns as its normal (cos theta, sin theta) does.
+  const cv::Point2d direction = cv::norm(span) >= 1 ? span : cv::Point2d(-std::sin(predicted.theta), std::cos(predicted.theta));
+  const cv::Point2d turned(c * direction.x - s * direction.y, s * direction.x + c * direction.y);
+  symmetry::Line line = line_through(predicted.seg1, predicted.seg1 + turned, size);
+  line.seg1 = predicted.seg1;
+  line.seg2 = cv::norm(span) >= 1 ? predicted.seg1 + turned : predicted.seg1;
+  return line;
+}
+
+std::optional<symmetry::Line> find_moved_line(const cv::Mat& after, const symmetry::Line& predicted_after,
+                                              const symmetry::Line& predicted_before,
+                                              const std::optional<symmetry::Line>& before_line,
+                                              const LineSearchParams& params) {
+  if (before_line && params.lean_window_deg > 0) {
+    const double lean = symmetry::line_difference(*before_line, predicted_before).theta;
+    LineSearchParams narrow = params;
+    narrow.window_deg = std::min(params.lean_window_deg, params.window_deg);
+    if (auto line = find_line_near(after, turned_about_foot(predicted_after, lean, after.size()), narrow)) return line;
+  }
+  return find_line_near(after, predicted_after, params);
 }
 
 }  // namespace nudge::supervisor

@@ -536,7 +536,7 @@ void Supervisor::segment(int64_t now) {
   // The object's own lines in the stills; the calibration's prediction where none is detected.
   // (The before still's line was searched for while the arm nudged: see before_lines.)
   if (!a.before_line) a.before_line = find_line_near(a.before, *predicted_before, config_.line_search);
-  a.after_line = find_line_near(a.after, *predicted_after, config_.line_search);
+  a.after_line = find_moved_line(a.after, *predicted_after, *predicted_before, a.before_line, config_.line_search);
   if (!a.before_line) a.before_line = predicted_before;
   if (!a.after_line) a.after_line = predicted_after;
   const bool stages_later = a.learn && segment_stageless_;

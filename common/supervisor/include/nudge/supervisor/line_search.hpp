@@ -1,14 +1,14 @@
 #pragma once
 // A target's symmetry line in a high-resolution still, found near where the calibration predicts it:
-// the detector restricted to a few degrees about the predicted angle, the peak nearest the predicted
-// R taken. The prediction alone is off by the triangulation's error (millimetres = pixels); motion
-// segmentation wants the object's own line.
+// the detector restricted to a few degrees about the predicted angle and a few pixels about the
+// predicted R, the strongest peak there taken. The prediction alone is off by the triangulation's
+// error (millimetres = pixels); motion segmentation wants the object's own line.
 //
 // An object's line stands on the table: the edge pairs that voted for it reach down to its foot.
 // A line in the window whose support ends well above the predicted foot is something standing
 // behind the object or above it (the arm's base column, seen over a bottle that stood in front of
 // it, outvoted the moved bottle's own line in a held-out run): lines that reach the foot are
-// preferred, the nearest of them taken.
+// preferred, the strongest of them taken.
 #include <opencv2/core.hpp>
 
 #include <optional>
@@ -20,7 +20,9 @@ namespace nudge::supervisor {
 struct LineSearchParams {
   double window_deg = 6;     // +- about the predicted angle
   double window_px = 30;     // largest |R - R_predicted| accepted, at the still's resolution
-  int lines = 5;             // peaks examined
+  // Peaks examined. The band about the prediction holds the neighbours' lines too (edge pairs up
+  // to max_pair_width_px wide): in a multi-object scene five peaks were often all theirs.
+  int lines = 10;
   double mirror_tolerance_deg = 15;  // mirror-consistent pairs (docs: clutter and texture)
   // The edge pairs' widths, px at 640x480 (scaled to the still's): the thesis' Dmin and Dmax.
   double min_pair_width_px = 25, max_pair_width_px = 250;
@@ -33,6 +35,14 @@ struct LineSearchParams {
   // found are the same lines (in the whole still's coordinates); the still's other edges are
   // neither detected nor voted with, which was most of the search's time in a 1280x960 still.
   bool crop_to_prediction = true;
+  // Of the lines in the windows (those reaching the foot first when any does), the one with the
+  // most votes rather than the one nearest the prediction. The prediction is off by the
+  // triangulation's error; a faint line (an object's edge paired with the arm's base column
+  // behind it) can lie nearer it than the object's own strong one.
+  bool strongest = true;
+  // find_moved_line: the after still's line is searched first within this many degrees of the
+  // before line's lean carried over to the rest (0: not; the window_deg search alone).
+  double lean_window_deg = 2;
 };
 
 // The part of a `size` image a search for lines near `predicted` needs: the band about the predicted
@@ -42,10 +52,26 @@ struct LineSearchParams {
 cv::Rect search_region(const cv::Size& size, const symmetry::Line& predicted, const LineSearchParams& params = {});
 
 
-// The detected line nearest the prediction within the windows, of those that reach the predicted
-// foot when any does, or nothing. The prediction's seg1 is its foot on the table and seg2 its top
+// The strongest detected line within the windows (the nearest with params.strongest off), of those
+// that reach the predicted foot when any does, or nothing. The prediction's seg1 is its foot on the table and seg2 its top
 // (SceneGeometry::right_axis_line); a prediction without that span (seg1 == seg2) prefers no line.
 std::optional<symmetry::Line> find_line_near(const cv::Mat& image, const symmetry::Line& predicted,
                                              const LineSearchParams& params = {});
+
+// The nudged object's line in the still after the nudge. An object that slid and stayed upright
+// keeps its lean: its line leans from the calibration's prediction at its rest (an upright axis)
+// as much as `before_line` (the object's line found in the before still) leaned from the
+// prediction at its start. Lines within params.lean_window_deg of that are searched for first
+// (find_line_near about the prediction turned by the lean about its foot); then, when none is
+// found or no before line is known, the whole window_deg about `predicted_after` (a push that
+// changed the lean; a tipped object is the settling check's to refuse).
+std::optional<symmetry::Line> find_moved_line(const cv::Mat& after, const symmetry::Line& predicted_after,
+                                              const symmetry::Line& predicted_before,
+                                              const std::optional<symmetry::Line>& before_line,
+                                              const LineSearchParams& params = {});
+
+// `predicted` turned by `angle` (radians, the (R, theta) convention's sense) about its seg1, its
+// span turned with it.
+symmetry::Line turned_about_foot(const symmetry::Line& predicted, double angle, const cv::Size& size);
 
 }  // namespace nudge::supervisor
