@@ -158,6 +158,15 @@ nudge_in_private_network() {
 # (docs/supervisor.md, nudge-exp-survey-line-tilt: 2 and 3 deg keep as many real candidates).
 # A survey that leaves nothing to nudge is asked once more at 5 deg before the run ends
 # (nudge-supervisor --wide-survey-tilt 5): a label can lean a lone bottle's line past 2 deg.
+# The supervisor's survey flags for NUDGE_LOOP_TABLE: nudge_run_loop's, and a replay's of its runs
+# (experiments/nudge_segmentation_replay.sh).
+nudge_loop_survey_flags() {
+  case "${NUDGE_LOOP_TABLE:-plain}" in
+    verified|busy) echo "--survey-lines 8" ;;
+    *) echo "--wide-survey-tilt 5" ;;
+  esac
+}
+
 nudge_run_loop() {
   local bin=$1 scene=$2 calibration=$3 workspace=$4 out=$5 run=$6
   shift 6
@@ -179,7 +188,9 @@ nudge_run_loop() {
   # (nudge-arm --supervisor-timeout; a loaded, shared machine may starve the supervisor that long).
   local arm_watchdog=
   [ -n "${NUDGE_LOOP_ARM_WATCHDOG:-}" ] && arm_watchdog=", \"--supervisor-timeout\", \"$NUDGE_LOOP_ARM_WATCHDOG\""
-  local symmetry_flags='"--lines", "5"' triangulation_flags= survey=() column_mask=${NUDGE_LOOP_COLUMN_MASK:-0}
+  local symmetry_flags='"--lines", "5"' triangulation_flags= column_mask=${NUDGE_LOOP_COLUMN_MASK:-0}
+  local survey
+  read -r -a survey <<<"$(nudge_loop_survey_flags)"
   # The accumulator's suppression: 4 px and 4 deg for "verified", 3 for "busy" (docs/clutter.md, fifth round).
   local suppression=4
   [ "${NUDGE_LOOP_TABLE:-plain}" = busy ] && suppression=3
@@ -189,16 +200,14 @@ nudge_run_loop() {
     verified)
       symmetry_flags=$verified
       triangulation_flags=', "--stereo-check", "--cluster-min-fraction", "0.03"'
-      survey=(--survey-lines 8)
       column_mask=1 ;;
     busy)
       symmetry_flags="$verified"', "--colour-edges", "--blur", "2", "--dmin", "8", "--dmax", "90", "--support-gap", "16"'
       triangulation_flags=', "--stereo-check", "--min-height-overlap", "0.2", "--stereo-appearance", "0.6",
                              "--appearance-waived-at-overlap", "0.85", "--cluster-min-fraction", "0.05"'
-      survey=(--survey-lines 8) ;;
+ ;;
     plain)
       triangulation_flags=', "--candidate-line-tilt", "2"'
-      survey=(--wide-survey-tilt 5)
       if [ "${NUDGE_LOOP_REACH:-1}" = 1 ]; then
         symmetry_flags='"--lines", "20", "--reach-calibration", "'"$calibration"'", "--reach-inner-radius", "0.10", "--reach-keep", "5"'
       fi ;;

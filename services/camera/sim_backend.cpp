@@ -89,14 +89,17 @@ int run_sim_camera(bus::Service& service, const SimOptions& options) {
                                                           snapshot_ids[c]++, kCameraNames[c], options.jpeg_quality));
     pending[c].reset();
   };
-  // Answers the stills whose time the newest state has reached.
-  auto answer_due = [&]() {
+  // Answers the stills whose time the newest drawn state has reached; with a reason (no state for a
+  // while: the world paused or stopped, or the input ended), every waiting still, with the newest
+  // state there is.
+  auto answer = [&](const char* stale_reason) {
     for (int c = 0; c < 2; ++c)
-      if (pending[c] && last_state_utime && *last_state_utime >= *pending[c]) take_still(c, nullptr);
+      if (pending[c] && last_state_utime && (stale_reason || *last_state_utime >= *pending[c])) take_still(c, stale_reason);
   };
   int64_t skipped = 0;
   service.subscriptions().subscribe_timed<sim_state_t>(bus::channel::SIM_STATE, [&](const sim_state_t& state, const std::string&,
                                                                                     int64_t receive_utime) {
+    last_state_wall = wall_utime();  // a state came, drawn or not: the world runs
     // A state that waited in the queue past the lag limit is not drawn: a camera that cannot draw
     // every state shows the newest ones rather than falling further behind (its frame id is used
     // up, so the gap is seen downstream as a missed frame).
@@ -118,8 +121,7 @@ int run_sim_camera(bus::Service& service, const SimOptions& options) {
     previous = poses;
     if (blur) sim::apply_poses(world, poses);  // snapshots show the state itself
     ++frame_id;
-    last_state_wall = wall_utime();
-    answer_due();
+    answer(nullptr);
     if (options.count > 0 && frame_id >= options.count) service.request_stop();
   });
   if (options.snapshots) {
@@ -136,7 +138,7 @@ int run_sim_camera(bus::Service& service, const SimOptions& options) {
             const int64_t due = other_clock ? *last_state_utime : request.utime;
             pending[c] = pending[c] ? std::max(*pending[c], due) : due;
           }
-          answer_due();
+          answer(nullptr);
         });
   }
   // One pair per world state (README; the integration tests count them) unless --max-lag-ms:
@@ -144,17 +146,11 @@ int run_sim_camera(bus::Service& service, const SimOptions& options) {
   // its backlog up to --max-lag-ms late instead of losing states to a short queue
   // (docs/reliability.md, "Soak").
   service.subscriptions().set_stream_queue_capacity(30);
-  // No state for a while (the world paused or stopped, or the input ended): a waiting still shows
-  // the newest state there is.
-  auto answer_stale = [&](const char* why) {
-    for (int c = 0; c < 2; ++c)
-      if (pending[c] && last_state_utime) take_still(c, why);
-  };
   const int code = service.run([&]() -> int {
-    if (wall_utime() - last_state_wall > kNoStateUs) answer_stale("no state at or after the request's time came");
+    if (wall_utime() - last_state_wall > kNoStateUs) answer("no state at or after the request's time came");
     return 20;
   });
-  answer_stale("the camera stopped before a state at or after the request's time came");
+  answer("the camera stopped before a state at or after the request's time came");
   if (skipped > 0) log::info() << skipped << " states not drawn: they waited past --max-lag-ms";
   return code;
 }

@@ -96,7 +96,6 @@ int main(int argc, char** argv) {
     });
 
     std::map<std::string, std::map<int64_t, cv::Mat>> frames;  // camera channel -> utime -> image
-    std::map<std::string, std::set<int64_t>> seen;       // channel -> utimes with lines
     std::map<std::string, std::set<int64_t>> frame_ids;  // channel -> frame ids with lines
     std::map<int64_t, sim_state_t> states;                            // utime -> state (recent ones)
     std::map<std::string, std::map<std::string, TruthStats>> stats;  // channel -> object -> stats
@@ -118,7 +117,6 @@ int main(int argc, char** argv) {
       }
       service.subscriptions().subscribe<symmetry_lines_t>(channel, [&, cam](const symmetry_lines_t& msg,
                                                                            const std::string& ch) {
-        seen[ch].insert(msg.utime);
         frame_ids[ch].insert(msg.frame_id);
         std::ostringstream line;
         line << ch << " frame " << msg.frame_id << ": " << msg.num_edges << " edges, "
@@ -176,7 +174,7 @@ int main(int argc, char** argv) {
     // Done when every channel has lines for every frame, or (with --allow-missing) has the last
     // frame (id expect_frames - 1) and at most allow_missing gaps before it: nothing more will come.
     const auto channel_done = [&](const std::string& c) {
-      const int n = static_cast<int>(seen[c].size());
+      const int n = static_cast<int>(frame_ids[c].size());
       if (n >= expect_frames) return true;
       const bool has_last = !frame_ids[c].empty() && *frame_ids[c].rbegin() >= expect_frames - 1;
       return has_last && n >= expect_frames - allow_missing;
@@ -204,12 +202,12 @@ int main(int argc, char** argv) {
     if (expect_frames > 0) {
       bool enough = true;
       for (const auto& c : list) {
-        log::info() << c << ": lines for " << seen[c].size() << " frames";
+        log::info() << c << ": lines for " << frame_ids[c].size() << " frames";
         std::ostringstream missing;
         for (int64_t id = 0; id < expect_frames; ++id)
           if (!frame_ids[c].count(id)) missing << " " << id;
         if (!missing.str().empty()) log::warn() << c << ": no lines for frame(s)" << missing.str();
-        enough &= static_cast<int>(seen[c].size()) >= expect_frames - allow_missing;
+        enough &= static_cast<int>(frame_ids[c].size()) >= expect_frames - allow_missing;
       }
       return complete || enough ? 0 : 1;
     }

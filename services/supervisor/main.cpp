@@ -581,6 +581,9 @@ void add_flags(Flags& f, Options& o) {
                "the rest (0: only about the upright prediction)");
   f.add_int("still-lines", &o.config.line_search.lines,
             "symmetry peaks examined in a still's search for the object's line (the prediction's windows keep the nearby ones)");
+  f.add_double("column-line-px", &o.config.line_search.not_object_px,
+               "a still's line within this many px (and 1.5 deg) of the arm's base column's projected axis is the column's, "
+               "not the object's (0: no such check)");
   f.add_string("line-pick", &o.line_pick,
                "of the lines near a still's predicted object line: the strongest (most votes) or the nearest");
   f.add_double("min-mask-mirror", &o.config.min_mask_mirror_agreement,
@@ -646,6 +649,8 @@ int main(int argc, char** argv) {
     if (opt.line_pick != "strongest" && opt.line_pick != "nearest")
       throw FlagError("--line-pick: strongest or nearest, not '" + opt.line_pick + "'");
     opt.config.line_search.strongest = opt.line_pick == "strongest";
+    if (!(opt.config.line_search.not_object_px >= 0 && opt.config.line_search.not_object_px < 100))
+      throw FlagError("--column-line-px must lie in [0, 100)");
     if (opt.config.line_search.lines < 1 || opt.config.line_search.lines > 100) throw FlagError("--still-lines must lie in [1, 100]");
     if (!(opt.config.line_search.lean_window_deg >= 0 && opt.config.line_search.lean_window_deg <= 90))
       throw FlagError("--after-line-lean-window must lie in [0, 90] deg");

@@ -2155,6 +2155,32 @@ TEST(LineSearch, TheMovedObjectsLineKeepsTheLeanItHadBeforeTheNudge) {
   }
 }
 
+// A bright column standing from the still's top down to the bottle's foot, 20 px beside a fainter
+// bottle: the column's line is the strongest in the window; given as not an object's, it is passed
+// over, unless the prediction lies on it (the object in line with the column: its line is the one).
+TEST(LineSearch, TheArmBaseColumnsLineIsPassedOverUnlessThePredictionLiesOnIt) {
+  cv::Mat still(960, 1280, CV_8UC3, cv::Scalar(128, 128, 128));
+  cv::rectangle(still, cv::Point(560, 0), cv::Point(720, 560), cv::Scalar(230, 230, 230), cv::FILLED);
+  cv::rectangle(still, cv::Point(575, 300), cv::Point(665, 560), cv::Scalar(150, 150, 150), cv::FILLED);
+  const auto upright_at = [&](double x) {
+    nudge::symmetry::Line line = sv::line_through({x, 560}, {x, 240}, still.size());
+    line.seg1 = {x, 560};
+    line.seg2 = {x, 240};
+    return line;
+  };
+  const nudge::symmetry::Line column = upright_at(640);
+  const sv::LineSearchParams params;
+  const auto strongest = sv::find_line_near(still, upright_at(630), params);
+  ASSERT_TRUE(strongest);
+  EXPECT_NEAR(sv::signed_distance(*strongest, {640, 400}, still.size()), 0, 3.0);  // the column's
+  const auto object = sv::find_line_near(still, upright_at(630), params, {column});
+  ASSERT_TRUE(object);
+  EXPECT_NEAR(sv::signed_distance(*object, {620, 400}, still.size()), 0, 3.0);  // the bottle's
+  const auto in_line = sv::find_line_near(still, upright_at(642), params, {column});
+  ASSERT_TRUE(in_line);
+  EXPECT_NEAR(sv::signed_distance(*in_line, {640, 400}, still.size()), 0, 3.0);
+}
+
 TEST(LineSearch, TakesTheNearestLineWhenNoneReachesTheFoot) {
   const ColumnAndBottle scene(/*with_bottle=*/false);
   const auto found = sv::find_line_near(scene.still, scene.predicted(true), scene.params);

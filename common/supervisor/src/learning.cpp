@@ -62,12 +62,12 @@ void Supervisor::on_left_still(const cv::Mat& still, int64_t utime, int64_t now)
 void Supervisor::before_lines() {
   Attempt& a = *attempt_;
   if (const auto right = scene_.right_axis_line(a.target.position, config_.object_height_m, config_.still_size))
-    a.before_line = find_line_near(a.before, *right, config_.line_search);
+    a.before_line = find_line_near(a.before, *right, config_.line_search, base_column_lines(1));
   if (a.height_limit > 0 && a.before_line)
     a.measured_height = measure_object_height(scene_, a.before, *a.before_line, a.target.position, config_.height);
   if (!a.learn) return;
   if (const auto left = scene_.left_axis_line(a.target.position, config_.object_height_m, config_.still_size))
-    a.before_line_left = find_line_near(a.before_left, *left, config_.line_search);
+    a.before_line_left = find_line_near(a.before_left, *left, config_.line_search, base_column_lines(0));
 }
 
 // Sec. 7.3 before the nudge: a candidate the learner already knows is not learned twice.
@@ -101,8 +101,10 @@ void Supervisor::segment_left(Attempt& a) const {
   const auto predicted_before = scene_.left_axis_line(a.target.position, config_.object_height_m, config_.still_size);
   const auto predicted_after = scene_.left_axis_line(*a.rest, config_.object_height_m, config_.still_size);
   if (!predicted_before || !predicted_after) return;
-  if (!a.before_line_left) a.before_line_left = find_line_near(a.before_left, *predicted_before, config_.line_search);
-  a.after_line_left = find_moved_line(a.after_left, *predicted_after, *predicted_before, a.before_line_left, config_.line_search);
+  const std::vector<symmetry::Line> column = base_column_lines(0);
+  if (!a.before_line_left) a.before_line_left = find_line_near(a.before_left, *predicted_before, config_.line_search, column);
+  a.after_line_left =
+      find_moved_line(a.after_left, *predicted_after, *predicted_before, a.before_line_left, config_.line_search, column);
   if (!a.before_line_left) a.before_line_left = predicted_before;
   if (!a.after_line_left) a.after_line_left = predicted_after;
   const SegmentFunction& segment = segment_left_ ? segment_left_ : segment_;

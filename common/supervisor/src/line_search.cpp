@@ -53,7 +53,8 @@ cv::Rect search_region(const cv::Size& size, const symmetry::Line& predicted, co
 }
 
 std::optional<symmetry::Line> find_line_near(const cv::Mat& image, const symmetry::Line& predicted,
-                                             const LineSearchParams& params) {
+                                             const LineSearchParams& params,
+                                             const std::vector<symmetry::Line>& not_objects) {
   if (image.empty()) return std::nullopt;
   const double scale = image.cols / 640.0;  // the detector's thesis distances are for 640x480
   symmetry::Params p;
@@ -75,6 +76,12 @@ std::optional<symmetry::Line> find_line_near(const cv::Mat& image, const symmetr
                                                     : cv::Rect(0, 0, image.cols, image.rows);
   if (region.width < 2 || region.height < 2) return std::nullopt;  // the predicted axis lies outside the still
   const symmetry::Result result = detector.detect(image(region));
+  // A not-an-object line the prediction itself lies on is not avoided: the object stands in line
+  // with it in the image (its line and the column's are one), and the one line is the object's.
+  const double not_object_angle = params.not_object_deg * M_PI / 180;
+  std::vector<symmetry::Line> avoided;
+  for (const symmetry::Line& other : not_objects)
+    if (!lines_agree(predicted, other, not_object_angle, params.not_object_px)) avoided.push_back(other);
   std::optional<symmetry::Line> best;
   bool best_reaches = false;
   double best_offset = params.window_px;
@@ -84,6 +91,10 @@ std::optional<symmetry::Line> find_line_near(const cv::Mat& image, const symmetr
     // In the form nearer the prediction: (R, theta) equals (-R, theta +- 180 deg).
     const double offset = std::abs(symmetry::line_difference(line, predicted).r);
     if (offset > params.window_px) continue;
+    if (std::any_of(avoided.begin(), avoided.end(), [&](const symmetry::Line& other) {
+          return lines_agree(line, other, not_object_angle, params.not_object_px);
+        }))
+      continue;
     const bool reaches = reaches_foot(line, predicted, params.foot_slack);
     const bool preferred = params.strongest ? line.votes > best_votes : offset <= best_offset;
     if (!best || (reaches && !best_reaches) || (reaches == best_reaches && preferred)) {
@@ -111,14 +122,16 @@ symmetry::Line turned_about_foot(const symmetry::Line& predicted, double angle, 
 std::optional<symmetry::Line> find_moved_line(const cv::Mat& after, const symmetry::Line& predicted_after,
                                               const symmetry::Line& predicted_before,
                                               const std::optional<symmetry::Line>& before_line,
-                                              const LineSearchParams& params) {
+                                              const LineSearchParams& params,
+                                              const std::vector<symmetry::Line>& not_objects) {
   if (before_line && params.lean_window_deg > 0) {
     const double lean = symmetry::line_difference(*before_line, predicted_before).theta;
     LineSearchParams narrow = params;
     narrow.window_deg = std::min(params.lean_window_deg, params.window_deg);
-    if (auto line = find_line_near(after, turned_about_foot(predicted_after, lean, after.size()), narrow)) return line;
+    if (auto line = find_line_near(after, turned_about_foot(predicted_after, lean, after.size()), narrow, not_objects))
+      return line;
   }
-  return find_line_near(after, predicted_after, params);
+  return find_line_near(after, predicted_after, params, not_objects);
 }
 
 }  // namespace nudge::supervisor

@@ -237,6 +237,14 @@ std::vector<Candidate> Supervisor::drop_hidden_behind_arm_base(std::vector<Rejec
   return visible;
 }
 
+std::vector<symmetry::Line> Supervisor::base_column_lines(int camera) const {
+  if (config_.line_search.not_object_px <= 0) return {};
+  const Eigen::Vector3d base = Eigen::Vector3d::Zero();
+  const auto line = camera == 0 ? scene_.left_axis_line(base, config_.object_height_m, config_.still_size)
+                                : scene_.right_axis_line(base, config_.object_height_m, config_.still_size);
+  return line ? std::vector<symmetry::Line>{*line} : std::vector<symmetry::Line>{};
+}
+
 // The places already explored, and this survey's candidates that are a rested object seen at
 // another depth: the object nudged before is remembered by where it now stands.
 std::vector<Eigen::Vector3d> Supervisor::explored_with_ray_mates() const {
@@ -535,8 +543,9 @@ void Supervisor::segment(int64_t now) {
   if (a.learn) left = std::async(segment_left_ ? std::launch::async : std::launch::deferred, [this, &a] { segment_left(a); });
   // The object's own lines in the stills; the calibration's prediction where none is detected.
   // (The before still's line was searched for while the arm nudged: see before_lines.)
-  if (!a.before_line) a.before_line = find_line_near(a.before, *predicted_before, config_.line_search);
-  a.after_line = find_moved_line(a.after, *predicted_after, *predicted_before, a.before_line, config_.line_search);
+  const std::vector<symmetry::Line> column = base_column_lines(1);
+  if (!a.before_line) a.before_line = find_line_near(a.before, *predicted_before, config_.line_search, column);
+  a.after_line = find_moved_line(a.after, *predicted_after, *predicted_before, a.before_line, config_.line_search, column);
   if (!a.before_line) a.before_line = predicted_before;
   if (!a.after_line) a.after_line = predicted_after;
   const bool stages_later = a.learn && segment_stageless_;

@@ -12,6 +12,7 @@
 #include <opencv2/core.hpp>
 
 #include <optional>
+#include <vector>
 
 #include "nudge/symmetry/detector.hpp"
 
@@ -43,6 +44,11 @@ struct LineSearchParams {
   // find_moved_line: the after still's line is searched first within this many degrees of the
   // before line's lean carried over to the rest (0: not; the window_deg search alone).
   double lean_window_deg = 2;
+  // A found line within this many px (at the still's resolution) and degrees of one of the
+  // not-an-object lines given to the search (the arm's base column's axis, projected) is that
+  // thing's, not the object's: an object standing in front of the column in the image shows the
+  // column's line beside its own, often stronger and reaching down to the object's foot.
+  double not_object_px = 8, not_object_deg = 1.5;
 };
 
 // The part of a `size` image a search for lines near `predicted` needs: the band about the predicted
@@ -55,8 +61,11 @@ cv::Rect search_region(const cv::Size& size, const symmetry::Line& predicted, co
 // The strongest detected line within the windows (the nearest with params.strongest off), of those
 // that reach the predicted foot when any does, or nothing. The prediction's seg1 is its foot on the table and seg2 its top
 // (SceneGeometry::right_axis_line); a prediction without that span (seg1 == seg2) prefers no line.
+// Lines agreeing with one of `not_objects` (params.not_object_px, not_object_deg) are passed over,
+// unless the prediction agrees with it too (the object in line with it).
 std::optional<symmetry::Line> find_line_near(const cv::Mat& image, const symmetry::Line& predicted,
-                                             const LineSearchParams& params = {});
+                                             const LineSearchParams& params = {},
+                                             const std::vector<symmetry::Line>& not_objects = {});
 
 // The nudged object's line in the still after the nudge. An object that slid and stayed upright
 // keeps its lean: its line leans from the calibration's prediction at its rest (an upright axis)
@@ -68,7 +77,8 @@ std::optional<symmetry::Line> find_line_near(const cv::Mat& image, const symmetr
 std::optional<symmetry::Line> find_moved_line(const cv::Mat& after, const symmetry::Line& predicted_after,
                                               const symmetry::Line& predicted_before,
                                               const std::optional<symmetry::Line>& before_line,
-                                              const LineSearchParams& params = {});
+                                              const LineSearchParams& params = {},
+                                              const std::vector<symmetry::Line>& not_objects = {});
 
 // `predicted` turned by `angle` (radians, the (R, theta) convention's sense) about its seg1, its
 // span turned with it.

@@ -428,6 +428,9 @@ class Supervisor {
   // upright axis at `foot` passes through the mask (within 2 px): 1 on the object, 0 beside it.
   double share_of_mask_rows_on_line(const Eigen::Vector3d& foot, const Rested& object) const;
   std::vector<Candidate> drop_hidden_behind_arm_base(std::vector<Rejection>& rejected) const;
+  // The arm's base column's axis in a still of the right (camera 1) or left (0) camera: a line the
+  // still line searches pass over (LineSearchParams::not_object_px).
+  std::vector<symmetry::Line> base_column_lines(int camera) const;
   Eigen::Vector2d viewing_ray(const Eigen::Vector3d& at) const;
   std::vector<Axis> settled_axes_;
   bool rest_found_ = false;  // settled_axes_ hold a rest group of at least min_axes
