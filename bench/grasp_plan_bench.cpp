@@ -80,7 +80,8 @@ void BM_GraspPlanAfterNudge(benchmark::State& state) {
     auto camera_top = [&](int c) {
       const Camera& cam = cameras[c];
       auto line_before = before_lines[c];
-      auto line_after = sv::find_line_near(cam.after, *cam.predicted_after, search);
+      // As the supervisor: first at the before line's lean (find_moved_line).
+      auto line_after = sv::find_moved_line(cam.after, *cam.predicted_after, *cam.predicted_before, line_before, search);
       if (!line_before) line_before = cam.predicted_before;
       if (!line_after) line_after = cam.predicted_after;
       const sv::Segmentation s = (c == 0 ? segment_left : segment)(cam.before, cam.after, *line_before, *line_after);
