@@ -204,8 +204,7 @@ nudge_run_loop() {
     busy)
       symmetry_flags="$verified"', "--colour-edges", "--blur", "2", "--dmin", "8", "--dmax", "90", "--support-gap", "16"'
       triangulation_flags=', "--stereo-check", "--min-height-overlap", "0.2", "--stereo-appearance", "0.6",
-                             "--appearance-waived-at-overlap", "0.85", "--cluster-min-fraction", "0.05"'
- ;;
+                             "--appearance-waived-at-overlap", "0.85", "--cluster-min-fraction", "0.05"' ;;
     plain)
       triangulation_flags=', "--candidate-line-tilt", "2"'
       if [ "${NUDGE_LOOP_REACH:-1}" = 1 ]; then

@@ -109,13 +109,14 @@ std::optional<symmetry::Line> find_line_near(const cv::Mat& image, const symmetr
 
 symmetry::Line turned_about_foot(const symmetry::Line& predicted, double angle, const cv::Size& size) {
   const cv::Point2d span = predicted.seg2 - predicted.seg1;
+  const bool has_span = cv::norm(span) >= 1;
   const double c = std::cos(angle), s = std::sin(angle);
   // The line's direction (-sin theta, cos theta) turns as its normal (cos theta, sin theta) does.
-  const cv::Point2d direction = cv::norm(span) >= 1 ? span : cv::Point2d(-std::sin(predicted.theta), std::cos(predicted.theta));
+  const cv::Point2d direction = has_span ? span : cv::Point2d(-std::sin(predicted.theta), std::cos(predicted.theta));
   const cv::Point2d turned(c * direction.x - s * direction.y, s * direction.x + c * direction.y);
   symmetry::Line line = line_through(predicted.seg1, predicted.seg1 + turned, size);
   line.seg1 = predicted.seg1;
-  line.seg2 = cv::norm(span) >= 1 ? predicted.seg1 + turned : predicted.seg1;
+  line.seg2 = has_span ? predicted.seg1 + turned : predicted.seg1;
   return line;
 }
 

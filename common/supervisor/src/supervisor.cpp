@@ -221,11 +221,8 @@ std::vector<Candidate> Supervisor::drop_hidden_behind_arm_base(std::vector<Rejec
   for (const Candidate& c : candidates_) {
     bool hidden = false;
     for (int camera = 0; camera < 2 && !hidden; ++camera) {
-      const auto line = [&](const Eigen::Vector3d& foot) {
-        return camera == 0 ? scene_.left_axis_line(foot, config_.object_height_m, config_.frame_size)
-                           : scene_.right_axis_line(foot, config_.object_height_m, config_.frame_size);
-      };
-      const auto of_base = line(base), of_candidate = line(c.position);
+      const auto of_base = axis_line_in(camera, base, config_.frame_size);
+      const auto of_candidate = axis_line_in(camera, c.position, config_.frame_size);
       const bool farther = (c.position - cameras[camera]).head<2>().norm() > (base - cameras[camera]).head<2>().norm();
       hidden = farther && of_base && of_candidate && lines_agree(*of_candidate, *of_base, max_angle, config_.agreement_offset_px);
     }
@@ -237,11 +234,14 @@ std::vector<Candidate> Supervisor::drop_hidden_behind_arm_base(std::vector<Rejec
   return visible;
 }
 
+std::optional<symmetry::Line> Supervisor::axis_line_in(int camera, const Eigen::Vector3d& foot, cv::Size size) const {
+  return camera == 0 ? scene_.left_axis_line(foot, config_.object_height_m, size)
+                     : scene_.right_axis_line(foot, config_.object_height_m, size);
+}
+
 std::vector<symmetry::Line> Supervisor::base_column_lines(int camera) const {
   if (config_.line_search.not_object_px <= 0) return {};
-  const Eigen::Vector3d base = Eigen::Vector3d::Zero();
-  const auto line = camera == 0 ? scene_.left_axis_line(base, config_.object_height_m, config_.still_size)
-                                : scene_.right_axis_line(base, config_.object_height_m, config_.still_size);
+  const auto line = axis_line_in(camera, Eigen::Vector3d::Zero(), config_.still_size);  // the base at the world origin
   return line ? std::vector<symmetry::Line>{*line} : std::vector<symmetry::Line>{};
 }
 

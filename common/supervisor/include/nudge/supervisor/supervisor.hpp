@@ -431,6 +431,8 @@ class Supervisor {
   // The arm's base column's axis in a still of the right (camera 1) or left (0) camera: a line the
   // still line searches pass over (LineSearchParams::not_object_px).
   std::vector<symmetry::Line> base_column_lines(int camera) const;
+  // An upright axis at `foot` (object_height_m tall) in an image of the right (1) or left (0) camera.
+  std::optional<symmetry::Line> axis_line_in(int camera, const Eigen::Vector3d& foot, cv::Size size) const;
   Eigen::Vector2d viewing_ray(const Eigen::Vector3d& at) const;
   std::vector<Axis> settled_axes_;
   bool rest_found_ = false;  // settled_axes_ hold a rest group of at least min_axes
