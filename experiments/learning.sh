@@ -42,7 +42,7 @@ if [ $runs = 1 ]; then
   # One database for all seven, started empty: what a run learns, the next ones know.
   rm -rf "${runs_dir:?}"
   mkdir -p "$runs_dir/objects"
-  export -f nudge_run_loop
+  nudge_export_loop
   # The loop is real-time (heartbeats every second, 1.5-3 s watchdogs), and a shared 2-core machine
   # at load 20 starves it: services fall silent, the arm stops, attempts abort (docs/learning.md).
   # What this experiment measures is learning and recognition, so: not under nice; the world at half

@@ -32,7 +32,7 @@ calibration="$NUDGE_ROOT/config/calibration_sim.yaml"
 declare -A scene_dirs=([heldout]="$NUDGE_ROOT/experiments/scenes/nudge_segmentation_heldout"
                        [heldout2]="$NUDGE_ROOT/experiments/scenes/nudge_segmentation_heldout2"
                        [development]="$NUDGE_ROOT/experiments/scenes/nudge_segmentation")
-export -f nudge_run_loop
+nudge_export_loop
 
 # run_set SET [SCENE_NAME...]: every scene of the set (or the ones named) into OUT/SET/.
 run_set() {

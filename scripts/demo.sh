@@ -98,7 +98,7 @@ export -f run_images_pipeline run_sim_pipeline
 if [ $# -eq 0 ]; then
   scene=${NUDGE_DEMO_SCENE:-$NUDGE_ROOT/common/sim/scenes/arm_three_objects.yaml}
   run="run-$(date +%Y%m%d-%H%M%S)"
-  export -f nudge_run_loop
+  nudge_export_loop
   export NUDGE_LOOP_LEARN=${NUDGE_DEMO_LEARN:-1}
   nudge_log "autonomous segmentation of $(basename "$scene"): world, camera, symmetry, triangulation, arm, learner and supervisor over LCM; run $run"
   status=0

@@ -167,6 +167,13 @@ nudge_loop_survey_flags() {
   esac
 }
 
+# nudge_run_loop runs in a child shell (nudge_in_private_network bash -c ...): it and every
+# function it calls must be exported into it. Call this, not `export -f nudge_run_loop` (a helper
+# left out is "command not found" in the child, and the loop ran without its survey flags).
+nudge_export_loop() {
+  export -f nudge_run_loop nudge_loop_survey_flags
+}
+
 nudge_run_loop() {
   local bin=$1 scene=$2 calibration=$3 workspace=$4 out=$5 run=$6
   shift 6
@@ -189,8 +196,9 @@ nudge_run_loop() {
   local arm_watchdog=
   [ -n "${NUDGE_LOOP_ARM_WATCHDOG:-}" ] && arm_watchdog=", \"--supervisor-timeout\", \"$NUDGE_LOOP_ARM_WATCHDOG\""
   local symmetry_flags='"--lines", "5"' triangulation_flags= column_mask=${NUDGE_LOOP_COLUMN_MASK:-0}
-  local survey
-  read -r -a survey <<<"$(nudge_loop_survey_flags)"
+  local survey survey_text
+  survey_text=$(nudge_loop_survey_flags) || { echo "nudge_run_loop: no survey flags (a helper of lib.sh not exported to this shell?)" >&2; return 2; }
+  read -r -a survey <<<"$survey_text"
   # The accumulator's suppression: 4 px and 4 deg for "verified", 3 for "busy" (docs/clutter.md, fifth round).
   local suppression=4
   [ "${NUDGE_LOOP_TABLE:-plain}" = busy ] && suppression=3
