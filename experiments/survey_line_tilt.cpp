@@ -3,8 +3,10 @@
 // replayed through nudge-triangulation at each tilt, with the run's own SYMMETRY lines and
 // CANDIDATES_REQUESTs, and every candidate of every survey is scored against the simulator's
 // SIM_STATE of that moment: within --real-radius of an object it is that object (real), else a
-// phantom. Writes docs/results/NAME.{json,md} (default survey_line_tilt).
-//   nudge-exp-survey-line-tilt RUNS_DIR [RUNS_DIR...] [--tilts 1,2,3] [--real-radius 0.03] [--name STEM]
+// phantom. With --lines, each CANDIDATES_REQUEST is also replayed asking for that many lines per
+// image (the supervisor's --survey-lines) instead of the recorded number. Writes
+// docs/results/NAME.{json,md} (default survey_line_tilt).
+//   nudge-exp-survey-line-tilt RUNS_DIR [RUNS_DIR...] [--tilts 1,2,3] [--lines 3,5] [--real-radius 0.03] [--name STEM]
 // Later surveys follow what the recorded run did (its pushes, its explored places): a replay
 // scores the lines each tilt keeps, not a new run. Choose on development runs only.
 #include <unistd.h>
@@ -21,6 +23,7 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "nudge/candidates_request_t.hpp"
 #include "nudge/candidates_t.hpp"
 #include "nudge/json.hpp"
 #include "nudge/progress.hpp"
@@ -39,14 +42,27 @@ struct Score {
   int objects = 0;
 };
 
-std::vector<double> parse_list(const std::string& text) {
+// One replayed setting: the survey-line tilt and the lines per image (0: as the log's requests ask).
+struct Variant {
+  double tilt = 0;
+  int lines = 0;
+  bool operator<(const Variant& o) const { return lines != o.lines ? lines < o.lines : tilt < o.tilt; }
+  std::string name() const {
+    std::ostringstream text;
+    text << tilt << "°";
+    if (lines) text << " " << lines << " lines";
+    return text.str();
+  }
+};
+
+std::vector<double> parse_list(const std::string& text, const std::string& flag) {
   std::vector<double> values;
   std::stringstream in(text);
   std::string item;
   while (std::getline(in, item, ',')) {
     char* end = nullptr;
     const double v = std::strtod(item.c_str(), &end);
-    if (item.empty() || *end != '\0' || !(v > 0)) throw std::invalid_argument("--tilts: not a positive number: '" + item + "'");
+    if (item.empty() || *end != '\0' || !(v > 0)) throw std::invalid_argument(flag + ": not a positive number: '" + item + "'");
     values.push_back(v);
   }
   return values;
@@ -64,6 +80,27 @@ std::vector<Message> read_channel(const fs::path& log_path, const std::string& c
     if (m.decode(e->data, 0, e->datalen) >= 0) messages.push_back(std::move(m));
   }
   return messages;
+}
+
+// A copy of the log whose CANDIDATES_REQUESTs ask for `lines` lines per image: the recorded surveys
+// replayed as if the supervisor had run with --survey-lines `lines`.
+void write_with_survey_lines(const fs::path& from, const fs::path& to, int lines) {
+  lcm::LogFile in(from.string(), "r");
+  lcm::LogFile out(to.string(), "w");
+  if (!in.good() || !out.good()) throw std::runtime_error("cannot copy " + from.string() + " to " + to.string());
+  std::vector<uint8_t> buffer;
+  for (const lcm::LogEvent* e = in.readNextEvent(); e; e = in.readNextEvent()) {
+    lcm::LogEvent copy = *e;
+    nudge::candidates_request_t request;
+    if (e->channel == "CANDIDATES_REQUEST" && request.decode(e->data, 0, e->datalen) >= 0) {
+      request.lines_per_image = lines;
+      buffer.resize(request.getEncodedSize());
+      request.encode(buffer.data(), 0, static_cast<int>(buffer.size()));
+      copy.data = buffer.data();
+      copy.datalen = static_cast<int32_t>(buffer.size());
+    }
+    if (out.writeEvent(&copy) != 0) throw std::runtime_error("cannot write " + to.string());
+  }
 }
 
 // The latest state at or before `utime` (states are in log order, utime rising).
@@ -119,19 +156,22 @@ std::string shell_quote(const std::string& s) {
 int main(int argc, char** argv) try {
   std::vector<std::string> run_sets;
   std::vector<double> tilts{1, 1.5, 2, 3, 4, 5, 7};
+  std::vector<int> survey_lines;  // empty: as recorded
   double real_radius = 0.03;
   std::string name = "survey_line_tilt";
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     const bool has_value = i + 1 < argc;
-    if (arg == "--tilts" && has_value) tilts = parse_list(argv[++i]);
+    if (arg == "--tilts" && has_value) tilts = parse_list(argv[++i], arg);
+    else if (arg == "--lines" && has_value)
+      for (double n : parse_list(argv[++i], arg)) survey_lines.push_back(static_cast<int>(n));
     else if (arg == "--real-radius" && has_value) real_radius = std::stod(argv[++i]);
     else if (arg == "--name" && has_value) name = argv[++i];
     else if (!arg.empty() && arg[0] == '-') throw std::invalid_argument("unknown option " + arg);
     else run_sets.push_back(arg);
   }
   if (run_sets.empty()) {
-    std::cerr << "usage: nudge-exp-survey-line-tilt RUNS_DIR [RUNS_DIR...] [--tilts 1,2,3] [--real-radius 0.03] [--name STEM]\n";
+    std::cerr << "usage: nudge-exp-survey-line-tilt RUNS_DIR [RUNS_DIR...] [--tilts 1,2,3] [--lines 3,5] [--real-radius 0.03] [--name STEM]\n";
     return 2;
   }
   const fs::path source = NUDGE_SOURCE_DIR;
@@ -140,6 +180,11 @@ int main(int argc, char** argv) try {
   const SceneGeometry scene = SceneGeometry::load(calibration);
   const std::string triangulation = (own_directory() / "nudge-triangulation").string();
   const fs::path replay = fs::temp_directory_path() / ("survey_line_tilt_" + std::to_string(getpid()) + ".lcmlog");
+  const fs::path rewritten = fs::temp_directory_path() / ("survey_line_tilt_in_" + std::to_string(getpid()) + ".lcmlog");
+  // The variants replayed: every tilt at every lines-per-image (0: the recorded requests').
+  std::vector<Variant> variants;
+  for (int lines : survey_lines.empty() ? std::vector<int>{0} : survey_lines)
+    for (double tilt : tilts) variants.push_back({tilt, lines});
 
   // Each run is named by its set's number (the RUNS_DIRs in order) and its scene.
   std::vector<std::pair<std::string, fs::path>> logs;
@@ -155,59 +200,65 @@ int main(int argc, char** argv) try {
   }
   if (logs.empty()) throw std::runtime_error("no run logs under the RUNS_DIRs given");
 
-  // tilt -> run -> score
-  std::map<double, std::map<std::string, Score>> scores;
+  // variant -> run -> score
+  std::map<Variant, std::map<std::string, Score>> scores;
   nudge::Progress progress("nudge-exp-survey-line-tilt", static_cast<int>(logs.size()));
   for (const auto& [run, log] : logs) {
     progress.step(run);
     const auto states = read_channel<nudge::sim_state_t>(log, "SIM_STATE");
     if (states.empty()) throw std::runtime_error(log.string() + ": no SIM_STATE (a simulated run's log is needed)");
     std::string line = run + ":";
-    for (double tilt : tilts) {
-      const std::string command = shell_quote(triangulation) + " --lcm-in " + shell_quote("file://" + log.string() + "?speed=0") +
+    int rewritten_lines = 0;
+    for (const Variant& variant : variants) {
+      if (variant.lines != rewritten_lines) write_with_survey_lines(log, rewritten, variant.lines), rewritten_lines = variant.lines;
+      const fs::path& input = variant.lines ? rewritten : log;
+      const std::string command = shell_quote(triangulation) + " --lcm-in " + shell_quote("file://" + input.string() + "?speed=0") +
                                   " --lcm-out " + shell_quote("file://" + replay.string() + "?mode=w") + " --calibration " +
                                   shell_quote(calibration) + " --workspace " + shell_quote(workspace) +
-                                  " --candidate-line-tilt " + std::to_string(tilt) + " >/dev/null 2>&1";
+                                  " --candidate-line-tilt " + std::to_string(variant.tilt) + " >/dev/null 2>&1";
       if (std::system(command.c_str()) != 0) throw std::runtime_error("nudge-triangulation failed on " + log.string());
-      Score& s = scores[tilt][run];
+      Score& s = scores[variant][run];
       s.objects = static_cast<int>(states.front().objects.size());
       score_surveys(read_channel<nudge::candidates_t>(replay, "CANDIDATES"), states, scene, real_radius, &s);
-      line += " " + std::to_string(tilt).substr(0, 4) + " deg: " + std::to_string(s.real) + "/" + std::to_string(s.phantom);
+      line += " " + variant.name() + ": " + std::to_string(s.real) + "/" + std::to_string(s.phantom);
     }
     progress.note(line);
   }
-  progress.finish(std::to_string(logs.size()) + " runs replayed at " + std::to_string(tilts.size()) + " tilts");
+  progress.finish(std::to_string(logs.size()) + " runs replayed at " + std::to_string(variants.size()) + " settings");
   fs::remove(replay);
+  fs::remove(rewritten);
 
   nudge::JsonWriter json(4);
   json.begin_object().field("machine", nudge::experiments::machine_description()).field("date", nudge::experiments::today());
-  json.field("runs", static_cast<int>(logs.size())).field("real_radius_m", real_radius).key("tilts").begin_array();
+  json.field("runs", static_cast<int>(logs.size())).field("real_radius_m", real_radius).key("variants").begin_array();
   std::ostringstream md;
-  md << "# Survey-line tilt: candidates kept at each `--candidate-line-tilt`\n\n"
+  md << "# Survey lines: candidates kept at each `--candidate-line-tilt` and lines per image\n\n"
      << "`nudge-exp-survey-line-tilt` replayed each recorded run's log through `nudge-triangulation` at each tilt "
-        "(the run's own SYMMETRY lines and CANDIDATES_REQUESTs) and scored every survey's candidates against the "
+        "and number of lines per image (the run's own SYMMETRY lines and CANDIDATES_REQUESTs; `as recorded`: the "
+        "requests' own lines per image, else each request rewritten to ask for that many) and scored every survey's candidates against the "
         "simulator's state: within " << real_radius * 1000 << " mm of an object it is real, else a phantom. Later "
         "surveys follow what the recorded run did. Runs: ";
   for (size_t i = 0; i < run_sets.size(); ++i) md << (i ? ", " : "") << i + 1 << ": `" << run_sets[i] << "`";
   md << " (" << logs.size() << " runs). " << nudge::experiments::machine_description() << ", "
      << nudge::experiments::today() << ".\n\n"
-     << "| tilt (deg) | real candidates | phantoms | objects ever a candidate |\n|---|---|---|---|\n";
-  for (const auto& [tilt, runs] : scores) {
+     << "| tilt (deg) | lines per image | real candidates | phantoms | objects ever a candidate |\n|---|---|---|---|---|\n";
+  for (const auto& [variant, runs] : scores) {
     int real = 0, phantom = 0, found = 0, objects = 0;
     for (const auto& [run, s] : runs) real += s.real, phantom += s.phantom, found += static_cast<int>(s.objects_found.size()), objects += s.objects;
-    md << "| " << tilt << " | " << real << " | " << phantom << " | " << found << "/" << objects << " |\n";
-    json.begin_object().field("tilt_deg", tilt).field("real", real).field("phantoms", phantom);
+    md << "| " << variant.tilt << " | " << (variant.lines ? std::to_string(variant.lines) : "as recorded") << " | " << real
+       << " | " << phantom << " | " << found << "/" << objects << " |\n";
+    json.begin_object().field("tilt_deg", variant.tilt).field("lines_per_image", variant.lines).field("real", real).field("phantoms", phantom);
     json.field("objects_found", found).field("objects", objects).end_object();
   }
   json.end_array().end_object();
   md << "\nPer run (set:scene; real/phantoms, and objects ever a candidate):\n\n| run |";
-  for (const auto& [tilt, runs] : scores) md << " " << tilt << "° |";
+  for (const auto& [variant, runs] : scores) md << " " << variant.name() << " |";
   md << "\n|---|";
   for (size_t i = 0; i < scores.size(); ++i) md << "---|";
   md << "\n";
   for (const auto& [run, log] : logs) {
     md << "| " << run << " |";
-    for (auto& [tilt, runs] : scores) {
+    for (auto& [variant, runs] : scores) {
       const Score& s = runs[run];
       md << " " << s.real << "/" << s.phantom << " (" << s.objects_found.size() << "/" << s.objects << ") |";
     }
