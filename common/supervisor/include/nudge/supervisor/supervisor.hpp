@@ -113,6 +113,14 @@ struct Config {
   // shows no upright axis at all.
   double upright_max_tilt_deg = 15;
   double min_displacement_m = 0.004; // a smaller slide gives no difference to segment
+  // An after line where the before line stood while the rest moved less than
+  // standing_line_max_travel_m along the push, and lies off the push line in depth (beyond
+  // max_lateral_m: the settled axes a stereo mismatch), is something that stood still (a line in
+  // line with the object): the object's line is then looked for push_travel_m along the push from
+  // where it stood, the standing line passed over (Supervisor::line_along_the_push). 0: no such
+  // search.
+  double standing_line_max_travel_m = 0.01;
+  double push_travel_m = 0.025;
   double object_height_m = 0.25;     // the tallest expected object (lines drawn up to it)
   int min_mask_pixels = 200;         // a smaller mask (in the still) is no object
   // Nor is a mask smaller than this share of the still's image of the smallest object expected
@@ -462,6 +470,8 @@ class Supervisor {
     int near = 0;
   };
   RestGroup rest_group() const;
+  std::optional<symmetry::Line> line_along_the_push(const Attempt& a, const symmetry::Line& predicted_before,
+                                                    const std::vector<symmetry::Line>& column) const;
   bool settling_longer(int64_t now) const;
   // ---- learning ----
   bool learning_enabled() const;
