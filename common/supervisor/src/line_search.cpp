@@ -125,6 +125,9 @@ std::optional<symmetry::Line> find_moved_line(const cv::Mat& after, const symmet
                                               const std::optional<symmetry::Line>& before_line,
                                               const LineSearchParams& params,
                                               const std::vector<symmetry::Line>& not_objects) {
+  // Two detections, not one over +-window_deg filtered twice: the narrow one's `lines` peaks all
+  // lie within +-lean_window_deg, where the wide one's strongest could all lie outside it (a
+  // neighbour's lines, a label's stripes), leaving the object's line unexamined.
   if (before_line && params.lean_window_deg > 0) {
     const double lean = symmetry::line_difference(*before_line, predicted_before).theta;
     LineSearchParams narrow = params;
