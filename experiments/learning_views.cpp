@@ -266,9 +266,13 @@ int run(const Options& o) {
       sim::World world(scene);
       auto merged = std::make_shared<learning::ObjectModel>();
       merged->info.name = bottles[b].name;
+      const std::vector<learning::TrainingImage> upright = turntable_views(scene, 0);  // rendered once, painted per depth
       for (double depth : depths) {
-        std::vector<learning::TrainingImage> views = turntable_views(scene, 0);
-        for (auto& view : views) paint_finger_band(world, scene, depth, &view);
+        std::vector<learning::TrainingImage> views = upright;
+        for (auto& view : views) {
+          view.image = view.image.clone();
+          paint_finger_band(world, scene, depth, &view);
+        }
         learning::ObjectInfo info;
         info.name = bottles[b].name;
         // Pruned per grasp: the background rule compares a view with its own turn's neighbours.
