@@ -63,6 +63,7 @@ struct Options {
   double nudge_speed_scale = 0.25;
   bool keep_running = false;
   std::string line_pick = "strongest";  // strongest, nearest (LineSearchParams::strongest)
+  int rest_from_still = 1;               // Config::rest_from_still
   std::string learn = "auto";      // on, off, auto (while the learner's heartbeat is heard)
   std::string learner = "learner"; // the learner service's heartbeat name
   sv::Config config;
@@ -587,6 +588,9 @@ void add_flags(Flags& f, Options& o) {
   f.add_double("push-travel", &o.config.push_travel_m,
                "an after line where the before line stood, with the rest not come along the push: the object's line is "
                "looked for this far along the push from where it stood, m (0: no such search; the lines agree within --column-line-px)");
+  f.add_int("rest-from-still", &o.rest_from_still,
+            "1: too few settled axes near the push line, though something moved, and the object is looked for as a new "
+            "upright line along the push in the right after still (--push-travel along it); 0: tipped or lost at once");
   f.add_string("line-pick", &o.line_pick,
                "of the lines near a still's predicted object line: the strongest (most votes) or the nearest");
   f.add_double("min-mask-mirror", &o.config.min_mask_mirror_agreement,
@@ -652,6 +656,8 @@ int main(int argc, char** argv) {
     if (opt.line_pick != "strongest" && opt.line_pick != "nearest")
       throw FlagError("--line-pick: strongest or nearest, not '" + opt.line_pick + "'");
     opt.config.line_search.strongest = opt.line_pick == "strongest";
+    if (opt.rest_from_still != 0 && opt.rest_from_still != 1) throw FlagError("--rest-from-still must be 0 or 1");
+    opt.config.rest_from_still = opt.rest_from_still == 1;
     if (!(opt.config.line_search.not_object_px >= 0 && opt.config.line_search.not_object_px < 100))
       throw FlagError("--column-line-px must lie in [0, 100)");
     if (!(opt.config.push_travel_m >= 0 && opt.config.push_travel_m <= opt.config.max_travel_m))

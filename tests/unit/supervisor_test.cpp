@@ -770,16 +770,76 @@ TEST_F(SupervisorTest, ATippedObjectIsReportedNotSegmented) {
   EXPECT_NEAR(*ended[0].attempt->rest_tilt_deg, 0.4 * 180 / M_PI, 0.1);
   EXPECT_TRUE(ended[0].attempt->after.empty());  // no still taken, nothing segmented
   EXPECT_EQ(s.report().failed_attempts, 1) << "an ended attempt that segmented nothing";
-  // Lying down it has no upright axis at all: also reported.
+  // Lying down it has no upright axis at all, and no upright line along the push in the after
+  // still: also reported.
   answer_survey(s, {Eigen::Vector3d(0.30, 0.10, 0)});
   s.on_right_still(draw_scene(scene_, {1280, 960}, {Eigen::Vector3d(0.30, 0.10, 0)}), now_, now_);
   const auto second = outputs_of<sv::NudgeCommand>(s.take_outputs()).at(0);
   play_nudge(s, second.seq, second.target, second.target + 0.03 * second.direction);
   settle_with_axes(s, {});
-  ended = outputs_of<sv::AttemptEnded>(s.take_outputs());
-  ASSERT_EQ(ended.size(), 1u);
-  EXPECT_EQ(ended[0].attempt->outcome, sv::Outcome::Tipped);
+  const auto lying = park_and_show_after_still_of(s, {});
+  ASSERT_TRUE(lying);
+  EXPECT_EQ(lying->outcome, sv::Outcome::Tipped);
+  EXPECT_NE(lying->reason.find("no new upright line along the push"), std::string::npos) << lying->reason;
   EXPECT_EQ(s.report().failed_attempts, 2);
+}
+
+// A clear or frosted bottle before a busy background is seldom paired in both cameras: after the
+// push no settled axis placed it, though it slid upright (held-out h11: 1.7 cm, development s09:
+// 2.1 cm) and was called tipped. The right after still shows it: a new upright line along the push.
+TEST_F(SupervisorTest, AnObjectNoSettledAxisPlacedIsFoundAsANewLineAlongThePush) {
+  const Eigen::Vector3d object(0.28, -0.05, 0);
+  for (const bool from_still : {true, false}) {
+    SCOPED_TRACE(from_still ? "rest from the still" : "no rest from the still");
+    sv::Config config;
+    config.rest_from_still = from_still;
+    sv::Supervisor s = make(config);
+    const sv::NudgeCommand nudge = nudge_command_for(s, object);
+    const Eigen::Vector3d rest = object + 0.02 * nudge.direction;
+    play_nudge(s, nudge.seq, object, rest);
+    settle_with_axes(s, {});  // the settled frames' AXES came, none of them the object's
+    if (!from_still) {
+      const auto ended = outputs_of<sv::AttemptEnded>(s.take_outputs());
+      ASSERT_EQ(ended.size(), 1u);
+      EXPECT_EQ(ended[0].attempt->outcome, sv::Outcome::Tipped);
+      continue;
+    }
+    const auto attempt = park_and_show_after_still(s, rest);
+    ASSERT_TRUE(attempt && attempt->rest && attempt->after_line);
+    EXPECT_EQ(attempt->outcome, sv::Outcome::Segmented) << attempt->reason;
+    EXPECT_TRUE(attempt->rest_from_still);
+    EXPECT_LT((*attempt->rest - rest).norm(), 0.005) << "where an upright axis on the push line meets its line";
+    const auto rest_line = scene_.right_axis_line(rest, 0.25, {1280, 960});
+    ASSERT_TRUE(rest_line);
+    EXPECT_LT(std::abs(nudge::symmetry::line_difference(*attempt->after_line, *rest_line).r), 10);
+  }
+}
+
+// What stood along the push before it is no new line: a neighbour there, when the pushed object
+// tipped over, is not taken for it.
+TEST_F(SupervisorTest, ANeighbourStandingAlongThePushIsNotTakenForAnObjectNoSettledAxisPlaced) {
+  const Eigen::Vector3d object(0.28, -0.05, 0);
+  sv::Config config;
+  config.push_travel_m = 0.09;  // where the neighbour stands, clear of the object
+  sv::Supervisor s = make(config);
+  start_with(s, {object});
+  // The before still shows the neighbour too; the nudge's direction is the one nudge_command_for
+  // would see.
+  const Eigen::Vector3d direction = [&] {
+    sv::Supervisor probe = make(config);
+    return nudge_command_for(probe, object).direction;
+  }();
+  const Eigen::Vector3d neighbour = object + config.push_travel_m * direction;
+  s.on_right_still(draw_scene(scene_, {1280, 960}, {object, neighbour}), now_, now_);
+  const sv::NudgeCommand nudge = outputs_of<sv::NudgeCommand>(s.take_outputs()).at(0);
+  ASSERT_LT((nudge.direction - direction).norm(), 1e-9);
+  play_nudge(s, nudge.seq, object, object + 0.02 * nudge.direction, {neighbour});
+  last_objects_ = {neighbour};  // the object fell over: no upright object where it went
+  settle_with_axes(s, {});
+  const auto attempt = park_and_show_after_still_of(s, {neighbour});
+  ASSERT_TRUE(attempt);
+  EXPECT_EQ(attempt->outcome, sv::Outcome::Tipped) << attempt->reason;
+  EXPECT_NE(attempt->reason.find("no new upright line along the push"), std::string::npos) << attempt->reason;
 }
 
 // A pipeline that lags (docs/reliability.md, "Soak": AXES about a second behind under load)
@@ -857,10 +917,12 @@ TEST_F(SupervisorTest, AnAxisHiddenPastTheSettlingTimeIsWaitedForUpToTheLongestS
       EXPECT_EQ(s.state(), sv::State::Home) << sv::to_string(s.state()) << ": " << s.report().reason;
       EXPECT_GE(now_, arm_done + static_cast<int64_t>((hidden_s + 0.2) * kSecond)) << "settled on until the axes came";
     } else {
-      ASSERT_EQ(ended.size(), 1u);
-      EXPECT_EQ(ended[0].attempt->outcome, sv::Outcome::Tipped);
-      EXPECT_NE(ended[0].attempt->reason.find("after 4 s of settling"), std::string::npos) << ended[0].attempt->reason;
+      // Placed neither by the axes nor (the after still shows nothing upright) by the still.
       EXPECT_NEAR(static_cast<double>(now_ - arm_done) / kSecond, config.max_settle_s, 0.15);
+      const auto attempt = park_and_show_after_still_of(s, {});
+      ASSERT_TRUE(attempt);
+      EXPECT_EQ(attempt->outcome, sv::Outcome::Tipped);
+      EXPECT_NE(attempt->reason.find("after 4 s of settling"), std::string::npos) << attempt->reason;
     }
   }
 }
@@ -2133,6 +2195,36 @@ TEST(LineSearch, TheBandIsTheWholeStillWithoutASpanAndEmptyOffIt) {
   off.seg2 = {5000, 300};
   EXPECT_TRUE(sv::search_region(size, off).empty());
   EXPECT_FALSE(sv::find_line_near(cv::Mat(size, CV_8UC3, cv::Scalar::all(100)), off));
+}
+
+// A still taken earlier tells a line that stood there from one that arrived: the share of pixels
+// about the line that changed. Two bars: one stands still, the other arrives where nothing stood.
+TEST(LineSearch, AnEarlierStillPassesOverTheLineThatStoodThereAndKeepsTheOneThatArrived) {
+  cv::Mat earlier(960, 1280, CV_8UC3, cv::Scalar(128, 128, 128));
+  // The standing bar is the taller: more rows vote for it.
+  cv::rectangle(earlier, cv::Point(400, 200), cv::Point(480, 700), cv::Scalar(40, 50, 60), cv::FILLED);
+  cv::Mat later = earlier.clone();
+  cv::rectangle(later, cv::Point(560, 300), cv::Point(640, 700), cv::Scalar(200, 60, 40), cv::FILLED);  // arrives
+  const cv::Size size = later.size();
+  auto standing = sv::line_through({440, 700}, {440, 300}, size);
+  auto arrived = sv::line_through({600, 700}, {600, 300}, size);
+  EXPECT_NEAR(sv::changed_share(earlier, later, arrived, 25, 25), 400.0 / 960, 0.01) << "along the whole image's span";
+  standing.seg1 = {440, 700}, standing.seg2 = {440, 300};  // along the bars' height
+  arrived.seg1 = {600, 700}, arrived.seg2 = {600, 300};
+  EXPECT_EQ(sv::changed_share(earlier, later, standing, 25, 25), 0);
+  EXPECT_GT(sv::changed_share(earlier, later, arrived, 25, 25), 0.9);
+  EXPECT_EQ(sv::changed_share(cv::Mat(480, 640, CV_8UC3), later, arrived, 25, 25), 0) << "stills of different sizes";
+  // Searched for midway between the two, within reach of both: the standing bar's line is taken
+  // without the earlier still, the arriving one's with it.
+  sv::LineSearchParams params;
+  params.window_px = 100;
+  const auto midway = sv::line_through({520, 700}, {520, 300}, size);
+  const auto without = sv::find_line_near(later, midway, params);
+  const auto with = sv::find_line_near(later, midway, params, {}, earlier);
+  ASSERT_TRUE(without && with);
+  EXPECT_LT(std::abs(nudge::symmetry::line_difference(*without, standing).r), 3);
+  EXPECT_LT(std::abs(nudge::symmetry::line_difference(*with, arrived).r), 3);
+  EXPECT_THROW(sv::find_line_near(later, midway, params, {}, cv::Mat(480, 640, CV_8UC3)), std::invalid_argument);
 }
 
 // A dark bottle 25 px beside the prediction and, at the prediction, a short faint pair of stripes

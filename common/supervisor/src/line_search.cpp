@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+
+#include <opencv2/core.hpp>
 
 #include "nudge/supervisor/scene.hpp"
 #include "nudge/symmetry/line.hpp"
@@ -22,6 +25,44 @@ bool reaches_foot(const symmetry::Line& line, const symmetry::Line& predicted, d
 }
 
 }  // namespace
+
+namespace {
+
+// Per pixel, the largest change of a channel between two stills of the same size and type.
+cv::Mat largest_channel_change(const cv::Mat& earlier, const cv::Mat& later) {
+  cv::Mat difference;
+  cv::absdiff(earlier, later, difference);
+  if (difference.channels() == 1) return difference;
+  std::vector<cv::Mat> channels;
+  cv::split(difference, channels);
+  for (size_t c = 1; c < channels.size(); ++c) channels[0] = cv::max(channels[0], channels[c]);
+  return channels[0];
+}
+
+double changed_share_of(const cv::Mat& change, const symmetry::Line& line, double half_width_px, int threshold) {
+  cv::Point2d from = line.seg1, to = line.seg2;
+  if (cv::norm(to - from) < 1) symmetry::border_endpoints(line.r, line.theta, change.cols, change.rows, &from, &to);
+  const double length = cv::norm(to - from);
+  if (length < 1) return 0;
+  const cv::Point2d along = (to - from) / length, across(-along.y, along.x);
+  int samples = 0, changed = 0;
+  for (double t = 0; t <= length; t += 1)
+    for (double u = -half_width_px; u <= half_width_px; u += 1) {
+      const cv::Point p(cvRound(from.x + t * along.x + u * across.x), cvRound(from.y + t * along.y + u * across.y));
+      if (p.x < 0 || p.y < 0 || p.x >= change.cols || p.y >= change.rows) continue;
+      ++samples;
+      changed += change.at<uint8_t>(p) > threshold;
+    }
+  return samples ? static_cast<double>(changed) / samples : 0;
+}
+
+}  // namespace
+
+double changed_share(const cv::Mat& earlier, const cv::Mat& later, const symmetry::Line& line, double half_width_px,
+                     int threshold) {
+  if (earlier.empty() || earlier.size() != later.size() || earlier.type() != later.type()) return 0;
+  return changed_share_of(largest_channel_change(earlier, later), line, half_width_px, threshold);
+}
 
 cv::Rect search_region(const cv::Size& size, const symmetry::Line& predicted, const LineSearchParams& params) {
   const cv::Rect whole(0, 0, size.width, size.height);
@@ -54,7 +95,8 @@ cv::Rect search_region(const cv::Size& size, const symmetry::Line& predicted, co
 
 std::optional<symmetry::Line> find_line_near(const cv::Mat& image, const symmetry::Line& predicted,
                                              const LineSearchParams& params,
-                                             const std::vector<symmetry::Line>& not_objects) {
+                                             const std::vector<symmetry::Line>& not_objects,
+                                             const cv::Mat& earlier) {
   if (image.empty()) return std::nullopt;
   const double scale = image.cols / 640.0;  // the detector's thesis distances are for 640x480
   symmetry::Params p;
@@ -76,6 +118,10 @@ std::optional<symmetry::Line> find_line_near(const cv::Mat& image, const symmetr
                                                     : cv::Rect(0, 0, image.cols, image.rows);
   if (region.width < 2 || region.height < 2) return std::nullopt;  // the predicted axis lies outside the still
   const symmetry::Result result = detector.detect(image(region));
+  const bool compare = !earlier.empty();
+  if (compare && (earlier.size() != image.size() || earlier.type() != image.type()))
+    throw std::invalid_argument("find_line_near: the earlier still differs from the still in size or type");
+  const cv::Mat change = compare ? largest_channel_change(earlier, image) : cv::Mat();
   // A not-an-object line the prediction itself lies on is not avoided: the object stands in line
   // with it in the image (its line and the column's are one), and the one line is the object's.
   const double not_object_angle = params.not_object_deg * M_PI / 180;
@@ -94,6 +140,9 @@ std::optional<symmetry::Line> find_line_near(const cv::Mat& image, const symmetr
     if (std::any_of(avoided.begin(), avoided.end(), [&](const symmetry::Line& other) {
           return lines_agree(line, other, not_object_angle, params.not_object_px);
         }))
+      continue;
+    // Where nothing changed about the line since the earlier still, it stood there then.
+    if (compare && changed_share_of(change, line, 0.5 * p.dmin, params.change_threshold) < params.min_changed_share)
       continue;
     const bool reaches = reaches_foot(line, predicted, params.foot_slack);
     const bool preferred = params.strongest ? line.votes > best_votes : offset <= best_offset;
@@ -124,7 +173,8 @@ std::optional<symmetry::Line> find_moved_line(const cv::Mat& after, const symmet
                                               const symmetry::Line& predicted_before,
                                               const std::optional<symmetry::Line>& before_line,
                                               const LineSearchParams& params,
-                                              const std::vector<symmetry::Line>& not_objects) {
+                                              const std::vector<symmetry::Line>& not_objects,
+                                              const cv::Mat& earlier) {
   // Two detections, not one over +-window_deg filtered twice: the narrow one's `lines` peaks all
   // lie within +-lean_window_deg, where the wide one's strongest could all lie outside it (a
   // neighbour's lines, a label's stripes), leaving the object's line unexamined.
@@ -132,10 +182,10 @@ std::optional<symmetry::Line> find_moved_line(const cv::Mat& after, const symmet
     const double lean = symmetry::line_difference(*before_line, predicted_before).theta;
     LineSearchParams narrow = params;
     narrow.window_deg = std::min(params.lean_window_deg, params.window_deg);
-    if (auto line = find_line_near(after, turned_about_foot(predicted_after, lean, after.size()), narrow, not_objects))
+    if (auto line = find_line_near(after, turned_about_foot(predicted_after, lean, after.size()), narrow, not_objects, earlier))
       return line;
   }
-  return find_line_near(after, predicted_after, params, not_objects);
+  return find_line_near(after, predicted_after, params, not_objects, earlier);
 }
 
 }  // namespace nudge::supervisor

@@ -375,7 +375,9 @@ void Supervisor::verify(int64_t now) {
   // The after still is taken with the arm parked where it was for the before still (at home):
   // the arm then makes no difference between the two.
   nudge_seq_ = 0;
-  park(now, "object at rest at " + millimetres(*a.rest) + ": parking the arm before the after still");
+  park(now, a.rest_from_still ? "object not placed by the settled axes (" + a.settle_note +
+                                    "): parking the arm to look for it along the push in the after still"
+                              : "object at rest at " + millimetres(*a.rest) + ": parking the arm before the after still");
 }
 
 void Supervisor::park(int64_t now, const std::string& why) {
@@ -509,10 +511,18 @@ bool Supervisor::verify_by_axes(int64_t now) {
     tilts.push_back(axis->tilt_rad);
   }
   if (static_cast<int>(xs.size()) < config_.min_axes) {
-    end_attempt(Outcome::Tipped, "object tipped or lost: " + std::to_string(xs.size()) +
-                                     " upright axes in one place near the push line after " +
-                                     seconds_text(std::round(std::max<double>(0, latest_axes_utime_ - arm_done_time_) / 1e5) / 10) +
-                                     " of settling (" + std::to_string(rest.near) + " near it)", now);
+    const std::string settled =
+        std::to_string(xs.size()) + " upright axes in one place near the push line after " +
+        seconds_text(std::round(std::max<double>(0, latest_axes_utime_ - arm_done_time_) / 1e5) / 10) +
+        " of settling (" + std::to_string(rest.near) + " near it)";
+    if (rest_from_still_allowed()) {
+      // Placed by the after still's line (segment()); until then, where the push would take it.
+      a.rest_from_still = true;
+      a.settle_note = settled;
+      a.rest = a.target.position + config_.push_travel_m * a.direction;
+      return true;
+    }
+    end_attempt(Outcome::Tipped, "object tipped or lost: " + settled, now);
     return false;
   }
   const double tilt_deg = median(tilts) * 180 / M_PI;
@@ -532,6 +542,12 @@ void Supervisor::segment(int64_t now) {
   Attempt& a = *attempt_;
   enter(State::Segment, now, "motion segmentation of the stills");
   const auto predicted_before = scene_.right_axis_line(a.target.position, config_.object_height_m, config_.still_size);
+  const std::vector<symmetry::Line> column = base_column_lines(1);
+  if (predicted_before && a.rest_from_still && !place_by_after_still(a, *predicted_before, column)) {
+    end_attempt(Outcome::Tipped, "object tipped or lost: " + a.settle_note +
+                                     ", and no new upright line along the push in the after still", now);
+    return;
+  }
   const auto predicted_after = scene_.right_axis_line(*a.rest, config_.object_height_m, config_.still_size);
   if (!predicted_before || !predicted_after) {
     end_attempt(Outcome::SegmentationFailed, "the object left the right camera's view", now);
@@ -543,10 +559,11 @@ void Supervisor::segment(int64_t now) {
   if (a.learn) left = std::async(segment_left_ ? std::launch::async : std::launch::deferred, [this, &a] { segment_left(a); });
   // The object's own lines in the stills; the calibration's prediction where none is detected.
   // (The before still's line was searched for while the arm nudged: see before_lines.)
-  const std::vector<symmetry::Line> column = base_column_lines(1);
   if (!a.before_line) a.before_line = find_line_near(a.before, *predicted_before, config_.line_search, column);
-  a.after_line = find_moved_line(a.after, *predicted_after, *predicted_before, a.before_line, config_.line_search, column);
-  if (const auto pushed = line_along_the_push(a, *predicted_before, column)) a.after_line = pushed;
+  if (!a.rest_from_still) {
+    a.after_line = find_moved_line(a.after, *predicted_after, *predicted_before, a.before_line, config_.line_search, column);
+    if (const auto pushed = line_along_the_push(a, *predicted_before, column)) a.after_line = pushed;
+  }
   if (!a.before_line) a.before_line = predicted_before;
   if (!a.after_line) a.after_line = predicted_after;
   const bool stages_later = a.learn && segment_stageless_;
@@ -613,6 +630,43 @@ std::optional<symmetry::Line> Supervisor::line_along_the_push(const Attempt& a, 
   std::vector<symmetry::Line> standing = column;
   standing.push_back(*a.after_line);
   return find_moved_line(a.after, *predicted, predicted_before, a.before_line, config_.line_search, standing);
+}
+
+// The after still may place an object the settled axes did not (Config::rest_from_still) only
+// when the pipeline delivered the settled frames' axes: without them (a stalled pipeline) nothing
+// says the object is not simply unseen by a dead service, and the attempt ends as before.
+bool Supervisor::rest_from_still_allowed() const {
+  const int64_t settled = arm_done_time_ + static_cast<int64_t>(config_.settle_s * kMicro);
+  return config_.rest_from_still && config_.push_travel_m >= config_.min_displacement_m && !trackers_decide() &&
+         latest_axes_utime_ >= settled;
+}
+
+// Config::rest_from_still: the object's line in the right after still, a new upright line along
+// the push. Lines the before still shows as strongly stood there before the push and are passed
+// over (the object's own line when it did not move, a neighbour standing along the push, the arm's
+// base column; LineSearchParams::stood_there_share). Sets
+// the attempt's after line and its rest (the point of the push line whose upright axis projects
+// nearest the line); false when no such line is found.
+bool Supervisor::place_by_after_still(Attempt& a, const symmetry::Line& predicted_before,
+                                      const std::vector<symmetry::Line>& column) const {
+  const Eigen::Vector3d& from = a.target.position;
+  const Eigen::Vector3d along = a.direction.normalized();
+  const auto predicted = scene_.right_axis_line(from + config_.push_travel_m * along, config_.object_height_m, config_.still_size);
+  if (!predicted || a.after.empty()) return false;
+  const auto found = find_moved_line(a.after, *predicted, predicted_before, a.before_line, config_.line_search, column, a.before);
+  if (!found) return false;
+  double best_offset = config_.line_search.window_px, best_travel = 0;
+  bool placed = false;
+  for (double travel = -config_.max_lateral_m; travel <= config_.max_travel_m; travel += 0.001) {
+    const auto line = scene_.right_axis_line(from + travel * along, config_.object_height_m, config_.still_size);
+    if (!line) continue;
+    const double offset = std::abs(symmetry::line_difference(*found, *line).r);
+    if (offset < best_offset) best_offset = offset, best_travel = travel, placed = true;
+  }
+  if (!placed) return false;
+  a.rest = from + best_travel * along;
+  a.after_line = found;
+  return true;
 }
 
 std::string Supervisor::mask_shape_problem(const cv::Mat& mask, const Eigen::Vector3d& rest, const symmetry::Line& line) const {

@@ -49,7 +49,21 @@ struct LineSearchParams {
   // thing's, not the object's: an object standing in front of the column in the image shows the
   // column's line beside its own, often stronger and reaching down to the object's foot.
   double not_object_px = 8, not_object_deg = 1.5;
+  // With an earlier still given to the search: a line about which less than this share of the
+  // pixels changed (changed_share: Dmin/2 either side, along its support, by more than
+  // change_threshold grey levels in a channel) stood there already, not the pushed object
+  // arriving. A symmetry count would not tell: a checkered table gives any line there hundreds
+  // of voting pairs in either still (held-out h11: the moved bottle's line 849 pairs after, 477
+  // before).
+  double min_changed_share = 0.15;
+  int change_threshold = 25;
 };
+
+// The share of the pixels within `half_width_px` of `line` (along its support seg1-seg2; the whole
+// image's span of it when it has none) whose colour differs between two stills of the same view
+// by more than `threshold` in some channel. 0 for stills of different sizes or types.
+double changed_share(const cv::Mat& earlier, const cv::Mat& later, const symmetry::Line& line, double half_width_px,
+                     int threshold);
 
 // The part of a `size` image a search for lines near `predicted` needs: the band about the predicted
 // axis' span (seg1 to seg2, lengthened by params.window_px at both ends) that holds every edge pair of
@@ -62,10 +76,14 @@ cv::Rect search_region(const cv::Size& size, const symmetry::Line& predicted, co
 // that reach the predicted foot when any does, or nothing. The prediction's seg1 is its foot on the table and seg2 its top
 // (SceneGeometry::right_axis_line); a prediction without that span (seg1 == seg2) prefers no line.
 // Lines agreeing with one of `not_objects` (params.not_object_px, not_object_deg) are passed over,
-// unless the prediction agrees with it too (the object in line with it).
+// unless the prediction agrees with it too (the object in line with it). With `earlier` (a still
+// of the same view, the same size and type, taken before; std::invalid_argument otherwise), a line
+// about which too little changed since then stood there and is passed over wherever the
+// prediction lies (params.min_changed_share).
 std::optional<symmetry::Line> find_line_near(const cv::Mat& image, const symmetry::Line& predicted,
                                              const LineSearchParams& params = {},
-                                             const std::vector<symmetry::Line>& not_objects = {});
+                                             const std::vector<symmetry::Line>& not_objects = {},
+                                             const cv::Mat& earlier = cv::Mat());
 
 // The nudged object's line in the still after the nudge. An object that slid and stayed upright
 // keeps its lean: its line leans from the calibration's prediction at its rest (an upright axis)
@@ -78,7 +96,8 @@ std::optional<symmetry::Line> find_moved_line(const cv::Mat& after, const symmet
                                               const symmetry::Line& predicted_before,
                                               const std::optional<symmetry::Line>& before_line,
                                               const LineSearchParams& params = {},
-                                              const std::vector<symmetry::Line>& not_objects = {});
+                                              const std::vector<symmetry::Line>& not_objects = {},
+                                              const cv::Mat& earlier = cv::Mat());
 
 // `predicted` turned by `angle` (radians, the (R, theta) convention's sense) about its seg1, its
 // span turned with it.

@@ -121,6 +121,15 @@ struct Config {
   // search.
   double standing_line_max_travel_m = 0.01;
   double push_travel_m = 0.025;
+  // Too few settled axes near the push line (a clear or frosted bottle before a busy background is
+  // seldom paired in both cameras), though the pipeline delivered the settled frames' axes and
+  // something moved: the object is looked for in the right after still instead, as a new upright
+  // line along the push (push_travel_m from where it stood, the search's windows about that),
+  // where neither the object's before line nor a line of the before still stood. Its rest is
+  // where an upright axis on the push line projects onto that line. No such line: tipped or lost.
+  // (Held-out h11 and development s09: the bottle slid 1.7 and 2.1 cm upright and was called
+  // tipped.) Off: no settled axes, no rest (tipped or lost at once). Needs push_travel_m.
+  bool rest_from_still = true;
   double object_height_m = 0.25;     // the tallest expected object (lines drawn up to it)
   int min_mask_pixels = 200;         // a smaller mask (in the still) is no object
   // Nor is a mask smaller than this share of the still's image of the smallest object expected
@@ -273,6 +282,10 @@ struct Attempt {
   // it becomes the rest when the settled axes' rest is far from it (Config::rest_mask_disagreement_m).
   std::optional<Eigen::Vector3d> rest_from_mask;
   std::optional<Eigen::Vector3d> rest_from_axes;  // the settled axes' rest, when the mask's replaced it
+  // Config::rest_from_still: the settled axes did not place the object (settle_note says how
+  // few there were); its rest is the after still's line along the push.
+  bool rest_from_still = false;
+  std::string settle_note;
   cv::Mat before, after;                   // right stills
   int64_t after_utime = 0;                 // when the right after still was taken (segmentation_t.utime)
   std::optional<symmetry::Line> before_line, after_line;  // in the stills
@@ -470,6 +483,8 @@ class Supervisor {
     int near = 0;
   };
   RestGroup rest_group() const;
+  bool rest_from_still_allowed() const;
+  bool place_by_after_still(Attempt& a, const symmetry::Line& predicted_before, const std::vector<symmetry::Line>& column) const;
   std::optional<symmetry::Line> line_along_the_push(const Attempt& a, const symmetry::Line& predicted_before,
                                                     const std::vector<symmetry::Line>& column) const;
   bool settling_longer(int64_t now) const;
