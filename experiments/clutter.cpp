@@ -150,6 +150,7 @@ struct LineLoss {
 // (stereo pairing, the stereo check, the upright / workspace filter); intersects but no cluster.
 struct CandidateLoss {
   int candidate = 0, never_both = 0, no_intersect = 0, not_clustered = 0;
+  int never_both_but_each = 0;  // of never_both: in each camera's lines, only never in the same frame
 };
 // What became of the pairing of an object's own left and right lines, per object-frame in both
 // cameras' lines (--diagnose): one line ranked beyond the lines paired, the axis refused (tilt,
@@ -479,6 +480,8 @@ SceneResult run_scene(const std::string& file, const Pipeline& pipeline, int fra
   std::vector<sym::Line> first_left;
   cv::Mat first_image;
   std::vector<int> frames_in_both(world.num_objects(), 0);
+  std::array<std::vector<int>, 2> frames_in(
+      {std::vector<int>(world.num_objects(), 0), std::vector<int>(world.num_objects(), 0)});
   for (int f = 0; f < frames; ++f) {
     const sim::StereoImages images = world.render_stereo(f == 0);
     std::array<std::vector<sym::Line>, 2> lines;
@@ -530,7 +533,10 @@ SceneResult run_scene(const std::string& file, const Pipeline& pipeline, int fra
       first_left = lines[0];
       first_image = images.colour[0];
     }
-    for (int i = 0; i < world.num_objects(); ++i) frames_in_both[i] += in_lines[0][i] && in_lines[1][i];
+    for (int i = 0; i < world.num_objects(); ++i) {
+      frames_in_both[i] += in_lines[0][i] && in_lines[1][i];
+      for (int c = 0; c < 2; ++c) frames_in[c][i] += in_lines[c][i];
+    }
     if (pair_dump) dump_pairings(rig, table, finder, locations, lines, truth, world, images, result.name, f, pair_dump);
     if (diagnose) {
       const std::vector<geo::PairedAxis> axes = finder.frame_axes(lines[0], lines[1], images.colour[0], images.colour[1]);
@@ -581,7 +587,10 @@ SceneResult run_scene(const std::string& file, const Pipeline& pipeline, int fra
     }
     CandidateLoss& loss = result.candidate_loss;
     if (has_candidate[i]) ++loss.candidate;
-    else if (frames_in_both[i] == 0) ++loss.never_both;
+    else if (frames_in_both[i] == 0) {
+      ++loss.never_both;
+      loss.never_both_but_each += frames_in[0][i] > 0 && frames_in[1][i] > 0;
+    }
     else if (near == 0) ++loss.no_intersect;
     else ++loss.not_clustered;
   }
@@ -662,7 +671,8 @@ std::string losses_text(const std::vector<SceneResult>& results) {
   s << "object-frames: in lines " << l.found << ", dropped by verification " << l.verification
     << ", a peak removed by suppression " << l.suppressed << ", a peak ranked below the peaks taken " << l.rank_low
     << ", a peak below min_peak_ratio " << l.below_ratio << ", no peak " << l.no_peak << "; objects: candidate "
-    << c.candidate << ", never in both cameras' lines " << c.never_both << ", no intersect near it "
+    << c.candidate << ", never in both cameras' lines " << c.never_both << " (in each camera's in some frame "
+    << c.never_both_but_each << "), no intersect near it "
     << c.no_intersect << ", intersects but no cluster " << c.not_clustered;
   return s.str();
 }
@@ -771,6 +781,7 @@ CandidateLoss total_candidate_loss(const std::vector<SceneResult>& rs) {
   for (const auto& r : rs) {
     c.candidate += r.candidate_loss.candidate;
     c.never_both += r.candidate_loss.never_both;
+    c.never_both_but_each += r.candidate_loss.never_both_but_each;
     c.no_intersect += r.candidate_loss.no_intersect;
     c.not_clustered += r.candidate_loss.not_clustered;
   }
