@@ -591,6 +591,9 @@ void add_flags(Flags& f, Options& o) {
   f.add_int("rest-from-still", &o.rest_from_still,
             "1: too few settled axes near the push line, though something moved, and the object is looked for as a new "
             "upright line along the push in the right after still (--push-travel along it); 0: tipped or lost at once");
+  f.add_double("far-rest", &o.config.far_rest_m,
+               "with --rest-from-still 1: a settled axes' rest farther than this along the push, about whose line the stills "
+               "show no change, gives way to a new line along the push when one is found, m (0: never)");
   f.add_string("line-pick", &o.line_pick,
                "of the lines near a still's predicted object line: the strongest (most votes) or the nearest");
   f.add_double("min-mask-mirror", &o.config.min_mask_mirror_agreement,
@@ -657,6 +660,8 @@ int main(int argc, char** argv) {
       throw FlagError("--line-pick: strongest or nearest, not '" + opt.line_pick + "'");
     opt.config.line_search.strongest = opt.line_pick == "strongest";
     if (opt.rest_from_still != 0 && opt.rest_from_still != 1) throw FlagError("--rest-from-still must be 0 or 1");
+    if (!(opt.config.far_rest_m >= 0 && opt.config.far_rest_m <= opt.config.max_travel_m))
+      throw FlagError("--far-rest must lie in [0, " + std::to_string(opt.config.max_travel_m) + "] m");
     opt.config.rest_from_still = opt.rest_from_still == 1;
     if (!(opt.config.line_search.not_object_px >= 0 && opt.config.line_search.not_object_px < 100))
       throw FlagError("--column-line-px must lie in [0, 100)");

@@ -548,6 +548,13 @@ void Supervisor::segment(int64_t now) {
                                      ", and no new upright line along the push in the after still", now);
     return;
   }
+  if (predicted_before && !a.rest_from_still && far_rest_where_nothing_changed(a)) {
+    const Eigen::Vector3d from_axes = *a.rest;
+    if (place_by_after_still(a, *predicted_before, column)) {
+      a.rest_from_axes = from_axes;
+      a.rest_from_still = true;
+    }
+  }
   const auto predicted_after = scene_.right_axis_line(*a.rest, config_.object_height_m, config_.still_size);
   if (!predicted_before || !predicted_after) {
     end_attempt(Outcome::SegmentationFailed, "the object left the right camera's view", now);
@@ -639,6 +646,18 @@ bool Supervisor::rest_from_still_allowed() const {
   const int64_t settled = arm_done_time_ + static_cast<int64_t>(config_.settle_s * kMicro);
   return config_.rest_from_still && config_.push_travel_m >= config_.min_displacement_m && !trackers_decide() &&
          latest_axes_utime_ >= settled;
+}
+
+// Config::far_rest_m: the settled axes' rest lies far along the push, and nothing changed about
+// its projected line between the stills.
+bool Supervisor::far_rest_where_nothing_changed(const Attempt& a) const {
+  if (!config_.rest_from_still || config_.far_rest_m <= 0 || !a.rest || a.before.empty() || a.after.empty()) return false;
+  if ((*a.rest - a.target.position).head<2>().dot(a.direction.head<2>()) <= config_.far_rest_m) return false;
+  const auto line = scene_.right_axis_line(*a.rest, config_.object_height_m, config_.still_size);
+  if (!line) return false;
+  const double half_width = 0.5 * config_.line_search.min_pair_width_px * a.after.cols / 640.0;
+  return changed_share(a.before, a.after, *line, half_width, config_.line_search.change_threshold) <
+         config_.line_search.min_changed_share;
 }
 
 // Config::rest_from_still: the object's line in the right after still, a new upright line along
