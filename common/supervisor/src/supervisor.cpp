@@ -661,11 +661,11 @@ bool Supervisor::far_rest_where_nothing_changed(const Attempt& a) const {
 }
 
 // Config::rest_from_still: the object's line in the right after still, a new upright line along
-// the push. Lines the before still shows as strongly stood there before the push and are passed
-// over (the object's own line when it did not move, a neighbour standing along the push, the arm's
-// base column; LineSearchParams::stood_there_share). Sets
-// the attempt's after line and its rest (the point of the push line whose upright axis projects
-// nearest the line); false when no such line is found.
+// the push. A line about which nothing changed since the before still stood there before the push
+// and is passed over (the object's own line when it did not move, a neighbour standing along the
+// push, the arm's base column; LineSearchParams::min_changed_share). Sets the attempt's after line
+// and its rest (the point of the push line whose upright axis projects nearest the line); false
+// when no such line is found.
 bool Supervisor::place_by_after_still(Attempt& a, const symmetry::Line& predicted_before,
                                       const std::vector<symmetry::Line>& column) const {
   const Eigen::Vector3d& from = a.target.position;
