@@ -217,6 +217,21 @@ class SupervisorTest : public ::testing::Test {
     s.on_right_still(draw_scene(scene_, {1280, 960}, {object}), now_, now_);
     return outputs_of<sv::NudgeCommand>(s.take_outputs()).at(0);
   }
+  // A run started on `object` whose before still also shows a neighbour `neighbour_travel_m` along
+  // the push the supervisor will command (found with a probe run on the same config): the nudge it
+  // commands, and where the neighbour stands.
+  std::pair<sv::NudgeCommand, Eigen::Vector3d> nudge_command_with_neighbour_along(sv::Supervisor& s, const sv::Config& config,
+                                                                                  const Eigen::Vector3d& object,
+                                                                                  double neighbour_travel_m) {
+    sv::Supervisor probe = make(config);
+    const Eigen::Vector3d direction = nudge_command_for(probe, object).direction;
+    const Eigen::Vector3d neighbour = object + neighbour_travel_m * direction;
+    start_with(s, {object});
+    s.on_right_still(draw_scene(scene_, {1280, 960}, {object, neighbour}), now_, now_);
+    const sv::NudgeCommand nudge = outputs_of<sv::NudgeCommand>(s.take_outputs()).at(0);
+    EXPECT_LT((nudge.direction - direction).norm(), 1e-9);
+    return {nudge, neighbour};
+  }
   // A run's first attempt on `object` up to the after still: surveyed, the before still taken,
   // nudged 3 cm, settled and parked. Returns where it rests.
   Eigen::Vector3d nudge_and_park(sv::Supervisor& s, const Eigen::Vector3d& object) {
@@ -822,17 +837,7 @@ TEST_F(SupervisorTest, ANeighbourStandingAlongThePushIsNotTakenForAnObjectNoSett
   sv::Config config;
   config.push_travel_m = 0.09;  // where the neighbour stands, clear of the object
   sv::Supervisor s = make(config);
-  start_with(s, {object});
-  // The before still shows the neighbour too; the nudge's direction is the one nudge_command_for
-  // would see.
-  const Eigen::Vector3d direction = [&] {
-    sv::Supervisor probe = make(config);
-    return nudge_command_for(probe, object).direction;
-  }();
-  const Eigen::Vector3d neighbour = object + config.push_travel_m * direction;
-  s.on_right_still(draw_scene(scene_, {1280, 960}, {object, neighbour}), now_, now_);
-  const sv::NudgeCommand nudge = outputs_of<sv::NudgeCommand>(s.take_outputs()).at(0);
-  ASSERT_LT((nudge.direction - direction).norm(), 1e-9);
+  const auto [nudge, neighbour] = nudge_command_with_neighbour_along(s, config, object, config.push_travel_m);
   play_nudge(s, nudge.seq, object, object + 0.02 * nudge.direction, {neighbour});
   last_objects_ = {neighbour};  // the object fell over: no upright object where it went
   settle_with_axes(s, {});
@@ -1362,14 +1367,7 @@ TEST_F(SupervisorTest, AFarRestWhereNothingChangedGivesWayToTheObjectsNewLineAlo
     sv::Config config;
     config.far_rest_m = far_rest_m;
     sv::Supervisor s = make(config);
-    const Eigen::Vector3d direction = [&] {
-      sv::Supervisor probe = make(config);
-      return nudge_command_for(probe, object).direction;
-    }();
-    const Eigen::Vector3d neighbour = object + 0.10 * direction;
-    start_with(s, {object});
-    s.on_right_still(draw_scene(scene_, {1280, 960}, {object, neighbour}), now_, now_);
-    const sv::NudgeCommand nudge = outputs_of<sv::NudgeCommand>(s.take_outputs()).at(0);
+    const auto [nudge, neighbour] = nudge_command_with_neighbour_along(s, config, object, 0.10);
     const Eigen::Vector3d rest = object + 0.02 * nudge.direction;
     play_nudge(s, nudge.seq, object, rest, {neighbour});
     settle_with_axes(s, {neighbour});
