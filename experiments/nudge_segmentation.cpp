@@ -9,7 +9,9 @@
 // overlaps most is the one segmented; IoU with it, and the mask's pixels on the end effector (pad
 // or gripper: the pixels that change when it is hidden) are counted.
 //   nudge-exp-nudge-segmentation RUNS_DIR SCENE_DIR [RUN...] [--development RUNS_DIR SCENE_DIR]
-// (default: every scene in SCENE_DIR). The first set gives the headline keys (the held-out scenes); the
+//                                [--name STEM] [--workspace FILE]
+// (default: every scene in SCENE_DIR). Objects a scene stages outside the workspace ring (FILE's,
+// default the code's) are counted apart: the loop's candidates are within the ring. The first set gives the headline keys (the held-out scenes); the
 // development set goes under its own key "development".
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -35,6 +37,7 @@
 #include "nudge/bus/sim_convert.hpp"
 #include "nudge/json.hpp"
 #include "nudge/progress.hpp"
+#include "nudge/robot/workspace.hpp"
 #include "nudge/segmentation/motion.hpp"
 #include "nudge/segmentation_t.hpp"
 #include "nudge/sim/mask_score.hpp"
@@ -68,6 +71,10 @@ struct Run {
   std::string end_reason;
   std::vector<Segmented> segmented;
   std::set<int> objects_found;  // scene indices segmented with IoU >= 0.5
+  // Scene indices of the objects the scene stages outside the arm's workspace ring (the object's
+  // axis nearer the base than ring_inner or farther than ring_outer): the candidates the
+  // triangulation gives are within the ring, so the loop cannot be expected to find these.
+  std::set<int> objects_beyond_reach;
   bool success() const { return !objects_found.empty(); }
 };
 
@@ -142,7 +149,18 @@ cv::Mat gallery_row(const fs::path& attempt_dir, const cv::Mat& mask) {
   return row;
 }
 
-Run evaluate(const std::string& name, const fs::path& run_dir, const fs::path& scene_file) {
+// The objects of `scene` whose axis stands outside the workspace ring (the world frame's origin is
+// on the arm base's axis: docs/robot.md).
+std::set<int> objects_beyond_reach(const sim::Scene& scene, const robot::Workspace& workspace) {
+  std::set<int> beyond;
+  for (size_t i = 0; i < scene.objects.size(); ++i) {
+    const double radius = scene.objects[i].position.norm();
+    if (radius < workspace.ring_inner || radius > workspace.ring_outer) beyond.insert(static_cast<int>(i));
+  }
+  return beyond;
+}
+
+Run evaluate(const std::string& name, const fs::path& run_dir, const fs::path& scene_file, const robot::Workspace& workspace) {
   Run run;
   run.name = name;
   const std::string summary = read_text(run_dir / "summary.json");
@@ -157,6 +175,7 @@ Run evaluate(const std::string& name, const fs::path& run_dir, const fs::path& s
   sim::Scene scene = sim::load_scene(scene_file.string());
   scene.render.noise_sigma = 0;
   run.objects_present = static_cast<int>(scene.objects.size());
+  run.objects_beyond_reach = objects_beyond_reach(scene, workspace);
   sim::World world(scene);
   lcm::LogFile log((run_dir / (run_dir.filename().string() + ".lcmlog")).string(), "r");
   if (!log.good()) throw std::runtime_error(run_dir.string() + ": no run log");
@@ -218,6 +237,8 @@ struct SetScore {
   std::vector<Run> runs;
   std::vector<fs::path> attempt_dirs;
   int single_runs = 0, successes = 0, effector = 0, tool_changed = 0, phantoms = 0, multi_found = 0, multi_present = 0;
+  int multi_in_reach = 0, multi_found_in_reach = 0;  // the same, over the objects within the workspace ring
+  std::vector<std::string> beyond_reach;             // "run: object i at r mm" for the objects outside it
   std::vector<double> ious;
   std::string table;
   std::vector<cv::Mat> gallery;
@@ -276,7 +297,8 @@ Detection detection_of(const fs::path& runs_dir) {
   return d;
 }
 
-SetScore score_set(const fs::path& runs_dir, const fs::path& scene_dir, std::vector<std::string> names) {
+SetScore score_set(const fs::path& runs_dir, const fs::path& scene_dir, std::vector<std::string> names,
+                   const robot::Workspace& workspace) {
   if (names.empty()) names = scene_names(scene_dir);
   SetScore set;
   nudge::Progress progress("nudge-exp-nudge-segmentation", static_cast<int>(names.size()));
@@ -287,7 +309,7 @@ SetScore score_set(const fs::path& runs_dir, const fs::path& scene_dir, std::vec
       progress.note(name + ": no run in " + run_dir.string() + " (skipped)");
       continue;
     }
-    set.runs.push_back(evaluate(name, run_dir, scene_dir / (name + ".yaml")));
+    set.runs.push_back(evaluate(name, run_dir, scene_dir / (name + ".yaml"), workspace));
     for (const auto& entry : fs::directory_iterator(run_dir))
       if (entry.is_directory() && entry.path().filename().string().rfind("attempt_", 0) == 0) set.attempt_dirs.push_back(entry.path());
   }
@@ -301,6 +323,10 @@ SetScore score_set(const fs::path& runs_dir, const fs::path& scene_dir, std::vec
     if (r.objects_present > 1) {
       set.multi_found += static_cast<int>(r.objects_found.size());
       set.multi_present += r.objects_present;
+      set.multi_in_reach += r.objects_present - static_cast<int>(r.objects_beyond_reach.size());
+      for (int object : r.objects_found) set.multi_found_in_reach += !r.objects_beyond_reach.count(object);
+      for (int object : r.objects_beyond_reach)
+        set.beyond_reach.push_back(r.name + " object " + std::to_string(object) + (r.objects_found.count(object) ? " (segmented)" : ""));
     } else {
       ++set.single_runs;
       set.successes += r.success();
@@ -333,7 +359,14 @@ void json_fields(JsonWriter& j, const SetScore& s, double ms) {
   j.field("segmentations", static_cast<int>(s.ious.size())).field("effector_pixels", s.effector);
   j.field("tool_changed_pixels", s.tool_changed);
   j.field("mean_ms_motion_segmentation", ms).field("multi_object_found", s.multi_found).field("multi_object_present", s.multi_present);
+  j.field("multi_object_in_reach", s.multi_in_reach).field("multi_object_found_in_reach", s.multi_found_in_reach);
   j.field("phantoms_rejected", s.phantoms);
+}
+
+std::string join(const std::vector<std::string>& parts, const std::string& separator) {
+  std::string out;
+  for (const std::string& p : parts) out += (out.empty() ? "" : separator) + p;
+  return out;
 }
 
 std::string figures_table(const SetScore& s, double ms) {
@@ -347,6 +380,8 @@ std::string figures_table(const SetScore& s, double ms) {
   md << line << "| end-effector pixels in the masks (the pad's or gripper's own) | – | " << s.effector << " |\n"
      << "| mask pixels the tool changes (itself and its shadow; the count reported before 2026-11-25) | – | " << s.tool_changed << " |\n"
      << "| objects of the multi-object scenes segmented | (one object per scene) | " << s.multi_found << "/" << s.multi_present << " |\n"
+     << "| of them standing within the arm's workspace ring, segmented | – | " << s.multi_found_in_reach << "/" << s.multi_in_reach
+     << (s.beyond_reach.empty() ? std::string() : " (outside the ring: " + join(s.beyond_reach, ", ") + ")") << " |\n"
      << "| attempts that found no motion (phantoms, out-of-view) | – | " << s.phantoms << " |\n";
   return md.str();
 }
@@ -368,6 +403,22 @@ int main(int argc, char** argv) {
       args.erase(args.begin() + static_cast<long>(i), args.begin() + static_cast<long>(i) + 2);
       break;
     }
+  robot::Workspace workspace;  // --workspace FILE: the ring the objects are counted in reach by
+  for (size_t i = 0; i < args.size(); ++i)
+    if (args[i] == "--workspace") {
+      if (i + 1 >= args.size()) {
+        std::cerr << "--workspace needs a workspace file\n";
+        return 2;
+      }
+      try {
+        workspace = robot::load_workspace(args[i + 1]);
+      } catch (const std::exception& e) {
+        std::cerr << e.what() << "\n";
+        return 2;
+      }
+      args.erase(args.begin() + static_cast<long>(i), args.begin() + static_cast<long>(i) + 2);
+      break;
+    }
   for (size_t i = 0; i < args.size(); ++i)
     if (args[i] == "--development") {
       if (i + 2 >= args.size()) {
@@ -380,15 +431,16 @@ int main(int argc, char** argv) {
     }
   if (args.size() < 2) {
     std::cerr << "usage: nudge-exp-nudge-segmentation RUNS_DIR SCENE_DIR [RUN...] [--development RUNS_DIR SCENE_DIR] [--name STEM]\n"
+                 "         [--workspace FILE]  (the workspace ring objects count as in reach by; default: the code's)\n"
                  "  (the first set gives the headline figures: the held-out scenes; STEM.json, STEM.md in docs/results,\n"
                  "  default nudge_segmentation)\n";
     return 2;
   }
   const fs::path runs_dir = args[0], scene_dir = args[1];
   const std::vector<std::string> names(args.begin() + 2, args.end());
-  const SetScore main_set = score_set(runs_dir, scene_dir, names);
+  const SetScore main_set = score_set(runs_dir, scene_dir, names, workspace);
   std::optional<SetScore> dev_set;
-  if (development) dev_set = score_set(development->first, development->second, {});
+  if (development) dev_set = score_set(development->first, development->second, {}, workspace);
   std::vector<fs::path> attempt_dirs = main_set.attempt_dirs;
   if (dev_set) attempt_dirs.insert(attempt_dirs.end(), dev_set->attempt_dirs.begin(), dev_set->attempt_dirs.end());
   const double ms = time_motion_segmentation(attempt_dirs);

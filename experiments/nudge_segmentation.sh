@@ -59,14 +59,14 @@ run_set() {
   nudge_log "$set: ${#list[@]} scenes run in $((SECONDS - loop_start)) s"
 }
 
-score="$NUDGE_BUILD_DIR/bin/nudge-exp-nudge-segmentation"
+score=("$NUDGE_BUILD_DIR/bin/nudge-exp-nudge-segmentation" --workspace "$NUDGE_ROOT/config/workspace.yaml")
 if [ "$which_set" = both ]; then
   run_set heldout
   run_set development
-  "$score" "$out_dir/heldout" "${scene_dirs[heldout]}" --development "$out_dir/development" "${scene_dirs[development]}"
+  "${score[@]}" "$out_dir/heldout" "${scene_dirs[heldout]}" --development "$out_dir/development" "${scene_dirs[development]}"
 else
   run_set "$which_set" "${names[@]}"
   result_name=nudge_segmentation
   [ "$which_set" = heldout2 ] && result_name=nudge_segmentation_heldout2
-  "$score" "$out_dir/$which_set" "${scene_dirs[$which_set]}" "${names[@]}" --name "$result_name"
+  "${score[@]}" "$out_dir/$which_set" "${scene_dirs[$which_set]}" "${names[@]}" --name "$result_name"
 fi

@@ -61,7 +61,7 @@ done
 [ "$count" -gt 0 ] || { echo "no finished run in $runs_dir" >&2; exit 1; }
 # The scorer writes docs/results/STEM.*: a name of its own, moved into OUT.
 stem="replay_$$"
-"$NUDGE_BUILD_DIR/bin/nudge-exp-nudge-segmentation" "$replayed" "${scene_dirs[$which_set]}" --name "$stem" | tail -1
+"$NUDGE_BUILD_DIR/bin/nudge-exp-nudge-segmentation" --workspace "$NUDGE_ROOT/config/workspace.yaml" "$replayed" "${scene_dirs[$which_set]}" --name "$stem" | tail -1
 for ext in json md; do mv "$NUDGE_ROOT/docs/results/$stem.$ext" "$out_dir/replay.$ext"; done
 mv "$NUDGE_ROOT/docs/results/${stem}_gallery.png" "$out_dir/replay_gallery.png" 2>/dev/null || true
 sed -i "s/${stem}_gallery.png/replay_gallery.png/" "$out_dir/replay.md"

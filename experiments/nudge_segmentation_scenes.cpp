@@ -131,8 +131,11 @@ void stage(Draw& d, sim::Scene& scene, Look look) {
 
 double footprint(const sim::ObjectSpec& o) { return sim::model_of(o, 8).max_radius + (o.kind == "mug" ? 0.02 : 0.0); }
 
-// Objects in the arm's reach and both cameras' views: one in front of the arm, several spread
-// with room between them for a push (5 cm between outlines). A crowded draw starts over.
+// Objects in both cameras' views: one in front of the arm, several spread with room between them
+// for a push (5 cm between outlines). A crowded draw starts over. The several are drawn from a
+// box whose far corners (up to 0.367 m from the base) lie beyond the workspace ring's 0.35 m: an
+// object drawn there cannot be nudged, and nudge-exp-nudge-segmentation counts it apart
+// ("within the arm's workspace ring"). The sets written are kept as they are (seeds fixed).
 bool try_place(Draw& d, std::vector<sim::ObjectSpec>& objects) {
   for (size_t i = 0; i < objects.size(); ++i) {
     sim::ObjectSpec& o = objects[i];

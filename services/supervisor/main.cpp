@@ -64,6 +64,7 @@ struct Options {
   bool keep_running = false;
   std::string line_pick = "strongest";  // strongest, nearest (LineSearchParams::strongest)
   int rest_from_still = 1;               // Config::rest_from_still
+  int rival_by_foot = 1;                 // Config::rival_by_foot
   std::string learn = "auto";      // on, off, auto (while the learner's heartbeat is heard)
   std::string learner = "learner"; // the learner service's heartbeat name
   sv::Config config;
@@ -594,6 +595,15 @@ void add_flags(Flags& f, Options& o) {
   f.add_double("far-rest", &o.config.far_rest_m,
                "with --rest-from-still 1: a settled axes' rest farther than this along the push, about whose line the stills "
                "show no change, gives way to a new line along the push when one is found, m (0: never)");
+  f.add_int("rival-by-foot", &o.rival_by_foot,
+            "1: a candidate on the target's right-camera line whose depth beyond the foot of the line in the before still is "
+            "nearer --foot-depth-typical by --rival-margin is nudged instead; 0: the survey's choice stands");
+  f.add_double("foot-depth-typical", &o.config.foot_depth_typical_m,
+               "how far an object's axis stands beyond the table point under its line's lowest pixel (its radius), m");
+  f.add_double("rival-margin", &o.config.rival_margin_m,
+               "with --rival-by-foot 1: how much nearer the typical depth a rival must stand to be nudged instead, m");
+  f.add_double("rival-max-misfit", &o.config.rival_max_misfit_m,
+               "with --rival-by-foot 1: a rival farther than this from --foot-depth-typical fits the foot no better, m");
   f.add_string("line-pick", &o.line_pick,
                "of the lines near a still's predicted object line: the strongest (most votes) or the nearest");
   f.add_double("min-mask-mirror", &o.config.min_mask_mirror_agreement,
@@ -663,6 +673,10 @@ int main(int argc, char** argv) {
     if (!(opt.config.far_rest_m >= 0 && opt.config.far_rest_m <= opt.config.max_travel_m))
       throw FlagError("--far-rest must lie in [0, " + std::to_string(opt.config.max_travel_m) + "] m");
     opt.config.rest_from_still = opt.rest_from_still == 1;
+    if (opt.rival_by_foot != 0 && opt.rival_by_foot != 1) throw FlagError("--rival-by-foot must be 0 or 1");
+    if (!(opt.config.rival_margin_m >= 0)) throw FlagError("--rival-margin must be 0 or more");
+    if (!(opt.config.rival_max_misfit_m >= 0)) throw FlagError("--rival-max-misfit must be 0 or more");
+    opt.config.rival_by_foot = opt.rival_by_foot == 1;
     if (!(opt.config.line_search.not_object_px >= 0 && opt.config.line_search.not_object_px < 100))
       throw FlagError("--column-line-px must lie in [0, 100)");
     if (!(opt.config.push_travel_m >= 0 && opt.config.push_travel_m <= opt.config.max_travel_m))

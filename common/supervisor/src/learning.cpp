@@ -38,6 +38,7 @@ void Supervisor::stills_arrived(int64_t now) {
     return;
   }
   before_lines();
+  prefer_rival_at_the_lines_foot();
   if (attempt_->learn) {
     recognise(now);
   } else {

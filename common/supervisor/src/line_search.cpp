@@ -24,10 +24,6 @@ bool reaches_foot(const symmetry::Line& line, const symmetry::Line& predicted, d
   return reach >= (1 - slack) * length;
 }
 
-}  // namespace
-
-namespace {
-
 // Per pixel, the largest change of a channel between two stills of the same size and type.
 cv::Mat largest_channel_change(const cv::Mat& earlier, const cv::Mat& later) {
   cv::Mat difference;

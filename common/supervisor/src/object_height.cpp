@@ -32,6 +32,22 @@ std::optional<double> ray_height_over(const SceneGeometry& scene, const Eigen::V
   return origin.z() + t * ray.z();
 }
 
+std::optional<double> depth_beyond_line_foot(const SceneGeometry& scene, const symmetry::Line& line,
+                                             const Eigen::Vector3d& foot, cv::Size size) {
+  if (cv::norm(line.seg1 - line.seg2) < 1) return std::nullopt;  // no support
+  const cv::Point2d lower = line.seg1.y >= line.seg2.y ? line.seg1 : line.seg2;
+  const geometry::Camera& camera = scene.rig().right;
+  const auto normalised = camera.normalise(to_calibration(camera, lower, size));
+  if (!normalised) return std::nullopt;
+  const Eigen::Vector3d origin = scene.right_camera_in_world();
+  const Eigen::Vector3d ray = scene.right_to_world(Eigen::Vector3d(normalised->x(), normalised->y(), 1.0)) - origin;
+  if (!(ray.z() < -1e-9)) return std::nullopt;  // level or looking up: it never meets the table
+  const Eigen::Vector3d on_table = origin - (origin.z() / ray.z()) * ray;
+  const Eigen::Vector2d view = (foot - origin).head<2>();
+  if (view.norm() < 1e-9) return std::nullopt;
+  return (foot - on_table).head<2>().dot(view.normalized());
+}
+
 namespace {
 
 // The end of a line's support segment higher in the image.

@@ -162,6 +162,21 @@ std::string attempt_json(const Attempt& a) {
     }
     j.field("pushed_object_height_m", a.pushed_object_height);
   }
+  if (a.foot_depth_m) j.field("foot_depth_m", *a.foot_depth_m);
+  if (a.replaced) {
+    j.key("replaced").begin_object().field("candidate_index", a.replaced->index).field("foot_depth_m", a.replaced_foot_depth_m);
+    write_point(j, "position", a.replaced->position);
+    j.end_object();
+  }
+  if (!a.rivals.empty()) {
+    j.key("rivals").begin_array();
+    for (const auto& [c, depth] : a.rivals) {
+      j.begin_object().field("candidate_index", c.index).field("foot_depth_m", depth);
+      write_point(j, "position", c.position);
+      j.end_object();
+    }
+    j.end_array();
+  }
   if (a.rest_from_mask) write_point(j, "rest_from_mask", *a.rest_from_mask);
   if (a.rest_from_axes) write_point(j, "rest_from_axes", *a.rest_from_axes);
   if (a.rest_from_still) j.field("rest_from_still", true);

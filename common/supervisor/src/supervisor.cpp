@@ -191,6 +191,49 @@ void Supervisor::choose(int64_t now) {
   request_still(State::SnapshotBefore, now, choice.note);
 }
 
+// Config::rival_by_foot: the target's depth checked against its before line's foot, and a
+// candidate on the same right-camera line at the depth the foot shows nudged instead.
+void Supervisor::prefer_rival_at_the_lines_foot() {
+  Attempt& a = *attempt_;
+  if (!a.before_line) return;
+  auto depth = [&](const Candidate& c) { return depth_beyond_line_foot(scene_, *a.before_line, c.position, config_.still_size); };
+  auto misfit = [&](double d) { return std::abs(d - config_.foot_depth_typical_m); };
+  a.foot_depth_m = depth(a.target);
+  const auto target_line = scene_.right_axis_line(a.target.position, config_.object_height_m, config_.frame_size);
+  if (!a.foot_depth_m || !target_line) return;
+  const double max_angle = config_.agreement_angle_deg * M_PI / 180;
+  std::vector<Rejection> hidden;
+  std::optional<std::pair<Candidate, double>> best;
+  for (const Candidate& c : drop_hidden_behind_arm_base(hidden)) {
+    if (c.index == a.target.index) continue;
+    const auto line = scene_.right_axis_line(c.position, config_.object_height_m, config_.frame_size);
+    if (!line || !lines_agree(*line, *target_line, max_angle, config_.agreement_offset_px)) continue;
+    const auto d = depth(c);
+    if (!d) continue;
+    a.rivals.emplace_back(c, *d);
+    if (!best || misfit(*d) < misfit(best->second)) best = a.rivals.back();
+  }
+  if (!config_.rival_by_foot || !best || misfit(best->second) > config_.rival_max_misfit_m ||
+      misfit(best->second) > misfit(*a.foot_depth_m) - config_.rival_margin_m)
+    return;
+  const History history{explored_with_ray_mates(), phantoms_, empty_, standing_};
+  const TargetChoice choice = choose_target({best->first}, history, scene_.right_camera_in_world(), arm_, joints_, config_.targets);
+  if (!choice.found) return;  // the rival is explored or out of reach: the survey's choice stands
+  a.replaced = a.target;
+  a.replaced_foot_depth_m = *a.foot_depth_m;
+  a.foot_depth_m = best->second;
+  a.target = choice.target;
+  a.direction = choice.direction;
+  a.plan = choice.plan;
+  a.height_limit = choice.height_limit;
+  report_.candidate_index = choice.target.index;
+  report_.target = choice.target.position;
+  a.before_line.reset();
+  a.measured_height.reset();
+  a.before_line_left.reset();
+  before_lines();  // the new target's prediction
+}
+
 // The horizontal direction from the right camera to a point on the table.
 Eigen::Vector2d Supervisor::viewing_ray(const Eigen::Vector3d& at) const {
   const Eigen::Vector2d ray = (at - scene_.right_camera_in_world()).head<2>();
@@ -353,7 +396,15 @@ void Supervisor::start_nudge(int64_t now) {
     if ((config_.track || config_.track_trace) && target_lines_[camera]) trackers_[camera] = std::make_unique<tracking::SymmetryTracker>(config_.tracker);
   }
   nudge_seq_ = next_seq_++;
-  enter(State::Nudge, now, "nudging candidate " + std::to_string(a.target.index) + " at " + millimetres(a.target.position));
+  std::string rival;
+  if (a.replaced) {
+    char text[200];
+    std::snprintf(text, sizeof text, " instead of candidate %d at %s on its right-camera line: they stand %.0f and %.0f mm beyond "
+                  "the foot of the line in the still", a.replaced->index, millimetres(a.replaced->position).c_str(),
+                  1e3 * *a.foot_depth_m, 1e3 * a.replaced_foot_depth_m);
+    rival = text;
+  }
+  enter(State::Nudge, now, "nudging candidate " + std::to_string(a.target.index) + " at " + millimetres(a.target.position) + rival);
   outputs_.push_back(NudgeCommand{nudge_seq_, a.target.position, a.direction, *object_height});
 }
 

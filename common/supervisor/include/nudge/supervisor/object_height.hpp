@@ -40,6 +40,16 @@ void validate(const HeightParams& params);
 std::optional<double> ray_height_over(const SceneGeometry& scene, const Eigen::Vector3d& foot, const cv::Point2d& pixel,
                                       cv::Size size);
 
+// How far `foot` (world: an axis standing on the table) lies beyond the table point under the
+// lower end of `line`'s support in the right camera (image `size`), along the camera's horizontal
+// view towards `foot`, m. The lowest pixel of an upright object's outline is the front of its
+// base: for the object's own axis this is about its radius (0 to 5 cm); for a candidate that a
+// stereo mismatch placed at another depth on the same right-camera line, it is off by the
+// mismatch. Nothing for a line without support, or when the ray through the lower end does not
+// meet the table in front of the camera.
+std::optional<double> depth_beyond_line_foot(const SceneGeometry& scene, const symmetry::Line& line,
+                                             const Eigen::Vector3d& foot, cv::Size size);
+
 // The object's height in the right still: the top of the edge pairs symmetric about
 // `object_line` (its line in the still, e.g. find_line_near's), read over the vertical through
 // `foot`, and never below the top of `object_line`'s own support. Nothing when no line near

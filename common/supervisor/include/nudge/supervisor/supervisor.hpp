@@ -139,6 +139,21 @@ struct Config {
   // development runs an object nudged at its axis slid at most 5 cm along the push (the pad stops
   // 2 cm short of the target's axis).
   double far_rest_m = 0.06;
+  // The before still says how deep the target stands: the ray through the lower end of its line's
+  // support meets the table at the front of the object's base, about its radius before the axis
+  // (depth_beyond_line_foot; foot_depth_typical_m). The candidates of the same survey on the same
+  // right-camera line (agreement_angle_deg, agreement_offset_px) are the one line paired at other
+  // depths; the one whose depth beyond the foot is nearest the typical is nudged instead of the
+  // target when it is nearer by at least rival_margin_m, itself within rival_max_misfit_m of the
+  // typical (a foot neither fits is not the object's: development s09's line ended 17 and 26 cm
+  // off both), and the arm can push it. The lower end
+  // wanders (a clear bottle's base shows no pair, a shadow adds some; on the recorded runs the
+  // chosen objects stood -9 to +13 cm beyond it, most 1-5 cm), hence a comparison with the
+  // rivals, never a bound on the target alone. (Held-out h11: a candidate 5.9 cm behind the clear
+  // bottle, on its right-camera line and seen in more frames, was nudged; the push grazed the
+  // bottle and the segmentation failed.) Off: the survey's choice stands.
+  bool rival_by_foot = true;
+  double foot_depth_typical_m = 0.03, rival_margin_m = 0.03, rival_max_misfit_m = 0.05;
   double object_height_m = 0.25;     // the tallest expected object (lines drawn up to it)
   int min_mask_pixels = 200;         // a smaller mask (in the still) is no object
   // Nor is a mask smaller than this share of the still's image of the smallest object expected
@@ -272,6 +287,12 @@ struct Attempt {
   double pushed_object_height = 0;
   std::vector<Candidate> candidates;       // the survey it was chosen from
   std::vector<Rejection> rejected;         // candidates passed over for it
+  // Config::rival_by_foot: how far the target stands beyond its before line's foot (depth_beyond_line_foot),
+  // and the candidate first chosen when a rival on its right-camera line was nudged instead.
+  std::optional<double> foot_depth_m;
+  std::optional<Candidate> replaced;
+  double replaced_foot_depth_m = 0;
+  std::vector<std::pair<Candidate, double>> rivals;  // on the target's right-camera line, with their depths beyond its foot
   Outcome outcome = Outcome::Aborted;
   std::string reason;
   int64_t started = 0, ended = 0;          // task clock, us
@@ -503,6 +524,7 @@ class Supervisor {
   bool stills_complete() const;
   void stills_arrived(int64_t now);
   void before_lines();
+  void prefer_rival_at_the_lines_foot();
   void segment_left(Attempt& attempt) const;
   SegmentFunction segment_left_;
   SegmentFunction segment_stageless_;
