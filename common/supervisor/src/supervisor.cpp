@@ -195,33 +195,17 @@ void Supervisor::choose(int64_t now) {
 // candidate on the same right-camera line at the depth the foot shows nudged instead.
 void Supervisor::prefer_rival_at_the_lines_foot() {
   Attempt& a = *attempt_;
-  if (!a.before_line) return;
-  auto depth = [&](const Candidate& c) { return depth_beyond_line_foot(scene_, *a.before_line, c.position, config_.still_size); };
+  const std::optional<size_t> rival = rivals_at_the_lines_foot(a);
+  if (!config_.rival_by_foot || !rival) return;
   auto misfit = [&](double d) { return std::abs(d - config_.foot_depth_typical_m); };
-  a.foot_depth_m = depth(a.target);
-  const auto target_line = scene_.right_axis_line(a.target.position, config_.object_height_m, config_.frame_size);
-  if (!a.foot_depth_m || !target_line) return;
-  const double max_angle = config_.agreement_angle_deg * M_PI / 180;
-  std::vector<Rejection> hidden;
-  std::optional<std::pair<Candidate, double>> best;
-  for (const Candidate& c : drop_hidden_behind_arm_base(hidden)) {
-    if (c.index == a.target.index) continue;
-    const auto line = scene_.right_axis_line(c.position, config_.object_height_m, config_.frame_size);
-    if (!line || !lines_agree(*line, *target_line, max_angle, config_.agreement_offset_px)) continue;
-    const auto d = depth(c);
-    if (!d) continue;
-    a.rivals.emplace_back(c, *d);
-    if (!best || misfit(*d) < misfit(best->second)) best = a.rivals.back();
-  }
-  if (!config_.rival_by_foot || !best || misfit(best->second) > config_.rival_max_misfit_m ||
-      misfit(best->second) > misfit(*a.foot_depth_m) - config_.rival_margin_m)
-    return;
+  const auto& [candidate, depth] = a.rivals[*rival];
+  if (misfit(depth) > config_.rival_max_misfit_m || misfit(depth) > misfit(*a.foot_depth_m) - config_.rival_margin_m) return;
   const History history{explored_with_ray_mates(), phantoms_, empty_, standing_};
-  const TargetChoice choice = choose_target({best->first}, history, scene_.right_camera_in_world(), arm_, joints_, config_.targets);
+  const TargetChoice choice = choose_target({candidate}, history, scene_.right_camera_in_world(), arm_, joints_, config_.targets);
   if (!choice.found) return;  // the rival is explored or out of reach: the survey's choice stands
   a.replaced = a.target;
   a.replaced_foot_depth_m = *a.foot_depth_m;
-  a.foot_depth_m = best->second;
+  a.foot_depth_m = depth;
   a.target = choice.target;
   a.direction = choice.direction;
   a.plan = choice.plan;
@@ -232,6 +216,31 @@ void Supervisor::prefer_rival_at_the_lines_foot() {
   a.measured_height.reset();
   a.before_line_left.reset();
   before_lines();  // the new target's prediction
+}
+
+// Sets the attempt's foot_depth_m and rivals (the survey's candidates on the target's right-camera
+// line, with their depths beyond its before line's foot); the index of the rival nearest the
+// typical depth, or nothing.
+std::optional<size_t> Supervisor::rivals_at_the_lines_foot(Attempt& a) const {
+  if (!a.before_line) return std::nullopt;
+  auto depth = [&](const Candidate& c) { return depth_beyond_line_foot(scene_, *a.before_line, c.position, config_.still_size); };
+  auto misfit = [&](double d) { return std::abs(d - config_.foot_depth_typical_m); };
+  a.foot_depth_m = depth(a.target);
+  const auto target_line = scene_.right_axis_line(a.target.position, config_.object_height_m, config_.frame_size);
+  if (!a.foot_depth_m || !target_line) return std::nullopt;
+  const double max_angle = config_.agreement_angle_deg * M_PI / 180;
+  std::vector<Rejection> hidden;
+  std::optional<size_t> best;
+  for (const Candidate& c : drop_hidden_behind_arm_base(hidden)) {
+    if (c.index == a.target.index) continue;
+    const auto line = scene_.right_axis_line(c.position, config_.object_height_m, config_.frame_size);
+    if (!line || !lines_agree(*line, *target_line, max_angle, config_.agreement_offset_px)) continue;
+    const auto d = depth(c);
+    if (!d) continue;
+    a.rivals.emplace_back(c, *d);
+    if (!best || misfit(*d) < misfit(a.rivals[*best].second)) best = a.rivals.size() - 1;
+  }
+  return best;
 }
 
 // The horizontal direction from the right camera to a point on the table.

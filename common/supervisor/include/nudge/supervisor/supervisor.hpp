@@ -525,6 +525,7 @@ class Supervisor {
   void stills_arrived(int64_t now);
   void before_lines();
   void prefer_rival_at_the_lines_foot();
+  std::optional<size_t> rivals_at_the_lines_foot(Attempt& a) const;
   void segment_left(Attempt& attempt) const;
   SegmentFunction segment_left_;
   SegmentFunction segment_stageless_;
