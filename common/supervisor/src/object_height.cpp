@@ -18,13 +18,25 @@ void validate(const HeightParams& p) {
   require(p.margin_m >= 0 && p.margin_m < 1, "margin_m must be in [0, 1) m");
 }
 
-std::optional<double> ray_height_over(const SceneGeometry& scene, const Eigen::Vector3d& foot, const cv::Point2d& pixel,
-                                      cv::Size size) {
+namespace {
+
+// The right camera's ray through `pixel` (image `size`), world frame: its direction (not
+// normalised); nothing when the pixel does not map to a ray.
+std::optional<Eigen::Vector3d> right_ray(const SceneGeometry& scene, const cv::Point2d& pixel, cv::Size size) {
   const geometry::Camera& camera = scene.rig().right;
   const auto normalised = camera.normalise(to_calibration(camera, pixel, size));
   if (!normalised) return std::nullopt;
+  return scene.right_to_world(Eigen::Vector3d(normalised->x(), normalised->y(), 1.0)) - scene.right_camera_in_world();
+}
+
+}  // namespace
+
+std::optional<double> ray_height_over(const SceneGeometry& scene, const Eigen::Vector3d& foot, const cv::Point2d& pixel,
+                                      cv::Size size) {
+  const auto direction = right_ray(scene, pixel, size);
+  if (!direction) return std::nullopt;
   const Eigen::Vector3d origin = scene.right_camera_in_world();
-  const Eigen::Vector3d ray = scene.right_to_world(Eigen::Vector3d(normalised->x(), normalised->y(), 1.0)) - origin;
+  const Eigen::Vector3d& ray = *direction;
   const Eigen::Vector2d across = ray.head<2>();
   if (across.squaredNorm() < 1e-12) return std::nullopt;  // looking straight down the vertical
   const double t = (foot - origin).head<2>().dot(across) / across.squaredNorm();
@@ -36,11 +48,10 @@ std::optional<double> depth_beyond_line_foot(const SceneGeometry& scene, const s
                                              const Eigen::Vector3d& foot, cv::Size size) {
   if (cv::norm(line.seg1 - line.seg2) < 1) return std::nullopt;  // no support
   const cv::Point2d lower = line.seg1.y >= line.seg2.y ? line.seg1 : line.seg2;
-  const geometry::Camera& camera = scene.rig().right;
-  const auto normalised = camera.normalise(to_calibration(camera, lower, size));
-  if (!normalised) return std::nullopt;
+  const auto direction = right_ray(scene, lower, size);
+  if (!direction) return std::nullopt;
   const Eigen::Vector3d origin = scene.right_camera_in_world();
-  const Eigen::Vector3d ray = scene.right_to_world(Eigen::Vector3d(normalised->x(), normalised->y(), 1.0)) - origin;
+  const Eigen::Vector3d& ray = *direction;
   if (!(ray.z() < -1e-9)) return std::nullopt;  // level or looking up: it never meets the table
   const Eigen::Vector3d on_table = origin - (origin.z() / ray.z()) * ray;
   const Eigen::Vector2d view = (foot - origin).head<2>();
