@@ -55,12 +55,6 @@ cv::Mat read_frame(const std::string& dir, const std::string& name) {
   return bytes.empty() ? cv::Mat() : cv::imdecode(bytes, cv::IMREAD_COLOR);
 }
 
-double thread_cpu_ms() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return t.tv_sec * 1e3 + t.tv_nsec * 1e-6;
-}
-
 // The histogram step of the voting on its own: every vote of the plain accumulator (the same count
 // per theta and R bin) as a 16-bit bin, in random order within each theta, added into four
 // interleaved int32 copies of an accumulator row as the voting does, the copies summed per theta.

@@ -14,6 +14,9 @@ std::string results_dir();
 void write_result(const std::string& name, const std::string& text);
 
 double median(std::vector<double> v);
+// The calling thread's CPU time, ms: what a single-threaded computation cost, whatever else the
+// (shared) host ran meanwhile.
+double thread_cpu_ms();
 double mean(const std::vector<double>& v);
 
 struct LinearFit {

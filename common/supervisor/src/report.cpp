@@ -9,6 +9,7 @@
 
 #include "nudge/atomic_file.hpp"
 #include "nudge/json.hpp"
+#include "nudge/segmentation/motion.hpp"
 
 namespace nudge::supervisor {
 
@@ -211,7 +212,9 @@ std::string save_attempt(const std::string& directory, const Attempt& attempt, c
   write_png((folder / "before.png").string(), attempt.before);
   write_png((folder / "after.png").string(), attempt.after);
   write_png((folder / "mask.png").string(), attempt.segmentation.mask);
-  write_png((folder / "cutout.png").string(), attempt.segmentation.cutout);
+  const cv::Mat& mask = attempt.segmentation.mask;
+  if (!mask.empty() && mask.size() == attempt.after.size())
+    write_png((folder / "cutout.png").string(), segmentation::cut_out(attempt.after, mask));
   write_png((folder / "workspace.png").string(), draw_workspace(attempt, arm, right_camera));
   for (const auto& [stage, image] : attempt.segmentation.stages) write_png((folder / "stages" / (stage + ".png")).string(), image);
   // Learning (additive): the left stills and segmentation; the views are saved as they are taken.

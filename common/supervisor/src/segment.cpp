@@ -15,7 +15,6 @@ SegmentFunction motion_segmentation(segmentation::MotionParams params, bool keep
       const segmentation::MotionSegmentation result = segmenter->segment(before, after, before_line, after_line, keep_stages ? &stages : nullptr);
       if (!result.found) out.error = result.reason;
       out.mask = result.mask;
-      out.cutout = result.cutout;
     } catch (const std::invalid_argument& e) {
       out.error = e.what();
       return out;

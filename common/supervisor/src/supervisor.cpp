@@ -820,7 +820,6 @@ void Supervisor::keep_object_rows(Attempt& a) const {
   const int last = std::clamp(static_cast<int>(lowest) + margin, 0, mask.rows);
   mask.rowRange(0, first).setTo(0);
   mask.rowRange(last, mask.rows).setTo(0);
-  if (!a.segmentation.cutout.empty()) a.segmentation.cutout.setTo(cv::Scalar::all(0), mask == 0);
 }
 
 void Supervisor::end_attempt(Outcome outcome, const std::string& reason, int64_t now) {

@@ -233,7 +233,6 @@ struct Axis {
 // ---- what motion segmentation returns (common/segmentation, thesis sec. 6.4) ----
 struct Segmentation {
   cv::Mat mask;                                            // CV_8U 0/255, the still's size
-  cv::Mat cutout;                                          // the after still where the mask is set
   std::vector<std::pair<std::string, cv::Mat>> stages;     // fig. 6.7's intermediate images
   std::string error;                                       // why there is no mask
 };
