@@ -344,6 +344,18 @@ TEST(MotionSegmentation, TheDifferenceIsEachPixelsLargestChannelChangeAtAnyWidth
   }
 }
 
+TEST(MotionSegmentation, TheLargestChannelChangeIsNamedForBadImagesAndWorksForFourChannels) {
+  cv::Mat a(3, 20, CV_8UC4, cv::Scalar(10, 20, 30, 40)), b(3, 20, CV_8UC4, cv::Scalar(10, 25, 0, 41));
+  const cv::Mat change = largest_channel_change(a, b);
+  ASSERT_EQ(change.type(), CV_8U);
+  EXPECT_EQ(change.at<uint8_t>(1, 7), 30);
+  const cv::Mat grey = largest_channel_change(cv::Mat(2, 17, CV_8U, cv::Scalar(9)), cv::Mat(2, 17, CV_8U, cv::Scalar(4)));
+  EXPECT_EQ(grey.at<uint8_t>(1, 16), 5);
+  EXPECT_THROW(largest_channel_change(a, cv::Mat(3, 21, CV_8UC4)), std::invalid_argument);
+  EXPECT_THROW(largest_channel_change(a, cv::Mat(3, 20, CV_8UC3)), std::invalid_argument);
+  EXPECT_THROW(largest_channel_change(cv::Mat(3, 20, CV_16U), cv::Mat(3, 20, CV_16U)), std::invalid_argument);
+}
+
 TEST(MotionSegmentation, TheCutOutIsTheImageWhereTheMaskIsSet) {
   const cv::Mat image(4, 5, CV_8UC3, cv::Scalar(10, 20, 30));
   cv::Mat mask = cv::Mat::zeros(4, 5, CV_8U);

@@ -564,6 +564,21 @@ void MotionStages::save(const std::string& directory) const {
   }
 }
 
+cv::Mat largest_channel_change(const cv::Mat& earlier, const cv::Mat& later) {
+  if (earlier.empty() || earlier.size() != later.size() || earlier.type() != later.type() || earlier.depth() != CV_8U)
+    throw std::invalid_argument("largest_channel_change: the images must be 8-bit, of one size and type");
+  cv::Mat change;
+  if (earlier.channels() == 1 || earlier.channels() == 3) {
+    channel_max_difference(earlier, later, change);
+    return change;
+  }
+  cv::absdiff(earlier, later, change);
+  std::vector<cv::Mat> channels;
+  cv::split(change, channels);
+  for (size_t c = 1; c < channels.size(); ++c) cv::max(channels[0], channels[c], channels[0]);
+  return channels[0];
+}
+
 cv::Mat cut_out(const cv::Mat& image, const cv::Mat& mask) {
   if (image.empty() || mask.size() != image.size() || mask.type() != CV_8UC1)
     throw std::invalid_argument("cut_out: the mask must be 8-bit, one channel, the image's size");

@@ -6,6 +6,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "nudge/segmentation/motion.hpp"
 #include "nudge/supervisor/scene.hpp"
 #include "nudge/symmetry/line.hpp"
 
@@ -22,17 +23,6 @@ bool reaches_foot(const symmetry::Line& line, const symmetry::Line& predicted, d
   const cv::Point2d down = top_to_foot / length;
   const double reach = std::max((line.seg1 - predicted.seg2).dot(down), (line.seg2 - predicted.seg2).dot(down));
   return reach >= (1 - slack) * length;
-}
-
-// Per pixel, the largest change of a channel between two stills of the same size and type.
-cv::Mat largest_channel_change(const cv::Mat& earlier, const cv::Mat& later) {
-  cv::Mat difference;
-  cv::absdiff(earlier, later, difference);
-  if (difference.channels() == 1) return difference;
-  std::vector<cv::Mat> channels;
-  cv::split(difference, channels);
-  for (size_t c = 1; c < channels.size(); ++c) channels[0] = cv::max(channels[0], channels[c]);
-  return channels[0];
 }
 
 double changed_share_of(const cv::Mat& change, const symmetry::Line& line, double half_width_px, int threshold) {
@@ -57,7 +47,7 @@ double changed_share_of(const cv::Mat& change, const symmetry::Line& line, doubl
 double changed_share(const cv::Mat& earlier, const cv::Mat& later, const symmetry::Line& line, double half_width_px,
                      int threshold) {
   if (earlier.empty() || earlier.size() != later.size() || earlier.type() != later.type()) return 0;
-  return changed_share_of(largest_channel_change(earlier, later), line, half_width_px, threshold);
+  return changed_share_of(segmentation::largest_channel_change(earlier, later), line, half_width_px, threshold);
 }
 
 cv::Rect search_region(const cv::Size& size, const symmetry::Line& predicted, const LineSearchParams& params) {
@@ -117,7 +107,11 @@ std::optional<symmetry::Line> find_line_near(const cv::Mat& image, const symmetr
   const bool compare = !earlier.empty();
   if (compare && (earlier.size() != image.size() || earlier.type() != image.type()))
     throw std::invalid_argument("find_line_near: the earlier still differs from the still in size or type");
-  const cv::Mat change = compare ? largest_channel_change(earlier, image) : cv::Mat();
+  cv::Mat change;  // made when a line first needs it (lines off the window or avoided need none)
+  const auto changed_share_about = [&](const symmetry::Line& line) {
+    if (change.empty()) change = segmentation::largest_channel_change(earlier, image);
+    return changed_share_of(change, line, 0.5 * p.dmin, params.change_threshold);
+  };
   // A not-an-object line the prediction itself lies on is not avoided: the object stands in line
   // with it in the image (its line and the column's are one), and the one line is the object's.
   const double not_object_angle = params.not_object_deg * M_PI / 180;
@@ -138,7 +132,7 @@ std::optional<symmetry::Line> find_line_near(const cv::Mat& image, const symmetr
         }))
       continue;
     // Where nothing changed about the line since the earlier still, it stood there then.
-    if (compare && changed_share_of(change, line, 0.5 * p.dmin, params.change_threshold) < params.min_changed_share)
+    if (compare && changed_share_about(line) < params.min_changed_share)
       continue;
     const bool reaches = reaches_foot(line, predicted, params.foot_slack);
     const bool preferred = params.strongest ? line.votes > best_votes : offset <= best_offset;

@@ -124,6 +124,11 @@ class MotionSegmenter {
   detail::MotionScratch scratch_;
 };
 
+// Per pixel, the largest change of a channel between two 8-bit images of the same size and type
+// (a change of hue counts as much as one of brightness): CV_8U. Vectorised for 1 and 3 channels.
+// Throws std::invalid_argument for images that differ or are not 8-bit.
+cv::Mat largest_channel_change(const cv::Mat& earlier, const cv::Mat& later);
+
 // `image` where `mask` (8-bit, one channel, the image's size) is set, 0 elsewhere: fig. 6.7 (f).
 // Throws std::invalid_argument for a mask that does not fit.
 cv::Mat cut_out(const cv::Mat& image, const cv::Mat& mask);
