@@ -5,6 +5,7 @@
 
 #include <fstream>
 
+#include "nudge/camera/image_file.hpp"
 #include "nudge/camera/source.hpp"
 
 using namespace nudge::camera;
@@ -39,4 +40,25 @@ TEST(CameraSource, BadSpecsAreClearErrors) {
   EXPECT_NE(error_of("video:/nonexistent.mp4").find("cannot be opened"), std::string::npos);
   EXPECT_NE(error_of("webcam").find("unknown camera source"), std::string::npos);
   EXPECT_NE(error_of("device:abc").find("device index"), std::string::npos);
+}
+
+TEST(ImageFile, UnreadableFilesAreNamedWithWhy) {
+  auto error_of = [](const std::string& path) {
+    try {
+      read_image_file(path, cv::IMREAD_COLOR);
+    } catch (const ImageFileError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  const std::string dir = testing::TempDir() + "/image_file_test.png";  // a directory named like an image
+  ::mkdir(dir.c_str(), 0755);
+  EXPECT_NE(error_of(dir).find("a directory, not an image file"), std::string::npos) << error_of(dir);
+  EXPECT_NE(error_of(dir + "/missing.png").find("missing or unreadable"), std::string::npos);
+  const std::string empty = dir + "/empty.png";
+  { std::ofstream touch(empty); }
+  EXPECT_NE(error_of(empty).find("the file is empty"), std::string::npos);
+  const std::string text = dir + "/text.jpg";
+  { std::ofstream out(text); out << "hello"; }
+  EXPECT_NE(error_of(text).find("not an image OpenCV decodes"), std::string::npos);
 }

@@ -1050,6 +1050,24 @@ TEST(PhotoDetection, LargeImagesAreDetectedAtWorkingSizeAndMappedBack) {
   EXPECT_LT(angle_diff_deg(plain.in_image.lines[0].theta, 4.0 * kDeg), 1.0);
 }
 
+TEST(PhotoDetection, ImagesTooSmallOrTooThinAreNamedOrDetected) {
+  // A 1x1 or 3x3 image cannot hold an edge pair 5 px apart: a clear error, not a parameter's.
+  for (const int side : {1, 3}) {
+    try {
+      detect_photo(cv::Mat(side, side, CV_8UC3, cv::Scalar(9, 9, 9)), PhotoOptions{});
+      ADD_FAILURE() << side << " px image accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("too small"), std::string::npos) << e.what();
+    }
+  }
+  // A strip 4000 x 2 px is scaled to the working size with at least one row, and detected.
+  cv::Mat strip(2, 4000, CV_8UC3);
+  cv::randu(strip, cv::Scalar::all(0), cv::Scalar::all(255));
+  const PhotoDetection found = detect_photo(strip, PhotoOptions{});
+  EXPECT_GE(found.working_image.rows, 1);
+  EXPECT_EQ(found.in_image.width, 4000);
+}
+
 TEST(PhotoDetection, CompetitionRule) {
   Line l;
   l.theta = 0;

@@ -1,5 +1,6 @@
 #include "nudge/camera/image_file.hpp"
 
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <opencv2/imgcodecs.hpp>
@@ -11,6 +12,8 @@ namespace nudge::camera {
 
 cv::Mat read_image_file(const std::string& path, int imread_flags, int64_t max_pixels) {
   const auto fail = [&](const std::string& why) { return ImageFileError(path + ": cannot read the image (" + why + ")"); };
+  std::error_code error;
+  if (std::filesystem::is_directory(path, error)) throw fail("a directory, not an image file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw fail("missing or unreadable");
   const std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

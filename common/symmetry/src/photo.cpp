@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 #include "nudge/timing.hpp"
 
@@ -18,14 +19,22 @@ PhotoDetection detect_photo(const cv::Mat& image, const PhotoOptions& options) {
   out.working_image = image;
   const int long_side = std::max(image.cols, image.rows);
   if (options.max_side > 0 && long_side > options.max_side) {
+    // Each side at least 1 px: a strip 4000 x 2 px scaled by 1/4 would otherwise have no rows.
     const double f = static_cast<double>(options.max_side) / long_side;
-    cv::resize(image, out.working_image, cv::Size(), f, f, cv::INTER_AREA);
+    const cv::Size scaled(std::max(1, static_cast<int>(std::lround(image.cols * f))),
+                         std::max(1, static_cast<int>(std::lround(image.rows * f))));
+    cv::resize(image, out.working_image, scaled, 0, 0, cv::INTER_AREA);
   }
   const cv::Mat& work = out.working_image;
   const double short_side = std::min(work.cols, work.rows), work_long = std::max(work.cols, work.rows);
   out.params = options.params;
   out.params.dmin = options.dmin >= 0 ? options.dmin : std::max(5.0, 0.05 * short_side);
   out.params.dmax = options.dmax >= 0 ? options.dmax : 0.5 * work_long;
+  if (options.dmin < 0 && options.dmax < 0 && out.params.dmin > out.params.dmax)
+    throw std::invalid_argument("the image is " + std::to_string(image.cols) + "x" + std::to_string(image.rows) +
+                                " px: too small for symmetry (edge pairs at least " +
+                                std::to_string(static_cast<int>(out.params.dmin)) +
+                                " px apart need a longer side of at least twice that)");
   out.edge_params.blur_sigma = options.blur >= 0 ? options.blur : std::max(1.0, short_side / 480.0);
   if (options.canny.size() == 2) {
     out.edge_params.canny_low = options.canny[0];
