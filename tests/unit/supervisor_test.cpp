@@ -2202,6 +2202,13 @@ TEST_F(LearningTest, TheViewsTheLeftStillsAndTheLearningAreSavedBesideTheAttempt
   const std::string folder = sv::save_attempt(dir, *a, sv::ArmSetup{}, scene_.right_camera_in_world());
   for (const char* name : {"before.png", "after.png", "mask.png", "before_left.png", "after_left.png", "mask_left.png", "attempt.json"})
     EXPECT_TRUE(std::filesystem::exists(folder + "/" + name)) << name;
+  // The cut-out is made where it is written: the after still where the mask is set, black elsewhere.
+  const cv::Mat cutout = cv::imread(folder + "/cutout.png", cv::IMREAD_COLOR);
+  ASSERT_EQ(cutout.size(), a->after.size());
+  cv::Mat expected = cv::Mat::zeros(a->after.size(), a->after.type());
+  a->after.copyTo(expected, a->segmentation.mask);
+  EXPECT_EQ(cv::norm(cutout, expected, cv::NORM_INF), 0);
+  EXPECT_GT(cv::countNonZero(a->segmentation.mask), 0);
   std::ifstream in(folder + "/attempt.json");
   const std::string json((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   EXPECT_NE(json.find("\"learning\":{\"outcome\":\"snapshot lost\""), std::string::npos) << json.substr(0, 400);
