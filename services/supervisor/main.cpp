@@ -598,6 +598,10 @@ void add_flags(Flags& f, Options& o) {
   f.add_int("rival-by-foot", &o.rival_by_foot,
             "1: a candidate on the target's right-camera line whose depth beyond the foot of the line in the before still is "
             "nearer --foot-depth-typical by --rival-margin is nudged instead; 0: the survey's choice stands");
+  f.add_double("line-obstacles", &o.config.line_obstacle_share,
+               "> 0: a place on the table that the survey's right-camera lines mark (the ray through each line's lowest "
+               "pixel, --foot-depth-typical beyond) in at least this share of the frames is an obstacle every push keeps "
+               "clear of, as of a candidate (an object the stereo pairing missed); 0: off");
   f.add_double("foot-depth-typical", &o.config.foot_depth_typical_m,
                "how far an object's axis stands beyond the table point under its line's lowest pixel (its radius), m");
   f.add_double("rival-margin", &o.config.rival_margin_m,
@@ -674,6 +678,8 @@ int main(int argc, char** argv) {
       throw FlagError("--far-rest must lie in [0, " + std::to_string(opt.config.max_travel_m) + "] m");
     opt.config.rest_from_still = opt.rest_from_still == 1;
     if (opt.rival_by_foot != 0 && opt.rival_by_foot != 1) throw FlagError("--rival-by-foot must be 0 or 1");
+    if (!(opt.config.line_obstacle_share >= 0 && opt.config.line_obstacle_share <= 1))
+      throw FlagError("--line-obstacles must be in [0, 1]");
     if (!(opt.config.rival_margin_m >= 0)) throw FlagError("--rival-margin must be 0 or more");
     if (!(opt.config.rival_max_misfit_m >= 0)) throw FlagError("--rival-max-misfit must be 0 or more");
     opt.config.rival_by_foot = opt.rival_by_foot == 1;

@@ -212,6 +212,8 @@ class SupervisorTest : public ::testing::Test {
   // The object at rest for two seconds (frames and, for the loop without trackers, upright AXES).
   std::vector<sv::Output> slide_without_symmetry(sv::Supervisor& s);
   Eigen::Vector3d nudged_of_rivals_on_one_right_line(const sv::Config& config, double behind_m);
+  std::pair<std::optional<sv::NudgeCommand>, std::string> nudge_beside_an_unpaired_object(const sv::Config& config,
+                                                                                          const Eigen::Vector3d& beside);
   // A run started on `object` alone, its before still taken: the nudge the supervisor commands.
   sv::NudgeCommand nudge_command_for(sv::Supervisor& s, const Eigen::Vector3d& object) {
     start_with(s, {object});
@@ -1685,6 +1687,55 @@ TEST_F(SupervisorTest, ACandidateBeyondTheFootOfItsLineGivesWayToTheOneOnThatLin
   EXPECT_NEAR((nudged_of_rivals_on_one_right_line(off, -0.10) - object).norm(), 0.10, 1e-9);
   // 5 cm behind fits the foot better than the object does: the survey's choice stands.
   EXPECT_NEAR((nudged_of_rivals_on_one_right_line({}, 0.05) - object).norm(), 0.05, 1e-9);
+}
+
+// A survey whose only candidate is the object at (0.22, -0.05); the right camera's lines also show
+// a second object `beside` in every frame, which no left line pairs (so no candidate). The nudge
+// commanded, if any, and the supervisor's last reason.
+std::pair<std::optional<sv::NudgeCommand>, std::string> SupervisorTest::nudge_beside_an_unpaired_object(
+    const sv::Config& config, const Eigen::Vector3d& beside) {
+  sv::Supervisor s = make(config);
+  const Eigen::Vector3d object(0.22, -0.05, 0);
+  s.start(now_, 100);
+  s.on_services({}, now_);
+  // The unpaired object's line: its support's lower end over the front of its base.
+  const auto right_beside = scene_.right_axis_line(beside - 0.03 * along_ray(beside), 0.25, {640, 480});
+  const auto right = scene_.right_axis_line(object, 0.25, {640, 480});
+  const auto left = scene_.left_axis_line(object, 0.25, {640, 480});
+  EXPECT_TRUE(right && left && right_beside);
+  for (int i = 0; i < 10; ++i) {
+    s.on_lines(true, {*left}, now_ + kSecond / 10, now_ + kSecond / 5);
+    s.on_lines(false, {*right, *right_beside}, now_ + kSecond / 10, now_ + kSecond / 5);
+  }
+  now_ += kSecond;
+  s.take_outputs();
+  s.on_candidates({{0, object, 20}}, now_, now_);
+  if (s.state() != sv::State::SnapshotBefore) return {std::nullopt, s.report().reason};
+  s.on_right_still(draw_scene(scene_, {1280, 960}, {object}), now_, now_);
+  const auto nudges = outputs_of<sv::NudgeCommand>(s.take_outputs());
+  if (nudges.empty()) return {std::nullopt, s.report().reason};
+  return {nudges[0], s.report().reason};
+}
+
+TEST_F(SupervisorTest, AnObjectOnlyOneCameraSawIsKeptOffThePushWithLineObstaclesOn) {
+  const Eigen::Vector3d object(0.22, -0.05, 0);
+  sv::Config on;
+  on.line_obstacle_share = 0.5;
+  // Where the push goes with nothing else on the table.
+  const auto [free, free_reason] = nudge_beside_an_unpaired_object(on, Eigen::Vector3d(0.22, 0.30, 0));
+  ASSERT_TRUE(free) << free_reason;
+  const Eigen::Vector3d direction = free->direction.normalized();
+  // An object 9 cm before the target against that direction: on the pad's way in.
+  const Eigen::Vector3d in_the_way = object - 0.09 * direction;
+  const auto [off_nudge, off_reason] = nudge_beside_an_unpaired_object({}, in_the_way);
+  ASSERT_TRUE(off_nudge) << off_reason;
+  EXPECT_GT(off_nudge->direction.normalized().dot(direction), 0.99) << "off: the lines' object is unknown to the planner";
+  const auto [on_nudge, on_reason] = nudge_beside_an_unpaired_object(on, in_the_way);
+  if (on_nudge) {
+    EXPECT_LT(on_nudge->direction.normalized().dot(direction), 0.9) << "pushed through the object one camera saw";
+  } else {
+    EXPECT_NE(on_reason.find("object seen in one camera"), std::string::npos) << on_reason;
+  }
 }
 
 // ---- learning by interaction (thesis ch. 7): recognise, grasp, turn, learn, put back ----

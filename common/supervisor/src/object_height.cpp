@@ -44,8 +44,8 @@ std::optional<double> ray_height_over(const SceneGeometry& scene, const Eigen::V
   return origin.z() + t * ray.z();
 }
 
-std::optional<double> depth_beyond_line_foot(const SceneGeometry& scene, const symmetry::Line& line,
-                                             const Eigen::Vector3d& foot, cv::Size size) {
+std::optional<Eigen::Vector3d> table_point_under_line_foot(const SceneGeometry& scene, const symmetry::Line& line,
+                                                           cv::Size size) {
   if (cv::norm(line.seg1 - line.seg2) < 1) return std::nullopt;  // no support
   const cv::Point2d lower = line.seg1.y >= line.seg2.y ? line.seg1 : line.seg2;
   const auto direction = right_ray(scene, lower, size);
@@ -53,10 +53,16 @@ std::optional<double> depth_beyond_line_foot(const SceneGeometry& scene, const s
   const Eigen::Vector3d origin = scene.right_camera_in_world();
   const Eigen::Vector3d& ray = *direction;
   if (!(ray.z() < -1e-9)) return std::nullopt;  // level or looking up: it never meets the table
-  const Eigen::Vector3d on_table = origin - (origin.z() / ray.z()) * ray;
-  const Eigen::Vector2d view = (foot - origin).head<2>();
+  return Eigen::Vector3d(origin - (origin.z() / ray.z()) * ray);
+}
+
+std::optional<double> depth_beyond_line_foot(const SceneGeometry& scene, const symmetry::Line& line,
+                                             const Eigen::Vector3d& foot, cv::Size size) {
+  const auto on_table = table_point_under_line_foot(scene, line, size);
+  if (!on_table) return std::nullopt;
+  const Eigen::Vector2d view = (foot - scene.right_camera_in_world()).head<2>();
   if (view.norm() < 1e-9) return std::nullopt;
-  return (foot - on_table).head<2>().dot(view.normalized());
+  return (foot - *on_table).head<2>().dot(view.normalized());
 }
 
 namespace {

@@ -155,8 +155,7 @@ void Supervisor::choose(int64_t now) {
   const Eigen::Vector3d camera = scene_.right_camera_in_world();
   std::vector<Rejection> hidden;
   const std::vector<Candidate> visible = drop_hidden_behind_arm_base(hidden);
-  const History history{explored_with_ray_mates(), phantoms_, empty_, standing_};
-  TargetChoice choice = choose_target(visible, history, camera, arm_, joints_, config_.targets);
+  TargetChoice choice = choose_target(visible, history(), camera, arm_, joints_, config_.targets);
   choice.rejected.insert(choice.rejected.end(), hidden.begin(), hidden.end());
   summary_.rejections.clear();
   for (const Rejection& r : choice.rejected) ++summary_.rejections[r.reason];
@@ -200,8 +199,7 @@ void Supervisor::prefer_rival_at_the_lines_foot() {
   auto misfit = [&](double d) { return std::abs(d - config_.foot_depth_typical_m); };
   const auto& [candidate, depth] = a.rivals[*rival];
   if (misfit(depth) > config_.rival_max_misfit_m || misfit(depth) > misfit(*a.foot_depth_m) - config_.rival_margin_m) return;
-  const History history{explored_with_ray_mates(), phantoms_, empty_, standing_};
-  const TargetChoice choice = choose_target({candidate}, history, scene_.right_camera_in_world(), arm_, joints_, config_.targets);
+  const TargetChoice choice = choose_target({candidate}, history(), scene_.right_camera_in_world(), arm_, joints_, config_.targets);
   if (!choice.found) return;  // the rival is explored or out of reach: the survey's choice stands
   a.replaced = a.target;
   a.replaced_foot_depth_m = *a.foot_depth_m;
@@ -1156,6 +1154,43 @@ void Supervisor::on_lines(bool left, const std::vector<symmetry::Line>& lines, i
   auto& kept = survey_lines_[left ? 0 : 1];
   kept.push_back(lines);
   if (kept.size() > 50) kept.erase(kept.begin());
+}
+
+History Supervisor::history() const {
+  return History{explored_with_ray_mates(), phantoms_, empty_, standing_, places_seen_by_right_lines()};
+}
+
+std::vector<Eigen::Vector3d> Supervisor::places_seen_by_right_lines() const {
+  const auto& messages = survey_lines_[1];
+  if (config_.line_obstacle_share <= 0 || messages.empty()) return {};
+  struct Place {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    int lines = 0, frames = 0, last_frame = -1;
+    Eigen::Vector3d mean() const { return sum / lines; }
+  };
+  std::vector<Place> places;
+  const Eigen::Vector3d camera = scene_.right_camera_in_world();
+  for (int frame = 0; frame < static_cast<int>(messages.size()); ++frame) {
+    for (const symmetry::Line& line : messages[frame]) {
+      const auto front = table_point_under_line_foot(scene_, line, config_.frame_size);
+      if (!front) continue;
+      const Eigen::Vector3d view = Eigen::Vector3d((*front - camera).x(), (*front - camera).y(), 0).normalized();
+      const Eigen::Vector3d axis = *front + config_.foot_depth_typical_m * view;  // behind the base's front
+      const double reach = arm_.point_to_base(axis).head<2>().norm();
+      if (reach > config_.line_obstacle_reach_m || reach < config_.line_obstacle_inner_m) continue;
+      auto near = std::find_if(places.begin(), places.end(), [&](const Place& p) {
+        return (p.mean() - axis).head<2>().norm() < config_.targets.explored_radius;
+      });
+      if (near == places.end()) near = places.insert(places.end(), Place{});
+      near->sum += axis;
+      ++near->lines;
+      if (near->last_frame != frame) ++near->frames, near->last_frame = frame;
+    }
+  }
+  std::vector<Eigen::Vector3d> seen;
+  for (const Place& p : places)
+    if (p.frames >= config_.line_obstacle_share * static_cast<double>(messages.size())) seen.push_back(p.mean());
+  return seen;
 }
 
 double Supervisor::stereo_agreement(const Candidate& candidate) const {

@@ -75,8 +75,9 @@ struct Obstacle {
   const char* what;  // for reasons
 };
 
-// The places a push must keep clear of: the other candidates that count as objects, and the
-// explored objects standing where no candidate is (their lines left out of the survey).
+// The places a push must keep clear of: the other candidates that count as objects, the
+// explored objects standing where no candidate is (their lines left out of the survey), and the
+// objects only one camera's lines show.
 std::vector<Obstacle> obstacles_to(const Candidate& c, const std::vector<Candidate>& candidates, const History& history,
                                    const TargetParams& params) {
   std::vector<Obstacle> obstacles;
@@ -92,6 +93,8 @@ std::vector<Obstacle> obstacles_to(const Candidate& c, const std::vector<Candida
   }
   for (const Eigen::Vector3d& object : history.standing)
     if (far_from_target(object) && !near_an_obstacle(object)) obstacles.push_back({object, "explored object"});
+  for (const Eigen::Vector3d& object : history.sighted)
+    if (far_from_target(object) && !near_an_obstacle(object)) obstacles.push_back({object, "object seen in one camera"});
   return obstacles;
 }
 

@@ -40,6 +40,12 @@ void validate(const HeightParams& params);
 std::optional<double> ray_height_over(const SceneGeometry& scene, const Eigen::Vector3d& foot, const cv::Point2d& pixel,
                                       cv::Size size);
 
+// The table point (world, z = 0) under the lower end of `line`'s support in the right camera
+// (image `size`): where the ray through it meets the table. Nothing for a line without support, or
+// when that ray does not meet the table in front of the camera.
+std::optional<Eigen::Vector3d> table_point_under_line_foot(const SceneGeometry& scene, const symmetry::Line& line,
+                                                           cv::Size size);
+
 // How far `foot` (world: an axis standing on the table) lies beyond the table point under the
 // lower end of `line`'s support in the right camera (image `size`), along the camera's horizontal
 // view towards `foot`, m. The lowest pixel of an upright object's outline is the front of its

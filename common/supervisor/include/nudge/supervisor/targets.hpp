@@ -112,6 +112,10 @@ struct History {
   // Explored objects where they stand now. Later surveys leave their lines out, so they may be
   // no candidate; they are still obstacles to every push.
   std::vector<Eigen::Vector3d> standing;
+  // Where a line the right camera saw through most of the survey stands on the table, no
+  // candidate there (Config::line_obstacle_share): an object the stereo pairing missed; an
+  // obstacle to every push.
+  std::vector<Eigen::Vector3d> sighted;
 };
 
 // Candidates nearest the right camera first; the first nudgeable one that `history` does not
