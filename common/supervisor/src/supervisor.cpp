@@ -1050,7 +1050,10 @@ void Supervisor::on_candidates(const std::vector<Candidate>& candidates, int64_t
     std::snprintf(agreement, sizeof agreement, " (seen %.0f%%)", 100 * c.stereo_agreement);
     where += (where.empty() ? " at " : ", ") + millimetres(c.position) + agreement;
   }
-  enter(State::Choose, now, std::to_string(candidates.size()) + " candidates" + where);
+  std::string sighted;  // Config::line_obstacle_share: what the right camera alone showed
+  for (const Eigen::Vector3d& place : places_seen_by_right_lines())
+    sighted += (sighted.empty() ? "; the right camera's lines stand at " : ", ") + millimetres(place);
+  enter(State::Choose, now, std::to_string(candidates.size()) + " candidates" + where + sighted);
   choose(now);
 }
 
