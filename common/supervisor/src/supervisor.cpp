@@ -143,6 +143,7 @@ void Supervisor::survey(int64_t now, const std::string& why, double max_line_til
   request_time_ = now;
   wide_survey_ = max_line_tilt_deg > 0;
   for (auto& lines : survey_lines_) lines.clear();
+  sighted_.clear();
   char wide[64] = "";
   if (wide_survey_) std::snprintf(wide, sizeof wide, ", lines up to %.0f deg from upright", max_line_tilt_deg);
   enter(State::FindCandidates, now,
@@ -1050,8 +1051,9 @@ void Supervisor::on_candidates(const std::vector<Candidate>& candidates, int64_t
     std::snprintf(agreement, sizeof agreement, " (seen %.0f%%)", 100 * c.stereo_agreement);
     where += (where.empty() ? " at " : ", ") + millimetres(c.position) + agreement;
   }
-  std::string sighted;  // Config::line_obstacle_share: what the right camera alone showed
-  for (const Eigen::Vector3d& place : places_seen_by_right_lines())
+  sighted_ = places_seen_by_right_lines();  // the survey's lines are complete: found once, for every choice
+  std::string sighted;  // Config::line_obstacle_share: where the right camera's lines stand
+  for (const Eigen::Vector3d& place : sighted_)
     sighted += (sighted.empty() ? "; the right camera's lines stand at " : ", ") + millimetres(place);
   enter(State::Choose, now, std::to_string(candidates.size()) + " candidates" + where + sighted);
   choose(now);
@@ -1160,7 +1162,7 @@ void Supervisor::on_lines(bool left, const std::vector<symmetry::Line>& lines, i
 }
 
 History Supervisor::history() const {
-  return History{explored_with_ray_mates(), phantoms_, empty_, standing_, places_seen_by_right_lines()};
+  return History{explored_with_ray_mates(), phantoms_, empty_, standing_, sighted_};
 }
 
 std::vector<Eigen::Vector3d> Supervisor::places_seen_by_right_lines() const {

@@ -467,6 +467,7 @@ class Supervisor {
   std::vector<std::pair<Eigen::Vector3d, int>> retries_;
   bool wide_survey_ = false;  // the survey under way is the second, wider look
   std::vector<Eigen::Vector3d> standing_;  // explored objects where they stand now (CandidatesRequest::explored)
+  std::vector<Eigen::Vector3d> sighted_;   // places_seen_by_right_lines() of the last survey, found once
   // The segmented objects where they came to rest (they stand there now), with their masks.
   struct Rested {
     Eigen::Vector3d place;

@@ -112,9 +112,9 @@ struct History {
   // Explored objects where they stand now. Later surveys leave their lines out, so they may be
   // no candidate; they are still obstacles to every push.
   std::vector<Eigen::Vector3d> standing;
-  // Where a line the right camera saw through most of the survey stands on the table, no
-  // candidate there (Config::line_obstacle_share): an object the stereo pairing missed; an
-  // obstacle to every push.
+  // Where a line the right camera saw through most of the survey stands on the table
+  // (Config::line_obstacle_share): an object the stereo pairing may have missed; an obstacle to
+  // every push (one at a candidate that is itself an obstacle adds nothing).
   std::vector<Eigen::Vector3d> sighted;
 };
 
