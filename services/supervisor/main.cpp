@@ -624,6 +624,9 @@ void add_flags(Flags& f, Options& o) {
   f.add_double("max-push-turn", &o.config.targets.max_push_turn_deg,
                "when neither push across the camera's view plans, pushes turned off it up to this are tried, deg (0: across only)");
   f.add_double("push-turn-step", &o.config.targets.push_turn_step_deg, "the turned pushes' step, deg");
+  f.add_double("obstacle-height", &o.config.targets.obstacle_height,
+               "the arm's links, along the whole push and the park after it, keep clear of every other known object taken "
+               "this tall, m (0: not checked); a push that cannot is made only when none can");
   f.add_double("height-margin", &o.config.height.margin_m,
                "added to the object's measured height before the arm is told to clear it, m");
   f.add_string("learn", &o.learn,
@@ -680,6 +683,8 @@ int main(int argc, char** argv) {
     if (opt.rival_by_foot != 0 && opt.rival_by_foot != 1) throw FlagError("--rival-by-foot must be 0 or 1");
     if (!(opt.config.line_obstacle_share >= 0 && opt.config.line_obstacle_share <= 1))
       throw FlagError("--line-obstacles must be in [0, 1]");
+    if (!(opt.config.targets.obstacle_height >= 0 && opt.config.targets.obstacle_height <= 2))
+      throw FlagError("--obstacle-height must lie in [0, 2] m");
     if (!(opt.config.rival_margin_m >= 0)) throw FlagError("--rival-margin must be 0 or more");
     if (!(opt.config.rival_max_misfit_m >= 0)) throw FlagError("--rival-max-misfit must be 0 or more");
     opt.config.rival_by_foot = opt.rival_by_foot == 1;

@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -554,6 +555,40 @@ TEST(Safety, SelfCollisionOfTheToolWithThePedestalOrTheUpperArm) {
   // Switched off, nothing is refused for self-collision.
   safety.check_self_collision = false;
   EXPECT_TRUE(check_self_collision(model, safety, joints_from_degrees(0, 0, -215, 90, -90, 0)).ok());
+}
+
+TEST(Safety, TheLinksGapToAStandingObjectIsMeasuredAlongTheWholePath) {
+  const ArmModel model = puma260();
+  const SafetyConfig safety;
+  const IkResult home = home_configuration(model, safety);
+  ASSERT_TRUE(home.ok()) << home.reason;
+  // At home the tool points straight down: an object under it is nearest the tool's tip.
+  const Eigen::Vector3d tool = forward_kinematics(model, home.q).translation();
+  const StandingObject under{Eigen::Vector3d(tool.x(), tool.y(), 0), 0.04, 0.10};
+  const double expected = tool.z() - (safety.table_z + under.height) - safety.tool_radius - under.radius;
+  EXPECT_NEAR(link_gap_to_standing_object(model, safety, under, home.q), expected, 1e-9);
+  // Taller than the tool point is high: overlapping.
+  StandingObject tall = under;
+  tall.height = tool.z() - safety.table_z + 0.01;
+  EXPECT_LT(link_gap_to_standing_object(model, safety, tall, home.q), 0.0);
+  // One far from the arm is far from every link.
+  const StandingObject far{Eigen::Vector3d(-0.4, 0.4, 0), 0.04, 0.25};
+  EXPECT_GT(link_gap_to_standing_object(model, safety, far, home.q), 0.3);
+  // Along a path, the least gap is found between the waypoints too: turning joint 1 by 90 deg
+  // swings the tool into an object standing where the turn is half done, which neither end touches.
+  JointVector turned = home.q;
+  turned[0] += deg_to_rad(90.0);
+  const JointVector middle = 0.5 * (home.q + turned);
+  const Eigen::Vector3d halfway = forward_kinematics(model, middle).translation();
+  const StandingObject swept{Eigen::Vector3d(halfway.x(), halfway.y(), 0), 0.04, tall.height};
+  const double at_ends = std::min(link_gap_to_standing_object(model, safety, swept, home.q),
+                                  link_gap_to_standing_object(model, safety, swept, turned));
+  const double along = least_link_gap_along(model, safety, swept, {home.q, turned});
+  EXPECT_NEAR(along, link_gap_to_standing_object(model, safety, swept, middle), 5e-3);  // samples 1 deg apart: 4 mm at the tool
+  EXPECT_LT(along, 0.0);
+  EXPECT_GT(at_ends, 0.0);
+  EXPECT_EQ(least_link_gap_along(model, safety, swept, {}), std::numeric_limits<double>::infinity());
+  EXPECT_NEAR(least_link_gap_along(model, safety, swept, {turned}), link_gap_to_standing_object(model, safety, swept, turned), 1e-12);
 }
 
 TEST(Safety, JointPathBetweenSelfCollisionFreeEndsCanFoldTheToolIntoTheArm) {

@@ -85,6 +85,34 @@ ArmCapsules arm_capsules(const ArmModel& model, const SafetyConfig& config, cons
   return c;
 }
 
+double link_gap_to_standing_object(const ArmModel& model, const SafetyConfig& config, const StandingObject& object,
+                                   const JointVector& q) {
+  const ArmCapsules c = arm_capsules(model, config, q);
+  const Eigen::Vector3d bottom(object.place.x(), object.place.y(), config.table_z);
+  const Eigen::Vector3d top(object.place.x(), object.place.y(), config.table_z + std::max(0.0, object.height));
+  double gap = std::numeric_limits<double>::infinity();
+  for (const Capsule* link : {&c.upper_arm, &c.forearm, &c.tool})
+    gap = std::min(gap, segment_distance(link->a, link->b, bottom, top) - link->radius);
+  return gap - object.radius;
+}
+
+double least_link_gap_along(const ArmModel& model, const SafetyConfig& config, const StandingObject& object,
+                            const std::vector<JointVector>& waypoints) {
+  double least = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < waypoints.size(); ++i) {
+    const JointVector& to = waypoints[i];
+    const JointVector& from = i == 0 ? to : waypoints[i - 1];
+    const double largest_change = (to - from).cwiseAbs().maxCoeff();
+    // A non-finite path is refused by check_joint_path; here it only must not loop for ever.
+    const int steps = std::isfinite(largest_change) ? std::max(1, static_cast<int>(std::ceil(largest_change / config.path_step))) : 1;
+    for (int k = i == 0 ? steps : 1; k <= steps; ++k) {
+      const JointVector q = k == steps ? to : JointVector(from + (static_cast<double>(k) / steps) * (to - from));
+      least = std::min(least, link_gap_to_standing_object(model, config, object, q));
+    }
+  }
+  return least;
+}
+
 CheckResult check_self_collision(const ArmModel& model, const SafetyConfig& config, const JointVector& q) {
   if (!config.check_self_collision) return CheckResult::pass();
   const ArmCapsules c = arm_capsules(model, config, q);

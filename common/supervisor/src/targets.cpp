@@ -70,10 +70,36 @@ bool near_any(const Eigen::Vector3d& p, const std::vector<Eigen::Vector3d>& plac
 
 namespace {
 
-struct Obstacle {
-  Eigen::Vector3d place;
-  const char* what;  // for reasons
-};
+// Every joint position the arm passes through executing `steps` from `seed`, as waypoints of a
+// piecewise-linear joint path (a Move is a straight joint line to its goal).
+std::vector<robot::JointVector> joint_waypoints(const std::vector<robot::MotionStep>& steps, const robot::JointVector& seed) {
+  std::vector<robot::JointVector> waypoints = {seed};
+  for (const robot::MotionStep& step : steps) {
+    if (step.kind == robot::MotionStep::Kind::Move) waypoints.push_back(step.goal);
+    if (step.kind == robot::MotionStep::Kind::Path) waypoints.insert(waypoints.end(), step.path.begin(), step.path.end());
+  }
+  return waypoints;
+}
+
+}  // namespace
+
+PushConflict links_conflict(const robot::MotionPlan& plan, const robot::JointVector& seed,
+                            const std::vector<Obstacle>& obstacles, const ArmSetup& arm, const TargetParams& params) {
+  if (!(params.obstacle_height > 0) || obstacles.empty()) return {};
+  std::vector<robot::JointVector> waypoints = joint_waypoints(plan.steps, seed);
+  waypoints.push_back(arm.home());  // the arm parks after the push, before the after still
+  const robot::SafetyConfig safety = arm.safety_config();
+  for (const Obstacle& other : obstacles) {
+    const robot::StandingObject object{arm.point_to_base(other.place), params.object_radius, params.obstacle_height};
+    const double gap = robot::least_link_gap_along(arm.model, safety, object, waypoints);
+    if (gap < arm.nudge.link_clearance)
+      return {PushConflict::Kind::Links, std::string("the arm's links would pass within ") + std::to_string(std::lround(1e3 * std::max(0.0, gap))) +
+                                             " mm of the " + other.what + " at " + millimetres(other.place)};
+  }
+  return {};
+}
+
+namespace {
 
 // The places a push must keep clear of: the other candidates that count as objects, the
 // explored objects standing where no candidate is (their lines left out of the survey), and the
@@ -103,7 +129,8 @@ std::vector<Obstacle> obstacles_to(const Candidate& c, const std::vector<Candida
 // arm is (the move to P0 included): a target it would refuse is not chosen.
 struct PushPlan {
   robot::NudgePlan plan;
-  std::string problem;  // empty when both plan
+  robot::MotionPlan command;  // the arm service's steps, the move to P0 included
+  std::string problem;        // empty when both plan
   bool ok() const { return problem.empty(); }
 };
 PushPlan plan_push(const Candidate& c, const Eigen::Vector3d& direction_base, const Eigen::Vector3d& direction,
@@ -121,8 +148,8 @@ PushPlan plan_push(const Candidate& c, const Eigen::Vector3d& direction_base, co
   command.target_position = c.position;
   command.direction = horizontal(direction).normalized();
   command.object_height = height;
-  const robot::MotionPlan arm_plan = robot::plan_command(arm.planner(), command, seed);
-  if (!arm_plan.ok()) push.problem = "the arm would refuse: " + arm_plan.reason;
+  push.command = robot::plan_command(arm.planner(), command, seed);
+  if (!push.command.ok()) push.problem = "the arm would refuse: " + push.command.reason;
   return push;
 }
 
@@ -168,13 +195,34 @@ std::vector<std::pair<Eigen::Vector3d, double>> push_directions(const Eigen::Vec
   return out;
 }
 
-// One pass over the candidates in camera order. With `strict`, a push that may touch another
-// candidate is refused; otherwise it is taken and noted. Per candidate, the first push (in
-// push_directions' order) that clears the tallest object expected is taken; when none does, the
-// one that clears the tallest shorter object (TargetChoice::height_limit).
+// Which conflicts with other objects a pass over the candidates accepts (and notes): none, the
+// pushed object's slide, or the slide and the arm's links. The pad's never.
+enum class Tolerance { None, Slide, SlideAndLinks };
+
+bool tolerated(PushConflict::Kind kind, Tolerance tolerance) {
+  switch (kind) {
+    case PushConflict::Kind::None: return true;
+    case PushConflict::Kind::Slide: return tolerance != Tolerance::None;
+    case PushConflict::Kind::Links: return tolerance == Tolerance::SlideAndLinks;
+    case PushConflict::Kind::Pad: return false;
+  }
+  return false;
+}
+
+// Both conflicts of a push, for its note: the kind of the worse (the links), both reasons.
+PushConflict either(const PushConflict& pad_or_slide, const PushConflict& links) {
+  if (!links) return pad_or_slide;
+  if (!pad_or_slide) return links;
+  return {links.kind, pad_or_slide.reason + "; " + links.reason};
+}
+
+// One pass over the candidates in camera order: a push whose conflict with another object the
+// `tolerance` does not accept is refused; one it accepts is taken and noted. Per candidate, the
+// first push (in push_directions' order) that clears the tallest object expected is taken; when
+// none does, the one that clears the tallest shorter object (TargetChoice::height_limit).
 TargetChoice choose_pass(const std::vector<Candidate>& candidates, const std::vector<size_t>& order, const History& history,
                          const Eigen::Vector3d& camera_base, const ArmSetup& arm, const robot::JointVector& seed,
-                         const TargetParams& params, bool strict) {
+                         const TargetParams& params, Tolerance tolerance) {
   TargetChoice choice;
   for (size_t i : order) {
     const Candidate& c = candidates[i];
@@ -221,20 +269,31 @@ TargetChoice choose_pass(const std::vector<Candidate>& candidates, const std::ve
         if (found.kind == PushConflict::Kind::Pad || (found && !conflict)) conflict = found;
         if (conflict.kind == PushConflict::Kind::Pad) break;
       }
-      if (conflict && (strict || conflict.kind == PushConflict::Kind::Pad)) {
+      if (!tolerated(conflict.kind, tolerance)) {
         refuse(conflict.reason);
         continue;
       }
       PushPlan push = plan_push(c, direction_base, direction, arm, seed, arm.nudge.object_height);
-      if (push.ok()) return taken(direction, turn, conflict, std::move(push), 0.0);
+      if (push.ok()) {
+        // The links are checked only when the pad and slide allow the push: they need its plan.
+        const PushConflict links = links_conflict(push.command, seed, obstacles, arm, params);
+        if (!tolerated(links.kind, tolerance)) {
+          refuse(links.reason);
+          continue;
+        }
+        return taken(direction, turn, either(conflict, links), std::move(push), 0.0);
+      }
       refuse(push.problem);
       too_near.push_back({direction_base, direction, turn, conflict});
     }
     std::optional<TargetChoice> limited;
     for (const Refused& r : too_near) {
       auto shorter = push_for_shorter_object(c, r.direction_base, r.direction, arm, seed, params);
-      if (shorter && (!limited || shorter->first > limited->height_limit))
-        limited = taken(r.direction, r.turn, r.conflict, std::move(shorter->second), shorter->first);
+      if (!shorter) continue;
+      const PushConflict links = links_conflict(shorter->second.command, seed, obstacles, arm, params);
+      if (!tolerated(links.kind, tolerance)) continue;
+      if (!limited || shorter->first > limited->height_limit)
+        limited = taken(r.direction, r.turn, either(r.conflict, links), std::move(shorter->second), shorter->first);
     }
     if (limited) return *limited;
     if (turned_refused > 0)
@@ -257,9 +316,10 @@ TargetChoice choose_target(const std::vector<Candidate>& candidates, const Histo
     return (candidates[a].position - right_camera).norm() < (candidates[b].position - right_camera).norm();
   });
   const Eigen::Vector3d camera_base = arm.point_to_base(right_camera);
-  TargetChoice strict = choose_pass(candidates, order, history, camera_base, arm, seed, params, true);
+  TargetChoice strict = choose_pass(candidates, order, history, camera_base, arm, seed, params, Tolerance::None);
   if (strict.found) return strict;
-  TargetChoice relaxed = choose_pass(candidates, order, history, camera_base, arm, seed, params, false);
+  TargetChoice relaxed = choose_pass(candidates, order, history, camera_base, arm, seed, params, Tolerance::Slide);
+  if (!relaxed.found) relaxed = choose_pass(candidates, order, history, camera_base, arm, seed, params, Tolerance::SlideAndLinks);
   if (!relaxed.found) return strict;  // the strict pass's reasons say why each was passed over
   // Keep the strict pass's reasons for the candidates passed over before the chosen one.
   relaxed.rejected.clear();

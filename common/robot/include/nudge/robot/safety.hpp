@@ -57,6 +57,25 @@ struct ArmCapsules {
 };
 ArmCapsules arm_capsules(const ArmModel& model, const SafetyConfig& config, const JointVector& q);
 
+// An object standing upright on the table that the arm must keep clear of (base frame; the
+// place's x, y are used): a capsule-shaped column of `radius` from the table up to `height` above
+// it, so its top is taken `radius` higher than a flat one (a gap on the safe side).
+struct StandingObject {
+  Eigen::Vector3d place = Eigen::Vector3d::Zero();
+  double radius = 0;
+  double height = 0;
+};
+
+// The least gap between the moving links (upper arm, forearm, tool with its pad) at `q` and
+// `object`; negative when they overlap. The pedestal does not move and is not counted.
+double link_gap_to_standing_object(const ArmModel& model, const SafetyConfig& config, const StandingObject& object,
+                                   const JointVector& q);
+
+// The least such gap along a piecewise-linear joint path, sampled as check_joint_path samples
+// it (no joint moves more than config.path_step between samples). Infinity for no waypoints.
+double least_link_gap_along(const ArmModel& model, const SafetyConfig& config, const StandingObject& object,
+                            const std::vector<JointVector>& waypoints);
+
 // The pairs of links that are not joined to each other: the forearm and the tool against the
 // pedestal, the tool against the upper arm. Names the pair and their gap when they come closer
 // than config.self_clearance. (The tool cannot fold back onto the forearm: joint 5 stops at

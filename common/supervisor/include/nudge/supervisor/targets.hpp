@@ -67,6 +67,11 @@ struct TargetParams {
   // workspace ring) may be pushed. 0: across the view only.
   double max_push_turn_deg = 40;
   double push_turn_step_deg = 20;
+  // The arm's links (upper arm, forearm, tool) along the whole command, the move to P0 included,
+  // keep robot::NudgeParams::link_clearance from every other known object, taken as an upright
+  // column of object_radius and this height (their heights are not measured: the tallest
+  // expected). A push that cannot is taken only when no push clears every object. 0: not checked.
+  double obstacle_height = 0.25;
 };
 
 struct Candidate {
@@ -123,16 +128,18 @@ struct History {
 // Beyond the thesis (one object per scene): on a crowded table every push may pass near another
 // candidate, many of them phantoms between two objects. When no push is clear, the nearest
 // candidate whose push only risks sliding it into another candidate is nudged anyway (the nudge
-// is gentle and short) and `note` says which; the pad itself never descends onto or sweeps
-// through another candidate, and the strict rule decides whenever it can.
+// is gentle and short) and `note` says which; failing that, the nearest whose arm links may also
+// pass near another object (TargetParams::obstacle_height). The pad itself never descends onto
+// or sweeps through another candidate, and the strict rule decides whenever it can.
 TargetChoice choose_target(const std::vector<Candidate>& candidates, const History& history, const Eigen::Vector3d& right_camera,
                            const ArmSetup& arm, const robot::JointVector& seed, const TargetParams& params = {});
 
 // Whether pushing `target` along `direction` would touch `other`, and how: the pad itself on its
 // way down at P1 and along P1 -> P2 (never acceptable), or the pushed object sliding into it
-// (acceptable on a crowded table where `other` may be a phantom).
+// (acceptable on a crowded table where `other` may be a phantom), or (links_conflict) the arm's
+// links passing near it (acceptable last of all).
 struct PushConflict {
-  enum class Kind { None, Pad, Slide };
+  enum class Kind { None, Pad, Slide, Links };
   Kind kind = Kind::None;
   std::string reason;
   explicit operator bool() const { return kind != Kind::None; }
@@ -141,6 +148,20 @@ struct PushConflict {
 PushConflict push_conflict(const Eigen::Vector3d& target, const Eigen::Vector3d& direction,
                            const Eigen::Vector3d& other, const ArmSetup& arm, const TargetParams& params,
                            const std::string& what = "candidate");
+
+// A place a push must keep clear of (world frame, on the table), and what stands there, for
+// reasons ("candidate", "explored object").
+struct Obstacle {
+  Eigen::Vector3d place;
+  const char* what = "candidate";
+};
+
+// Whether the arm's links, at every joint position of `plan` (the arm service's steps for the
+// push, executed from `seed`) and on the way home after it (where the arm parks), keep arm.nudge.link_clearance from an object
+// params.obstacle_height tall and params.object_radius wide standing at each of `obstacles`; the
+// first one they do not is named. No conflict when params.obstacle_height is 0.
+PushConflict links_conflict(const robot::MotionPlan& plan, const robot::JointVector& seed,
+                            const std::vector<Obstacle>& obstacles, const ArmSetup& arm, const TargetParams& params);
 
 // Whether `p` lies within `radius` of any of `places`, on the table (heights ignored).
 bool near_any(const Eigen::Vector3d& p, const std::vector<Eigen::Vector3d>& places, double radius);
