@@ -75,7 +75,9 @@ void Handlers::expire(int64_t now_utime) {
 void Handlers::on_view(const learn_view_t& msg) {
   expire(msg.utime);
   const Key key(msg.run_id, msg.object_key);
-  const std::string what = "LEARN_VIEW " + describe(msg.run_id, msg.object_key) + " view " + std::to_string(msg.view_index);
+  const bool scene = msg.kind == learn_view_t::KIND_SCENE;
+  const std::string what =
+      "LEARN_VIEW " + describe(msg.run_id, msg.object_key) + (scene ? " scene still" : " view " + std::to_string(msg.view_index));
   if (!pending_.count(key) && static_cast<int>(pending_.size()) >= options_.max_pending_objects) {
     auto oldest = std::min_element(pending_.begin(), pending_.end(), [](const auto& a, const auto& b) {
       return a.second.last_utime < b.second.last_utime;
@@ -87,16 +89,23 @@ void Handlers::on_view(const learn_view_t& msg) {
   Pending& pending = pending_[key];
   pending.last_utime = std::max(pending.last_utime, msg.utime);
   auto refuse = [&](const std::string& why) {
-    pending.bad_views += (pending.bad_views.empty() ? "" : "; ") + ("view " + std::to_string(msg.view_index) + ": " + why);
+    pending.bad_views += (pending.bad_views.empty() ? "" : "; ") +
+                         ((scene ? std::string("scene still") : "view " + std::to_string(msg.view_index)) + ": " + why);
     report(what + ": " + why);
   };
-  if (msg.view_index < 0 || msg.view_index >= options_.max_views)
+  if (msg.kind != learn_view_t::KIND_VIEW && !scene)
+    return refuse("kind " + std::to_string(msg.kind) + " is neither KIND_VIEW (0) nor KIND_SCENE (1)");
+  if (!scene && (msg.view_index < 0 || msg.view_index >= options_.max_views))
     return refuse("view_index outside 0.." + std::to_string(options_.max_views - 1));
   learning::TrainingImage view;
   try {
     view.image = bus::to_mat(msg.image);
   } catch (const bus::ImageError& e) {
     return refuse(std::string("undecodable image: ") + e.what());
+  }
+  if (scene) {
+    pending.scene = std::move(view.image);
+    return;
   }
   const cv::Rect box = rect_of(msg.box);
   if (box.width > 0 && (box.height <= 0 || (box & cv::Rect(cv::Point(0, 0), view.image.size())).empty()))
@@ -139,6 +148,13 @@ void Handlers::on_commit(const learn_commit_t& msg) {
   pending_.erase(it);
   auto images = std::make_shared<std::vector<learning::TrainingImage>>();
   for (auto& [index, view] : pending.views) images->push_back(std::move(view));
+  // A scene still that cannot serve is left out, not the object: the across-views rule still prunes.
+  cv::Mat scene = pending.scene;
+  if (!scene.empty() && (scene.size() != images->front().image.size() || scene.depth() != CV_8U)) {
+    log::warn() << what << ": the scene still (" << scene.cols << "x" << scene.rows
+                << ") is not the views' size or not 8-bit: learned without it";
+    scene.release();
+  }
   if (static_cast<int>(images->size()) != msg.num_views)
     log::warn() << what << ": " << images->size() << " of " << msg.num_views << " views arrived"
                 << (pending.bad_views.empty() ? "" : " (" + pending.bad_views + ")");
@@ -153,8 +169,8 @@ void Handlers::on_commit(const learn_commit_t& msg) {
   job_ = Job{out, {}, {}};
   // The worker learns and stores (the database write is atomic: nothing half-written if it fails);
   // the recognizer is only touched on this thread, in poll().
-  worker_.submit(msg.object_key, [this, info, images](const LearnWorker::Progress& progress) {
-    job_.model = learning::learn_object(info, *images, options_.learn, &job_.stats, progress);
+  worker_.submit(msg.object_key, [this, info, images, scene](const LearnWorker::Progress& progress) {
+    job_.model = learning::learn_object(info, *images, options_.learn, &job_.stats, progress, scene);
     db_.store(job_.model);
   });
   service_.set_status(worker_.status());
@@ -194,9 +210,10 @@ void Handlers::learned(const LearnWorker::Ended& ended) {
   out.ok = true;
   out.descriptors = stats.kept;
   out.descriptors_pruned = stats.outside_box + stats.background;
+  out.descriptors_pruned += stats.scene;
   log::info() << "learned " << out.object_name << " from " << out.views_used << " views: " << stats.kept
               << " descriptors kept, " << stats.outside_box << " outside the box, " << stats.background
-              << " background";
+              << " background, " << stats.scene << " in place in the scene still";
   service_.publish(bus::channel::LEARNED, out);
 }
 

@@ -54,6 +54,7 @@ class Handlers {
  private:
   struct Pending {
     std::map<int, learning::TrainingImage> views;  // by view_index
+    cv::Mat scene;                                 // learn_view_t::KIND_SCENE's still, or empty
     std::string bad_views;                         // why views were refused, for the commit's answer
     int64_t last_utime = 0;
   };

@@ -444,16 +444,22 @@ class Shell {
     publish(bus::channel::RECOGNIZE_REQUEST, m);
   }
   void handle(const sv::LearnView& v) {
-    const std::string file = sv::save_view(run_dir_, supervisor_.report().attempt, v);
     learn_view_t m{};
     m.utime = v.utime;
     m.run_id = opt_.run_id;
     m.object_key = v.object_key;
-    m.view_index = v.index;
+    m.view_index = v.scene ? -1 : v.index;
     m.wrist_angle = v.angle;
     const int box[4] = {v.box.x, v.box.y, v.box.width, v.box.height};
     std::copy(box, box + 4, m.box);
     m.image = bus::to_message(v.image, image_t::FORMAT_PNG, v.utime, v.index, "right");
+    m.kind = v.scene ? learn_view_t::KIND_SCENE : learn_view_t::KIND_VIEW;
+    if (v.scene) {  // the after still, already in the attempt's folder
+      publish(bus::channel::LEARN_VIEW, m);
+      log::info() << "the scene still (the after still) sent for pruning the views' background";
+      return;
+    }
+    const std::string file = sv::save_view(run_dir_, supervisor_.report().attempt, v);
     publish(bus::channel::LEARN_VIEW, m);
     log::info() << "view " << v.index << " (" << v.angle * 180 / M_PI << " deg) sent and saved as " << file;
   }

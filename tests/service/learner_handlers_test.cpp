@@ -171,6 +171,44 @@ TEST(LearnerHandlers, LearnsStoresAndRecognisesWithAMatchPicture) {
   fs::remove_all(db);
 }
 
+// The scene still (learn_view_t::KIND_SCENE): the views' scene without the object held prunes what
+// stands in place behind it; one of another size is left out, an unknown kind refused by name.
+TEST(LearnerHandlers, TheSceneStillPrunesWhatStandsBehindTheObject) {
+  const std::string db = fresh_db("scene");
+  InProcess run(db);
+  auto learn = [&](const std::string& key, const cv::Mat& scene, int8_t kind, int64_t t0, int64_t seq) {
+    run.teach("run_5", key, 13, t0);
+    if (!scene.empty()) {
+      nudge::learning::TrainingImage still;
+      still.image = scene;
+      auto msg = view_message("run_5", key, 0, still, t0 + 20 * kSecond);
+      msg.view_index = -1;
+      msg.kind = kind;
+      run.bus.publish(channel::LEARN_VIEW, &msg);
+    }
+    const auto commit = commit_message("run_5", key, key, 12, t0 + 21 * kSecond, seq);
+    run.bus.publish(channel::LEARN_COMMIT, &commit);
+    run.service.handle_pending();
+    run.handlers->finish_learning();
+    run.service.handle_pending();
+    return run.learned.get();
+  };
+  const cv::Mat behind = syn::random_texture({400, 300}, 500);  // turntable()'s scene
+  const auto plain = learn("plain", {}, 0, 100 * kSecond, 1);
+  const auto pruned = learn("pruned", behind, nudge::learn_view_t::KIND_SCENE, 200 * kSecond, 2);
+  const auto small = learn("small", syn::random_texture({200, 150}, 500), nudge::learn_view_t::KIND_SCENE, 300 * kSecond, 3);
+  ASSERT_TRUE(plain.ok && pruned.ok && small.ok) << plain.reason << pruned.reason << small.reason;
+  EXPECT_LT(pruned.descriptors, plain.descriptors);  // the scene the generous box still held
+  EXPECT_EQ(pruned.descriptors + pruned.descriptors_pruned, plain.descriptors + plain.descriptors_pruned);
+  EXPECT_EQ(small.descriptors, plain.descriptors) << "a scene still of another size is left out";
+  const int errors = run.service.counters().errors;
+  const auto odd = learn("odd", behind, 7, 400 * kSecond, 4);
+  EXPECT_TRUE(odd.ok) << "the views still serve";
+  EXPECT_EQ(odd.descriptors, plain.descriptors);
+  EXPECT_EQ(run.service.counters().errors, errors + 1) << "the unknown kind is reported";
+  fs::remove_all(db);
+}
+
 TEST(LearnerHandlers, BadInputIsReportedAndTheServiceKeepsAnswering) {
   const std::string db = fresh_db("bad");
   InProcess run(db);

@@ -65,9 +65,52 @@ std::vector<std::vector<bool>> background_descriptors(const std::vector<Features
   return background;
 }
 
+std::vector<bool> found_in_scene(const Features& view, const Features& scene, double ratio, double static_px) {
+  std::vector<bool> found(view.size(), false);
+  if (view.size() == 0 || scene.size() < 2) return found;
+  cv::BFMatcher matcher(cv::NORM_L2);
+  matcher.add(scene.descriptors);
+  for (const cv::DMatch& m : detail::ratio_matches(matcher, view.descriptors, scene.size(), ratio)) {
+    const cv::Point2f shift = view.keypoints[m.queryIdx].pt - scene.keypoints[m.trainIdx].pt;
+    if (shift.dot(shift) <= static_px * static_px) found[m.queryIdx] = true;
+  }
+  return found;
+}
+
+namespace {
+
+// The scene still's features as a view's layer sees them: the same detection in the same box.
+// Views share their box as a rule, so each box's features are detected once.
+class SceneFeatures {
+ public:
+  SceneFeatures(const cv::Mat& scene, const LearnParams& params) : scene_(scene), params_(params) {}
+  const Features& in(size_t layer, const cv::Rect& box) {
+    for (const Entry& e : cache_)
+      if (e.layer == layer && e.box == box) return e.features;
+    const Features all = layer == 0 ? detect_features(scene_, params_.sift)
+                                    : detect_features_tilted(scene_, params_.axis_tilts[layer - 1], params_.sift, box);
+    cache_.push_back({layer, box, features_inside(all, box)});
+    return cache_.back().features;
+  }
+
+ private:
+  struct Entry {
+    size_t layer;
+    cv::Rect box;
+    Features features;
+  };
+  const cv::Mat& scene_;
+  const LearnParams& params_;
+  std::vector<Entry> cache_;  // a box or two: a list is enough (a reference from in() lasts until its next call)
+};
+
+}  // namespace
+
 ObjectModel learn_object(const ObjectInfo& info, const std::vector<TrainingImage>& images, const LearnParams& params,
-                         LearnStats* stats, const LearnProgress& progress) {
+                         LearnStats* stats, const LearnProgress& progress, const cv::Mat& scene) {
   if (images.empty()) throw std::invalid_argument("object " + info.name + ": no training views");
+  if (!scene.empty() && (scene.depth() != CV_8U || scene.size() != images.front().image.size()))
+    throw std::invalid_argument("object " + info.name + ": the scene still is not 8-bit or not the views' size");
   for (double tilt : params.axis_tilts)
     if (!(tilt >= 1)) throw std::invalid_argument("object " + info.name + ": simulated tilt " + std::to_string(tilt) + " is below 1");
   LearnStats counts;
@@ -94,13 +137,22 @@ ObjectModel learn_object(const ObjectInfo& info, const std::vector<TrainingImage
     background.push_back(background_descriptors(layer, params.ratio, params.background_matches, params.background_static_px));
   ObjectModel model;
   model.info = info;
+  SceneFeatures scene_features(scene, params);
   for (size_t v = 0; v < images.size(); ++v) {
     ModelView view;
+    const cv::Rect box = images[v].box.empty() ? cv::Rect() : generous_box(images[v].box, params.box_margin, images[v].image.size());
     for (size_t l = 0; l < layers.size(); ++l) {
       std::vector<bool> keep(background[l][v].size());
       for (size_t k = 0; k < keep.size(); ++k) keep[k] = !background[l][v][k];
+      int in_scene = 0;
+      if (!scene.empty()) {
+        const std::vector<bool> seen = found_in_scene(layers[l][v], scene_features.in(l, box), params.scene_ratio, params.scene_static_px);
+        for (size_t k = 0; k < keep.size(); ++k)
+          if (keep[k] && seen[k]) keep[k] = false, ++in_scene;
+      }
       const Features kept = select_features(layers[l][v], keep);
-      counts.background += layers[l][v].size() - kept.size();
+      counts.scene += in_scene;
+      counts.background += layers[l][v].size() - kept.size() - in_scene;
       view.features = l == 0 ? kept : concatenate(view.features, kept);
     }
     view.box = images[v].box;

@@ -262,7 +262,9 @@ struct GraspCommand { int64_t seq = 0; Eigen::Vector3d position; double height =
 struct PlaceCommand { int64_t seq = 0; Eigen::Vector3d position; double height = 0; };
 struct RotateCommand { int64_t seq = 0; double angle = 0; };  // radians, relative
 struct RecognizeRequest { int64_t seq = 0; cv::Rect roi; cv::Mat image; };
-struct LearnView { int index = 0; double angle = 0; cv::Rect box; cv::Mat image; int64_t utime = 0; std::string object_key; };
+// scene: not a view but the right after still (the object on the table, the arm parked), sent
+// before the commit: what the views show in place in it is the scene behind the held object.
+struct LearnView { int index = 0; double angle = 0; cv::Rect box; cv::Mat image; int64_t utime = 0; std::string object_key; bool scene = false; };
 struct LearnCommit { int64_t seq = 0; std::string object_key; int views = 0; double height = 0, radius = 0; };
 // object_height: the pushed object's height the arm's links must clear, m; 0: the arm's default.
 struct NudgeCommand { int64_t seq = 0; Eigen::Vector3d target, direction; double object_height = 0; };
