@@ -432,6 +432,30 @@ double least_link_gap(const sv::TargetChoice& choice, const sv::ArmSetup& arm, c
   return nudge::robot::least_link_gap_along(arm.model, arm.safety_config(), object, path);
 }
 
+TEST(Targets, TheLinksNearAnExploredObjectOutweighTheLinksNearACandidate) {
+  const sv::ArmSetup arm;
+  const sv::TargetParams params;
+  nudge::robot::Command command;
+  command.kind = nudge::robot::CommandKind::Nudge;
+  command.target_position = Eigen::Vector3d(0.26, 0, 0);
+  command.direction = Eigen::Vector3d(0, 1, 0);
+  const auto plan = nudge::robot::plan_command(arm.planner(), command, arm_state_joints());
+  ASSERT_TRUE(plan.ok()) << plan.reason;
+  // Where the pad comes down (P1): every link passes there. Far behind the base: none does.
+  const Eigen::Vector3d p1 = command.target_position - arm.nudge.start_distance * command.direction;
+  const sv::Obstacle candidate{p1, "candidate", false}, explored{p1, "explored object", true};
+  const sv::Obstacle far{Eigen::Vector3d(-0.4, 0.4, 0), "candidate", false};
+  using Kind = sv::PushConflict::Kind;
+  EXPECT_EQ(sv::links_conflict(plan, arm_state_joints(), {far}, arm, params).kind, Kind::None);
+  const auto near = sv::links_conflict(plan, arm_state_joints(), {candidate, far}, arm, params);
+  EXPECT_EQ(near.kind, Kind::Links);
+  EXPECT_NE(near.reason.find("the arm's links would pass within 0 mm of the candidate at (260, -110) mm"), std::string::npos) << near.reason;
+  EXPECT_EQ(sv::links_conflict(plan, arm_state_joints(), {candidate, explored}, arm, params).kind, Kind::LinksOnKnown);
+  sv::TargetParams unchecked;
+  unchecked.obstacle_height = 0;
+  EXPECT_EQ(sv::links_conflict(plan, arm_state_joints(), {explored}, arm, unchecked).kind, Kind::None);
+}
+
 TEST(Targets, TheArmsLinksKeepClearOfTheOtherCandidatesWheneverSomePushDoes) {
   const sv::SceneGeometry scene = make_scene();
   const sv::ArmSetup arm;

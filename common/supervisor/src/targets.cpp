@@ -89,14 +89,18 @@ PushConflict links_conflict(const robot::MotionPlan& plan, const robot::JointVec
   std::vector<robot::JointVector> waypoints = joint_waypoints(plan.steps, seed);
   waypoints.push_back(arm.home());  // the arm parks after the push, before the after still
   const robot::SafetyConfig safety = arm.safety_config();
+  PushConflict first;  // near a candidate: the first; near a known object: that one, whatever came first
   for (const Obstacle& other : obstacles) {
+    if (first && !other.known) continue;
     const robot::StandingObject object{arm.point_to_base(other.place), params.object_radius, params.obstacle_height};
     const double gap = robot::least_link_gap_along(arm.model, safety, object, waypoints);
-    if (gap < arm.nudge.link_clearance)
-      return {other.known ? PushConflict::Kind::LinksOnKnown : PushConflict::Kind::Links, std::string("the arm's links would pass within ") + std::to_string(std::lround(1e3 * std::max(0.0, gap))) +
-                                             " mm of the " + other.what + " at " + millimetres(other.place)};
+    if (gap >= arm.nudge.link_clearance) continue;
+    const std::string reason = "the arm's links would pass within " + std::to_string(std::lround(1e3 * std::max(0.0, gap))) +
+                               " mm of the " + other.what + " at " + millimetres(other.place);
+    if (other.known) return {PushConflict::Kind::LinksOnKnown, reason};
+    first = {PushConflict::Kind::Links, reason};
   }
-  return {};
+  return first;
 }
 
 namespace {
