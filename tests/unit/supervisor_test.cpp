@@ -432,30 +432,6 @@ double least_link_gap(const sv::TargetChoice& choice, const sv::ArmSetup& arm, c
   return nudge::robot::least_link_gap_along(arm.model, arm.safety_config(), object, path);
 }
 
-TEST(Targets, TheLinksNearAnExploredObjectOutweighTheLinksNearACandidate) {
-  const sv::ArmSetup arm;
-  const sv::TargetParams params;
-  nudge::robot::Command command;
-  command.kind = nudge::robot::CommandKind::Nudge;
-  command.target_position = Eigen::Vector3d(0.26, 0, 0);
-  command.direction = Eigen::Vector3d(0, 1, 0);
-  const auto plan = nudge::robot::plan_command(arm.planner(), command, arm_state_joints());
-  ASSERT_TRUE(plan.ok()) << plan.reason;
-  // Where the pad comes down (P1): every link passes there. Far behind the base: none does.
-  const Eigen::Vector3d p1 = command.target_position - arm.nudge.start_distance * command.direction;
-  const sv::Obstacle candidate{p1, "candidate", false}, explored{p1, "explored object", true};
-  const sv::Obstacle far{Eigen::Vector3d(-0.4, 0.4, 0), "candidate", false};
-  using Kind = sv::PushConflict::Kind;
-  EXPECT_EQ(sv::links_conflict(plan, arm_state_joints(), {far}, arm, params).kind, Kind::None);
-  const auto near = sv::links_conflict(plan, arm_state_joints(), {candidate, far}, arm, params);
-  EXPECT_EQ(near.kind, Kind::Links);
-  EXPECT_NE(near.reason.find("the arm's links would pass within 0 mm of the candidate at (260, -110) mm"), std::string::npos) << near.reason;
-  EXPECT_EQ(sv::links_conflict(plan, arm_state_joints(), {candidate, explored}, arm, params).kind, Kind::LinksOnKnown);
-  sv::TargetParams unchecked;
-  unchecked.obstacle_height = 0;
-  EXPECT_EQ(sv::links_conflict(plan, arm_state_joints(), {explored}, arm, unchecked).kind, Kind::None);
-}
-
 TEST(Targets, TheArmsLinksKeepClearOfTheOtherCandidatesWheneverSomePushDoes) {
   const sv::SceneGeometry scene = make_scene();
   const sv::ArmSetup arm;
@@ -463,7 +439,7 @@ TEST(Targets, TheArmsLinksKeepClearOfTheOtherCandidatesWheneverSomePushDoes) {
   sv::TargetParams unchecked;
   unchecked.obstacle_height = 0;
   // Pairs of objects 9-15 cm apart over the workspace ring.
-  int strict = 0, mended = 0, spared = 0;
+  int strict = 0, mended = 0, beside_clear = 0;
   for (double radius = 0.18; radius <= 0.32; radius += 0.07)
     for (double bearing = -60; bearing <= 60; bearing += 30)
       for (double turn = 0; turn < 360; turn += 60) {
@@ -471,15 +447,14 @@ TEST(Targets, TheArmsLinksKeepClearOfTheOtherCandidatesWheneverSomePushDoes) {
         const Eigen::Vector3d first(radius * std::cos(b), radius * std::sin(b), 0);
         const Eigen::Vector3d second = first + 0.12 * Eigen::Vector3d(std::cos(t), std::sin(t), 0);
         const std::vector<sv::Candidate> candidates = {{0, first, 9}, {1, second, 9}};
-        // An object explored and standing there is struck by no push, not even as a last resort.
+        // An object explored and standing there is kept clear of as a candidate is.
         sv::History explored;
         explored.standing = {second};
         const auto beside = sv::choose_target({candidates[0]}, explored, scene.right_camera_in_world(), arm, arm_state_joints(), params);
-        if (beside.found) {
+        if (beside.found && beside.note.find("no clear push left") == std::string::npos) {
+          ++beside_clear;
           EXPECT_GE(least_link_gap(beside, arm, arm_state_joints(), second, params), arm.nudge.link_clearance)
-              << sv::millimetres(first) << " beside the explored " << sv::millimetres(second) << ": " << beside.note;
-        } else {
-          ++spared;
+              << sv::millimetres(first) << " beside the explored " << sv::millimetres(second);
         }
         const auto choice = sv::choose_target(candidates, {}, scene.right_camera_in_world(), arm, arm_state_joints(), params);
         if (!choice.found) continue;
@@ -502,7 +477,7 @@ TEST(Targets, TheArmsLinksKeepClearOfTheOtherCandidatesWheneverSomePushDoes) {
       }
   EXPECT_GT(strict, 20);
   EXPECT_GT(mended, 0);  // the check changes choices: without it some links pass through an object
-  EXPECT_GT(spared, 0);  // and some places are not pushed at all beside an explored object
+  EXPECT_GT(beside_clear, 20);
 }
 
 // The thesis' straight-down tool (no lean): its wrist rides beside the pushed object, so some

@@ -89,45 +89,36 @@ PushConflict links_conflict(const robot::MotionPlan& plan, const robot::JointVec
   std::vector<robot::JointVector> waypoints = joint_waypoints(plan.steps, seed);
   waypoints.push_back(arm.home());  // the arm parks after the push, before the after still
   const robot::SafetyConfig safety = arm.safety_config();
-  PushConflict first;  // near a candidate: the first; near a known object: that one, whatever came first
   for (const Obstacle& other : obstacles) {
-    if (first && !other.known) continue;
     const robot::StandingObject object{arm.point_to_base(other.place), params.object_radius, params.obstacle_height};
     const double gap = robot::least_link_gap_along(arm.model, safety, object, waypoints);
-    if (gap >= arm.nudge.link_clearance) continue;
-    const std::string reason = "the arm's links would pass within " + std::to_string(std::lround(1e3 * std::max(0.0, gap))) +
-                               " mm of the " + other.what + " at " + millimetres(other.place);
-    if (other.known) return {PushConflict::Kind::LinksOnKnown, reason};
-    first = {PushConflict::Kind::Links, reason};
+    if (gap < arm.nudge.link_clearance)
+      return {PushConflict::Kind::Links, "the arm's links would pass within " + std::to_string(std::lround(1e3 * std::max(0.0, gap))) +
+                                             " mm of the " + other.what + " at " + millimetres(other.place)};
   }
-  return first;
+  return {};
 }
 
 namespace {
 
 // The places a push must keep clear of: the other candidates that count as objects, the
-// explored objects standing (known: a candidate there is that object; their lines are left out of
-// later surveys, so often no candidate is), and the objects only one camera's lines show.
+// explored objects standing where no candidate is (their lines left out of the survey), and the
+// objects only one camera's lines show.
 std::vector<Obstacle> obstacles_to(const Candidate& c, const std::vector<Candidate>& candidates, const History& history,
                                    const TargetParams& params) {
   std::vector<Obstacle> obstacles;
   auto far_from_target = [&](const Eigen::Vector3d& p) { return horizontal(p - c.position).norm() >= params.same_object_radius; };
-  auto obstacle_near = [&](const Eigen::Vector3d& p) {
-    return std::find_if(obstacles.begin(), obstacles.end(),
-                        [&](const Obstacle& o) { return horizontal(o.place - p).norm() < params.same_object_radius; });
+  auto near_an_obstacle = [&](const Eigen::Vector3d& p) {
+    return std::any_of(obstacles.begin(), obstacles.end(),
+                       [&](const Obstacle& o) { return horizontal(o.place - p).norm() < params.same_object_radius; });
   };
-  auto near_an_obstacle = [&](const Eigen::Vector3d& p) { return obstacle_near(p) != obstacles.end(); };
   for (const Candidate& other : candidates) {
     if (other.index == c.index || near_any(other.position, history.empty, params.explored_radius)) continue;
     if (other.stereo_agreement < params.min_stereo_agreement) continue;
     if (far_from_target(other.position)) obstacles.push_back({other.position, "candidate"});
   }
-  for (const Eigen::Vector3d& object : history.standing) {
-    if (!far_from_target(object)) continue;
-    const auto seen_again = obstacle_near(object);
-    if (seen_again == obstacles.end()) obstacles.push_back({object, "explored object", true});
-    else seen_again->known = true;
-  }
+  for (const Eigen::Vector3d& object : history.standing)
+    if (far_from_target(object) && !near_an_obstacle(object)) obstacles.push_back({object, "explored object"});
   for (const Eigen::Vector3d& object : history.sighted)
     if (far_from_target(object) && !near_an_obstacle(object)) obstacles.push_back({object, "object seen in one camera"});
   return obstacles;
@@ -213,8 +204,7 @@ bool tolerated(PushConflict::Kind kind, Tolerance tolerance) {
     case PushConflict::Kind::None: return true;
     case PushConflict::Kind::Slide: return tolerance != Tolerance::None;
     case PushConflict::Kind::Links: return tolerance == Tolerance::SlideAndLinks;
-    case PushConflict::Kind::Pad:
-    case PushConflict::Kind::LinksOnKnown: return false;
+    case PushConflict::Kind::Pad: return false;
   }
   return false;
 }

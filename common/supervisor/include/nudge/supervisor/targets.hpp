@@ -137,10 +137,10 @@ TargetChoice choose_target(const std::vector<Candidate>& candidates, const Histo
 // Whether pushing `target` along `direction` would touch `other`, and how: the pad itself on its
 // way down at P1 and along P1 -> P2 (never acceptable), or the pushed object sliding into it
 // (acceptable on a crowded table where `other` may be a phantom), or (links_conflict) the arm's
-// links passing near it: acceptable last of all when it may be a phantom (a candidate, a place a
-// line marks), never when it is an object already explored and standing there (LinksOnKnown).
+// links passing near it (acceptable last of all: its height is not known, and the tallest
+// expected is assumed).
 struct PushConflict {
-  enum class Kind { None, Pad, Slide, Links, LinksOnKnown };
+  enum class Kind { None, Pad, Slide, Links };
   Kind kind = Kind::None;
   std::string reason;
   explicit operator bool() const { return kind != Kind::None; }
@@ -155,7 +155,6 @@ PushConflict push_conflict(const Eigen::Vector3d& target, const Eigen::Vector3d&
 struct Obstacle {
   Eigen::Vector3d place;
   const char* what = "candidate";
-  bool known = false;  // an object explored and standing there, not a candidate that may be a phantom
 };
 
 // Whether the arm's links, at every joint position of `plan` (the arm service's steps for the
