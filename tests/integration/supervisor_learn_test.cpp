@@ -49,10 +49,14 @@ const std::string kCalibration = kSource + "/config/calibration_sim.yaml";
 // The learner's part, played by the test; and where the cup went (SIM_STATE).
 struct Learner {
   lcm::LCM* lcm = nullptr;
-  int views = 0, boxes = 0, recognitions = 0, commits = 0;
+  int views = 0, boxes = 0, scene_stills = 0, recognitions = 0, commits = 0;
   std::optional<nudge::sim_state_t> first, last;
   double highest_cup = 0;
   void on_view(const lcm::ReceiveBuffer*, const std::string&, const nudge::learn_view_t* m) {
+    if (m->kind == nudge::learn_view_t::KIND_SCENE) {
+      scene_stills += m->image.width == 1280 && commits == 0;  // full size, before the commit
+      return;
+    }
     ++views;
     if (m->box[2] > 0 && m->box[3] > 0 && m->image.width == 1280) ++boxes;
   }
@@ -151,6 +155,7 @@ TEST(SupervisorLearn, GraspsTurnsTwelveViewsAndPutsTheCupBack) {
   EXPECT_EQ(learner.recognitions, 1) << "asked before the nudge";
   EXPECT_EQ(learner.views, 12);
   EXPECT_EQ(learner.boxes, 12) << "every view with the object's box, at full size";
+  EXPECT_EQ(learner.scene_stills, 1) << "the after still, for the learner's background, before the commit";
   EXPECT_EQ(learner.commits, 1);
   int saved = 0;
   for (int i = 0; i < 12; ++i) {
