@@ -80,20 +80,22 @@ std::vector<bool> found_in_scene(const Features& view, const Features& scene, do
 namespace {
 
 // The scene still's features as a view's layer sees them: the same detection in the same box.
-// Views share their box as a rule, so each box's features are detected once.
+// The whole still is detected once; a squeezed layer once per box (views share their box as a rule).
 class SceneFeatures {
  public:
   SceneFeatures(const cv::Mat& scene, const LearnParams& params) : scene_(scene), params_(params) {}
   const Features& in(size_t layer, const cv::Rect& box) {
     for (const Entry& e : cache_)
       if (e.layer == layer && e.box == box) return e.features;
-    const Features all = layer == 0 ? detect_features(scene_, params_.sift)
-                                    : detect_features_tilted(scene_, params_.axis_tilts[layer - 1], params_.sift, box);
+    if (layer == 0 && !whole_detected_) whole_ = detect_features(scene_, params_.sift), whole_detected_ = true;
+    const Features all = layer == 0 ? whole_ : detect_features_tilted(scene_, params_.axis_tilts[layer - 1], params_.sift, box);
     cache_.push_back({layer, box, features_inside(all, box)});
     return cache_.back().features;
   }
 
  private:
+  Features whole_;  // layer 0 over the whole still
+  bool whole_detected_ = false;
   struct Entry {
     size_t layer;
     cv::Rect box;

@@ -9,6 +9,19 @@
 namespace nudge::robot {
 namespace {
 
+// The samples of the straight joint line from `from` to `to` with no joint moving more than
+// `step` between two (`from` only with include_from; `to` exactly), each with its fraction of the
+// line, until `visit` returns false. A non-finite line is visited at `to` only.
+template <class Visit>
+void visit_joint_line(const JointVector& from, const JointVector& to, double step, bool include_from, Visit&& visit) {
+  const double largest_change = (to - from).cwiseAbs().maxCoeff();
+  const int steps = std::isfinite(largest_change) ? std::max(1, static_cast<int>(std::ceil(largest_change / step))) : 1;
+  for (int k = include_from ? 0 : 1; k <= steps; ++k) {
+    const double fraction = static_cast<double>(k) / steps;
+    if (!visit(k == steps ? to : JointVector(from + fraction * (to - from)), fraction)) return;
+  }
+}
+
 CheckResult check_above_table(const char* what, const Eigen::Vector3d& point,
                               const SafetyConfig& config) {
   const double lowest = config.table_z + config.table_margin;
@@ -99,16 +112,14 @@ double link_gap_to_standing_object(const ArmModel& model, const SafetyConfig& co
 double least_link_gap_along(const ArmModel& model, const SafetyConfig& config, const StandingObject& object,
                             const std::vector<JointVector>& waypoints) {
   double least = std::numeric_limits<double>::infinity();
+  auto visit = [&](const JointVector& q, double) {
+    least = std::min(least, link_gap_to_standing_object(model, config, object, q));
+    return true;
+  };
   for (size_t i = 0; i < waypoints.size(); ++i) {
-    const JointVector& to = waypoints[i];
-    const JointVector& from = i == 0 ? to : waypoints[i - 1];
-    const double largest_change = (to - from).cwiseAbs().maxCoeff();
-    // A non-finite path is refused by check_joint_path; here it only must not loop for ever.
-    const int steps = std::isfinite(largest_change) ? std::max(1, static_cast<int>(std::ceil(largest_change / config.path_step))) : 1;
-    for (int k = i == 0 ? steps : 1; k <= steps; ++k) {
-      const JointVector q = k == steps ? to : JointVector(from + (static_cast<double>(k) / steps) * (to - from));
-      least = std::min(least, link_gap_to_standing_object(model, config, object, q));
-    }
+    // Each segment's start is the previous one's end: only the first waypoint is visited alone.
+    if (i == 0) visit(waypoints[0], 0.0);
+    else visit_joint_line(waypoints[i - 1], waypoints[i], config.path_step, false, visit);
   }
   return least;
 }
@@ -184,21 +195,18 @@ CheckResult check_configuration(const ArmModel& model, const SafetyConfig& confi
 CheckResult check_joint_path(const ArmModel& model, const SafetyConfig& config,
                              const JointVector& from, const JointVector& to) {
   validate(config);
-  const double largest_change = (to - from).cwiseAbs().maxCoeff();
-  if (!std::isfinite(largest_change)) {
+  if (!std::isfinite((to - from).cwiseAbs().maxCoeff())) {
     return CheckResult::fail("path has non-finite joint values");
   }
-  const int steps = std::max(1, static_cast<int>(std::ceil(largest_change / config.path_step)));
-  for (int k = 0; k <= steps; ++k) {
-    const double fraction = static_cast<double>(k) / steps;
-    const JointVector q = k == steps ? to : JointVector(from + fraction * (to - from));
+  CheckResult unsafe = CheckResult::pass();
+  visit_joint_line(from, to, config.path_step, true, [&](const JointVector& q, double fraction) {
     CheckResult result = check_configuration(model, config, q);
     if (!result.ok()) {
-      return CheckResult::fail("unsafe at " + format_number(100.0 * fraction, 1) +
-                               "% of the path: " + result.reason);
+      unsafe = CheckResult::fail("unsafe at " + format_number(100.0 * fraction, 1) + "% of the path: " + result.reason);
     }
-  }
-  return CheckResult::pass();
+    return result.ok();
+  });
+  return unsafe;
 }
 
 CheckResult check_joint_path(const ArmModel& model, const SafetyConfig& config,

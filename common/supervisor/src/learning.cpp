@@ -209,12 +209,14 @@ void Supervisor::take_view(const cv::Mat& still, int64_t utime, int64_t now) {
 void Supervisor::commit_views(int64_t now) {
   Attempt& a = *attempt_;
   if (a.views.empty()) return place(now, "not learned", "no view was taken");
-  LearnView scene;
-  scene.scene = true;
-  scene.image = a.after;
-  scene.utime = a.after_utime;
-  scene.object_key = a.object_key();
-  outputs_.push_back(scene);
+  if (!a.after.empty()) {  // the scene still; without it the learner prunes across the views only
+    LearnView scene;
+    scene.scene = true;
+    scene.image = a.after;
+    scene.utime = a.after_utime;
+    scene.object_key = a.object_key();
+    outputs_.push_back(scene);
+  }
   learn_seq_ = next_seq_++;
   enter(State::Learn, now, "learning from " + std::to_string(a.views.size()) + " views");
   const double height = a.grasp->top_height_m;
