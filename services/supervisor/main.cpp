@@ -567,6 +567,9 @@ void add_flags(Flags& f, Options& o) {
              "plot) while the settled AXES decide");
   f.add_int("survey-frames", &o.config.survey_frames, "stereo pairs per candidate survey (thesis 25)");
   f.add_int("survey-lines", &o.config.survey_lines, "lines per image in a survey (thesis 3)");
+  f.add_int("agreement-lines", &o.config.agreement_lines,
+            "a candidate's stereo agreement counts each image's lines up to this many not of an explored object "
+            "(the symmetry service may publish more for later surveys)");
   f.add_double("wide-survey-tilt", &o.config.wide_survey_tilt_deg,
                "a survey leaving nothing to nudge is asked again with lines up to DEG from upright before the run ends (0: never)");
   f.add_int("max-attempts", &o.config.max_attempts, "nudges per run");

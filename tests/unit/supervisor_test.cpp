@@ -403,7 +403,8 @@ TEST(Targets, NearestTheCameraFirstAndEveryPassOverHasAReason) {
   // their lines out) block both pushes as candidates would.
   const double pad = 0.5 * (arm.nudge.start_distance + arm.nudge.stop_distance);
   sv::History blocked;
-  blocked.standing = {choice.target.position - pad * choice.direction, choice.target.position + pad * choice.direction};
+  blocked.standing = {sv::ExploredObject(choice.target.position - pad * choice.direction),
+                      sv::ExploredObject(choice.target.position + pad * choice.direction)};
   const auto around = sv::choose_target({candidates[1]}, blocked, scene.right_camera_in_world(), arm, arm_state_joints(),
                                         sv::TargetParams{});
   EXPECT_FALSE(around.found);
@@ -414,7 +415,7 @@ TEST(Targets, NearestTheCameraFirstAndEveryPassOverHasAReason) {
 // The least gap between the arm's links, along the whole command the arm service would run for
 // `choice` from `seed` and the way home after it, and an object of the expected size standing at `other`.
 double least_link_gap(const sv::TargetChoice& choice, const sv::ArmSetup& arm, const nudge::robot::JointVector& seed,
-                      const Eigen::Vector3d& other, const sv::TargetParams& params) {
+                      const Eigen::Vector3d& other, const sv::TargetParams& params, double height = 0) {
   nudge::robot::Command command;
   command.kind = nudge::robot::CommandKind::Nudge;
   command.target_position = choice.target.position;
@@ -428,8 +429,48 @@ double least_link_gap(const sv::TargetChoice& choice, const sv::ArmSetup& arm, c
     path.insert(path.end(), step.path.begin(), step.path.end());
   }
   path.push_back(arm.home());  // parking after the push
-  const nudge::robot::StandingObject object{arm.point_to_base(other), params.object_radius, params.obstacle_height};
+  const nudge::robot::StandingObject object{arm.point_to_base(other), params.object_radius, height > 0 ? height : params.obstacle_height};
   return nudge::robot::least_link_gap_along(arm.model, arm.safety_config(), object, path);
+}
+
+// An explored object is kept clear of as tall as the stills measured it: a short one frees pushes
+// whose links pass over it, a tall one is cleared in full. Unmeasured, it is the tallest expected.
+TEST(Targets, AnExploredObjectIsKeptClearOfAsTallAsItWasMeasured) {
+  const sv::SceneGeometry scene = make_scene();
+  const sv::ArmSetup arm;
+  const sv::TargetParams params;
+  int freed = 0, strict_short = 0, strict_tall = 0;
+  for (double radius = 0.18; radius <= 0.32; radius += 0.07)
+    for (double bearing = -60; bearing <= 60; bearing += 30)
+      for (double turn = 0; turn < 360; turn += 60) {
+        const double b = bearing * M_PI / 180, t = turn * M_PI / 180;
+        const Eigen::Vector3d first(radius * std::cos(b), radius * std::sin(b), 0);
+        const Eigen::Vector3d second = first + 0.12 * Eigen::Vector3d(std::cos(t), std::sin(t), 0);
+        auto choose = [&](double height) {
+          sv::History explored;
+          explored.standing = {sv::ExploredObject(second, height)};
+          return sv::choose_target({{0, first, 9}}, explored, scene.right_camera_in_world(), arm, arm_state_joints(), params);
+        };
+        auto strict = [](const sv::TargetChoice& c) { return c.found && c.note.find("no clear push left") == std::string::npos; };
+        const auto unmeasured = choose(0), short_one = choose(0.10), tall_one = choose(0.32);
+        if (strict(short_one)) {
+          ++strict_short;
+          EXPECT_GE(least_link_gap(short_one, arm, arm_state_joints(), second, params, 0.10), arm.nudge.link_clearance);
+          freed += !strict(unmeasured);
+        }
+        if (strict(tall_one)) {
+          ++strict_tall;
+          EXPECT_GE(least_link_gap(tall_one, arm, arm_state_joints(), second, params, 0.32), arm.nudge.link_clearance)
+              << sv::millimetres(first) << " beside the explored " << sv::millimetres(second);
+        }
+        // What clears the tallest expected clears a shorter object too.
+        if (strict(unmeasured)) {
+          EXPECT_TRUE(strict(short_one)) << sv::millimetres(first) << " beside " << sv::millimetres(second);
+        }
+      }
+  EXPECT_GT(strict_short, 20);
+  EXPECT_GT(strict_tall, 10);
+  EXPECT_GT(freed, 0) << "measured short, some pushes pass over it that the tallest expected would refuse";
 }
 
 TEST(Targets, TheArmsLinksKeepClearOfTheOtherCandidatesWheneverSomePushDoes) {
@@ -702,6 +743,10 @@ TEST_F(SupervisorTest, SegmentsTheObjectThenFindsNothingLeftToNudge) {
   ASSERT_TRUE(a.rest);
   EXPECT_LT((*a.rest - rest).norm(), 0.005);
   EXPECT_GT(cv::countNonZero(a.segmentation.mask), 1000);
+  // Measured where it stands, for later pushes' links: the box is 12 cm tall; the measurement errs
+  // high (its top face seen from above) and carries the 2 cm margin.
+  EXPECT_GT(a.standing_height, 0.115 + sv::HeightParams{}.margin_m);
+  EXPECT_LT(a.standing_height, 0.20);
   // The next survey leaves the segmented object's lines out, where it now stands.
   const auto surveys = outputs_of<sv::CandidatesRequest>(out);
   ASSERT_EQ(surveys.size(), 1u);
@@ -1067,6 +1112,64 @@ TEST_F(SupervisorTest, SurveyLinesOfFramesFromBeforeTheSurveyAreIgnored) {
   for (const sv::StateReport& r : outputs_of<sv::StateReport>(s.take_outputs()))
     if (r.state == sv::State::Choose) chosen = r.reason;
   EXPECT_NE(chosen.find("(seen 100%)"), std::string::npos) << chosen;
+}
+
+// A candidate's stereo agreement counts each image's lines up to the fifth that is not an explored
+// object's (Config::agreement_lines): the symmetry service may publish more, for the surveys after
+// an object is explored, whose lines are then left out (the triangulation service's rule).
+TEST_F(SupervisorTest, TheStereoAgreementCountsTheLinesASurveyCouldPair) {
+  const Eigen::Vector3d first(0.28, -0.05, 0), object(0.24, 0.08, 0);
+  const std::vector<Eigen::Vector3d> others = {{0.36, 0.22, 0}, {0.15, -0.17, 0}, {0.40, -0.20, 0}, {0.12, 0.20, 0}};
+  // Frames whose lines are the axes of `places`, strongest first.
+  auto hear = [&](sv::Supervisor& s, const std::vector<Eigen::Vector3d>& places) {
+    for (int frame = 0; frame < 10; ++frame)
+      for (const bool left : {true, false}) {
+        std::vector<nudge::symmetry::Line> lines;
+        for (const Eigen::Vector3d& p : places) {
+          const auto line = left ? scene_.left_axis_line(p, 0.25, {640, 480}) : scene_.right_axis_line(p, 0.25, {640, 480});
+          ASSERT_TRUE(line);
+          lines.push_back(*line);
+        }
+        s.on_lines(left, lines, now_ + kSecond / 10, now_ + kSecond / 5);
+      }
+  };
+  for (const Eigen::Vector3d& other : others)
+    for (const bool left : {true, false}) {
+      const auto a = left ? scene_.left_axis_line(other, 0.25, {640, 480}) : scene_.right_axis_line(other, 0.25, {640, 480});
+      const auto b = left ? scene_.left_axis_line(object, 0.25, {640, 480}) : scene_.right_axis_line(object, 0.25, {640, 480});
+      ASSERT_FALSE(sv::lines_agree(*a, *b, 3 * M_PI / 180, 6)) << "the other lines are not the object's";
+    }
+  // Nothing explored: the object's line as the fifth line counts, as the sixth it does not.
+  for (const size_t before : {others.size(), others.size() + 1}) {
+    SCOPED_TRACE(std::to_string(before) + " lines before the object's");
+    sv::Supervisor s = make();
+    s.start(now_, 100);
+    s.on_services({}, now_);
+    std::vector<Eigen::Vector3d> places = others;
+    if (before > others.size()) places.push_back(first);
+    places.push_back(object);
+    hear(s, places);
+    answer_survey(s, {object});
+    if (before == others.size()) {
+      EXPECT_EQ(s.state(), sv::State::SnapshotBefore) << s.report().reason;
+    } else {
+      EXPECT_EQ(s.state(), sv::State::Done) << s.report().reason;
+      EXPECT_EQ(s.summary().rejections.count("not seen upright by both cameras (a stereo mismatch)"), 1u);
+    }
+  }
+  // After the first object is segmented, its line ahead of the others is not counted: the object's
+  // line, sixth, is the fifth of an unexplored object's.
+  sv::Supervisor s = make();
+  const Eigen::Vector3d rest = nudge_and_park(s, first);
+  s.on_right_still(draw_scene(scene_, {1280, 960}, {rest}), now_, now_);
+  ASSERT_EQ(outputs_of<sv::AttemptEnded>(s.take_outputs()).at(0).attempt->outcome, sv::Outcome::Segmented);
+  ASSERT_EQ(s.state(), sv::State::FindCandidates);
+  std::vector<Eigen::Vector3d> places = {rest};
+  places.insert(places.end(), others.begin(), others.end());
+  places.push_back(object);
+  hear(s, places);
+  answer_survey(s, {object});
+  EXPECT_EQ(s.state(), sv::State::SnapshotBefore) << s.report().reason;
 }
 
 // A candidate that no frame of the survey shows as an upright axis in both cameras (seen 0%: the

@@ -84,6 +84,8 @@ Supervisor::Supervisor(Config config, SceneGeometry scene, ArmSetup arm, Segment
   if (!segment_) throw std::invalid_argument("supervisor: a segmentation function is required");
   if (config_.survey_frames <= 0 || config_.survey_lines <= 0 || config_.max_attempts <= 0)
     throw std::invalid_argument("supervisor: survey_frames, survey_lines and max_attempts must be positive");
+  if (config_.agreement_lines <= 0 || !(config_.explored_line_px > 0))
+    throw std::invalid_argument("supervisor: agreement_lines and explored_line_px must be positive");
   if (config_.views <= 0 || !(config_.view_step_deg > 0))
     throw std::invalid_argument("supervisor: views and view_step_deg must be positive");
   if (!(config_.settle_s >= 0 && config_.max_settle_s >= config_.settle_s))
@@ -149,7 +151,9 @@ void Supervisor::survey(int64_t now, const std::string& why, double max_line_til
   enter(State::FindCandidates, now,
         (why.empty() ? std::string() : why + "; ") + "surveying: candidates from " + std::to_string(config_.survey_frames) +
             " stereo pairs" + wide);
-  outputs_.push_back(CandidatesRequest{config_.survey_frames, config_.survey_lines, standing_, max_line_tilt_deg});
+  std::vector<Eigen::Vector3d> explored;
+  for (const ExploredObject& object : standing_) explored.push_back(object.place);
+  outputs_.push_back(CandidatesRequest{config_.survey_frames, config_.survey_lines, explored, max_line_tilt_deg});
 }
 
 void Supervisor::choose(int64_t now) {
@@ -849,9 +853,11 @@ void Supervisor::end_attempt(Outcome outcome, const std::string& reason, int64_t
       // out of the surveys would leave out the neighbours' lines that made it (development m03:
       // the yellow cup was never a candidate again).
       rested_.push_back({*a.rest, a.segmentation.mask, cv::boundingRect(a.segmentation.mask)});
-      standing_.push_back(*a.rest);
+      a.standing_height = explored_object_height(a);
+      standing_.push_back({*a.rest, a.standing_height});
     } else if (outcome == Outcome::Known || outcome == Outcome::Refused) {
-      standing_.push_back(a.target.position);  // never pushed: it stands where it was found
+      a.standing_height = explored_object_height(a);
+      standing_.push_back({a.target.position, a.standing_height});  // never pushed: it stands where it was found
     }
   }
   if (outcome == Outcome::SnapshotLost && a.before.empty()) {
@@ -1161,6 +1167,23 @@ void Supervisor::on_lines(bool left, const std::vector<symmetry::Line>& lines, i
   if (kept.size() > 50) kept.erase(kept.begin());
 }
 
+// The object where the attempt left it, in the still that shows it there: the top of the edge
+// pairs symmetric about its line (measure_object_height, built to err high) and the top of its
+// mask, whichever is higher. A segmented object is measured in the after still at its rest; one
+// never pushed (known, refused) in the before still where it stands, if at all.
+double Supervisor::explored_object_height(const Attempt& a) const {
+  const bool moved = a.outcome == Outcome::Segmented && a.rest;
+  const cv::Mat& still = moved ? a.after : a.before;
+  const std::optional<symmetry::Line>& line = moved ? a.after_line : a.before_line;
+  const Eigen::Vector3d foot = moved ? *a.rest : a.target.position;
+  std::optional<double> height = moved ? std::nullopt : a.measured_height;
+  if (!height && line && !still.empty()) height = measure_object_height(scene_, still, *line, foot, config_.height);
+  if (moved && a.top[1])
+    if (const auto top = ray_height_over(scene_, foot, *a.top[1], still.size()); top && (!height || *top > *height)) height = top;
+  if (!height || !std::isfinite(*height) || *height <= 0) return 0;
+  return *height + config_.height.margin_m;
+}
+
 History Supervisor::history() const {
   return History{explored_with_ray_mates(), phantoms_, empty_, standing_, sighted_};
 }
@@ -1198,6 +1221,21 @@ std::vector<Eigen::Vector3d> Supervisor::places_seen_by_right_lines() const {
   return seen;
 }
 
+std::vector<symmetry::Line> Supervisor::agreement_lines(geometry::Side side, const std::vector<symmetry::Line>& lines) const {
+  std::vector<symmetry::Line> kept;
+  int unexplored = 0;
+  for (const symmetry::Line& line : lines) {
+    if (unexplored >= config_.agreement_lines) break;
+    const bool explored = std::any_of(standing_.begin(), standing_.end(), [&](const ExploredObject& object) {
+      return geometry::is_image_of_upright_axis(scene_.rig(), side, scene_.table(), line, scene_.world_to_right(object.place),
+                                                config_.explored_line_px);
+    });
+    unexplored += !explored;
+    kept.push_back(line);
+  }
+  return kept;
+}
+
 double Supervisor::stereo_agreement(const Candidate& candidate) const {
   // The second, wider look paired lines leaning up to wide_survey_tilt_deg: one of those agrees
   // with the candidate's predicted axis when it leans no more and passes within the offset of the
@@ -1217,9 +1255,12 @@ double Supervisor::stereo_agreement(const Candidate& candidate) const {
     const auto predicted = camera == 0 ? scene_.left_axis_line(candidate.position, config_.object_height_m, config_.frame_size)
                                        : scene_.right_axis_line(candidate.position, config_.object_height_m, config_.frame_size);
     if (!predicted) return 0.0;
+    const geometry::Side side = camera == 0 ? geometry::Side::Left : geometry::Side::Right;
     int seen = 0;
-    for (const auto& lines : messages)
-      seen += std::any_of(lines.begin(), lines.end(), [&](const symmetry::Line& line) { return agree(line, *predicted); });
+    for (const auto& lines : messages) {
+      const std::vector<symmetry::Line> counted = agreement_lines(side, lines);
+      seen += std::any_of(counted.begin(), counted.end(), [&](const symmetry::Line& line) { return agree(line, *predicted); });
+    }
     agreement = std::min(agreement, static_cast<double>(seen) / messages.size());
   }
   return agreement;

@@ -90,7 +90,8 @@ PushConflict links_conflict(const robot::MotionPlan& plan, const robot::JointVec
   waypoints.push_back(arm.home());  // the arm parks after the push, before the after still
   const robot::SafetyConfig safety = arm.safety_config();
   for (const Obstacle& other : obstacles) {
-    const robot::StandingObject object{arm.point_to_base(other.place), params.object_radius, params.obstacle_height};
+    const double height = other.height > 0 ? other.height : params.obstacle_height;
+    const robot::StandingObject object{arm.point_to_base(other.place), params.object_radius, height};
     const double gap = robot::least_link_gap_along(arm.model, safety, object, waypoints);
     if (gap < arm.nudge.link_clearance)
       return {PushConflict::Kind::Links, "the arm's links would pass within " + std::to_string(std::lround(1e3 * std::max(0.0, gap))) +
@@ -108,17 +109,25 @@ std::vector<Obstacle> obstacles_to(const Candidate& c, const std::vector<Candida
                                    const TargetParams& params) {
   std::vector<Obstacle> obstacles;
   auto far_from_target = [&](const Eigen::Vector3d& p) { return horizontal(p - c.position).norm() >= params.same_object_radius; };
-  auto near_an_obstacle = [&](const Eigen::Vector3d& p) {
-    return std::any_of(obstacles.begin(), obstacles.end(),
-                       [&](const Obstacle& o) { return horizontal(o.place - p).norm() < params.same_object_radius; });
+  auto obstacle_near = [&](const Eigen::Vector3d& p) {
+    return std::find_if(obstacles.begin(), obstacles.end(),
+                        [&](const Obstacle& o) { return horizontal(o.place - p).norm() < params.same_object_radius; });
   };
+  auto near_an_obstacle = [&](const Eigen::Vector3d& p) { return obstacle_near(p) != obstacles.end(); };
   for (const Candidate& other : candidates) {
     if (other.index == c.index || near_any(other.position, history.empty, params.explored_radius)) continue;
     if (other.stereo_agreement < params.min_stereo_agreement) continue;
     if (far_from_target(other.position)) obstacles.push_back({other.position, "candidate"});
   }
-  for (const Eigen::Vector3d& object : history.standing)
-    if (far_from_target(object) && !near_an_obstacle(object)) obstacles.push_back({object, "explored object"});
+  for (const ExploredObject& object : history.standing) {
+    if (!far_from_target(object.place)) continue;
+    const auto near = obstacle_near(object.place);
+    if (near == obstacles.end()) {
+      obstacles.push_back({object.place, "explored object", object.height});
+    } else if (near->height <= 0) {
+      near->height = object.height;  // the candidate is the explored object's line seen again: as tall as measured
+    }
+  }
   for (const Eigen::Vector3d& object : history.sighted)
     if (far_from_target(object) && !near_an_obstacle(object)) obstacles.push_back({object, "object seen in one camera"});
   return obstacles;

@@ -190,6 +190,13 @@ struct Config {
   cv::Size still_size{1280, 960};    // SNAPSHOT_RIGHT
   double agreement_angle_deg = 3;    // a detected line is a candidate's: within this angle
   double agreement_offset_px = 6;    // and this R (at frame_size)
+  // A candidate's stereo agreement counts, in each image, the lines up to the agreement_lines-th
+  // that is not an explored object's (the image of an upright axis where one stands, within
+  // explored_line_px: the triangulation service's rule for the survey's lines). The symmetry
+  // service may publish more lines (nudge-symmetry --reach-keep): a later survey pairs them once
+  // explored objects' lines are left out, and they count here then, not before.
+  int agreement_lines = 5;
+  double explored_line_px = 8;
   TargetParams targets;
   MotionWatchParams motion;
   // Thesis sec. 6.3.2: motion at the target starts one symmetry tracker per camera at the target's
@@ -295,6 +302,9 @@ struct Attempt {
   double height_limit = 0;
   std::optional<double> measured_height;
   double pushed_object_height = 0;
+  // The object left standing (segmented, known, refused): how tall it was measured, margin
+  // included; later pushes' links keep clear of that (0: not measured, the tallest expected).
+  double standing_height = 0;
   std::vector<Candidate> candidates;       // the survey it was chosen from
   std::vector<Rejection> rejected;         // candidates passed over for it
   // Config::rival_by_foot: how far the target stands beyond its before line's foot (depth_beyond_line_foot),
@@ -468,7 +478,7 @@ class Supervisor {
   // with how many failed attempts led there.
   std::vector<std::pair<Eigen::Vector3d, int>> retries_;
   bool wide_survey_ = false;  // the survey under way is the second, wider look
-  std::vector<Eigen::Vector3d> standing_;  // explored objects where they stand now (CandidatesRequest::explored)
+  std::vector<ExploredObject> standing_;  // explored objects where they stand now (CandidatesRequest::explored)
   std::vector<Eigen::Vector3d> sighted_;   // places_seen_by_right_lines() of the last survey, found once
   // The segmented objects where they came to rest (they stand there now), with their masks.
   struct Rested {
@@ -482,6 +492,8 @@ class Supervisor {
   std::vector<Eigen::Vector3d> places_seen_by_right_lines() const;
   History history() const;
   bool retry_from_rest(Attempt& attempt);
+  // How tall the explored object of `attempt` stands, with HeightParams::margin_m (0: not measured).
+  double explored_object_height(const Attempt& attempt) const;
   // The smallest object expected standing at a foot, as the right still shows it (px; 0 x 0 when
   // it cannot be projected).
   cv::Size2d smallest_object_image(const Eigen::Vector3d& foot) const;
@@ -507,6 +519,10 @@ class Supervisor {
   bool frame_of_the_nudge(int64_t utime) const;
   std::vector<std::vector<symmetry::Line>> survey_lines_[2];  // [left, right]: per message, during a survey
   double stereo_agreement(const Candidate& candidate) const;
+  // The lines of one image (strongest first) that count towards a candidate's stereo agreement:
+  // up to the Config::agreement_lines-th that is not the image of an explored object standing on
+  // the table (standing_).
+  std::vector<symmetry::Line> agreement_lines(geometry::Side side, const std::vector<symmetry::Line>& lines) const;
   robot::JointVector joints_ = robot::JointVector::Zero();
   std::set<std::string> silent_;
   std::unique_ptr<Attempt> attempt_;

@@ -69,8 +69,9 @@ struct TargetParams {
   double push_turn_step_deg = 20;
   // The arm's links (upper arm, forearm, tool) along the whole command, the move to P0 included,
   // keep robot::NudgeParams::link_clearance from every other known object, taken as an upright
-  // column of object_radius and this height (their heights are not measured: the tallest
-  // expected). A push that cannot is taken only when no push clears every object. 0: not checked.
+  // column of object_radius and, unless the stills measured it (an explored object), this height
+  // (the tallest expected). A push that cannot is taken only when no push clears every object.
+  // 0: not checked.
   double obstacle_height = 0.25;
 };
 
@@ -106,6 +107,15 @@ struct TargetChoice {
 // "(x, y) mm" of a world point, for reasons.
 std::string millimetres(const Eigen::Vector3d& p);
 
+// An explored object where it stands now (world frame, on the table), and how tall the stills
+// measured it (m above the table, the measurement's margin included; 0: not measured, and taken
+// as TargetParams::obstacle_height).
+struct ExploredObject {
+  Eigen::Vector3d place;
+  double height = 0;
+  ExploredObject(const Eigen::Vector3d& place, double height = 0) : place(place), height(height) {}  // NOLINT: a place alone is an object not measured
+};
+
 // What the run's earlier attempts left on the table (world frame).
 struct History {
   // Places already nudged (where a candidate stood, where a nudged object came to rest): skipped.
@@ -116,7 +126,7 @@ struct History {
   std::vector<Eigen::Vector3d> empty;
   // Explored objects where they stand now. Later surveys leave their lines out, so they may be
   // no candidate; they are still obstacles to every push.
-  std::vector<Eigen::Vector3d> standing;
+  std::vector<ExploredObject> standing;
   // Where a line the right camera saw through most of the survey stands on the table
   // (Config::line_obstacle_share): an object the stereo pairing may have missed; an obstacle to
   // every push (one at a candidate that is itself an obstacle adds nothing).
@@ -155,12 +165,14 @@ PushConflict push_conflict(const Eigen::Vector3d& target, const Eigen::Vector3d&
 struct Obstacle {
   Eigen::Vector3d place;
   const char* what = "candidate";
+  double height = 0;  // m above the table as measured; 0: not measured (TargetParams::obstacle_height)
 };
 
 // Whether the arm's links, at every joint position of `plan` (the arm service's steps for the
-// push, executed from `seed`) and on the way home after it (where the arm parks), keep arm.nudge.link_clearance from an object
-// params.obstacle_height tall and params.object_radius wide standing at each of `obstacles`; the
-// first one they do not is named. No conflict when params.obstacle_height is 0.
+// push, executed from `seed`) and on the way home after it (where the arm parks), keep
+// arm.nudge.link_clearance from an object params.object_radius wide standing at each of
+// `obstacles`, as tall as it was measured (else params.obstacle_height); the first one they do not
+// is named. No conflict when params.obstacle_height is 0.
 PushConflict links_conflict(const robot::MotionPlan& plan, const robot::JointVector& seed,
                             const std::vector<Obstacle>& obstacles, const ArmSetup& arm, const TargetParams& params);
 
