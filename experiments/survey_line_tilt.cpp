@@ -4,9 +4,11 @@
 // CANDIDATES_REQUESTs, and every candidate of every survey is scored against the simulator's
 // SIM_STATE of that moment: within --real-radius of an object it is that object (real), else a
 // phantom. With --lines, each CANDIDATES_REQUEST is also replayed asking for that many lines per
-// image (the supervisor's --survey-lines) instead of the recorded number. Writes
+// image (the supervisor's --survey-lines) instead of the recorded number. With --published, each
+// SYMMETRY message is also cut to its first N lines (the symmetry service's --reach-keep: runs
+// recorded with more lines published replayed as if fewer had been). Writes
 // docs/results/NAME.{json,md} (default survey_line_tilt).
-//   nudge-exp-survey-line-tilt RUNS_DIR [RUNS_DIR...] [--tilts 1,2,3] [--lines 3,5] [--real-radius 0.03] [--name STEM]
+//   nudge-exp-survey-line-tilt RUNS_DIR [RUNS_DIR...] [--tilts 1,2,3] [--lines 3,5] [--published 5,8] [--real-radius 0.03] [--name STEM]
 // Later surveys follow what the recorded run did (its pushes, its explored places): a replay
 // scores the lines each tilt keeps, not a new run. Choose on development runs only.
 #include <unistd.h>
@@ -29,6 +31,7 @@
 #include "nudge/progress.hpp"
 #include "nudge/sim_state_t.hpp"
 #include "nudge/supervisor/scene.hpp"
+#include "nudge/symmetry_lines_t.hpp"
 #include "report.hpp"
 
 namespace fs = std::filesystem;
@@ -42,15 +45,21 @@ struct Score {
   int objects = 0;
 };
 
-// One replayed setting: the survey-line tilt and the lines per image (0: as the log's requests ask).
+// One replayed setting: the survey-line tilt, the lines per image the surveys pair (0: as the log's
+// requests ask) and the lines per image published (0: as recorded).
 struct Variant {
   double tilt = 0;
   int lines = 0;
-  bool operator<(const Variant& o) const { return lines != o.lines ? lines < o.lines : tilt < o.tilt; }
+  int published = 0;
+  bool operator<(const Variant& o) const {
+    return published != o.published ? published < o.published : lines != o.lines ? lines < o.lines : tilt < o.tilt;
+  }
+  bool rewritten() const { return lines || published; }
   std::string name() const {
     std::ostringstream text;
     text << tilt << "°";
     if (lines) text << " " << lines << " lines";
+    if (published) text << " " << published << " published";
     return text.str();
   }
 };
@@ -82,9 +91,11 @@ std::vector<Message> read_channel(const fs::path& log_path, const std::string& c
   return messages;
 }
 
-// A copy of the log whose CANDIDATES_REQUESTs ask for `lines` lines per image: the recorded surveys
-// replayed as if the supervisor had run with --survey-lines `lines`.
-void write_with_survey_lines(const fs::path& from, const fs::path& to, int lines) {
+// A copy of the log whose CANDIDATES_REQUESTs ask for `lines` lines per image (0: as recorded) and
+// whose SYMMETRY messages hold their first `published` lines (0: all): the recorded surveys replayed
+// as if the supervisor had run with --survey-lines `lines` and the symmetry service had published
+// `published` lines.
+void write_with_survey_lines(const fs::path& from, const fs::path& to, int lines, int published) {
   lcm::LogFile in(from.string(), "r");
   lcm::LogFile out(to.string(), "w");
   if (!in.good() || !out.good()) throw std::runtime_error("cannot copy " + from.string() + " to " + to.string());
@@ -92,12 +103,22 @@ void write_with_survey_lines(const fs::path& from, const fs::path& to, int lines
   for (const lcm::LogEvent* e = in.readNextEvent(); e; e = in.readNextEvent()) {
     lcm::LogEvent copy = *e;
     nudge::candidates_request_t request;
-    if (e->channel == "CANDIDATES_REQUEST" && request.decode(e->data, 0, e->datalen) >= 0) {
-      request.lines_per_image = lines;
-      buffer.resize(request.getEncodedSize());
-      request.encode(buffer.data(), 0, static_cast<int>(buffer.size()));
+    nudge::symmetry_lines_t symmetry;
+    auto replace = [&](const auto& message) {
+      buffer.resize(message.getEncodedSize());
+      message.encode(buffer.data(), 0, static_cast<int>(buffer.size()));
       copy.data = buffer.data();
       copy.datalen = static_cast<int32_t>(buffer.size());
+    };
+    if (lines && e->channel == "CANDIDATES_REQUEST" && request.decode(e->data, 0, e->datalen) >= 0) {
+      request.lines_per_image = lines;
+      replace(request);
+    }
+    if (published && e->channel.rfind("SYMMETRY_", 0) == 0 && symmetry.decode(e->data, 0, e->datalen) >= 0 &&
+        symmetry.num_lines > published) {
+      symmetry.num_lines = published;
+      symmetry.lines.resize(published);
+      replace(symmetry);
     }
     if (out.writeEvent(&copy) != 0) throw std::runtime_error("cannot write " + to.string());
   }
@@ -157,6 +178,7 @@ int main(int argc, char** argv) try {
   std::vector<std::string> run_sets;
   std::vector<double> tilts{1, 1.5, 2, 3, 4, 5, 7};
   std::vector<int> survey_lines;  // empty: as recorded
+  std::vector<int> published;     // empty: as recorded
   double real_radius = 0.03;
   std::string name = "survey_line_tilt";
   for (int i = 1; i < argc; ++i) {
@@ -165,13 +187,16 @@ int main(int argc, char** argv) try {
     if (arg == "--tilts" && has_value) tilts = parse_list(argv[++i], arg);
     else if (arg == "--lines" && has_value)
       for (double n : parse_list(argv[++i], arg)) survey_lines.push_back(static_cast<int>(n));
+    else if (arg == "--published" && has_value)
+      for (double n : parse_list(argv[++i], arg)) published.push_back(static_cast<int>(n));
     else if (arg == "--real-radius" && has_value) real_radius = std::stod(argv[++i]);
     else if (arg == "--name" && has_value) name = argv[++i];
     else if (!arg.empty() && arg[0] == '-') throw std::invalid_argument("unknown option " + arg);
     else run_sets.push_back(arg);
   }
   if (run_sets.empty()) {
-    std::cerr << "usage: nudge-exp-survey-line-tilt RUNS_DIR [RUNS_DIR...] [--tilts 1,2,3] [--lines 3,5] [--real-radius 0.03] [--name STEM]\n";
+    std::cerr << "usage: nudge-exp-survey-line-tilt RUNS_DIR [RUNS_DIR...] [--tilts 1,2,3] [--lines 3,5] [--published 5,8] "
+                 "[--real-radius 0.03] [--name STEM]\n";
     return 2;
   }
   const fs::path source = NUDGE_SOURCE_DIR;
@@ -181,10 +206,11 @@ int main(int argc, char** argv) try {
   const std::string triangulation = (own_directory() / "nudge-triangulation").string();
   const fs::path replay = fs::temp_directory_path() / ("survey_line_tilt_" + std::to_string(getpid()) + ".lcmlog");
   const fs::path rewritten = fs::temp_directory_path() / ("survey_line_tilt_in_" + std::to_string(getpid()) + ".lcmlog");
-  // The variants replayed: every tilt at every lines-per-image (0: the recorded requests').
+  // The variants replayed: every tilt at every lines-per-image and lines published (0: as recorded).
   std::vector<Variant> variants;
-  for (int lines : survey_lines.empty() ? std::vector<int>{0} : survey_lines)
-    for (double tilt : tilts) variants.push_back({tilt, lines});
+  for (int kept : published.empty() ? std::vector<int>{0} : published)
+    for (int lines : survey_lines.empty() ? std::vector<int>{0} : survey_lines)
+      for (double tilt : tilts) variants.push_back({tilt, lines, kept});
 
   // Each run is named by its set's number (the RUNS_DIRs in order) and its scene.
   std::vector<std::pair<std::string, fs::path>> logs;
@@ -208,10 +234,13 @@ int main(int argc, char** argv) try {
     const auto states = read_channel<nudge::sim_state_t>(log, "SIM_STATE");
     if (states.empty()) throw std::runtime_error(log.string() + ": no SIM_STATE (a simulated run's log is needed)");
     std::string line = run + ":";
-    int rewritten_lines = 0;
+    std::pair<int, int> rewritten_as{0, 0};
     for (const Variant& variant : variants) {
-      if (variant.lines != rewritten_lines) write_with_survey_lines(log, rewritten, variant.lines), rewritten_lines = variant.lines;
-      const fs::path& input = variant.lines ? rewritten : log;
+      if (variant.rewritten() && std::make_pair(variant.lines, variant.published) != rewritten_as) {
+        write_with_survey_lines(log, rewritten, variant.lines, variant.published);
+        rewritten_as = {variant.lines, variant.published};
+      }
+      const fs::path& input = variant.rewritten() ? rewritten : log;
       const std::string command = shell_quote(triangulation) + " --lcm-in " + shell_quote("file://" + input.string() + "?speed=0") +
                                   " --lcm-out " + shell_quote("file://" + replay.string() + "?mode=w") + " --calibration " +
                                   shell_quote(calibration) + " --workspace " + shell_quote(workspace) +
@@ -241,13 +270,15 @@ int main(int argc, char** argv) try {
   for (size_t i = 0; i < run_sets.size(); ++i) md << (i ? ", " : "") << i + 1 << ": `" << run_sets[i] << "`";
   md << " (" << logs.size() << " runs). " << nudge::experiments::machine_description() << ", "
      << nudge::experiments::today() << ".\n\n"
-     << "| tilt (deg) | lines per image | real candidates | phantoms | objects ever a candidate |\n|---|---|---|---|---|\n";
+     << "| tilt (deg) | lines per image | lines published | real candidates | phantoms | objects ever a candidate |\n|---|---|---|---|---|---|\n";
   for (const auto& [variant, runs] : scores) {
     int real = 0, phantom = 0, found = 0, objects = 0;
     for (const auto& [run, s] : runs) real += s.real, phantom += s.phantom, found += static_cast<int>(s.objects_found.size()), objects += s.objects;
-    md << "| " << variant.tilt << " | " << (variant.lines ? std::to_string(variant.lines) : "as recorded") << " | " << real
+    md << "| " << variant.tilt << " | " << (variant.lines ? std::to_string(variant.lines) : "as recorded") << " | "
+       << (variant.published ? std::to_string(variant.published) : "as recorded") << " | " << real
        << " | " << phantom << " | " << found << "/" << objects << " |\n";
-    json.begin_object().field("tilt_deg", variant.tilt).field("lines_per_image", variant.lines).field("real", real).field("phantoms", phantom);
+    json.begin_object().field("tilt_deg", variant.tilt).field("lines_per_image", variant.lines).field("lines_published", variant.published);
+    json.field("real", real).field("phantoms", phantom);
     json.field("objects_found", found).field("objects", objects).end_object();
   }
   json.end_array().end_object();

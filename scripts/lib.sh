@@ -148,14 +148,10 @@ nudge_in_private_network() {
 # NUDGE_LOOP_TABLE_TEXTURE (1, the default; 0: off) leaves the table's own texture out of the
 # edges (nudge-symmetry --table-texture-calibration: where the two cameras agree through the
 # calibrated table plane; docs/clutter.md, "The table's own texture").
-# NUDGE_LOOP_REACH (1, the default; 0: off) makes "plain" take 20 peaks and keep the 8 first whose
+# NUDGE_LOOP_REACH (1, the default; 0: off) makes "plain" take 20 peaks and keep the 5 first whose
 # support stands on the table within 0.45 m of the arm's base and not within 0.10 m of it
 # (nudge-symmetry --reach-calibration, --reach-inner-radius: a wall's or the far table's lines
 # cannot be objects the arm reaches, and the arm's own base column, 65 mm in radius, is none).
-# A survey pairs the 3 strongest that are not an explored object's; AXES and the candidates'
-# stereo agreement take the 5 strongest (nudge-supervisor --agreement-lines: the 5 strongest not
-# an explored object's): the 8 leave room for the objects still to find once explored objects'
-# lines are left out (docs/supervisor.md, "Lines for the objects still to find").
 # "plain" surveys pair only lines within 2 deg of the image of an upright axis
 # (nudge-triangulation --candidate-line-tilt 2): objects' lines lean 0-1 deg (a degraded one up
 # to 4), lines between two objects 2.5-5 deg; re-chosen on 33 recorded development runs
@@ -220,10 +216,7 @@ nudge_run_loop() {
     plain)
       triangulation_flags=', "--candidate-line-tilt", "2"'
       if [ "${NUDGE_LOOP_REACH:-1}" = 1 ]; then
-        symmetry_flags='"--lines", "20", "--reach-calibration", "'"$calibration"'", "--reach-inner-radius", "0.10", "--reach-keep", "8"'
-        # AXES pair the 5 strongest lines per image, as before 8 were published: the 3 more are
-        # for the later surveys, which leave explored objects' lines out.
-        triangulation_flags+=', "--lines", "5"'
+        symmetry_flags='"--lines", "20", "--reach-calibration", "'"$calibration"'", "--reach-inner-radius", "0.10", "--reach-keep", "5"'
       fi ;;
     *) echo "NUDGE_LOOP_TABLE: verified, plain or busy, not '$NUDGE_LOOP_TABLE'" >&2; return 2 ;;
   esac

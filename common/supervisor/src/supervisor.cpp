@@ -1167,21 +1167,27 @@ void Supervisor::on_lines(bool left, const std::vector<symmetry::Line>& lines, i
   if (kept.size() > 50) kept.erase(kept.begin());
 }
 
-// The object where the attempt left it, in the still that shows it there: the top of the edge
-// pairs symmetric about its line (measure_object_height, built to err high) and the top of its
-// mask, whichever is higher. A segmented object is measured in the after still at its rest; one
-// never pushed (known, refused) in the before still where it stands, if at all.
+// The object where the attempt left it, in the still that shows it there (a segmented object in
+// the after still at its rest; one never pushed, known or refused, in the before still where it
+// stands), with the margin: the top of the edge pairs symmetric about its line
+// (measure_object_height), which errs high (symmetric clutter above an object raises it: 0.27-0.29
+// m for a cup and a bottle before a cluttered wall, development m02), so it may lower the tallest
+// expected but not raise it; and the top of its mask, which may (a mask cut short errs low, and is
+// never trusted alone). 0 when the edge pairs give no height: the tallest expected is assumed.
 double Supervisor::explored_object_height(const Attempt& a) const {
   const bool moved = a.outcome == Outcome::Segmented && a.rest;
   const cv::Mat& still = moved ? a.after : a.before;
   const std::optional<symmetry::Line>& line = moved ? a.after_line : a.before_line;
   const Eigen::Vector3d foot = moved ? *a.rest : a.target.position;
-  std::optional<double> height = moved ? std::nullopt : a.measured_height;
-  if (!height && line && !still.empty()) height = measure_object_height(scene_, still, *line, foot, config_.height);
+  std::optional<double> edges = moved ? std::nullopt : a.measured_height;
+  if (!edges && line && !still.empty()) edges = measure_object_height(scene_, still, *line, foot, config_.height);
+  if (!edges || !std::isfinite(*edges) || *edges <= 0) return 0;
+  const double margin = config_.height.margin_m, tallest = config_.targets.obstacle_height;
+  double height = tallest > 0 ? std::min(*edges + margin, tallest) : *edges + margin;
   if (moved && a.top[1])
-    if (const auto top = ray_height_over(scene_, foot, *a.top[1], still.size()); top && (!height || *top > *height)) height = top;
-  if (!height || !std::isfinite(*height) || *height <= 0) return 0;
-  return *height + config_.height.margin_m;
+    if (const auto top = ray_height_over(scene_, foot, *a.top[1], still.size()); top && std::isfinite(*top))
+      height = std::max(height, *top + margin);
+  return height;
 }
 
 History Supervisor::history() const {
