@@ -2,7 +2,8 @@
 // Publishes SIM_STATE at --rate in simulated time, answers SIM_TRUTH_REQUEST with SIM_TRUTH
 // (state + both cameras' object masks), and puts the pusher (or, with --tool gripper, the
 // gripper, its opening from ARM_STATE.gripper; --tool auto: the gripper from a COMMAND_GRASP on,
-// the pad from a COMMAND_NUDGE on) at the arm's tool point from ARM_STATE. All logic
+// the pad from a COMMAND_NUDGE on, and from a COMMAND_HOME with the fingers open) at the arm's tool
+// point from ARM_STATE. All logic
 // runs on simulated time; see docs/sim.md, "The world service".
 #include <algorithm>
 #include <cmath>
@@ -141,6 +142,10 @@ class Simulation {
     log::info() << "tool: " << (gripper_ ? "gripper" : "pad");
   }
 
+  // The gripper is the tool and its fingers, as ARM_STATE last gave them, are not open: they may
+  // hold an object.
+  bool holding() const { return gripper_ && arm_ && arm_->gripper < 0.9 * sim::gripper_geometry().max_opening; }
+
   sim_state_t state_message() const {
     sim_state_t msg;
     msg.utime = utime();
@@ -198,6 +203,11 @@ class Inputs {
       service.subscriptions().subscribe<arm_command_t>(bus::channel::ARM_COMMAND, [this](const arm_command_t& msg, const std::string&) {
         if (msg.command == arm_command_t::COMMAND_GRASP) sim_.use_gripper(true);
         if (msg.command == arm_command_t::COMMAND_NUDGE) sim_.use_gripper(false);
+        // Parked, the one hand shows the pad again, as it did before the grasp: the still before
+        // the next nudge shows the hand as the still after it will (with the gripper drawn in
+        // one and the pad in the other, the motion segmentation cut out the hand: the demo,
+        // 2026-11-30). Not while the fingers hold something.
+        if (msg.command == arm_command_t::COMMAND_HOME && !sim_.holding()) sim_.use_gripper(false);
       });
     service.subscriptions().subscribe<arm_state_t>(bus::channel::ARM_STATE, [this](const arm_state_t& msg, const std::string&) {
       catch_up(msg.utime);

@@ -171,6 +171,9 @@ TEST(SupervisorLearn, GraspsTurnsTwelveViewsAndPutsTheCupBack) {
   EXPECT_LT(std::hypot(now[0] - start[0], now[1] - start[1]), 0.02) << "back where it stood before the nudge";
   EXPECT_NEAR(now[2], start[2], 0.005) << "on the table";
   EXPECT_GT(learner.last->objects[0].axis_direction[2], std::cos(5 * M_PI / 180)) << "upright";
+  // Parked after the place, the hand shows the pad again (SIM_STATE.gripper -1): the still before
+  // the next nudge shows the hand as the still after it will.
+  EXPECT_EQ(learner.last->gripper, -1.0) << "the gripper still drawn after parking";
 
   // Replay: the same states, commands and commit from the run's log alone (the learner's answers
   // are in it; the left camera's segmentation runs on its own thread and changes nothing).
