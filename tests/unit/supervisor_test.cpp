@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <random>
 
@@ -433,6 +434,21 @@ double least_link_gap(const sv::TargetChoice& choice, const sv::ArmSetup& arm, c
   return nudge::robot::least_link_gap_along(arm.model, arm.safety_config(), object, path);
 }
 
+// Pairs of objects 12 cm apart over the workspace ring: the first 0.18-0.32 m from the base within
+// 60 deg of straight ahead, the second at six bearings around it.
+void for_each_pair_over_the_ring(const std::function<void(const Eigen::Vector3d&, const Eigen::Vector3d&)>& visit) {
+  for (double radius = 0.18; radius <= 0.32; radius += 0.07)
+    for (double bearing = -60; bearing <= 60; bearing += 30)
+      for (double turn = 0; turn < 360; turn += 60) {
+        const double b = bearing * M_PI / 180, t = turn * M_PI / 180;
+        const Eigen::Vector3d first(radius * std::cos(b), radius * std::sin(b), 0);
+        visit(first, first + 0.12 * Eigen::Vector3d(std::cos(t), std::sin(t), 0));
+      }
+}
+
+// A choice the strict rule made (no conflict tolerated, so no note saying what it risks).
+bool chosen_strictly(const sv::TargetChoice& c) { return c.found && c.note.find("no clear push left") == std::string::npos; }
+
 // An explored object is kept clear of as tall as the stills measured it: a short one frees pushes
 // whose links pass over it, a tall one is cleared in full. Unmeasured, it is the tallest expected.
 TEST(Targets, AnExploredObjectIsKeptClearOfAsTallAsItWasMeasured) {
@@ -440,34 +456,28 @@ TEST(Targets, AnExploredObjectIsKeptClearOfAsTallAsItWasMeasured) {
   const sv::ArmSetup arm;
   const sv::TargetParams params;
   int freed = 0, strict_short = 0, strict_tall = 0;
-  for (double radius = 0.18; radius <= 0.32; radius += 0.07)
-    for (double bearing = -60; bearing <= 60; bearing += 30)
-      for (double turn = 0; turn < 360; turn += 60) {
-        const double b = bearing * M_PI / 180, t = turn * M_PI / 180;
-        const Eigen::Vector3d first(radius * std::cos(b), radius * std::sin(b), 0);
-        const Eigen::Vector3d second = first + 0.12 * Eigen::Vector3d(std::cos(t), std::sin(t), 0);
-        auto choose = [&](double height) {
-          sv::History explored;
-          explored.standing = {sv::ExploredObject(second, height)};
-          return sv::choose_target({{0, first, 9}}, explored, scene.right_camera_in_world(), arm, arm_state_joints(), params);
-        };
-        auto strict = [](const sv::TargetChoice& c) { return c.found && c.note.find("no clear push left") == std::string::npos; };
-        const auto unmeasured = choose(0), short_one = choose(0.10), tall_one = choose(0.32);
-        if (strict(short_one)) {
-          ++strict_short;
-          EXPECT_GE(least_link_gap(short_one, arm, arm_state_joints(), second, params, 0.10), arm.nudge.link_clearance);
-          freed += !strict(unmeasured);
-        }
-        if (strict(tall_one)) {
-          ++strict_tall;
-          EXPECT_GE(least_link_gap(tall_one, arm, arm_state_joints(), second, params, 0.32), arm.nudge.link_clearance)
-              << sv::millimetres(first) << " beside the explored " << sv::millimetres(second);
-        }
-        // What clears the tallest expected clears a shorter object too.
-        if (strict(unmeasured)) {
-          EXPECT_TRUE(strict(short_one)) << sv::millimetres(first) << " beside " << sv::millimetres(second);
-        }
-      }
+  for_each_pair_over_the_ring([&](const Eigen::Vector3d& first, const Eigen::Vector3d& second) {
+    auto choose = [&](double height) {
+      sv::History explored;
+      explored.standing = {sv::ExploredObject(second, height)};
+      return sv::choose_target({{0, first, 9}}, explored, scene.right_camera_in_world(), arm, arm_state_joints(), params);
+    };
+    const auto unmeasured = choose(0), short_one = choose(0.10), tall_one = choose(0.32);
+    if (chosen_strictly(short_one)) {
+      ++strict_short;
+      EXPECT_GE(least_link_gap(short_one, arm, arm_state_joints(), second, params, 0.10), arm.nudge.link_clearance);
+      freed += !chosen_strictly(unmeasured);
+    }
+    if (chosen_strictly(tall_one)) {
+      ++strict_tall;
+      EXPECT_GE(least_link_gap(tall_one, arm, arm_state_joints(), second, params, 0.32), arm.nudge.link_clearance)
+          << sv::millimetres(first) << " beside the explored " << sv::millimetres(second);
+    }
+    // What clears the tallest expected clears a shorter object too.
+    if (chosen_strictly(unmeasured)) {
+      EXPECT_TRUE(chosen_strictly(short_one)) << sv::millimetres(first) << " beside " << sv::millimetres(second);
+    }
+  });
   EXPECT_GT(strict_short, 20);
   EXPECT_GT(strict_tall, 10);
   EXPECT_GT(freed, 0) << "measured short, some pushes pass over it that the tallest expected would refuse";
@@ -479,43 +489,37 @@ TEST(Targets, TheArmsLinksKeepClearOfTheOtherCandidatesWheneverSomePushDoes) {
   const sv::TargetParams params;
   sv::TargetParams unchecked;
   unchecked.obstacle_height = 0;
-  // Pairs of objects 9-15 cm apart over the workspace ring.
   int strict = 0, mended = 0, beside_clear = 0;
-  for (double radius = 0.18; radius <= 0.32; radius += 0.07)
-    for (double bearing = -60; bearing <= 60; bearing += 30)
-      for (double turn = 0; turn < 360; turn += 60) {
-        const double b = bearing * M_PI / 180, t = turn * M_PI / 180;
-        const Eigen::Vector3d first(radius * std::cos(b), radius * std::sin(b), 0);
-        const Eigen::Vector3d second = first + 0.12 * Eigen::Vector3d(std::cos(t), std::sin(t), 0);
-        const std::vector<sv::Candidate> candidates = {{0, first, 9}, {1, second, 9}};
-        // An object explored and standing there is kept clear of as a candidate is.
-        sv::History explored;
-        explored.standing = {second};
-        const auto beside = sv::choose_target({candidates[0]}, explored, scene.right_camera_in_world(), arm, arm_state_joints(), params);
-        if (beside.found && beside.note.find("no clear push left") == std::string::npos) {
-          ++beside_clear;
-          EXPECT_GE(least_link_gap(beside, arm, arm_state_joints(), second, params), arm.nudge.link_clearance)
-              << sv::millimetres(first) << " beside the explored " << sv::millimetres(second);
-        }
-        const auto choice = sv::choose_target(candidates, {}, scene.right_camera_in_world(), arm, arm_state_joints(), params);
-        if (!choice.found) continue;
-        const Eigen::Vector3d other = candidates[1 - choice.target.index].position;
-        const double gap = least_link_gap(choice, arm, arm_state_joints(), other, params);
-        if (choice.note.find("no clear push left") != std::string::npos) {
-          // Taken only when no push of either cleared everything: then the note says what it risks.
-          if (gap < arm.nudge.link_clearance) {
-            EXPECT_NE(choice.note.find("the arm's links would pass within"), std::string::npos) << choice.note;
-          }
-          continue;
-        }
-        ++strict;
-        EXPECT_GE(gap, arm.nudge.link_clearance) << sv::millimetres(first) << " and " << sv::millimetres(second);
-        // Without the check the same pair may be pushed with the links through the other object.
-        const auto blind = sv::choose_target(candidates, {}, scene.right_camera_in_world(), arm, arm_state_joints(), unchecked);
-        ASSERT_TRUE(blind.found);
-        if (least_link_gap(blind, arm, arm_state_joints(), candidates[1 - blind.target.index].position, params) < arm.nudge.link_clearance)
-          ++mended;
+  for_each_pair_over_the_ring([&](const Eigen::Vector3d& first, const Eigen::Vector3d& second) {
+    const std::vector<sv::Candidate> candidates = {{0, first, 9}, {1, second, 9}};
+    // An object explored and standing there is kept clear of as a candidate is.
+    sv::History explored;
+    explored.standing = {second};
+    const auto beside = sv::choose_target({candidates[0]}, explored, scene.right_camera_in_world(), arm, arm_state_joints(), params);
+    if (chosen_strictly(beside)) {
+      ++beside_clear;
+      EXPECT_GE(least_link_gap(beside, arm, arm_state_joints(), second, params), arm.nudge.link_clearance)
+          << sv::millimetres(first) << " beside the explored " << sv::millimetres(second);
+    }
+    const auto choice = sv::choose_target(candidates, {}, scene.right_camera_in_world(), arm, arm_state_joints(), params);
+    if (!choice.found) return;
+    const Eigen::Vector3d other = candidates[1 - choice.target.index].position;
+    const double gap = least_link_gap(choice, arm, arm_state_joints(), other, params);
+    if (choice.note.find("no clear push left") != std::string::npos) {
+      // Taken only when no push of either cleared everything: then the note says what it risks.
+      if (gap < arm.nudge.link_clearance) {
+        EXPECT_NE(choice.note.find("the arm's links would pass within"), std::string::npos) << choice.note;
       }
+      return;
+    }
+    ++strict;
+    EXPECT_GE(gap, arm.nudge.link_clearance) << sv::millimetres(first) << " and " << sv::millimetres(second);
+    // Without the check the same pair may be pushed with the links through the other object.
+    const auto blind = sv::choose_target(candidates, {}, scene.right_camera_in_world(), arm, arm_state_joints(), unchecked);
+    ASSERT_TRUE(blind.found);
+    if (least_link_gap(blind, arm, arm_state_joints(), candidates[1 - blind.target.index].position, params) < arm.nudge.link_clearance)
+      ++mended;
+  });
   EXPECT_GT(strict, 20);
   EXPECT_GT(mended, 0);  // the check changes choices: without it some links pass through an object
   EXPECT_GT(beside_clear, 20);

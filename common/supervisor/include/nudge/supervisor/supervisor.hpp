@@ -196,7 +196,7 @@ struct Config {
   // service may publish more lines (nudge-symmetry --reach-keep): a later survey pairs them once
   // explored objects' lines are left out, and they count here then, not before.
   int agreement_lines = 5;
-  double explored_line_px = 8;
+  double explored_line_px = geometry::LocationParams{}.explored_line_px;
   TargetParams targets;
   MotionWatchParams motion;
   // Thesis sec. 6.3.2: motion at the target starts one symmetry tracker per camera at the target's
