@@ -650,6 +650,13 @@ void add_flags(Flags& f, Options& o) {
   f.add_double("held-min-opening", &o.config.held_min_opening_m,
                "ARM_STATE.gripper_measured below this after a grasp or turn: nothing held (dropped), m; 0: no check "
                "(no check either when the arm reports no measurement, -1)");
+  f.add_double("grip-width-low", &o.config.grip_width_low,
+               "after a grasp the fingers closed narrower than this part of the object's width at the grasp height "
+               "(its right segmentation): an edge pinched, put down again");
+  f.add_double("grip-width-high", &o.config.grip_width_high,
+               "after a grasp the fingers held wider than this part of the object's width (plus --grip-width-slack): "
+               "a finger on its rim or inside it, put down again; 0: neither check");
+  f.add_double("grip-width-slack", &o.config.grip_width_slack_m, "added to --grip-width-high's width, m");
   f.add_double("top-radius", &o.config.grasp.top_radius_m, "r of the grasp height's r*tan(theta) lowering, m (thesis: 36 mm at 30 deg)");
   f.add_int("first-seq", &o.first_seq, "first ARM_COMMAND seq (default: from the wall clock; set it to replay a run)");
 }
@@ -717,6 +724,10 @@ int main(int argc, char** argv) {
     if (!(opt.config.min_mask_share >= 0 && opt.config.min_mask_share <= 1)) throw FlagError("--min-mask-share must lie in [0, 1]");
     if (!(opt.config.min_mask_mirror_agreement >= 0 && opt.config.min_mask_mirror_agreement <= 1))
       throw FlagError("--min-mask-mirror must lie in [0, 1]");
+    if (!(opt.config.grip_width_low >= 0 && opt.config.grip_width_low < 1)) throw FlagError("--grip-width-low must lie in [0, 1)");
+    if (!(opt.config.grip_width_high == 0 || (opt.config.grip_width_high > 1 && opt.config.grip_width_high < 10)))
+      throw FlagError("--grip-width-high must be 0 (no check) or lie in (1, 10)");
+    if (!(opt.config.grip_width_slack_m >= 0 && opt.config.grip_width_slack_m < 0.1)) throw FlagError("--grip-width-slack must lie in [0, 0.1) m");
     if (!(opt.config.held_min_opening_m >= 0 && opt.config.held_min_opening_m < 0.1)) throw FlagError("--held-min-opening must lie in [0, 0.1) m");
     if (opt.config.views <= 0 || opt.config.views > 36) throw FlagError("--views must lie in [1, 36]");
     if (!(opt.config.view_step_deg > 0 && opt.config.view_step_deg <= 90)) throw FlagError("--view-step must lie in (0, 90] deg");

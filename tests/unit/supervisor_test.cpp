@@ -1624,9 +1624,10 @@ TEST_F(SupervisorTest, TheRestIsWhereTheSettledAxesRepeatNotTheMedianOfTheirGrou
 
 // Settled axes that agree among themselves but stand 5 cm behind the object along the ray (one
 // camera's line paired with another line, every frame: the white bottle's) give way to the foot
-// of the after still's mask; 2 cm off, they stay (the mask's foot errs that much on a mug).
+// of the after still's mask; 1.5 cm off, they stay (the mask's foot errs that much: the table's
+// shadow under the object lowers its front).
 TEST_F(SupervisorTest, AStableMismatchAlongTheRayGivesWayToTheMasksFoot) {
-  for (const double behind : {0.05, 0.02}) {
+  for (const double behind : {0.05, 0.025, 0.015}) {
     const Eigen::Vector3d object(0.28, -0.05, 0);
     Eigen::Vector3d truth = object;
     auto segment_cylinder = [&](const cv::Mat&, const cv::Mat& after, const nudge::symmetry::Line&, const nudge::symmetry::Line&) {
@@ -1645,7 +1646,7 @@ TEST_F(SupervisorTest, AStableMismatchAlongTheRayGivesWayToTheMasksFoot) {
     const sv::Attempt& a = *attempt;
     ASSERT_TRUE(a.rest && a.rest_from_mask) << a.reason;
     EXPECT_LT((*a.rest_from_mask - truth).norm(), 0.005);
-    if (behind > 0.03) {
+    if (behind > 0.02) {
       EXPECT_LT((*a.rest - truth).norm(), 0.005) << "the mask's foot";
       ASSERT_TRUE(a.rest_from_axes);
       EXPECT_LT((*a.rest_from_axes - (truth + behind * ray)).norm(), 0.002);
@@ -1957,6 +1958,71 @@ TEST(Grasp, TheMasksFootIsWhereTheUprightObjectStands) {
   EXPECT_FALSE(sv::foot_from_mask(scene, cv::Mat::zeros(still, CV_8U), *scene.right_axis_line(foot, 0.12, still)));
 }
 
+// A mug's handle sticks out on one side of the line: the base's width is read on the narrower
+// side, so the handle does not push the foot back along the ray.
+TEST(Grasp, AHandleOnOneSideDoesNotMoveTheMasksFoot) {
+  const sv::SceneGeometry scene = make_scene();
+  const cv::Size still(1280, 960);
+  for (const Eigen::Vector3d& foot : {Eigen::Vector3d(0.25, 0.0, 0), Eigen::Vector3d(0.30, -0.08, 0)}) {
+    cv::Mat mask = cylinder_mask(scene, still, foot, 0.04, 0.10);
+    // The handle: a smaller upright cylinder joined to the mug's body, 2-9 cm above the table
+    // (the simulated mug's: 1.8-8.3 cm, 7 cm out from the axis), turned half way towards the
+    // camera: nearer, it reaches down among the base's rows in the image.
+    Eigen::Vector3d towards = scene.right_camera_in_world() - foot;
+    towards.z() = 0;
+    towards.normalize();
+    const Eigen::Vector3d across(-towards.y(), towards.x(), 0);
+    const Eigen::Vector3d beside = 0.055 * (towards + across).normalized();
+    cv::Mat handle = cylinder_mask(scene, still, foot + beside + Eigen::Vector3d(0, 0, 0.02), 0.016, 0.07);
+    mask |= handle;
+    const auto line = scene.right_axis_line(foot, 0.10, still);
+    ASSERT_TRUE(line);
+    const auto found = sv::foot_from_mask(scene, mask, *line);
+    ASSERT_TRUE(found) << foot.transpose();
+    EXPECT_LT((*found - foot).norm(), 0.004) << "at " << foot.transpose();
+  }
+}
+
+// A segmentation that kept only a sliver of the object's lower part (the demo's white bottle) has
+// no foot to give: its base's width would put the foot short along the ray.
+TEST(Grasp, AMaskWithoutTheObjectsLowerPartGivesNoFoot) {
+  const sv::SceneGeometry scene = make_scene();
+  const cv::Size still(1280, 960);
+  const Eigen::Vector3d foot(0.25, 0.0, 0);
+  cv::Mat mask = cylinder_mask(scene, still, foot, 0.035, 0.20);
+  const auto line = scene.right_axis_line(foot, 0.20, still);
+  ASSERT_TRUE(line);
+  ASSERT_TRUE(sv::foot_from_mask(scene, mask, *line)) << "the whole object";
+  // The lowest quarter cut to a strip a fifth of the object's width, on the line.
+  std::vector<cv::Point> on;
+  cv::findNonZero(mask, on);
+  const cv::Rect box = cv::boundingRect(on);
+  const int cut = box.y + 3 * box.height / 4;
+  const int middle = static_cast<int>(std::lround((mask.cols - 1) / 2.0 + line->r / std::cos(line->theta) -
+                                                  (cut - (mask.rows - 1) / 2.0) * std::tan(line->theta)));
+  cv::Mat lower = mask.rowRange(cut, mask.rows);
+  cv::Mat strip = cv::Mat::zeros(lower.size(), CV_8U);
+  strip.colRange(middle - box.width / 10, middle + box.width / 10).setTo(255);
+  lower &= strip;
+  EXPECT_FALSE(sv::foot_from_mask(scene, mask, *line));
+}
+
+// The object's width where the fingers close, read from its right segmentation.
+TEST(Grasp, TheObjectsWidthAtTheGraspHeightComesFromItsMask) {
+  const sv::SceneGeometry scene = make_scene();
+  const cv::Size still(1280, 960);
+  for (const Eigen::Vector3d& foot : {Eigen::Vector3d(0.25, 0.0, 0), Eigen::Vector3d(0.30, -0.08, 0), Eigen::Vector3d(0.22, 0.10, 0)})
+    for (double radius : {0.03, 0.045}) {
+      const cv::Mat mask = cylinder_mask(scene, still, foot, radius, 0.15);
+      const auto width = sv::object_width_at(scene, mask, foot, 0.07);
+      ASSERT_TRUE(width) << foot.transpose();
+      EXPECT_NEAR(*width, 2 * radius, 0.1 * radius) << "at " << foot.transpose() << ", radius " << radius;
+    }
+  const Eigen::Vector3d foot(0.25, 0.0, 0);
+  EXPECT_FALSE(sv::object_width_at(scene, cylinder_mask(scene, still, foot, 0.03, 0.05), foot, 0.12)) << "above its top";
+  EXPECT_FALSE(sv::object_width_at(scene, cv::Mat::zeros(still, CV_8U), foot, 0.05)) << "no mask";
+}
+
 // The fingers close 90 mm below the estimated top (below a bottle's shoulder, where its sides are
 // vertical), and no lower than half way up a short object.
 TEST(Grasp, TheFingersCloseBelowTheTopOnTheSidesNotOnTheCap) {
@@ -2016,10 +2082,25 @@ class LearningTest : public SupervisorTest {
   const Eigen::Vector3d object_{0.28, -0.05, 0};
   Eigen::Vector3d rest_;
 
-  sv::Supervisor make_learning() {
-    sv::Config config;
+  sv::Supervisor make_learning(sv::Config config = {}) {
     config.learn = sv::Config::Learn::On;
-    return make(config);
+    return sv::Supervisor(config, scene_, sv::ArmSetup{}, mask_of_the_moved_object);
+  }
+  // The after still's drawn object (coloured, on the grey table; these tests' scenes hold the one
+  // object): where it came to rest, as the motion segmentation refines it (fig. 6.7), and as wide
+  // as it is where the fingers close.
+  static sv::Segmentation mask_of_the_moved_object(const cv::Mat&, const cv::Mat& after, const nudge::symmetry::Line&,
+                                                   const nudge::symmetry::Line&) {
+    sv::Segmentation s;
+    std::vector<cv::Mat> channels;
+    cv::split(after, channels);
+    cv::Mat low, high;
+    cv::min(channels[0], channels[1], low);
+    cv::min(low, channels[2], low);
+    cv::max(channels[0], channels[1], high);
+    cv::max(high, channels[2], high);
+    s.mask = (high - low) > 30;  // the table is grey, the object's outer bands coloured
+    return s;
   }
   void stills(sv::Supervisor& s, const std::vector<Eigen::Vector3d>& objects) {
     now_ += kSecond / 5;
@@ -2219,7 +2300,7 @@ TEST_F(LearningTest, ALearnerSilentAfterTheViewsStillGetsTheObjectPutBack) {
   sv::Config few;  // 2 views suffice here
   few.learn = sv::Config::Learn::On;
   few.views = 2;
-  sv::Supervisor s = make(few);
+  sv::Supervisor s = make_learning(few);
   done(s, to_grasp(s).seq);
   for (int view = 0; view < 2; ++view) {
     now_ += kSecond / 5;
@@ -2247,7 +2328,7 @@ TEST_F(LearningTest, LearnWaitsWhileTheLearnersHeartbeatSaysItLearnsTheObject) {
   few.learn_timeout_s = 30;
   few.learn_max_wait_s = 100;
   for (const bool answered : {true, false}) {
-    sv::Supervisor s = make(few);
+    sv::Supervisor s = make_learning(few);
     done(s, to_grasp(s).seq);
     std::vector<sv::LearnCommit> commits;
     for (int view = 0; view < 2; ++view) {
@@ -2297,7 +2378,7 @@ TEST_F(LearningTest, LearnEndsWhenTheLearnerStopsSayingItLearns) {
   sv::Config few;
   few.learn = sv::Config::Learn::On;
   few.views = 2;
-  sv::Supervisor s = make(few);
+  sv::Supervisor s = make_learning(few);
   done(s, to_grasp(s).seq);
   std::string key;
   for (int view = 0; view < 2; ++view) {
@@ -2387,6 +2468,33 @@ TEST_F(LearningTest, AGripperThatClosesFullyHoldsNothingAndOpensWhereItClosed) {
   EXPECT_EQ(a->learning, "dropped");
   EXPECT_NE(a->learning_reason.find("after the grasp"), std::string::npos) << a->learning_reason;
   EXPECT_EQ(outputs_of<sv::HomeCommand>(out).size(), 1u) << "the arm parks";
+}
+
+// The demo's mug, grasped 3 cm off its axis: a finger came down on its rim and the fingers were
+// held apart wider than they open (0.128 m); the mug hung on its side. Fingers closed far
+// narrower than the object is wide pinch an edge. Either is put down again where the fingers
+// closed, not learned.
+TEST_F(LearningTest, AGripFarWiderOrNarrowerThanTheObjectIsPutDownNotLearned) {
+  for (const double opening : {0.128, 0.02}) {
+    SCOPED_TRACE(opening);
+    sv::Supervisor s = make_learning();
+    const sv::GraspCommand grasp = to_grasp(s);
+    done(s, grasp.seq, opening);
+    auto out = s.take_outputs();
+    EXPECT_TRUE(outputs_of<sv::RotateCommand>(out).empty() && outputs_of<sv::SnapshotRequest>(out).empty()) << "no view";
+    const auto put_down = outputs_of<sv::PlaceCommand>(out);
+    ASSERT_EQ(put_down.size(), 1u) << s.report().reason;
+    EXPECT_LT((put_down[0].position - grasp.position).norm(), 1e-9) << "where the fingers closed";
+    done(s, put_down[0].seq);
+    const auto a = ended(s.take_outputs());
+    ASSERT_TRUE(a);
+    EXPECT_EQ(a->learning, "not grasped");
+    EXPECT_NE(a->learning_reason.find("off its axis"), std::string::npos) << a->learning_reason;
+    ASSERT_TRUE(a->expected_grip_width_m);
+    // The test's box is 7 cm wide, seen a little obliquely.
+    EXPECT_NEAR(*a->expected_grip_width_m, 0.07, 0.012);
+    EXPECT_DOUBLE_EQ(a->grip_opening_m, opening);
+  }
 }
 
 TEST_F(LearningTest, AnObjectDroppedWhileTurningIsNoticedAndTheRunGoesOn) {

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <utility>
 #include <vector>
 
 #include "nudge/geometry/plane.hpp"
@@ -35,9 +36,9 @@ class LargestBlob {
   bool contains(int x, int y) const {
     return box_.contains(cv::Point(x, y)) && labels_.at<int>(y - box_.y, x - box_.x) == label_;
   }
-  // The blob's width in row `y`: from its first to its last pixel there (0 when it has none).
-  int width_in_row(int y) const {
-    if (y < box_.y || y >= box_.y + box_.height) return 0;
+  // The blob's first and last column in row `y` (image coordinates); nothing when it has none.
+  std::optional<std::pair<int, int>> extent_in_row(int y) const {
+    if (y < box_.y || y >= box_.y + box_.height) return std::nullopt;
     const int* row = labels_.ptr<int>(y - box_.y);
     int first = -1, last = -1;
     for (int x = 0; x < box_.width; ++x)
@@ -45,7 +46,25 @@ class LargestBlob {
         if (first < 0) first = x;
         last = x;
       }
-    return first < 0 ? 0 : last - first + 1;
+    if (first < 0) return std::nullopt;
+    return std::make_pair(box_.x + first, box_.x + last);
+  }
+  // The blob's width in row `y`: from its first to its last pixel there (0 when it has none).
+  int width_in_row(int y) const {
+    const auto extent = extent_in_row(y);
+    return extent ? extent->second - extent->first + 1 : 0;
+  }
+  // The width in row `y` of an object symmetric about column `x`: the blob's, or twice its
+  // narrower side of x when one side is longer by more than 15 % of the width (what sticks out
+  // on one side only: a mug's handle). A line a few pixels off the middle keeps the full width.
+  // 0 when x is outside the blob's row.
+  int symmetric_width_in_row(int y, double x) const {
+    const auto extent = extent_in_row(y);
+    if (!extent) return 0;
+    const double left = x - extent->first + 0.5, right = extent->second - x + 0.5;
+    if (left <= 0 || right <= 0) return 0;
+    if (std::abs(left - right) <= 0.15 * (left + right)) return extent->second - extent->first + 1;
+    return static_cast<int>(std::lround(2 * std::min(left, right)));
   }
 
  private:
@@ -73,10 +92,13 @@ std::optional<MaskOnLine> read_mask_on_line(const cv::Mat& mask, const symmetry:
     front = cv::Point2d(x, y);
   }
   if (!top) return std::nullopt;
-  MaskOnLine reading{*top, *front, 0, mask.size()};
+  MaskOnLine reading{*top, *front, 0, 0, mask.size()};
   const int band = std::max(2, static_cast<int>((front->y - top->y) / 5));
-  for (int y = std::max(0, static_cast<int>(front->y) - band); y <= static_cast<int>(front->y); ++y)
-    reading.base_width_px = std::max(reading.base_width_px, blob.width_in_row(y));
+  for (int y = static_cast<int>(top->y); y <= static_cast<int>(front->y); ++y) {
+    const int width = blob.symmetric_width_in_row(y, cx + (line.r - (y - cy) * s) / c);
+    reading.widest_px = std::max(reading.widest_px, width);
+    if (y >= front->y - band) reading.base_width_px = std::max(reading.base_width_px, width);
+  }
   return reading;
 }
 
@@ -87,6 +109,7 @@ std::optional<cv::Point2d> object_top(const cv::Mat& mask, const symmetry::Line&
 }
 
 std::optional<Eigen::Vector3d> foot_from_mask(const SceneGeometry& scene, const MaskOnLine& right_mask) {
+  if (right_mask.base_width_px < kMinBaseShareOfWidest * right_mask.widest_px) return std::nullopt;
   const geometry::Camera& camera = scene.rig().right;
   const auto normalised = camera.normalise(to_calibration(camera, right_mask.front, right_mask.size));
   if (!normalised) return std::nullopt;
@@ -108,6 +131,24 @@ std::optional<Eigen::Vector3d> foot_from_mask(const SceneGeometry& scene, const 
   const auto reading = read_mask_on_line(mask, line);
   if (!reading) return std::nullopt;
   return foot_from_mask(scene, *reading);
+}
+
+std::optional<double> object_width_at(const SceneGeometry& scene, const cv::Mat& right_mask, const Eigen::Vector3d& foot,
+                                      double height) {
+  if (right_mask.empty() || right_mask.type() != CV_8U) return std::nullopt;
+  const Eigen::Vector3d point(foot.x(), foot.y(), height);
+  const auto pixel = scene.project_right(point, right_mask.size());
+  if (!pixel) return std::nullopt;
+  const int row = static_cast<int>(std::lround(pixel->y));
+  if (row < 0 || row >= right_mask.rows) return std::nullopt;
+  const LargestBlob blob(right_mask);
+  const int width_px = blob.width_in_row(row);
+  if (width_px <= 0) return std::nullopt;
+  const geometry::Camera& camera = scene.rig().right;
+  const double focal = camera.K(0, 0) * static_cast<double>(right_mask.cols) / camera.width;
+  const double depth = scene.world_to_right(point).z();
+  if (!(depth > 0)) return std::nullopt;
+  return width_px * depth / focal;
 }
 
 double grip_height(double top_height, const GraspTargetParams& params) {

@@ -124,6 +124,7 @@ void Supervisor::plan_grasp(int64_t now) {
                                                " segmentation" + (a.segmentation_left.error.empty() || camera == 1 ? "" : ": " + a.segmentation_left.error), now);
   a.grasp = grasp_target(scene_, *a.top[0], *a.top[1], config_.still_size, *a.rest, config_.grasp);
   if (!a.grasp->ok()) return learning_ended("not grasped", a.grasp->reason, now);
+  a.expected_grip_width_m = object_width_at(scene_, a.segmentation.mask, a.grasp->foot, a.grasp->grasp_height_m);
   robot::Command grasp;
   grasp.kind = robot::CommandKind::Grasp;
   grasp.target_position = a.grasp->foot;
@@ -145,13 +146,33 @@ void Supervisor::plan_grasp(int64_t now) {
 // above the table), so they open again where they closed, down at the grasp height. After a turn
 // the object was held and has slipped out: there is nothing to put down.
 bool Supervisor::holding(const ArmStatus& arm, const std::string& when, int64_t now) {
-  if (arm.gripper_opening < 0 || arm.gripper_opening >= config_.held_min_opening_m) return true;
+  if (state_ == State::Grasp) attempt_->grip_opening_m = arm.gripper_opening;
+  if (arm.gripper_opening < 0) return true;
+  if (arm.gripper_opening >= config_.held_min_opening_m) {
+    if (state_ != State::Grasp) return true;
+    const std::string off = grip_off_the_axis(arm.gripper_opening);
+    if (off.empty()) return true;
+    put_down(attempt_->grasp->foot, "the fingers open where they closed", now, "not grasped", off);
+    return false;
+  }
   const std::string reason = "nothing held " + when + ": the gripper closed to " + mm(arm.gripper_opening);
   if (state_ == State::Grasp)
     put_down(attempt_->grasp->foot, "the fingers open where they closed", now, "dropped", reason);
   else
     learning_ended("dropped", reason, now);
   return false;
+}
+
+// Config::grip_width_*: fingers closed much narrower or held much wider than the object is wide
+// where they closed did not take it by its middle. Empty when the grip is plausible or unchecked.
+std::string Supervisor::grip_off_the_axis(double opening) const {
+  const std::optional<double>& expected = attempt_->expected_grip_width_m;
+  if (!expected || config_.grip_width_high <= 0) return "";
+  const std::string measured = "the fingers closed to " + mm(opening) + " on an object " + mm(*expected) + " wide";
+  if (opening < config_.grip_width_low * *expected) return "grasped off its axis: " + measured + " (an edge pinched)";
+  if (opening > config_.grip_width_high * *expected + config_.grip_width_slack_m)
+    return "grasped off its axis: " + measured + " (a finger on its rim or inside it)";
+  return "";
 }
 
 void Supervisor::on_learning_arm_state(const ArmStatus& arm, int64_t now) {

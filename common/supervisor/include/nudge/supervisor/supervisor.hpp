@@ -91,7 +91,7 @@ struct Config {
   // with another line along the ray (development runs: 37-71 mm off where the mask's foot was
   // 3-56 mm off). Nearer, the axes stay (a mug's handle widens the mask: 24 mm off on s03, the
   // axes 1 mm). 0: the axes' rest always stays.
-  double rest_mask_disagreement_m = 0.03;
+  double rest_mask_disagreement_m = 0.02;
   // How far a triangulated axis may lie from the object along the right camera's viewing ray: a
   // stereo mismatch (a mug's handle moves its line differently in the two cameras) puts axes of the
   // same object up to ~5 cm nearer or farther (measured on s03_red_mug: 4.4 and 4.7 cm). Axes
@@ -226,6 +226,15 @@ struct Config {
   int views = 12;                    // training views per object (sec. 7.2.3)
   double view_step_deg = 30;         // wrist turn between views (SIFT tolerates +-15 deg)
   double held_min_opening_m = 0.004; // the gripper closed tighter than this holds nothing
+  // After the grasp the fingers should be as far apart as the object is wide where they closed
+  // (its right segmentation at the grasp height). Closed to less than `grip_width_low` of that,
+  // they pinch an edge; held wider than `grip_width_high` of it plus `grip_width_slack_m`, a
+  // finger rests on the object's rim or inside it: the grasp is off the axis and the object hangs
+  // tilted (the demo's mug, grasped 3 cm off its axis: fingers forced to 0.128 m, the mug carried
+  // on its side and learned so). Either way it is put down again, not learned. 0: no check.
+  double grip_width_low = 0.5;
+  double grip_width_high = 1.3;
+  double grip_width_slack_m = 0.01;
   double recognise_timeout_s = 5;    // for RECOGNITION; then the nudge goes ahead, the reason kept
   double learn_timeout_s = 30;       // for LEARNED, counted from the learner's last heartbeat saying it learns the object
   double learn_max_wait_s = 300;     // for LEARNED however busy the learner says it is
@@ -348,6 +357,10 @@ struct Attempt {
   Segmentation segmentation_left;
   std::optional<cv::Point2d> top[2];       // [left, right]: the object's top in the stills
   std::optional<GraspTarget> grasp;
+  // The right segmentation's width at the grasp height (object_width_at): what the fingers should
+  // close to. And what they closed to after the grasp (ARM_STATE.gripper_measured; -1: unknown).
+  std::optional<double> expected_grip_width_m;
+  double grip_opening_m = -1;
   std::string recognised;                  // the learner's label: a known object, not nudged
   std::string recognition_reason;          // why none was recognised (or the learner was silent)
   cv::Mat recognition_match;               // the learner's picture of the matches (recognised only)
@@ -563,6 +576,7 @@ class Supervisor {
   void plan_grasp(int64_t now);
   void on_learning_arm_state(const ArmStatus& arm, int64_t now);
   bool holding(const ArmStatus& arm, const std::string& when, int64_t now);
+  std::string grip_off_the_axis(double opening) const;
   void take_view(const cv::Mat& still, int64_t utime, int64_t now);
   void commit_views(int64_t now);
   void place(int64_t now, const std::string& learning, const std::string& reason);  // where it stood before the nudge
