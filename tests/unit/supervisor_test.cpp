@@ -2215,12 +2215,23 @@ TEST_F(LearningTest, GraspsTurnsTwelveTimesLearnsAndPutsTheObjectBack) {
   EXPECT_GE(a->grasp_plan_ms, 0.0) << "the grasp's plan time is recorded for the report";
   EXPECT_EQ(outputs_of<sv::HomeCommand>(out).size(), 1u) << "the arm parks after putting it back";
   EXPECT_EQ(s.summary().learned, 1);
+  ASSERT_TRUE(a->put_back_at);
+  EXPECT_LT((*a->put_back_at - object_).norm(), 1e-9);
+  // The next survey is told the object stands where it was put back, not at its rest.
+  park(s);
+  const auto survey = outputs_of<sv::CandidatesRequest>(s.take_outputs());
+  ASSERT_EQ(survey.size(), 1u);
+  ASSERT_EQ(survey[0].explored.size(), 1u);
+  EXPECT_LT((survey[0].explored[0] - object_).head<2>().norm(), 1e-9) << "not at the rest " << rest_.transpose();
 }
 
 // A candidate 5 cm behind the object along the ray (a stable stereo mismatch), and the settled
 // axes as far behind its rest: the grasp goes where the after still's mask stands, and the object
-// goes back where it stood, not where the candidate was.
+// goes back where it stood, not where the candidate was. With the candidate right and only the
+// settled axes off (the demo's mug), it goes back to the candidate.
 TEST_F(LearningTest, AStableMismatchIsGraspedWhereTheMaskStandsAndPutBackWhereItStood) {
+  for (const bool candidate_mismatched : {true, false}) {
+  SCOPED_TRACE(candidate_mismatched ? "the candidate shares the mismatch" : "the candidate is right");
   Eigen::Vector3d truth = object_;
   auto cylinder = [&](bool left) {
     return [&, left](const cv::Mat&, const cv::Mat& after, const nudge::symmetry::Line&, const nudge::symmetry::Line&) {
@@ -2235,7 +2246,7 @@ TEST_F(LearningTest, AStableMismatchIsGraspedWhereTheMaskStandsAndPutBackWhereIt
   sv::Supervisor s(config, scene_, sv::ArmSetup{}, cylinder(false));
   s.set_left_segmentation(cylinder(true));
   const Eigen::Vector3d mismatch = 0.05 * along_ray(object_);
-  start_with(s, {object_ + mismatch});
+  start_with(s, {candidate_mismatched ? Eigen::Vector3d(object_ + mismatch) : object_});
   stills(s, {object_});
   const auto request = outputs_of<sv::RecognizeRequest>(s.take_outputs()).at(0);
   s.on_recognition(request.seq, "", "empty database", now_);
@@ -2256,7 +2267,8 @@ TEST_F(LearningTest, AStableMismatchIsGraspedWhereTheMaskStandsAndPutBackWhereIt
   s.on_learned(commit.seq, true, "object_1", "", now_ += kSecond);
   ASSERT_EQ(s.state(), sv::State::Place) << s.report().reason;
   const auto place = outputs_of<sv::PlaceCommand>(s.take_outputs()).at(0);
-  EXPECT_LT((place.position - object_).head<2>().norm(), 0.005) << "where it stood, not where the candidate was";
+  EXPECT_LT((place.position - object_).head<2>().norm(), 0.006) << "where it stood";
+  }
 }
 
 TEST_F(LearningTest, AKnownObjectIsNotNudgedAndTheSummaryNamesIt) {

@@ -185,6 +185,7 @@ void Supervisor::on_learning_arm_state(const ArmStatus& arm, int64_t now) {
     return learning_ended("not grasped", "arm refused the grasp: " + arm.last_error, now);
   }
   if (state_ == State::Place) {
+    if (arm.motion == Motion::Done && pending_place_is_put_back_) attempt_->put_back_at = pending_place_;
     const std::string how = arm.motion == Motion::Done ? "" : "; the arm did not put it back (" + arm.last_error + ")";
     return learning_ended(pending_learning_, pending_reason_ + how, now);
   }
@@ -260,12 +261,25 @@ void Supervisor::on_learner_status(const std::string& status, int64_t now) {
 
 // Sec. 7.2.3: the object goes back where it stood before the nudge (revisits stay possible).
 void Supervisor::place(int64_t now, const std::string& learning, const std::string& reason) {
-  const Attempt& a = *attempt_;
-  // The candidate was where the settled axes were, before the nudge: when the mask's foot moved
-  // the rest off a stable stereo mismatch, the same mismatch put the candidate as far off.
-  Eigen::Vector3d before_nudge = a.target.position;
-  if (a.rest_from_axes) before_nudge += *a.rest - *a.rest_from_axes;
+  const Eigen::Vector3d before_nudge = where_it_stood(*attempt_);
   put_down(before_nudge, "putting the object back at " + millimetres(before_nudge), now, learning, reason);
+  pending_place_is_put_back_ = true;
+}
+
+// Where the object stood before the nudge: the candidate, unless the stable stereo mismatch that
+// the mask's foot moved the rest off (Attempt::rest_from_axes) put the candidate as far off (the
+// white bottle's, 5 cm behind it along the ray). Whether it did, the push tells: the object went
+// along it, about push_travel_m, so it stood there back from its rest. The demo's mug and bottle
+// showed the settled axes off while the candidate was right (the candidate moved by the axes' error
+// would have put them back 2 and 8 cm from where they stood). A rest placed along the push from the
+// candidate (rest_from_still) says nothing against the candidate.
+Eigen::Vector3d Supervisor::where_it_stood(const Attempt& a) const {
+  const Eigen::Vector3d& candidate = a.target.position;
+  if (!a.rest || !a.rest_from_axes || a.rest_from_still) return candidate;
+  const Eigen::Vector3d shared_mismatch = candidate + (*a.rest - *a.rest_from_axes);
+  const Eigen::Vector3d pushed_from = *a.rest - config_.push_travel_m * a.direction.normalized();
+  const auto off = [&](const Eigen::Vector3d& p) { return (p - pushed_from).head<2>().norm(); };
+  return off(shared_mismatch) < off(candidate) ? shared_mismatch : candidate;
 }
 
 void Supervisor::put_down(const Eigen::Vector3d& where, const std::string& what, int64_t now, const std::string& learning,
@@ -273,6 +287,8 @@ void Supervisor::put_down(const Eigen::Vector3d& where, const std::string& what,
   Attempt& a = *attempt_;
   pending_learning_ = learning;
   pending_reason_ = a.learning_reason.empty() ? reason : a.learning_reason + "; " + reason;
+  pending_place_ = where;
+  pending_place_is_put_back_ = false;  // place() says when it is
   learn_seq_ = next_seq_++;
   enter(State::Place, now, what + " (" + learning + ")");
   outputs_.push_back(PlaceCommand{learn_seq_, where, a.grasp->grasp_height_m});

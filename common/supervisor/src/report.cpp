@@ -74,6 +74,7 @@ void write_learning(JsonWriter& j, const Attempt& a) {
   j.key("expected_grip_width_m");
   if (a.expected_grip_width_m) j.value(*a.expected_grip_width_m); else j.raw("null");
   j.field("grip_opening_m", a.grip_opening_m);
+  if (a.put_back_at) write_point(j, "put_back_at", *a.put_back_at);
   j.key("views").begin_array();
   for (const LearnView& v : a.views)
     j.begin_object().field("index", v.index).field("wrist_angle", v.angle).field("utime", static_cast<long long>(v.utime))

@@ -852,9 +852,13 @@ void Supervisor::end_attempt(Outcome outcome, const std::string& reason, int64_t
       // phantom's axes seen again after a push that barely moved a neighbour; leaving its lines
       // out of the surveys would leave out the neighbours' lines that made it (development m03:
       // the yellow cup was never a candidate again).
-      rested_.push_back({*a.rest, a.segmentation.mask, cv::boundingRect(a.segmentation.mask)});
+      // Put back after learning, it stands where the arm put it, and its mask shows it no more.
+      const Eigen::Vector3d place = a.put_back_at.value_or(*a.rest);
+      const cv::Mat mask = a.put_back_at ? cv::Mat() : a.segmentation.mask;
+      rested_.push_back({place, mask, mask.empty() ? cv::Rect() : cv::boundingRect(mask)});
+      if (a.put_back_at) explored_.push_back(place);
       a.standing_height = explored_object_height(a);
-      standing_.push_back({*a.rest, a.standing_height});
+      standing_.push_back({place, a.standing_height});
     } else if (outcome == Outcome::Known || outcome == Outcome::Refused) {
       a.standing_height = explored_object_height(a);
       standing_.push_back({a.target.position, a.standing_height});  // never pushed: it stands where it was found

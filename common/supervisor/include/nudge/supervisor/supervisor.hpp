@@ -357,6 +357,9 @@ struct Attempt {
   Segmentation segmentation_left;
   std::optional<cv::Point2d> top[2];       // [left, right]: the object's top in the stills
   std::optional<GraspTarget> grasp;
+  // Where the arm put the object back after learning (the place done): it stands there now, not
+  // at its rest.
+  std::optional<Eigen::Vector3d> put_back_at;
   // The right segmentation's width at the grasp height (object_width_at): what the fingers should
   // close to. And what they closed to after the grasp (ARM_STATE.gripper_measured; -1: unknown).
   std::optional<double> expected_grip_width_m;
@@ -577,6 +580,7 @@ class Supervisor {
   void on_learning_arm_state(const ArmStatus& arm, int64_t now);
   bool holding(const ArmStatus& arm, const std::string& when, int64_t now);
   std::string grip_off_the_axis(double opening) const;
+  Eigen::Vector3d where_it_stood(const Attempt& a) const;
   void take_view(const cv::Mat& still, int64_t utime, int64_t now);
   void commit_views(int64_t now);
   void place(int64_t now, const std::string& learning, const std::string& reason);  // where it stood before the nudge
@@ -589,6 +593,8 @@ class Supervisor {
   int64_t learner_busy_ = 0;   // task clock: the learner's last heartbeat saying it learns the attempt's object
   double wrist_step_ = 0;      // rad, signed: the direction the wrist has room to turn
   std::string pending_learning_, pending_reason_;  // the learning outcome, once the object is put back
+  Eigen::Vector3d pending_place_ = Eigen::Vector3d::Zero();  // where the place in progress puts it down
+  bool pending_place_is_put_back_ = false;                    // back where it stood (not where the fingers closed)
   StateReport report_;
   Summary summary_;
 };
