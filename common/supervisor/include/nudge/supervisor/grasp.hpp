@@ -37,8 +37,9 @@ struct GraspTargetParams {
 // first and the last pixel of the mask's largest 8-connected blob (the object's top, and the front
 // of its base), and the blob's widest row in the lowest fifth between them (its base's width: the
 // sides are vertical there; the front pixel is the base ellipse's lowest point, of no width). A
-// row's width is twice its narrower side of the line: a mug's handle, on one side, widened the
-// base and put the foot 24 mm too far (development s03) before.
+// row lopsided about the line (one side longer by more than 15 % of the width) is read as twice
+// its narrower side: a mug's handle, on one side, widened the base and put the foot 24 mm too far
+// (development s03) before.
 // Nothing when the mask is empty, the line is near horizontal (no standing object's axis) or misses
 // the blob. The mask's blobs are labelled once for all three.
 struct MaskOnLine {

@@ -89,8 +89,9 @@ struct Config {
   // from it than this (and within the push window's max_lateral_m + max_depth_error_m), the
   // mask's foot is the rest: the settled axes were a stable mismatch, one camera's line paired
   // with another line along the ray (development runs: 37-71 mm off where the mask's foot was
-  // 3-56 mm off). Nearer, the axes stay (a mug's handle widens the mask: 24 mm off on s03, the
-  // axes 1 mm). 0: the axes' rest always stays.
+  // 3-56 mm off). Nearer, the axes stay: the mask's foot errs by up to ~2 cm where the axes are
+  // right (the table's shadow under the object lowers its front; 3 cm until the mask's foot read
+  // past a mug's handle, docs/supervisor.md). 0: the axes' rest always stays.
   double rest_mask_disagreement_m = 0.02;
   // How far a triangulated axis may lie from the object along the right camera's viewing ray: a
   // stereo mismatch (a mug's handle moves its line differently in the two cameras) puts axes of the
