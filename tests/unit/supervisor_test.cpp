@@ -1938,12 +1938,16 @@ TEST(Grasp, TheObjectTopIsTheLargestBlobsFirstPixelOnTheLine) {
   EXPECT_FALSE(sv::object_top(cv::Mat::zeros(200, 300, CV_8U), vertical));
 }
 
+// Where the grasp tests stand an upright object: ahead of the base, to its right and to its left.
+const std::vector<Eigen::Vector3d> kUprightObjectPlaces = {Eigen::Vector3d(0.25, 0.0, 0), Eigen::Vector3d(0.30, -0.08, 0),
+                                                           Eigen::Vector3d(0.22, 0.10, 0)};
+
 // One camera and the table find where a cylinder stands: its base's front on the line, pushed back
 // by the radius its mask's width gives; wherever a stereo mismatch would put it along the ray.
 TEST(Grasp, TheMasksFootIsWhereTheUprightObjectStands) {
   const sv::SceneGeometry scene = make_scene();
   const cv::Size still(1280, 960);
-  for (const Eigen::Vector3d& foot : {Eigen::Vector3d(0.25, 0.0, 0), Eigen::Vector3d(0.30, -0.08, 0), Eigen::Vector3d(0.22, 0.10, 0)})
+  for (const Eigen::Vector3d& foot : kUprightObjectPlaces)
     for (double radius : {0.03, 0.045}) {
       const cv::Mat mask = cylinder_mask(scene, still, foot, radius, 0.12);
       const auto line = scene.right_axis_line(foot, 0.12, still);
@@ -2011,7 +2015,7 @@ TEST(Grasp, AMaskWithoutTheObjectsLowerPartGivesNoFoot) {
 TEST(Grasp, TheObjectsWidthAtTheGraspHeightComesFromItsMask) {
   const sv::SceneGeometry scene = make_scene();
   const cv::Size still(1280, 960);
-  for (const Eigen::Vector3d& foot : {Eigen::Vector3d(0.25, 0.0, 0), Eigen::Vector3d(0.30, -0.08, 0), Eigen::Vector3d(0.22, 0.10, 0)})
+  for (const Eigen::Vector3d& foot : kUprightObjectPlaces)
     for (double radius : {0.03, 0.045}) {
       const cv::Mat mask = cylinder_mask(scene, still, foot, radius, 0.15);
       const auto width = sv::object_width_at(scene, mask, foot, 0.07);
