@@ -6,9 +6,12 @@
 // phantom. With --lines, each CANDIDATES_REQUEST is also replayed asking for that many lines per
 // image (the supervisor's --survey-lines) instead of the recorded number. With --published, each
 // SYMMETRY message is also cut to its first N lines (the symmetry service's --reach-keep: runs
-// recorded with more lines published replayed as if fewer had been). Writes
-// docs/results/NAME.{json,md} (default survey_line_tilt).
-//   nudge-exp-survey-line-tilt RUNS_DIR [RUNS_DIR...] [--tilts 1,2,3] [--lines 3,5] [--published 5,8] [--real-radius 0.03] [--name STEM]
+// recorded with more lines published replayed as if fewer had been). With --column, the surveys
+// treat the arm base column's lines as each mode says (nudge-triangulation
+// --candidate-column-lines: counted, dropped, uncounted). Writes docs/results/NAME.{json,md}
+// (default survey_line_tilt).
+//   nudge-exp-survey-line-tilt RUNS_DIR [RUNS_DIR...] [--tilts 1,2,3] [--lines 3,5] [--published 5,8]
+//                              [--column counted,uncounted] [--real-radius 0.03] [--name STEM]
 // Later surveys follow what the recorded run did (its pushes, its explored places): a replay
 // scores the lines each tilt keeps, not a new run. Choose on development runs only.
 #include <unistd.h>
@@ -21,12 +24,14 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include <lcm/lcm-cpp.hpp>
 
 #include "nudge/candidates_request_t.hpp"
 #include "nudge/candidates_t.hpp"
+#include "nudge/geometry/interesting_locations.hpp"
 #include "nudge/json.hpp"
 #include "nudge/progress.hpp"
 #include "nudge/sim_state_t.hpp"
@@ -46,13 +51,15 @@ struct Score {
 };
 
 // One replayed setting: the survey-line tilt, the lines per image the surveys pair (0: as the log's
-// requests ask) and the lines per image published (0: as recorded).
+// requests ask), the lines per image published (0: as recorded) and the column's lines (empty: the
+// service's default).
 struct Variant {
   double tilt = 0;
   int lines = 0;
   int published = 0;
+  std::string column;
   bool operator<(const Variant& o) const {
-    return published != o.published ? published < o.published : lines != o.lines ? lines < o.lines : tilt < o.tilt;
+    return std::tie(published, lines, column, tilt) < std::tie(o.published, o.lines, o.column, o.tilt);
   }
   bool rewritten() const { return lines || published; }
   std::string name() const {
@@ -60,6 +67,7 @@ struct Variant {
     text << tilt << "°";
     if (lines) text << " " << lines << " lines";
     if (published) text << " " << published << " published";
+    if (!column.empty()) text << " column " << column;
     return text.str();
   }
 };
@@ -179,6 +187,7 @@ int main(int argc, char** argv) try {
   std::vector<double> tilts{1, 1.5, 2, 3, 4, 5, 7};
   std::vector<int> survey_lines;  // empty: as recorded
   std::vector<int> published;     // empty: as recorded
+  std::vector<std::string> columns{""};  // "": the service's default
   double real_radius = 0.03;
   std::string name = "survey_line_tilt";
   for (int i = 1; i < argc; ++i) {
@@ -189,14 +198,21 @@ int main(int argc, char** argv) try {
       for (double n : parse_list(argv[++i], arg)) survey_lines.push_back(static_cast<int>(n));
     else if (arg == "--published" && has_value)
       for (double n : parse_list(argv[++i], arg)) published.push_back(static_cast<int>(n));
-    else if (arg == "--real-radius" && has_value) real_radius = std::stod(argv[++i]);
+    else if (arg == "--column" && has_value) {
+      columns.clear();
+      std::stringstream in(argv[++i]);
+      for (std::string mode; std::getline(in, mode, ',');) {
+        nudge::geometry::parse_column_lines(mode);  // refuses an unknown mode before any replay
+        columns.push_back(mode);
+      }
+    } else if (arg == "--real-radius" && has_value) real_radius = std::stod(argv[++i]);
     else if (arg == "--name" && has_value) name = argv[++i];
     else if (!arg.empty() && arg[0] == '-') throw std::invalid_argument("unknown option " + arg);
     else run_sets.push_back(arg);
   }
   if (run_sets.empty()) {
     std::cerr << "usage: nudge-exp-survey-line-tilt RUNS_DIR [RUNS_DIR...] [--tilts 1,2,3] [--lines 3,5] [--published 5,8] "
-                 "[--real-radius 0.03] [--name STEM]\n";
+                 "[--column counted,dropped,uncounted] [--real-radius 0.03] [--name STEM]\n";
     return 2;
   }
   const fs::path source = NUDGE_SOURCE_DIR;
@@ -210,7 +226,8 @@ int main(int argc, char** argv) try {
   std::vector<Variant> variants;
   for (int kept : published.empty() ? std::vector<int>{0} : published)
     for (int lines : survey_lines.empty() ? std::vector<int>{0} : survey_lines)
-      for (double tilt : tilts) variants.push_back({tilt, lines, kept});
+      for (const std::string& column : columns)
+        for (double tilt : tilts) variants.push_back({tilt, lines, kept, column});
 
   // Each run is named by its set's number (the RUNS_DIRs in order) and its scene.
   std::vector<std::pair<std::string, fs::path>> logs;
@@ -244,7 +261,9 @@ int main(int argc, char** argv) try {
       const std::string command = shell_quote(triangulation) + " --lcm-in " + shell_quote("file://" + input.string() + "?speed=0") +
                                   " --lcm-out " + shell_quote("file://" + replay.string() + "?mode=w") + " --calibration " +
                                   shell_quote(calibration) + " --workspace " + shell_quote(workspace) +
-                                  " --candidate-line-tilt " + std::to_string(variant.tilt) + " >/dev/null 2>&1";
+                                  " --candidate-line-tilt " + std::to_string(variant.tilt) +
+                                  (variant.column.empty() ? std::string() : " --candidate-column-lines " + variant.column) +
+                                  " >/dev/null 2>&1";
       if (std::system(command.c_str()) != 0) throw std::runtime_error("nudge-triangulation failed on " + log.string());
       Score& s = scores[variant][run];
       s.objects = static_cast<int>(states.front().objects.size());
@@ -270,14 +289,16 @@ int main(int argc, char** argv) try {
   for (size_t i = 0; i < run_sets.size(); ++i) md << (i ? ", " : "") << i + 1 << ": `" << run_sets[i] << "`";
   md << " (" << logs.size() << " runs). " << nudge::experiments::machine_description() << ", "
      << nudge::experiments::today() << ".\n\n"
-     << "| tilt (deg) | lines per image | lines published | real candidates | phantoms | objects ever a candidate |\n|---|---|---|---|---|---|\n";
+     << "| tilt (deg) | lines per image | lines published | column's lines | real candidates | phantoms | objects ever a candidate |\n|---|---|---|---|---|---|---|\n";
   for (const auto& [variant, runs] : scores) {
     int real = 0, phantom = 0, found = 0, objects = 0;
     for (const auto& [run, s] : runs) real += s.real, phantom += s.phantom, found += static_cast<int>(s.objects_found.size()), objects += s.objects;
     md << "| " << variant.tilt << " | " << (variant.lines ? std::to_string(variant.lines) : "as recorded") << " | "
-       << (variant.published ? std::to_string(variant.published) : "as recorded") << " | " << real
+       << (variant.published ? std::to_string(variant.published) : "as recorded") << " | "
+       << (variant.column.empty() ? "default" : variant.column) << " | " << real
        << " | " << phantom << " | " << found << "/" << objects << " |\n";
     json.begin_object().field("tilt_deg", variant.tilt).field("lines_per_image", variant.lines).field("lines_published", variant.published);
+    json.field("column_lines", variant.column.empty() ? std::string("default") : variant.column);
     json.field("real", real).field("phantoms", phantom);
     json.field("objects_found", found).field("objects", objects).end_object();
   }

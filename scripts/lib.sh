@@ -214,7 +214,9 @@ nudge_run_loop() {
       triangulation_flags=', "--stereo-check", "--min-height-overlap", "0.2", "--stereo-appearance", "0.6",
                              "--appearance-waived-at-overlap", "0.85", "--cluster-min-fraction", "0.05"' ;;
     plain)
-      triangulation_flags=', "--candidate-line-tilt", "2"'
+      # The arm's base column's lines are paired but do not take one of a survey's lines per
+      # image (--candidate-column-lines uncounted; docs/supervisor.md, "The column's line").
+      triangulation_flags=', "--candidate-line-tilt", "2", "--candidate-column-lines", "uncounted"'
       if [ "${NUDGE_LOOP_REACH:-1}" = 1 ]; then
         symmetry_flags='"--lines", "20", "--reach-calibration", "'"$calibration"'", "--reach-inner-radius", "0.10", "--reach-keep", "5"'
       fi ;;

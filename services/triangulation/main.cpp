@@ -48,6 +48,7 @@ struct Options {
   geo::AxisFilter filter;             // AXES: thesis ch. 4 (15 deg, within reach)
   geo::TriangulationParams triangulation;
   geo::LocationParams locations;      // CANDIDATES: thesis ch. 6
+  std::string column_lines = "counted";
 };
 
 // n . p + d = 0 from --table-plane NX NY NZ D (right camera frame).
@@ -275,6 +276,12 @@ void add_flags(Flags& f, Options& o) {
   f.add_double("candidate-line-tilt", &o.locations.max_line_tilt_deg,
                "CANDIDATES: pair only lines that are within this many degrees of the image of an upright axis "
                "(0: any line, the thesis)");
+  f.add_string("candidate-column-lines", &o.column_lines,
+               "CANDIDATES: the arm base column's lines (within --candidate-column-px of the image of its axis): "
+               "counted (like any line, the thesis), dropped, or uncounted (paired, but not among the "
+               "--candidate-lines); needs the arm base");
+  f.add_double("candidate-column-px", &o.locations.column_line_px,
+               "CANDIDATES: a line this near the image of the arm base column's axis is the column's, px");
   f.add_double("cluster-radius", &o.locations.qt.radius, "CANDIDATES: QT cluster radius, m");
   f.add_double("cluster-min-fraction", &o.locations.qt.min_fraction, "CANDIDATES: smallest cluster, fraction of all");
   f.add_bool("stereo-check", &o.locations.stereo_check,
@@ -329,6 +336,11 @@ int main(int argc, char** argv) {
     const robot::Workspace workspace = workspace_flags.resolve();
     opt.locations.ring_inner_m = workspace.ring_inner;
     opt.locations.ring_outer_m = workspace.ring_outer;
+    try {
+      opt.locations.column_lines = geo::parse_column_lines(opt.column_lines);
+    } catch (const std::invalid_argument& e) {
+      throw FlagError(std::string("--candidate-column-lines: ") + e.what());
+    }
     check(opt);
     opt.locations.max_range_m = opt.filter.max_range_m;
     Triangulation triangulation(service, opt);  // loads the rig: a bad file ends here, naming the field

@@ -713,6 +713,42 @@ TEST(GeometryLocations, AnExploredObjectsLinesAreLeftOutOfTheStrongest) {
   EXPECT_THROW(LocationFinder(rig, plane, std::nullopt, params), std::invalid_argument);
 }
 
+// The arm's base column is the strongest line of an image. Counted, it takes the one line a survey
+// pairs per image (and its own pairing lies at the base, outside the workspace ring: nothing);
+// uncounted, the next line is paired too; dropped, the next line is the only one.
+TEST(GeometryLocations, TheArmBaseColumnsLineNeedNotTakeASurveysPlace) {
+  const StereoRig rig = verged_rig(Lens::Typical);
+  const Table table;
+  const Plane plane = table_plane_in_right(rig, table);
+  const StereoAxis column = observe_axis(rig, table, 0.0, 0.85, 0.2), object = observe_axis(rig, table, -0.08, 0.6, 0.15);
+  LocationParams params;
+  params.frames = 1;
+  params.lines_per_image = 1;
+  const auto intersects_with = [&](LocationParams::ColumnLines mode) {
+    params.column_lines = mode;
+    LocationFinder finder(rig, plane, column.base, params);
+    finder.add_frame({column.left, object.left}, {column.right, object.right});
+    return finder.intersect_points();
+  };
+  EXPECT_TRUE(intersects_with(LocationParams::ColumnLines::Counted).empty());
+  for (const auto mode : {LocationParams::ColumnLines::Uncounted, LocationParams::ColumnLines::Dropped}) {
+    const std::vector<Eigen::Vector3d> points = intersects_with(mode);
+    EXPECT_TRUE(std::any_of(points.begin(), points.end(), [&](const Eigen::Vector3d& p) { return (p - object.base).norm() < 0.01; }))
+        << "mode " << static_cast<int>(mode);
+  }
+  EXPECT_EQ(intersects_with(LocationParams::ColumnLines::Dropped).size(), 1u);
+  // Without an arm base there is no column to tell apart: every mode counts every line.
+  params.column_lines = LocationParams::ColumnLines::Uncounted;
+  LocationFinder no_base(rig, plane, std::nullopt, params);
+  no_base.add_frame({column.left, object.left}, {column.right, object.right});
+  ASSERT_EQ(no_base.intersects(), 1);
+  EXPECT_LT((no_base.intersect_points()[0] - column.base).norm(), 0.01);
+  EXPECT_EQ(parse_column_lines("uncounted"), LocationParams::ColumnLines::Uncounted);
+  EXPECT_THROW(parse_column_lines("sometimes"), std::invalid_argument);
+  params.column_line_px = 0;
+  EXPECT_THROW(LocationFinder(rig, plane, column.base, params), std::invalid_argument);
+}
+
 // A stronger line that cannot be the image of an upright axis (turned 15 deg about its middle) is
 // not among the lines a survey takes when it asks for upright lines only.
 TEST(GeometryLocations, ASurveyCanTakeOnlyLinesThatCanBeUprightAxes) {

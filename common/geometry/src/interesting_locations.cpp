@@ -99,6 +99,7 @@ void validate(const LocationParams& p) {
     throw std::invalid_argument("location parameter min_height_overlap must be in [0, 1]");
   if (!(p.max_foot_height_m > 0)) throw std::invalid_argument("location parameter max_foot_height_m must be > 0");
   if (!(p.explored_line_px > 0)) throw std::invalid_argument("location parameter explored_line_px must be > 0");
+  if (!(p.column_line_px > 0)) throw std::invalid_argument("location parameter column_line_px must be > 0");
   if (!(p.min_axis_colour_agreement >= 0 && p.min_axis_colour_agreement <= 1))
     throw std::invalid_argument("location parameter min_axis_colour_agreement must be in [0, 1]");
   if (!(p.appearance_waived_at_overlap >= 0))
@@ -230,7 +231,7 @@ LocationFinder::LocationFinder(const StereoRig& rig, const Plane& table, const s
   filter_.ring_inner_m = params_.ring_inner_m;
   filter_.ring_outer_m = params_.ring_outer_m;
   // The ring lies on the table around the base's foot, whatever the base's height.
-  if (arm_base) filter_.ring_centre = TableFrame(table, arm_base).origin();
+  if (arm_base) filter_.ring_centre = column_foot_.emplace(TableFrame(table, arm_base).origin());
 }
 
 std::vector<symmetry::Line> LocationFinder::survey_lines(Side side, const std::vector<symmetry::Line>& lines) const {
@@ -248,6 +249,27 @@ std::vector<symmetry::Line> LocationFinder::survey_lines(Side side, const std::v
     kept.push_back(line);
   }
   return kept;
+}
+
+std::vector<symmetry::Line> LocationFinder::paired_lines(Side side, const std::vector<symmetry::Line>& lines) const {
+  std::vector<symmetry::Line> paired;
+  int counted = 0;
+  for (const symmetry::Line& line : lines) {
+    if (counted >= params_.lines_per_image) break;
+    const bool column = params_.column_lines != LocationParams::ColumnLines::Counted && column_foot_ &&
+                        is_image_of_upright_axis(rig_, side, table_, line, *column_foot_, params_.column_line_px);
+    if (column && params_.column_lines == LocationParams::ColumnLines::Dropped) continue;
+    paired.push_back(line);
+    counted += !column;
+  }
+  return paired;
+}
+
+LocationParams::ColumnLines parse_column_lines(const std::string& text) {
+  if (text == "counted") return LocationParams::ColumnLines::Counted;
+  if (text == "dropped") return LocationParams::ColumnLines::Dropped;
+  if (text == "uncounted") return LocationParams::ColumnLines::Uncounted;
+  throw std::invalid_argument("column lines: '" + text + "' is not one of counted, dropped, uncounted");
 }
 
 PairingResult appearance_consistent(const StereoRig& rig, const std::vector<symmetry::Line>& left,
@@ -290,8 +312,9 @@ std::vector<PairedAxis> LocationFinder::frame_axes(const std::vector<symmetry::L
   const bool appearance = params_.min_axis_colour_agreement > 0;
   if (appearance && (left_image.empty() || right_image.empty()))
     throw std::invalid_argument("location finder: min_axis_colour_agreement needs the frame's two images");
-  const std::vector<symmetry::Line> left = survey_lines(Side::Left, all_left), right = survey_lines(Side::Right, all_right);
-  PairingResult result = triangulate_pairings(rig_, left, right, &table_, filter_, triangulation_, params_.lines_per_image);
+  const std::vector<symmetry::Line> left = paired_lines(Side::Left, survey_lines(Side::Left, all_left));
+  const std::vector<symmetry::Line> right = paired_lines(Side::Right, survey_lines(Side::Right, all_right));
+  PairingResult result = triangulate_pairings(rig_, left, right, &table_, filter_, triangulation_, 0);  // 0: all of them
   if (appearance && params_.stereo_check) result = with_support_heights(rig_, left, right, std::move(result), table_);  // once for both
   if (appearance) result = appearance_consistent(rig_, left, right, result, table_, left_image, right_image, params_);
   return params_.stereo_check ? consistent_pairings(rig_, left, right, result, table_, params_) : result.axes;

@@ -109,7 +109,24 @@ struct LocationParams {
   // Objects' lines lean 0-1 deg, lines between two objects 2.5-5 deg, the clutter's often more
   // (docs/supervisor.md). 0: off (the thesis takes the strongest lines whatever they are).
   double max_line_tilt_deg = 0;
+  // Beyond the thesis: the arm's own base column (an upright cylinder at the arm_base the finder
+  // is given, always in view) is symmetric, and its line is often an image's strongest, taking
+  // one of the lines_per_image places in every frame of every survey (the demo scene: in both
+  // cameras, so the fourth-ranked bottle never paired). A line within column_line_px of the image
+  // of the column's axis (is_image_of_upright_axis) is
+  //   Counted:   a line like any other (the thesis);
+  //   Dropped:   left out, like an explored object's. An object standing in line with the column
+  //              in a camera loses its line there: single objects placed in front of the arm
+  //              often do (replayed held-out runs lost 6 of 24);
+  //   Uncounted: paired, but not one of the lines_per_image: the next line is paired too, and an
+  //              object in line with the column, whose line is the column's, still pairs.
+  enum class ColumnLines { Counted, Dropped, Uncounted };
+  ColumnLines column_lines = ColumnLines::Counted;
+  double column_line_px = 8;
 };
+
+// "counted", "dropped", "uncounted" (std::invalid_argument naming the text otherwise).
+LocationParams::ColumnLines parse_column_lines(const std::string& text);
 
 // Whether `line` (in the camera of `side`) is the image of an upright axis standing at `foot`
 // (right camera frame, on `table`): the foot and the point 0.1 m above it both project within
@@ -154,8 +171,8 @@ class LocationFinder {
                  LocationParams params = {}, TriangulationParams triangulation = {});
 
   // The pairings one stereo pair's lines (strongest first) give, as add_frame counts them: the
-  // indices are into the lines left after survey_lines (the lines given, when nothing is explored
-  // and max_line_tilt_deg is 0).
+  // indices are into the lines left after survey_lines and paired_lines (the lines given, when
+  // nothing is explored, max_line_tilt_deg is 0 and the column's lines are counted).
   // With images (the ones the lines were found in), min_axis_colour_agreement applies.
   std::vector<PairedAxis> frame_axes(const std::vector<symmetry::Line>& left, const std::vector<symmetry::Line>& right,
                                      const cv::Mat& left_image = {}, const cv::Mat& right_image = {}) const;
@@ -177,6 +194,9 @@ class LocationFinder {
   // The lines (in their order) that may be a new object's: not the image of an explored place's
   // axis, and (with max_line_tilt_deg) the image of an upright axis.
   std::vector<symmetry::Line> survey_lines(Side side, const std::vector<symmetry::Line>& lines) const;
+  // Of those, the ones paired: the first lines_per_image, and the arm's base column's lines as
+  // column_lines says.
+  std::vector<symmetry::Line> paired_lines(Side side, const std::vector<symmetry::Line>& lines) const;
 
   StereoRig rig_;
   Plane table_;
@@ -184,6 +204,7 @@ class LocationFinder {
   TriangulationParams triangulation_;
   AxisFilter filter_;
   PlaneFrame plane_frame_;
+  std::optional<Eigen::Vector3d> column_foot_;  // the arm base's foot on the table, right camera frame
   int frames_ = 0;
   std::vector<Eigen::Vector3d> points_;  // right camera frame
 };
