@@ -89,15 +89,20 @@ PushConflict links_conflict(const robot::MotionPlan& plan, const robot::JointVec
   std::vector<robot::JointVector> waypoints = joint_waypoints(plan.steps, seed);
   waypoints.push_back(arm.home());  // the arm parks after the push, before the after still
   const robot::SafetyConfig safety = arm.safety_config();
+  PushConflict first;
   for (const Obstacle& other : obstacles) {
+    if (first && !other.known) continue;  // only a known object's conflict outranks the first
     const double height = other.height > 0 ? other.height : params.obstacle_height;
     const robot::StandingObject object{arm.point_to_base(other.place), params.object_radius, height};
     const double gap = robot::least_link_gap_along(arm.model, safety, object, waypoints);
-    if (gap < arm.nudge.link_clearance)
-      return {PushConflict::Kind::Links, "the arm's links would pass within " + std::to_string(std::lround(1e3 * std::max(0.0, gap))) +
-                                             " mm of the " + other.what + " at " + millimetres(other.place)};
+    if (gap >= arm.nudge.link_clearance) continue;
+    PushConflict conflict{other.known ? PushConflict::Kind::KnownLinks : PushConflict::Kind::Links,
+                          "the arm's links would pass within " + std::to_string(std::lround(1e3 * std::max(0.0, gap))) +
+                              " mm of the " + other.what + " at " + millimetres(other.place)};
+    if (other.known) return conflict;
+    first = conflict;
   }
-  return {};
+  return first;
 }
 
 namespace {
@@ -123,9 +128,10 @@ std::vector<Obstacle> obstacles_to(const Candidate& c, const std::vector<Candida
     if (!far_from_target(object.place)) continue;
     const auto near = obstacle_near(object.place);
     if (near == obstacles.end()) {
-      obstacles.push_back({object.place, "explored object", object.height});
+      obstacles.push_back({object.place, "explored object", object.height, true});
     } else if (near->height <= 0) {
       near->height = object.height;  // the candidate is the explored object's line seen again: as tall as measured
+      near->known = true;
     }
   }
   for (const Eigen::Vector3d& object : history.sighted)
@@ -213,6 +219,7 @@ bool tolerated(PushConflict::Kind kind, Tolerance tolerance) {
     case PushConflict::Kind::None: return true;
     case PushConflict::Kind::Slide: return tolerance != Tolerance::None;
     case PushConflict::Kind::Links: return tolerance == Tolerance::SlideAndLinks;
+    case PushConflict::Kind::KnownLinks: return false;  // a found object is not knocked over for a maybe
     case PushConflict::Kind::Pad: return false;
   }
   return false;

@@ -150,7 +150,9 @@ TargetChoice choose_target(const std::vector<Candidate>& candidates, const Histo
 // links passing near it (acceptable last of all: its height is not known, and the tallest
 // expected is assumed).
 struct PushConflict {
-  enum class Kind { None, Pad, Slide, Links };
+  // KnownLinks: the links would sweep an explored object (one the robot has found, often learned
+  // and put back): never tolerated, where sweeping a candidate (perhaps a phantom) is, last.
+  enum class Kind { None, Pad, Slide, Links, KnownLinks };
   Kind kind = Kind::None;
   std::string reason;
   explicit operator bool() const { return kind != Kind::None; }
@@ -166,13 +168,14 @@ struct Obstacle {
   Eigen::Vector3d place;
   const char* what = "candidate";
   double height = 0;  // m above the table as measured; 0: not measured (TargetParams::obstacle_height)
+  bool known = false;  // an explored object standing there: real, and its links conflict is KnownLinks
 };
 
 // Whether the arm's links, at every joint position of `plan` (the arm service's steps for the
 // push, executed from `seed`) and on the way home after it (where the arm parks), keep
 // arm.nudge.link_clearance from an object params.object_radius wide standing at each of
 // `obstacles`, as tall as it was measured (else params.obstacle_height); the first one they do not
-// is named. No conflict when params.obstacle_height is 0.
+// is named, a known one (KnownLinks) before any other. No conflict when params.obstacle_height is 0.
 PushConflict links_conflict(const robot::MotionPlan& plan, const robot::JointVector& seed,
                             const std::vector<Obstacle>& obstacles, const ArmSetup& arm, const TargetParams& params);
 
