@@ -2020,6 +2020,41 @@ TEST(Grasp, AMaskWithoutTheObjectsLowerPartGivesNoFoot) {
   EXPECT_FALSE(sv::foot_from_mask(scene, mask, *line));
 }
 
+// A known object standing in front hides the target's base: the mask ends at its outline, and the
+// foot read there lies far along the ray. The front is then known to be hidden.
+TEST(Grasp, AMasksFrontHiddenByANearerKnownObjectIsNoBase) {
+  const sv::SceneGeometry scene = make_scene();
+  const cv::Size still(1280, 960);
+  const Eigen::Vector3d foot(0.22, -0.10, 0);
+  Eigen::Vector3d towards = scene.right_camera_in_world() - foot;
+  towards.z() = 0;
+  towards.normalize();
+  const Eigen::Vector3d across(-towards.y(), towards.x(), 0);
+  const Eigen::Vector3d in_front = foot + 0.10 * towards + 0.02 * across, behind = foot - 0.12 * towards;
+  const auto line = scene.right_axis_line(foot, 0.20, still);
+  ASSERT_TRUE(line);
+  const cv::Mat whole = cylinder_mask(scene, still, foot, 0.035, 0.20);
+  const cv::Mat hidden = whole & ~cylinder_mask(scene, still, in_front, 0.04, 0.10);
+  const auto reading = sv::read_mask_on_line(hidden, *line);
+  ASSERT_TRUE(reading);
+  const auto short_foot = sv::foot_from_mask(scene, *reading);
+  ASSERT_TRUE(short_foot);
+  EXPECT_GT((*short_foot - foot).norm(), 0.03) << "the foot read at the nearer object's outline";
+  // The object stands at `foot` by another measure (the settled axes).
+  EXPECT_TRUE(sv::mask_front_hidden_by(scene, *reading, foot, in_front, 0.045, 0.10));
+  // Standing behind the object, or far beside its line, it hides nothing of it.
+  EXPECT_FALSE(sv::mask_front_hidden_by(scene, *reading, foot, behind, 0.045, 0.10));
+  EXPECT_FALSE(sv::mask_front_hidden_by(scene, *reading, foot, in_front + 0.15 * across, 0.045, 0.10));
+  // The whole object's front is its base: a low object farther in front is below it in the image.
+  const auto whole_reading = sv::read_mask_on_line(whole, *line);
+  ASSERT_TRUE(whole_reading);
+  const auto true_foot = sv::foot_from_mask(scene, *whole_reading);
+  ASSERT_TRUE(true_foot);
+  EXPECT_LT((*true_foot - foot).norm(), 0.004);
+  EXPECT_FALSE(sv::mask_front_hidden_by(scene, *whole_reading, foot, foot + 0.16 * towards, 0.045, 0.02));
+  EXPECT_TRUE(sv::mask_front_hidden_by(scene, *whole_reading, foot, foot + 0.16 * towards, 0.045, 0.10)) << "taller, it would hide the base";
+}
+
 // The object's width where the fingers close, read from its right segmentation.
 TEST(Grasp, TheObjectsWidthAtTheGraspHeightComesFromItsMask) {
   const sv::SceneGeometry scene = make_scene();

@@ -133,6 +133,30 @@ std::optional<Eigen::Vector3d> foot_from_mask(const SceneGeometry& scene, const 
   return foot_from_mask(scene, *reading);
 }
 
+bool mask_front_hidden_by(const SceneGeometry& scene, const MaskOnLine& right_mask, const Eigen::Vector3d& stands_at,
+                          const Eigen::Vector3d& place, double radius, double height) {
+  const Eigen::Vector3d camera = scene.right_camera_in_world();
+  if ((place - camera).head<2>().norm() >= (stands_at - camera).head<2>().norm()) return false;  // behind it
+  const Eigen::Vector3d base(place.x(), place.y(), 0.0), top(place.x(), place.y(), height);
+  Eigen::Vector3d away = base - camera;
+  away.z() = 0;
+  if (away.norm() < 1e-9) return false;
+  away = radius * away.normalized();
+  const auto base_px = scene.project_right(base, right_mask.size), top_px = scene.project_right(top, right_mask.size);
+  // Seen from above, its outline reaches up to its top's far rim and down to its base's near rim.
+  const auto far_rim = scene.project_right(top + away, right_mask.size), near_rim = scene.project_right(base - away, right_mask.size);
+  const double depth = scene.world_to_right(base).z();
+  if (!base_px || !top_px || !far_rim || !near_rim || !(depth > 0)) return false;
+  const geometry::Camera& right = scene.rig().right;
+  const double radius_px = radius * right.K(0, 0) * static_cast<double>(right_mask.size.width) / right.width / depth;
+  // The pixel just below the front: the first one the mask does not hold on the line.
+  const cv::Point2d below = right_mask.front + cv::Point2d(0, std::max(2.0, 0.1 * radius_px));
+  if (below.y < far_rim->y || below.y > near_rim->y) return false;
+  const double t = std::abs(base_px->y - top_px->y) > 1e-9 ? (below.y - base_px->y) / (top_px->y - base_px->y) : 0.0;
+  const double axis_x = base_px->x + t * (top_px->x - base_px->x);
+  return std::abs(below.x - axis_x) <= radius_px;
+}
+
 std::optional<double> object_width_at(const SceneGeometry& scene, const cv::Mat& right_mask, const Eigen::Vector3d& foot,
                                       double height) {
   if (right_mask.empty() || right_mask.type() != CV_8U) return std::nullopt;

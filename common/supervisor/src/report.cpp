@@ -185,6 +185,7 @@ std::string attempt_json(const Attempt& a) {
   }
   if (a.rest_from_mask) write_point(j, "rest_from_mask", *a.rest_from_mask);
   if (a.rest_from_axes) write_point(j, "rest_from_axes", *a.rest_from_axes);
+  if (a.mask_front_hidden_behind) write_point(j, "mask_front_hidden_behind", *a.mask_front_hidden_behind);
   if (a.rest_from_still) j.field("rest_from_still", true);
   j.field("motion_frames", a.motion_frames).field("motion_blocks", a.motion_blocks);
   j.field("tracking_started_s", a.tracking_started / 1e6);

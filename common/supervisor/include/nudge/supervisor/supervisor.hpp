@@ -342,6 +342,7 @@ struct Attempt {
   // it becomes the rest when the settled axes' rest is far from it (Config::rest_mask_disagreement_m).
   std::optional<Eigen::Vector3d> rest_from_mask;
   std::optional<Eigen::Vector3d> rest_from_axes;  // the settled axes' rest, when the mask's replaced it
+  std::optional<Eigen::Vector3d> mask_front_hidden_behind;  // the known object hiding the mask's base: its foot not used
   // Config::rest_from_still: the settled axes did not place the object (settle_note says how
   // few there were); its rest is the after still's line along the push.
   bool rest_from_still = false;
