@@ -794,11 +794,15 @@ cv::Size2d Supervisor::smallest_object_image(const Eigen::Vector3d& foot) const 
 void Supervisor::check_rest_with_mask(Attempt& a, const std::optional<MaskOnLine>& right_mask) const {
   if (right_mask) a.rest_from_mask = foot_from_mask(scene_, *right_mask);
   if (!a.rest_from_mask || !a.rest || config_.rest_mask_disagreement_m <= 0) return;
-  // A known object standing in front of the base hides it: the mask ends at its outline.
+  // A known object standing in front of the base hides it: the mask ends at its outline. Its
+  // place is known to a couple of centimetres (a rest, or where it was put back), and the line
+  // may run along its edge (the demo's bottle behind the mug), so it is taken that much wider.
+  constexpr double kPlaceUncertainty = 0.02;
   for (const ExploredObject& object : standing_) {
     if ((object.place - *a.rest).head<2>().norm() < config_.targets.same_object_radius) continue;  // the object itself
     const double height = object.height > 0 ? object.height : config_.targets.obstacle_height;
-    if (mask_front_hidden_by(scene_, *right_mask, *a.rest, object.place, config_.targets.object_radius, height)) {
+    if (mask_front_hidden_by(scene_, *right_mask, *a.rest, object.place, config_.targets.object_radius + kPlaceUncertainty,
+                             height)) {
       a.mask_front_hidden_behind = object.place;
       return;
     }
