@@ -231,7 +231,7 @@ LocationFinder::LocationFinder(const StereoRig& rig, const Plane& table, const s
   filter_.ring_inner_m = params_.ring_inner_m;
   filter_.ring_outer_m = params_.ring_outer_m;
   // The ring lies on the table around the base's foot, whatever the base's height.
-  if (arm_base) filter_.ring_centre = column_foot_.emplace(TableFrame(table, arm_base).origin());
+  if (arm_base) filter_.ring_centre = TableFrame(table, arm_base).origin();
 }
 
 std::vector<symmetry::Line> LocationFinder::survey_lines(Side side, const std::vector<symmetry::Line>& lines) const {
@@ -252,12 +252,14 @@ std::vector<symmetry::Line> LocationFinder::survey_lines(Side side, const std::v
 }
 
 std::vector<symmetry::Line> LocationFinder::paired_lines(Side side, const std::vector<symmetry::Line>& lines) const {
+  // The ring's centre is the arm base's foot, where its column stands.
+  const std::optional<Eigen::Vector3d>& column_foot = filter_.ring_centre;
   std::vector<symmetry::Line> paired;
   int counted = 0;
   for (const symmetry::Line& line : lines) {
     if (counted >= params_.lines_per_image) break;
-    const bool column = params_.column_lines != LocationParams::ColumnLines::Counted && column_foot_ &&
-                        is_image_of_upright_axis(rig_, side, table_, line, *column_foot_, params_.column_line_px);
+    const bool column = params_.column_lines != LocationParams::ColumnLines::Counted && column_foot &&
+                        is_image_of_upright_axis(rig_, side, table_, line, *column_foot, params_.column_line_px);
     if (column && params_.column_lines == LocationParams::ColumnLines::Dropped) continue;
     paired.push_back(line);
     counted += !column;

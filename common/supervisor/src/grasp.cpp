@@ -73,6 +73,13 @@ class LargestBlob {
   int label_ = 0;
 };
 
+// The right camera's focal length in pixels of an image of `size` (a still is the same camera at
+// another resolution).
+double right_focal_px(const SceneGeometry& scene, cv::Size size) {
+  const geometry::Camera& camera = scene.rig().right;
+  return camera.K(0, 0) * static_cast<double>(size.width) / camera.width;
+}
+
 }  // namespace
 
 std::optional<MaskOnLine> read_mask_on_line(const cv::Mat& mask, const symmetry::Line& line) {
@@ -117,7 +124,7 @@ std::optional<Eigen::Vector3d> foot_from_mask(const SceneGeometry& scene, const 
                                                     scene.table());  // right camera frame
   if (!base_front) return std::nullopt;
   // At the foot's depth a pixel spans depth / f metres (f at the mask's size).
-  const double focal = camera.K(0, 0) * static_cast<double>(right_mask.size.width) / camera.width;
+  const double focal = right_focal_px(scene, right_mask.size);
   const double radius = 0.5 * right_mask.base_width_px * base_front->z() / focal;
   const Eigen::Vector3d front = scene.right_to_world(*base_front);
   Eigen::Vector3d along = front - scene.right_camera_in_world();
@@ -147,8 +154,7 @@ bool mask_front_hidden_by(const SceneGeometry& scene, const MaskOnLine& right_ma
   const auto far_rim = scene.project_right(top + away, right_mask.size), near_rim = scene.project_right(base - away, right_mask.size);
   const double depth = scene.world_to_right(base).z();
   if (!base_px || !top_px || !far_rim || !near_rim || !(depth > 0)) return false;
-  const geometry::Camera& right = scene.rig().right;
-  const double radius_px = radius * right.K(0, 0) * static_cast<double>(right_mask.size.width) / right.width / depth;
+  const double radius_px = radius * right_focal_px(scene, right_mask.size) / depth;
   // The pixel just below the front: the first one the mask does not hold on the line.
   const cv::Point2d below = right_mask.front + cv::Point2d(0, std::max(2.0, 0.1 * radius_px));
   if (below.y < far_rim->y || below.y > near_rim->y) return false;
@@ -168,8 +174,7 @@ std::optional<double> object_width_at(const SceneGeometry& scene, const cv::Mat&
   const LargestBlob blob(right_mask);
   const int width_px = blob.width_in_row(row);
   if (width_px <= 0) return std::nullopt;
-  const geometry::Camera& camera = scene.rig().right;
-  const double focal = camera.K(0, 0) * static_cast<double>(right_mask.cols) / camera.width;
+  const double focal = right_focal_px(scene, right_mask.size());
   const double depth = scene.world_to_right(point).z();
   if (!(depth > 0)) return std::nullopt;
   return width_px * depth / focal;

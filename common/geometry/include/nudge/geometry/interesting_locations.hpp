@@ -204,7 +204,6 @@ class LocationFinder {
   TriangulationParams triangulation_;
   AxisFilter filter_;
   PlaneFrame plane_frame_;
-  std::optional<Eigen::Vector3d> column_foot_;  // the arm base's foot on the table, right camera frame
   int frames_ = 0;
   std::vector<Eigen::Vector3d> points_;  // right camera frame
 };
