@@ -8,10 +8,13 @@
 // SYMMETRY message is also cut to its first N lines (the symmetry service's --reach-keep: runs
 // recorded with more lines published replayed as if fewer had been). With --column, the surveys
 // treat the arm base column's lines as each mode says (nudge-triangulation
-// --candidate-column-lines: counted, dropped, uncounted). Writes docs/results/NAME.{json,md}
-// (default survey_line_tilt).
+// --candidate-column-lines: counted, dropped, uncounted). With --published-column-uncounted, each
+// --published N is also replayed with the column's lines riding along uncounted among the N
+// (nudge-symmetry --reach-column-px 8). Writes docs/results/NAME.{json,md} (default
+// survey_line_tilt).
 //   nudge-exp-survey-line-tilt RUNS_DIR [RUNS_DIR...] [--tilts 1,2,3] [--lines 3,5] [--published 5,8]
-//                              [--column counted,uncounted] [--real-radius 0.03] [--name STEM]
+//                              [--published-column-uncounted] [--column counted,uncounted]
+//                              [--real-radius 0.03] [--name STEM]
 // Later surveys follow what the recorded run did (its pushes, its explored places): a replay
 // scores the lines each tilt keeps, not a new run. Choose on development runs only.
 #include <unistd.h>
@@ -32,6 +35,8 @@
 #include "nudge/candidates_request_t.hpp"
 #include "nudge/candidates_t.hpp"
 #include "nudge/geometry/interesting_locations.hpp"
+#include "nudge/geometry/stereo_rig.hpp"
+#include "nudge/geometry/workspace.hpp"
 #include "nudge/json.hpp"
 #include "nudge/progress.hpp"
 #include "nudge/sim_state_t.hpp"
@@ -57,16 +62,19 @@ struct Variant {
   double tilt = 0;
   int lines = 0;
   int published = 0;
+  bool published_column_uncounted = false;  // the column's lines ride along among the `published`
   std::string column;
   bool operator<(const Variant& o) const {
-    return std::tie(published, lines, column, tilt) < std::tie(o.published, o.lines, o.column, o.tilt);
+    return std::tie(published, published_column_uncounted, lines, column, tilt) <
+           std::tie(o.published, o.published_column_uncounted, o.lines, o.column, o.tilt);
   }
   bool rewritten() const { return lines || published; }
+  std::tuple<int, int, bool> rewrite() const { return {lines, published, published_column_uncounted}; }
   std::string name() const {
     std::ostringstream text;
     text << tilt << "°";
     if (lines) text << " " << lines << " lines";
-    if (published) text << " " << published << " published";
+    if (published) text << " " << published << (published_column_uncounted ? "+column" : "") << " published";
     if (!column.empty()) text << " column " << column;
     return text.str();
   }
@@ -102,8 +110,15 @@ std::vector<Message> read_channel(const fs::path& log_path, const std::string& c
 // A copy of the log whose CANDIDATES_REQUESTs ask for `lines` lines per image (0: as recorded) and
 // whose SYMMETRY messages hold their first `published` lines (0: all): the recorded surveys replayed
 // as if the supervisor had run with --survey-lines `lines` and the symmetry service had published
-// `published` lines.
-void write_with_survey_lines(const fs::path& from, const fs::path& to, int lines, int published) {
+// `published` lines. With `column` (the rig, table and arm base), the arm base column's lines ride
+// along uncounted among the `published` (nudge-symmetry --reach-column-px 8).
+struct ColumnPlace {
+  nudge::geometry::StereoRig rig;
+  nudge::geometry::Plane table;
+  Eigen::Vector3d foot;
+};
+void write_with_survey_lines(const fs::path& from, const fs::path& to, int lines, int published,
+                             const ColumnPlace* column) {
   lcm::LogFile in(from.string(), "r");
   lcm::LogFile out(to.string(), "w");
   if (!in.good() || !out.good()) throw std::runtime_error("cannot copy " + from.string() + " to " + to.string());
@@ -124,8 +139,22 @@ void write_with_survey_lines(const fs::path& from, const fs::path& to, int lines
     }
     if (published && e->channel.rfind("SYMMETRY_", 0) == 0 && symmetry.decode(e->data, 0, e->datalen) >= 0 &&
         symmetry.num_lines > published) {
-      symmetry.num_lines = published;
-      symmetry.lines.resize(published);
+      int kept = published;
+      if (column) {
+        std::vector<nudge::symmetry::Line> recorded;
+        for (const auto& l : symmetry.lines) {
+          nudge::symmetry::Line line;
+          line.r = l.r;
+          line.theta = l.theta;
+          recorded.push_back(line);
+        }
+        const auto side = e->channel == "SYMMETRY_LEFT" ? nudge::geometry::Side::Left : nudge::geometry::Side::Right;
+        kept = static_cast<int>(nudge::geometry::first_lines_column_uncounted(column->rig, side, column->table, recorded,
+                                                                              published, column->foot, 8)
+                                    .size());
+      }
+      symmetry.num_lines = kept;
+      symmetry.lines.resize(kept);
       replace(symmetry);
     }
     if (out.writeEvent(&copy) != 0) throw std::runtime_error("cannot write " + to.string());
@@ -188,6 +217,7 @@ int main(int argc, char** argv) try {
   std::vector<int> survey_lines;  // empty: as recorded
   std::vector<int> published;     // empty: as recorded
   std::vector<std::string> columns{""};  // "": the service's default
+  bool published_column_uncounted = false;
   double real_radius = 0.03;
   std::string name = "survey_line_tilt";
   for (int i = 1; i < argc; ++i) {
@@ -198,6 +228,7 @@ int main(int argc, char** argv) try {
       for (double n : parse_list(argv[++i], arg)) survey_lines.push_back(static_cast<int>(n));
     else if (arg == "--published" && has_value)
       for (double n : parse_list(argv[++i], arg)) published.push_back(static_cast<int>(n));
+    else if (arg == "--published-column-uncounted") published_column_uncounted = true;
     else if (arg == "--column" && has_value) {
       columns.clear();
       std::stringstream in(argv[++i]);
@@ -212,7 +243,7 @@ int main(int argc, char** argv) try {
   }
   if (run_sets.empty()) {
     std::cerr << "usage: nudge-exp-survey-line-tilt RUNS_DIR [RUNS_DIR...] [--tilts 1,2,3] [--lines 3,5] [--published 5,8] "
-                 "[--column counted,dropped,uncounted] [--real-radius 0.03] [--name STEM]\n";
+                 "[--published-column-uncounted] [--column counted,dropped,uncounted] [--real-radius 0.03] [--name STEM]\n";
     return 2;
   }
   const fs::path source = NUDGE_SOURCE_DIR;
@@ -225,9 +256,16 @@ int main(int argc, char** argv) try {
   // The variants replayed: every tilt at every lines-per-image and lines published (0: as recorded).
   std::vector<Variant> variants;
   for (int kept : published.empty() ? std::vector<int>{0} : published)
-    for (int lines : survey_lines.empty() ? std::vector<int>{0} : survey_lines)
-      for (const std::string& column : columns)
-        for (double tilt : tilts) variants.push_back({tilt, lines, kept, column});
+    for (bool uncounted : {false, true}) {
+      if (uncounted && (!kept || !published_column_uncounted)) continue;
+      for (int lines : survey_lines.empty() ? std::vector<int>{0} : survey_lines)
+        for (const std::string& column : columns)
+          for (double tilt : tilts) variants.push_back({tilt, lines, kept, uncounted, column});
+    }
+  const nudge::geometry::Workspace place = nudge::geometry::load_workspace(calibration);
+  if (!place.table || !place.arm_base) throw std::runtime_error(calibration + " needs table_plane and arm_base");
+  const ColumnPlace column_place{nudge::geometry::load_rig(calibration), *place.table,
+                                 nudge::geometry::TableFrame(*place.table, *place.arm_base).origin()};
 
   // Each run is named by its set's number (the RUNS_DIRs in order) and its scene.
   std::vector<std::pair<std::string, fs::path>> logs;
@@ -251,11 +289,12 @@ int main(int argc, char** argv) try {
     const auto states = read_channel<nudge::sim_state_t>(log, "SIM_STATE");
     if (states.empty()) throw std::runtime_error(log.string() + ": no SIM_STATE (a simulated run's log is needed)");
     std::string line = run + ":";
-    std::pair<int, int> rewritten_as{0, 0};
+    std::tuple<int, int, bool> rewritten_as{0, 0, false};
     for (const Variant& variant : variants) {
-      if (variant.rewritten() && std::make_pair(variant.lines, variant.published) != rewritten_as) {
-        write_with_survey_lines(log, rewritten, variant.lines, variant.published);
-        rewritten_as = {variant.lines, variant.published};
+      if (variant.rewritten() && variant.rewrite() != rewritten_as) {
+        write_with_survey_lines(log, rewritten, variant.lines, variant.published,
+                                variant.published_column_uncounted ? &column_place : nullptr);
+        rewritten_as = variant.rewrite();
       }
       const fs::path& input = variant.rewritten() ? rewritten : log;
       const std::string command = shell_quote(triangulation) + " --lcm-in " + shell_quote("file://" + input.string() + "?speed=0") +
@@ -294,10 +333,12 @@ int main(int argc, char** argv) try {
     int real = 0, phantom = 0, found = 0, objects = 0;
     for (const auto& [run, s] : runs) real += s.real, phantom += s.phantom, found += static_cast<int>(s.objects_found.size()), objects += s.objects;
     md << "| " << variant.tilt << " | " << (variant.lines ? std::to_string(variant.lines) : "as recorded") << " | "
-       << (variant.published ? std::to_string(variant.published) : "as recorded") << " | "
+       << (variant.published ? std::to_string(variant.published) + (variant.published_column_uncounted ? " + column" : "")
+                             : "as recorded") << " | "
        << (variant.column.empty() ? "default" : variant.column) << " | " << real
        << " | " << phantom << " | " << found << "/" << objects << " |\n";
     json.begin_object().field("tilt_deg", variant.tilt).field("lines_per_image", variant.lines).field("lines_published", variant.published);
+    json.field("published_column_uncounted", variant.published_column_uncounted);
     json.field("column_lines", variant.column.empty() ? std::string("default") : variant.column);
     json.field("real", real).field("phantoms", phantom);
     json.field("objects_found", found).field("objects", objects).end_object();

@@ -151,7 +151,9 @@ nudge_in_private_network() {
 # NUDGE_LOOP_REACH (1, the default; 0: off) makes "plain" take 20 peaks and keep the 5 first whose
 # support stands on the table within 0.45 m of the arm's base and not within 0.10 m of it
 # (nudge-symmetry --reach-calibration, --reach-inner-radius: a wall's or the far table's lines
-# cannot be objects the arm reaches, and the arm's own base column, 65 mm in radius, is none).
+# cannot be objects the arm reaches, and the arm's own base column, 65 mm in radius, is none);
+# the column's line, when its support reaches past 0.10 m, is published without counting among
+# the 5 (--reach-column-px 8), as the survey pairs it uncounted.
 # "plain" surveys pair only lines within 2 deg of the image of an upright axis
 # (nudge-triangulation --candidate-line-tilt 2): objects' lines lean 0-1 deg (a degraded one up
 # to 4), lines between two objects 2.5-5 deg; re-chosen on 33 recorded development runs
@@ -218,7 +220,8 @@ nudge_run_loop() {
       # image (--candidate-column-lines uncounted; docs/supervisor.md, "The column's line").
       triangulation_flags=', "--candidate-line-tilt", "2", "--candidate-column-lines", "uncounted"'
       if [ "${NUDGE_LOOP_REACH:-1}" = 1 ]; then
-        symmetry_flags='"--lines", "20", "--reach-calibration", "'"$calibration"'", "--reach-inner-radius", "0.10", "--reach-keep", "5"'
+        symmetry_flags='"--lines", "20", "--reach-calibration", "'"$calibration"'", "--reach-inner-radius", "0.10", "--reach-keep", "5",
+                        "--reach-column-px", "8"'
       fi ;;
     *) echo "NUDGE_LOOP_TABLE: verified, plain or busy, not '$NUDGE_LOOP_TABLE'" >&2; return 2 ;;
   esac

@@ -65,6 +65,7 @@ struct Options {
   std::string line_pick = "strongest";  // strongest, nearest (LineSearchParams::strongest)
   int rest_from_still = 1;               // Config::rest_from_still
   int rival_by_foot = 1;                 // Config::rival_by_foot
+  int graspable_push_first = 1;          // Config::graspable_push_first
   std::string learn = "auto";      // on, off, auto (while the learner's heartbeat is heard)
   std::string learner = "learner"; // the learner service's heartbeat name
   sv::Config config;
@@ -607,6 +608,9 @@ void add_flags(Flags& f, Options& o) {
   f.add_int("rival-by-foot", &o.rival_by_foot,
             "1: a candidate on the target's right-camera line whose depth beyond the foot of the line in the before still is "
             "nearer --foot-depth-typical by --rival-margin is nudged instead; 0: the survey's choice stands");
+  f.add_int("graspable-push-first", &o.graspable_push_first,
+            "1: with learning, of the two ways across the view the one that leaves the object where the arm can grasp "
+            "it (--push-travel along it) is tried first; 0: the same way first as without learning");
   f.add_double("line-obstacles", &o.config.line_obstacle_share,
                "> 0: a place on the table that the survey's right-camera lines mark (the ray through each line's lowest "
                "pixel, --foot-depth-typical beyond) in at least this share of the frames is an obstacle every push keeps "
@@ -704,6 +708,8 @@ int main(int argc, char** argv) {
     if (!(opt.config.rival_margin_m >= 0)) throw FlagError("--rival-margin must be 0 or more");
     if (!(opt.config.rival_max_misfit_m >= 0)) throw FlagError("--rival-max-misfit must be 0 or more");
     opt.config.rival_by_foot = opt.rival_by_foot == 1;
+    if (opt.graspable_push_first != 0 && opt.graspable_push_first != 1) throw FlagError("--graspable-push-first must be 0 or 1");
+    opt.config.graspable_push_first = opt.graspable_push_first == 1;
     if (!(opt.config.line_search.not_object_px >= 0 && opt.config.line_search.not_object_px < 100))
       throw FlagError("--column-line-px must lie in [0, 100)");
     if (!(opt.config.push_travel_m >= 0 && opt.config.push_travel_m <= opt.config.max_travel_m))

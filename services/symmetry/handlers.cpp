@@ -7,6 +7,7 @@
 #include "nudge/bus/image.hpp"
 #include "nudge/bus/symmetry_convert.hpp"
 #include "nudge/contours_t.hpp"
+#include "nudge/geometry/interesting_locations.hpp"
 #include "nudge/geometry/upright.hpp"
 #include "nudge/log.hpp"
 #include "nudge/timing.hpp"
@@ -158,7 +159,12 @@ void Handlers::detect_and_publish(const cv::Mat& image, const image_t& msg, cons
     result.lines = geometry::lines_standing_within(reach.rig, side, reach.table, reach.centre, reach.radius, result.lines,
                                                       reach.inner_radius);
     symmetry::drop_weak_lines(result.lines, options_.params.min_peak_ratio);
-    if (reach.keep > 0 && static_cast<int>(result.lines.size()) > reach.keep) result.lines.resize(reach.keep);
+    if (reach.keep > 0 && reach.column_px > 0)
+      result.lines = geometry::first_lines_column_uncounted(reach.rig, side, reach.table, result.lines, reach.keep,
+                                                            geometry::TableFrame(reach.table, reach.centre).origin(),
+                                                            reach.column_px);
+    else if (reach.keep > 0 && static_cast<int>(result.lines.size()) > reach.keep)
+      result.lines.resize(reach.keep);
     result.ms.peaks_ms += reach_watch.elapsed_ms();
   }
   if (options_.verify) {  // part of finding the peaks

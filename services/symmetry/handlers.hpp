@@ -52,7 +52,10 @@ struct Options {
   // Only lines standing within reach (geometry/upright.hpp, lines_standing_within): of the
   // params.num_lines peaks, those whose support segment stands on the table within `radius` of
   // `centre` (right camera frame) and not within `inner_radius` of it (the arm's base column), the
-  // first `keep` of them (0: all). Needs the channels' cameras.
+  // first `keep` of them (0: all). With column_px > 0 a line within column_px of the image of the
+  // arm's base column (the upright axis at `centre`'s foot on the table) rides along without
+  // counting among the `keep` (geometry::first_lines_column_uncounted): the column, always in
+  // view, would otherwise take one of the places in every image. Needs the channels' cameras.
   struct Reach {
     geometry::StereoRig rig;
     geometry::Plane table;
@@ -60,6 +63,7 @@ struct Options {
     double radius = 0.45;
     double inner_radius = 0.0;
     int keep = 0;
+    double column_px = 0;
   };
   std::optional<Reach> reach;
 };

@@ -90,6 +90,9 @@ int main(int argc, char** argv) {
                  "with --reach-calibration: drop lines whose foot is nearer the arm_base than this, m (its base "
                  "column's lines; 0: keep them)");
     f.add_int("reach-keep", &reach.keep, "with --reach-calibration: publish at most this many of the lines standing within reach (0: all)");
+    f.add_double("reach-column-px", &reach.column_px,
+                 "with --reach-keep: a line within this many pixels of the image of the arm's base column (the "
+                 "upright axis at arm_base) is published without counting among the kept (0: it counts)");
     f.add_bool("colour-edges", &edge.colour, "Canny on the colour image (the channel that changes most)");
     f.add_int("contours", &options.contours, "also segment the contours of the top N lines (CONTOURS_*); 0: off");
     if (!service.parse(argc, argv)) return 0;
@@ -172,6 +175,7 @@ int main(int argc, char** argv) {
         if (!(reach.inner_radius >= 0 && reach.inner_radius < reach.radius))
           throw std::invalid_argument("--reach-inner-radius must be >= 0 and below --reach-radius");
         if (reach.keep < 0) throw std::invalid_argument("--reach-keep must be >= 0");
+        if (!(reach.column_px >= 0)) throw std::invalid_argument("--reach-column-px must be >= 0");
         reach.rig = geometry::load_rig(reach_calibration);
         const geometry::Workspace scene = geometry::load_workspace(reach_calibration);
         if (!scene.table || !scene.arm_base) throw std::invalid_argument(reach_calibration + " needs table_plane and arm_base");

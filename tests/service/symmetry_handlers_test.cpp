@@ -325,3 +325,52 @@ TEST(SymmetryHandlers, OnlyLinesStandingWithinReachArePublished) {
   EXPECT_NEAR(all.lines[0].r, 10 + 5 * 11.5 - 159.5, 3.0) << "the panel's axis";
   EXPECT_GT(all.lines[0].votes, 10 * lines.lines[0].votes);
 }
+
+// The arm's base column rides along without counting among the lines kept within reach
+// (Reach::column_px): with one line kept, the strongest line, standing where the column does,
+// no longer keeps the next object's line out. A column line ranked after the kept lines is not
+// added, and with column_px 0 the column counts (as before).
+TEST(SymmetryHandlers, TheArmBaseColumnsLineDoesNotTakeAPlaceAmongTheLinesKept) {
+  nudge::symmetry_service::Options options = mono_options();
+  options.inputs = {"CAMERA_RIGHT"};
+  options.params.dmax = 70;  // no pairs across the two bottles: only their own lines
+  nudge::symmetry_service::Options::Reach reach;
+  for (nudge::geometry::Camera* camera : {&reach.rig.left, &reach.rig.right}) {
+    camera->width = 320;
+    camera->height = 240;
+    camera->K << 300, 0, 159.5, 0, 300, 119.5, 0, 0, 1;
+  }
+  reach.table.normal = Eigen::Vector3d(0, -1, 0);  // a level camera 0.3 m above the table
+  reach.table.offset = 0.3;
+  reach.radius = 5.0;
+  reach.keep = 1;
+  cv::Mat img(240, 320, CV_8UC3, cv::Scalar(200, 210, 220));
+  syn::draw_shape(img, syn::bottle_profile(160, 30), 60, 0, 0, cv::Scalar(40, 60, 90));   // the strongest
+  syn::draw_shape(img, syn::bottle_profile(110, 30), -80, 0, 0, cv::Scalar(40, 60, 90));  // the next
+  // An upright axis at x = Z r / f projects to the vertical line at r (the camera is level).
+  const auto column_at = [](double r) { return Eigen::Vector3d(r / 300.0, 0.3, 1.0); };
+  auto published = [&](double column_px, const Eigen::Vector3d& column) {
+    reach.column_px = column_px;
+    reach.centre = column;
+    options.reach = reach;
+    InProcess run(options);
+    Latest<nudge::symmetry_lines_t> right(run.probe, "SYMMETRY_RIGHT");
+    nudge::image_t image = nudge::bus::to_message(img, nudge::image_t::FORMAT_GRAY8, 1, 1, "right");
+    run.bus.publish("CAMERA_RIGHT", &image);
+    run.service.handle_pending();
+    EXPECT_EQ(run.service.counters().errors, 0);
+    std::vector<double> r;
+    for (const auto& line : right.get().lines) r.push_back(line.r);
+    return r;
+  };
+  const std::vector<double> counted = published(0, column_at(60));
+  ASSERT_EQ(counted.size(), 1u) << "column_px 0: the column's line counts";
+  EXPECT_NEAR(counted[0], 60, 1.0);
+  const std::vector<double> uncounted = published(8, column_at(60));
+  ASSERT_EQ(uncounted.size(), 2u) << "the column's line and the one line kept";
+  EXPECT_NEAR(uncounted[0], 60, 1.0);
+  EXPECT_NEAR(uncounted[1], -80, 1.0);
+  const std::vector<double> column_second = published(8, column_at(-80));
+  ASSERT_EQ(column_second.size(), 1u) << "a column line after the kept lines is not added";
+  EXPECT_NEAR(column_second[0], 60, 1.0);
+}

@@ -603,6 +603,44 @@ TEST(Targets, APlaceNeitherPushAcrossTheViewReachesIsPushedTurnedOffIt) {
   EXPECT_GT(turned, 0);
 }
 
+// With learning, of the two ways across the view the one that leaves the object where the arm can
+// grasp it comes first (TargetParams::rest_travel): over the workspace ring, pushes that left the
+// object ungraspable (towards the arm's base, joint 3's limit) turn to the other way where it
+// plans, and no place is left worse off.
+TEST(Targets, WithLearningThePushThatLeavesTheObjectGraspableComesFirst) {
+  const sv::SceneGeometry scene = make_scene();
+  const sv::ArmSetup arm;
+  sv::TargetParams learning;
+  learning.rest_travel = 0.025;
+  auto graspable_rest = [&](const sv::TargetChoice& choice) {
+    nudge::robot::Command grasp;
+    grasp.kind = nudge::robot::CommandKind::Grasp;
+    grasp.target_position = choice.target.position + learning.rest_travel * choice.direction;
+    grasp.height = learning.rest_grasp_height;
+    return nudge::robot::plan_command(arm.planner(), grasp, arm_state_joints()).ok();
+  };
+  int mended = 0, places = 0;
+  for (double radius = 0.16; radius <= 0.34; radius += 0.03)
+    for (double bearing = -90; bearing <= 90; bearing += 15) {
+      const double b = bearing * M_PI / 180;
+      const std::vector<sv::Candidate> candidates = {{0, Eigen::Vector3d(radius * std::cos(b), radius * std::sin(b), 0), 9}};
+      const auto before = sv::choose_target(candidates, {}, scene.right_camera_in_world(), arm, arm_state_joints(), sv::TargetParams{});
+      const auto choice = sv::choose_target(candidates, {}, scene.right_camera_in_world(), arm, arm_state_joints(), learning);
+      ASSERT_EQ(before.found, choice.found) << "the order changes, not which places are pushed";
+      if (!choice.found) continue;
+      ++places;
+      EXPECT_TRUE(choice.plan.ok());
+      if (graspable_rest(before)) {
+        EXPECT_TRUE(graspable_rest(choice)) << "radius " << radius << " bearing " << bearing;
+        EXPECT_NEAR((choice.direction - before.direction).norm(), 0.0, 1e-9) << "already graspable: the same push";
+      } else if (graspable_rest(choice)) {
+        ++mended;
+      }
+    }
+  EXPECT_GT(places, 20);
+  EXPECT_GT(mended, 0) << "some pushes over the ring left the object ungraspable, and the other way does not";
+}
+
 TEST(ObjectHeight, TheRayIsReadWhereItPassesOverTheAxis) {
   const sv::SceneGeometry scene = make_scene();
   const Eigen::Vector3d foot(0.28, -0.05, 0);

@@ -251,18 +251,31 @@ std::vector<symmetry::Line> LocationFinder::survey_lines(Side side, const std::v
   return kept;
 }
 
+std::vector<symmetry::Line> first_lines_column_uncounted(const StereoRig& rig, Side side, const Plane& table,
+                                                         const std::vector<symmetry::Line>& lines, int count,
+                                                         const Eigen::Vector3d& column_foot, double column_px) {
+  std::vector<symmetry::Line> first;
+  int counted = 0;
+  for (const symmetry::Line& line : lines) {
+    if (counted >= count) break;
+    first.push_back(line);
+    counted += !is_image_of_upright_axis(rig, side, table, line, column_foot, column_px);
+  }
+  return first;
+}
+
 std::vector<symmetry::Line> LocationFinder::paired_lines(Side side, const std::vector<symmetry::Line>& lines) const {
   // The ring's centre is the arm base's foot, where its column stands.
   const std::optional<Eigen::Vector3d>& column_foot = filter_.ring_centre;
-  std::vector<symmetry::Line> paired;
-  int counted = 0;
+  const int count = params_.lines_per_image;
+  if (!column_foot || params_.column_lines == LocationParams::ColumnLines::Counted)
+    return {lines.begin(), lines.begin() + std::min<std::ptrdiff_t>(count, static_cast<std::ptrdiff_t>(lines.size()))};
+  if (params_.column_lines == LocationParams::ColumnLines::Uncounted)
+    return first_lines_column_uncounted(rig_, side, table_, lines, count, *column_foot, params_.column_line_px);
+  std::vector<symmetry::Line> paired;  // Dropped
   for (const symmetry::Line& line : lines) {
-    if (counted >= params_.lines_per_image) break;
-    const bool column = params_.column_lines != LocationParams::ColumnLines::Counted && column_foot &&
-                        is_image_of_upright_axis(rig_, side, table_, line, *column_foot, params_.column_line_px);
-    if (column && params_.column_lines == LocationParams::ColumnLines::Dropped) continue;
-    paired.push_back(line);
-    counted += !column;
+    if (static_cast<int>(paired.size()) >= count) break;
+    if (!is_image_of_upright_axis(rig_, side, table_, line, *column_foot, params_.column_line_px)) paired.push_back(line);
   }
   return paired;
 }

@@ -156,11 +156,18 @@ void Supervisor::survey(int64_t now, const std::string& why, double max_line_til
   outputs_.push_back(CandidatesRequest{config_.survey_frames, config_.survey_lines, explored, max_line_tilt_deg});
 }
 
+// The choice's parameters: with learning, a push that leaves the object graspable comes first.
+TargetParams Supervisor::target_params() const {
+  TargetParams params = config_.targets;
+  if (config_.graspable_push_first && learning_enabled()) params.rest_travel = config_.push_travel_m;
+  return params;
+}
+
 void Supervisor::choose(int64_t now) {
   const Eigen::Vector3d camera = scene_.right_camera_in_world();
   std::vector<Rejection> hidden;
   const std::vector<Candidate> visible = drop_hidden_behind_arm_base(hidden);
-  TargetChoice choice = choose_target(visible, history(), camera, arm_, joints_, config_.targets);
+  TargetChoice choice = choose_target(visible, history(), camera, arm_, joints_, target_params());
   choice.rejected.insert(choice.rejected.end(), hidden.begin(), hidden.end());
   summary_.rejections.clear();
   for (const Rejection& r : choice.rejected) ++summary_.rejections[r.reason];
@@ -204,7 +211,7 @@ void Supervisor::prefer_rival_at_the_lines_foot() {
   auto misfit = [&](double d) { return std::abs(d - config_.foot_depth_typical_m); };
   const auto& [candidate, depth] = a.rivals[*rival];
   if (misfit(depth) > config_.rival_max_misfit_m || misfit(depth) > misfit(*a.foot_depth_m) - config_.rival_margin_m) return;
-  const TargetChoice choice = choose_target({candidate}, history(), scene_.right_camera_in_world(), arm_, joints_, config_.targets);
+  const TargetChoice choice = choose_target({candidate}, history(), scene_.right_camera_in_world(), arm_, joints_, target_params());
   if (!choice.found) return;  // the rival is explored or out of reach: the survey's choice stands
   a.replaced = a.target;
   a.replaced_foot_depth_m = *a.foot_depth_m;

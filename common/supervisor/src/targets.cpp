@@ -197,9 +197,11 @@ std::optional<std::pair<double, PushPlan>> push_for_shorter_object(const Candida
 // The horizontal push directions tried for a target (base frame): the two across the camera's view
 // (thesis), then each turned by push_turn_step_deg, 2 push_turn_step_deg, ... up to
 // max_push_turn_deg towards and away from the camera, in that order; with the angle turned.
+// With other_way_first, across[1] and its turns come before across[0]'s.
 std::vector<std::pair<Eigen::Vector3d, double>> push_directions(const Eigen::Vector3d& camera_base, const Eigen::Vector3d& target_base,
-                                                                const TargetParams& params) {
-  const auto across = robot::directions_across_view(camera_base, target_base);
+                                                                const TargetParams& params, bool other_way_first) {
+  auto across = robot::directions_across_view(camera_base, target_base);
+  if (other_way_first) std::swap(across[0], across[1]);
   std::vector<std::pair<Eigen::Vector3d, double>> out = {{across[0], 0.0}, {across[1], 0.0}};
   if (!(params.push_turn_step_deg > 0)) return out;
   // Below 90 deg: a push along the ray moves the object in depth only, which no camera sees as motion.
@@ -208,6 +210,27 @@ std::vector<std::pair<Eigen::Vector3d, double>> push_directions(const Eigen::Vec
       for (double sign : {1.0, -1.0})
         out.emplace_back(Eigen::AngleAxisd(sign * turn * M_PI / 180, Eigen::Vector3d::UnitZ()) * d, turn);
   return out;
+}
+
+// Whether the arm could grasp the object where a push along `direction_base` would leave it
+// (TargetParams::rest_travel along it; the grasp the supervisor will ask for, at the lowest usual
+// height, planned by the arm service's own planner).
+bool graspable_after_push(const Candidate& c, const Eigen::Vector3d& direction_base, const ArmSetup& arm,
+                          const robot::JointVector& seed, const TargetParams& params) {
+  robot::Command grasp;
+  grasp.kind = robot::CommandKind::Grasp;
+  grasp.target_position = c.position + params.rest_travel * horizontal(arm.direction_to_world(direction_base)).normalized();
+  grasp.height = params.rest_grasp_height;
+  return robot::plan_command(arm.planner(), grasp, seed).ok();
+}
+
+// TargetParams::rest_travel: whether the second way across the view leaves the object graspable
+// and the first does not.
+bool other_way_first(const Candidate& c, const Eigen::Vector3d& camera_base, const ArmSetup& arm,
+                     const robot::JointVector& seed, const TargetParams& params) {
+  if (!(params.rest_travel > 0)) return false;
+  const auto across = robot::directions_across_view(camera_base, arm.point_to_base(c.position));
+  return !graspable_after_push(c, across[0], arm, seed, params) && graspable_after_push(c, across[1], arm, seed, params);
 }
 
 // Which conflicts with other objects a pass over the candidates accepts (and notes): none, the
@@ -273,7 +296,8 @@ TargetChoice choose_pass(const std::vector<Candidate>& candidates, const std::ve
       return t;
     };
     const std::vector<Obstacle> obstacles = obstacles_to(c, candidates, history, params);
-    for (const auto& [direction_base, turn] : push_directions(camera_base, arm.point_to_base(c.position), params)) {
+    const bool swapped = other_way_first(c, camera_base, arm, seed, params);
+    for (const auto& [direction_base, turn] : push_directions(camera_base, arm.point_to_base(c.position), params, swapped)) {
       const Eigen::Vector3d direction = arm.direction_to_world(direction_base);
       auto refuse = [&](const std::string& problem) {
         if (turn > 0) ++turned_refused;

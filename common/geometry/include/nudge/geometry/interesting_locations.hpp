@@ -134,6 +134,15 @@ LocationParams::ColumnLines parse_column_lines(const std::string& text);
 bool is_image_of_upright_axis(const StereoRig& rig, Side side, const Plane& table, const symmetry::Line& line,
                               const Eigen::Vector3d& foot, double tolerance_px);
 
+// The strongest lines (`lines` strongest first) up to `count` of them, where a line that is the
+// image of the arm's base column (is_image_of_upright_axis at `column_foot`, within
+// `column_px`) rides along without counting: the column is always in view and often an image's
+// strongest line, and would otherwise take the place of an object's line wherever lines are
+// capped (the survey's lines per image, the symmetry service's lines published within reach).
+std::vector<symmetry::Line> first_lines_column_uncounted(const StereoRig& rig, Side side, const Plane& table,
+                                                         const std::vector<symmetry::Line>& lines, int count,
+                                                         const Eigen::Vector3d& column_foot, double column_px);
+
 // Throws std::invalid_argument naming the offending parameter.
 void validate(const LocationParams& params);
 

@@ -155,6 +155,10 @@ struct Config {
   // bottle and the segmentation failed.) Off: the survey's choice stands.
   bool rival_by_foot = true;
   double foot_depth_typical_m = 0.03, rival_margin_m = 0.03, rival_max_misfit_m = 0.05;
+  // With learning on (the attempt's), of the two ways across the view the one that leaves the
+  // object where the arm can grasp it is tried first (TargetParams::rest_travel, set to
+  // push_travel_m for the choice). Off: the first way across the view first, as without learning.
+  bool graspable_push_first = true;
   // Objects the stereo pairing missed are still obstacles: a right-camera line of the survey stands
   // on the table where the ray through the lower end of its support meets it, its axis
   // foot_depth_typical_m beyond (History::sighted). A place such lines mark in at least this share
@@ -569,6 +573,7 @@ class Supervisor {
   bool settling_longer(int64_t now) const;
   // ---- learning ----
   bool learning_enabled() const;
+  TargetParams target_params() const;
   bool stills_complete() const;
   void stills_arrived(int64_t now);
   void before_lines();

@@ -73,6 +73,14 @@ struct TargetParams {
   // (the tallest expected). A push that cannot is taken only when no push clears every object.
   // 0: not checked.
   double obstacle_height = 0.25;
+  // Beyond the thesis (which does not say which way across the view to push): with learning on,
+  // the pushed object is grasped where it comes to rest, and a push towards the arm's base can
+  // leave it where no grasp plans (joint 3's limit: the demo's bottle, segmented but not learned).
+  // When > 0, of the two ways across the view the one whose expected rest (rest_travel along the
+  // push) the arm can grasp at rest_grasp_height is tried first (with its turned pushes); the
+  // other way stays, after it. 0: across[0] first, as before.
+  double rest_travel = 0;
+  double rest_grasp_height = 0.06;  // fingers above the table: a 12 cm cup's grip, the lowest usual
 };
 
 struct Candidate {
