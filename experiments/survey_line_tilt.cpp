@@ -13,7 +13,7 @@
 // (nudge-symmetry --reach-column-px 8). Writes docs/results/NAME.{json,md} (default
 // survey_line_tilt).
 //   nudge-exp-survey-line-tilt RUNS_DIR [RUNS_DIR...] [--tilts 1,2,3] [--lines 3,5] [--published 5,8]
-//                              [--published-column-uncounted] [--column counted,uncounted]
+//                              [--published-column-uncounted] [--explored-px 8,12] [--column counted,uncounted]
 //                              [--real-radius 0.03] [--name STEM]
 // Later surveys follow what the recorded run did (its pushes, its explored places): a replay
 // scores the lines each tilt keeps, not a new run. Choose on development runs only.
@@ -64,9 +64,10 @@ struct Variant {
   int published = 0;
   bool published_column_uncounted = false;  // the column's lines ride along among the `published`
   std::string column;
+  double explored_px = 0;  // 0: the service's default
   bool operator<(const Variant& o) const {
-    return std::tie(published, published_column_uncounted, lines, column, tilt) <
-           std::tie(o.published, o.published_column_uncounted, o.lines, o.column, o.tilt);
+    return std::tie(published, published_column_uncounted, lines, column, explored_px, tilt) <
+           std::tie(o.published, o.published_column_uncounted, o.lines, o.column, o.explored_px, o.tilt);
   }
   bool rewritten() const { return lines || published; }
   std::tuple<int, int, bool> rewrite() const { return {lines, published, published_column_uncounted}; }
@@ -76,6 +77,7 @@ struct Variant {
     if (lines) text << " " << lines << " lines";
     if (published) text << " " << published << (published_column_uncounted ? "+column" : "") << " published";
     if (!column.empty()) text << " column " << column;
+    if (explored_px > 0) text << " explored " << explored_px << " px";
     return text.str();
   }
 };
@@ -218,6 +220,7 @@ int main(int argc, char** argv) try {
   std::vector<int> published;     // empty: as recorded
   std::vector<std::string> columns{""};  // "": the service's default
   bool published_column_uncounted = false;
+  std::vector<double> explored_px{0};  // 0: the service's default
   double real_radius = 0.03;
   std::string name = "survey_line_tilt";
   for (int i = 1; i < argc; ++i) {
@@ -229,6 +232,7 @@ int main(int argc, char** argv) try {
     else if (arg == "--published" && has_value)
       for (double n : parse_list(argv[++i], arg)) published.push_back(static_cast<int>(n));
     else if (arg == "--published-column-uncounted") published_column_uncounted = true;
+    else if (arg == "--explored-px" && has_value) explored_px = parse_list(argv[++i], arg);
     else if (arg == "--column" && has_value) {
       columns.clear();
       std::stringstream in(argv[++i]);
@@ -260,7 +264,8 @@ int main(int argc, char** argv) try {
       if (uncounted && (!kept || !published_column_uncounted)) continue;
       for (int lines : survey_lines.empty() ? std::vector<int>{0} : survey_lines)
         for (const std::string& column : columns)
-          for (double tilt : tilts) variants.push_back({tilt, lines, kept, uncounted, column});
+          for (double explored : explored_px)
+            for (double tilt : tilts) variants.push_back({tilt, lines, kept, uncounted, column, explored});
     }
   const nudge::geometry::Workspace place = nudge::geometry::load_workspace(calibration);
   if (!place.table || !place.arm_base) throw std::runtime_error(calibration + " needs table_plane and arm_base");
@@ -302,6 +307,7 @@ int main(int argc, char** argv) try {
                                   shell_quote(calibration) + " --workspace " + shell_quote(workspace) +
                                   " --candidate-line-tilt " + std::to_string(variant.tilt) +
                                   (variant.column.empty() ? std::string() : " --candidate-column-lines " + variant.column) +
+                                  (variant.explored_px > 0 ? " --candidate-explored-px " + std::to_string(variant.explored_px) : std::string()) +
                                   " >/dev/null 2>&1";
       if (std::system(command.c_str()) != 0) throw std::runtime_error("nudge-triangulation failed on " + log.string());
       Score& s = scores[variant][run];
@@ -328,18 +334,20 @@ int main(int argc, char** argv) try {
   for (size_t i = 0; i < run_sets.size(); ++i) md << (i ? ", " : "") << i + 1 << ": `" << run_sets[i] << "`";
   md << " (" << logs.size() << " runs). " << nudge::experiments::machine_description() << ", "
      << nudge::experiments::today() << ".\n\n"
-     << "| tilt (deg) | lines per image | lines published | column's lines | real candidates | phantoms | objects ever a candidate |\n|---|---|---|---|---|---|---|\n";
+     << "| tilt (deg) | lines per image | lines published | column's lines | explored objects' lines within (px) | real candidates | phantoms | objects ever a candidate |\n|---|---|---|---|---|---|---|---|\n";
   for (const auto& [variant, runs] : scores) {
     int real = 0, phantom = 0, found = 0, objects = 0;
     for (const auto& [run, s] : runs) real += s.real, phantom += s.phantom, found += static_cast<int>(s.objects_found.size()), objects += s.objects;
     md << "| " << variant.tilt << " | " << (variant.lines ? std::to_string(variant.lines) : "as recorded") << " | "
        << (variant.published ? std::to_string(variant.published) + (variant.published_column_uncounted ? " + column" : "")
                              : "as recorded") << " | "
-       << (variant.column.empty() ? "default" : variant.column) << " | " << real
+       << (variant.column.empty() ? "default" : variant.column) << " | "
+       << (variant.explored_px > 0 ? std::to_string(std::lround(variant.explored_px)) : std::string("default")) << " | " << real
        << " | " << phantom << " | " << found << "/" << objects << " |\n";
     json.begin_object().field("tilt_deg", variant.tilt).field("lines_per_image", variant.lines).field("lines_published", variant.published);
     json.field("published_column_uncounted", variant.published_column_uncounted);
     json.field("column_lines", variant.column.empty() ? std::string("default") : variant.column);
+    json.field("explored_line_px", variant.explored_px);
     json.field("real", real).field("phantoms", phantom);
     json.field("objects_found", found).field("objects", objects).end_object();
   }

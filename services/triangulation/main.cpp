@@ -282,6 +282,9 @@ void add_flags(Flags& f, Options& o) {
                "--candidate-lines); needs the arm base");
   f.add_double("candidate-column-px", &o.locations.column_line_px,
                "CANDIDATES: a line this near the image of the arm base column's axis is the column's, px");
+  f.add_double("candidate-explored-px", &o.locations.explored_line_px,
+               "CANDIDATES: a line this near the image of an explored object's axis (the request's explored places) "
+               "is that object's, not among the --candidate-lines, px");
   f.add_double("cluster-radius", &o.locations.qt.radius, "CANDIDATES: QT cluster radius, m");
   f.add_double("cluster-min-fraction", &o.locations.qt.min_fraction, "CANDIDATES: smallest cluster, fraction of all");
   f.add_bool("stereo-check", &o.locations.stereo_check,
