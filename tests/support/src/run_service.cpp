@@ -8,15 +8,49 @@
 #include <atomic>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <mutex>
+#include <set>
+#include <system_error>
 
 namespace nudge::test {
 
 std::string bin_dir() { return NUDGE_BIN_DIR; }
 
+namespace {
+
+// The paths temp_path handed out, removed at exit when every test passed (the registry is made on
+// the first call, inside RUN_ALL_TESTS, so it is destroyed before gtest's UnitTest).
+class TempPaths {
+ public:
+  void add(const std::string& path) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    paths_.insert(path);
+  }
+  ~TempPaths() {
+    if (std::getenv("NUDGE_KEEP_TEST_RUNS") || !testing::UnitTest::GetInstance()->Passed()) return;
+    std::error_code ignored;
+    for (const std::string& path : paths_) std::filesystem::remove_all(path, ignored);
+  }
+
+ private:
+  std::mutex mutex_;
+  std::set<std::string> paths_;
+};
+
+TempPaths& temp_paths() {
+  static TempPaths paths;
+  return paths;
+}
+
+}  // namespace
+
 std::string temp_path(const std::string& name) {
-  return testing::TempDir() + "/" + std::to_string(::getpid()) + "_" + name;
+  const std::string path = testing::TempDir() + "/" + std::to_string(::getpid()) + "_" + name;
+  temp_paths().add(path);
+  return path;
 }
 
 int run_command(const std::string& command) {

@@ -11,7 +11,9 @@ namespace nudge::test {
 // Where the build put the programs (build/bin).
 std::string bin_dir();
 // A path in the test's temporary directory that no other process uses (several build trees may
-// run their tests at the same time).
+// run their tests at the same time). Every path handed out is removed (file or directory) when
+// the test program ends with every test passed, unless NUDGE_KEEP_TEST_RUNS is set: a failed run
+// keeps its logs to look at, a passed one leaves nothing behind.
 std::string temp_path(const std::string& name);
 // Runs a shell command. Returns its exit code, or -1 when it did not exit (killed by a signal).
 int run_command(const std::string& command);
