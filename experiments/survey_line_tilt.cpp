@@ -32,6 +32,7 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "nudge/bus/symmetry_convert.hpp"
 #include "nudge/candidates_request_t.hpp"
 #include "nudge/candidates_t.hpp"
 #include "nudge/geometry/interesting_locations.hpp"
@@ -118,6 +119,7 @@ struct ColumnPlace {
   nudge::geometry::StereoRig rig;
   nudge::geometry::Plane table;
   Eigen::Vector3d foot;
+  double px = 8;  // the loop's nudge-symmetry --reach-column-px
 };
 void write_with_survey_lines(const fs::path& from, const fs::path& to, int lines, int published,
                              const ColumnPlace* column) {
@@ -144,15 +146,10 @@ void write_with_survey_lines(const fs::path& from, const fs::path& to, int lines
       int kept = published;
       if (column) {
         std::vector<nudge::symmetry::Line> recorded;
-        for (const auto& l : symmetry.lines) {
-          nudge::symmetry::Line line;
-          line.r = l.r;
-          line.theta = l.theta;
-          recorded.push_back(line);
-        }
+        for (const auto& l : symmetry.lines) recorded.push_back(nudge::bus::from_message(l));
         const auto side = e->channel == "SYMMETRY_LEFT" ? nudge::geometry::Side::Left : nudge::geometry::Side::Right;
         kept = static_cast<int>(nudge::geometry::first_lines_column_uncounted(column->rig, side, column->table, recorded,
-                                                                              published, column->foot, 8)
+                                                                              published, column->foot, column->px)
                                     .size());
       }
       symmetry.num_lines = kept;
@@ -247,7 +244,7 @@ int main(int argc, char** argv) try {
   }
   if (run_sets.empty()) {
     std::cerr << "usage: nudge-exp-survey-line-tilt RUNS_DIR [RUNS_DIR...] [--tilts 1,2,3] [--lines 3,5] [--published 5,8] "
-                 "[--published-column-uncounted] [--column counted,dropped,uncounted] [--real-radius 0.03] [--name STEM]\n";
+                 "[--published-column-uncounted] [--explored-px 8,12] [--column counted,dropped,uncounted] [--real-radius 0.03] [--name STEM]\n";
     return 2;
   }
   const fs::path source = NUDGE_SOURCE_DIR;
