@@ -10,10 +10,14 @@
 // treat the arm base column's lines as each mode says (nudge-triangulation
 // --candidate-column-lines: counted, dropped, uncounted). With --published-column-uncounted, each
 // --published N is also replayed with the column's lines riding along uncounted among the N
-// (nudge-symmetry --reach-column-px 8). Writes docs/results/NAME.{json,md} (default
-// survey_line_tilt).
+// (nudge-symmetry --reach-column-px 8). With --symmetry, the run's camera frames are first replayed
+// through nudge-symmetry with its own flags and then each flag set given (';'-separated; "recorded":
+// the lines as recorded), and those lines stand in for the recorded ones. Writes
+// docs/results/NAME.{json,md} (default survey_line_tilt). With --triangulation, each ';'-separated
+// flag set ("none": none) is added to the replayed nudge-triangulation's command.
 //   nudge-exp-survey-line-tilt RUNS_DIR [RUNS_DIR...] [--tilts 1,2,3] [--lines 3,5] [--published 5,8]
 //                              [--published-column-uncounted] [--explored-px 8,12] [--column counted,uncounted]
+//                              [--symmetry "recorded;--reach-max-tilt 15"] [--triangulation "none;--cluster-min-fraction 0.04"]
 //                              [--real-radius 0.03] [--name STEM]
 // Later surveys follow what the recorded run did (its pushes, its explored places): a replay
 // scores the lines each tilt keeps, not a new run. Choose on development runs only.
@@ -44,8 +48,13 @@
 #include "nudge/supervisor/scene.hpp"
 #include "nudge/symmetry_lines_t.hpp"
 #include "report.hpp"
+#include "run_logs.hpp"
 
 namespace fs = std::filesystem;
+using nudge::experiments::own_directory;
+using nudge::experiments::read_channel;
+using nudge::experiments::shell_quote;
+using nudge::experiments::state_at;
 using nudge::supervisor::SceneGeometry;
 
 namespace {
@@ -66,18 +75,23 @@ struct Variant {
   bool published_column_uncounted = false;  // the column's lines ride along among the `published`
   std::string column;
   double explored_px = 0;  // 0: the service's default
+  std::string symmetry;    // nudge-symmetry flags the camera frames are replayed with ("": lines as recorded)
+  std::string triangulation;  // more nudge-triangulation flags ("": none)
   bool operator<(const Variant& o) const {
-    return std::tie(published, published_column_uncounted, lines, column, explored_px, tilt) <
-           std::tie(o.published, o.published_column_uncounted, o.lines, o.column, o.explored_px, o.tilt);
+    return std::tie(symmetry, published, published_column_uncounted, lines, column, explored_px, triangulation, tilt) <
+           std::tie(o.symmetry, o.published, o.published_column_uncounted, o.lines, o.column, o.explored_px,
+                    o.triangulation, o.tilt);
   }
-  bool rewritten() const { return lines || published; }
-  std::tuple<int, int, bool> rewrite() const { return {lines, published, published_column_uncounted}; }
+  bool rewritten() const { return lines || published || !symmetry.empty(); }
+  std::tuple<int, int, bool, std::string> rewrite() const { return {lines, published, published_column_uncounted, symmetry}; }
   std::string name() const {
     std::ostringstream text;
     text << tilt << "°";
     if (lines) text << " " << lines << " lines";
     if (published) text << " " << published << (published_column_uncounted ? "+column" : "") << " published";
     if (!column.empty()) text << " column " << column;
+    if (!symmetry.empty()) text << " symmetry `" << symmetry << "`";
+    if (!triangulation.empty()) text << " `" << triangulation << "`";
     if (explored_px > 0) text << " explored " << explored_px << " px";
     return text.str();
   }
@@ -96,20 +110,6 @@ std::vector<double> parse_list(const std::string& text, const std::string& flag)
   return values;
 }
 
-// Every message of `channel` in a log, in log order.
-template <typename Message>
-std::vector<Message> read_channel(const fs::path& log_path, const std::string& channel) {
-  std::vector<Message> messages;
-  lcm::LogFile log(log_path.string(), "r");
-  if (!log.good()) throw std::runtime_error("cannot read " + log_path.string());
-  for (const lcm::LogEvent* e = log.readNextEvent(); e; e = log.readNextEvent()) {
-    if (e->channel != channel) continue;
-    Message m;
-    if (m.decode(e->data, 0, e->datalen) >= 0) messages.push_back(std::move(m));
-  }
-  return messages;
-}
-
 // A copy of the log whose CANDIDATES_REQUESTs ask for `lines` lines per image (0: as recorded) and
 // whose SYMMETRY messages hold their first `published` lines (0: all): the recorded surveys replayed
 // as if the supervisor had run with --survey-lines `lines` and the symmetry service had published
@@ -121,8 +121,19 @@ struct ColumnPlace {
   Eigen::Vector3d foot;
   double px = 8;  // the loop's nudge-symmetry --reach-column-px
 };
+// SYMMETRY_LEFT/RIGHT lines by channel and image time, replayed (nudge-symmetry with other flags).
+using ReplayedLines = std::map<std::pair<std::string, int64_t>, nudge::symmetry_lines_t>;
+ReplayedLines replayed_lines(const fs::path& log) {
+  ReplayedLines lines;
+  for (const std::string channel : {"SYMMETRY_LEFT", "SYMMETRY_RIGHT"})
+    for (auto& m : read_channel<nudge::symmetry_lines_t>(log, channel)) lines[{channel, m.utime}] = std::move(m);
+  return lines;
+}
+
+// With `replayed`, each recorded SYMMETRY message is replaced by the replayed one of its image
+// (none: dropped) before the cut to `published`.
 void write_with_survey_lines(const fs::path& from, const fs::path& to, int lines, int published,
-                             const ColumnPlace* column) {
+                             const ColumnPlace* column, const ReplayedLines* replayed) {
   lcm::LogFile in(from.string(), "r");
   lcm::LogFile out(to.string(), "w");
   if (!in.good() || !out.good()) throw std::runtime_error("cannot copy " + from.string() + " to " + to.string());
@@ -141,8 +152,14 @@ void write_with_survey_lines(const fs::path& from, const fs::path& to, int lines
       request.lines_per_image = lines;
       replace(request);
     }
-    if (published && e->channel.rfind("SYMMETRY_", 0) == 0 && symmetry.decode(e->data, 0, e->datalen) >= 0 &&
-        symmetry.num_lines > published) {
+    const bool is_symmetry = e->channel.rfind("SYMMETRY_", 0) == 0 && symmetry.decode(e->data, 0, e->datalen) >= 0;
+    if (is_symmetry && replayed) {
+      const auto it = replayed->find({e->channel, symmetry.utime});
+      if (it == replayed->end()) continue;
+      symmetry = it->second;
+      replace(symmetry);
+    }
+    if (published && is_symmetry && symmetry.num_lines > published) {
       int kept = published;
       if (column) {
         std::vector<nudge::symmetry::Line> recorded;
@@ -158,16 +175,6 @@ void write_with_survey_lines(const fs::path& from, const fs::path& to, int lines
     }
     if (out.writeEvent(&copy) != 0) throw std::runtime_error("cannot write " + to.string());
   }
-}
-
-// The latest state at or before `utime` (states are in log order, utime rising).
-const nudge::sim_state_t* state_at(const std::vector<nudge::sim_state_t>& states, int64_t utime) {
-  const nudge::sim_state_t* found = nullptr;
-  for (const auto& s : states) {
-    if (s.utime > utime) break;
-    found = &s;
-  }
-  return found;
 }
 
 void score_surveys(const std::vector<nudge::candidates_t>& surveys, const std::vector<nudge::sim_state_t>& states,
@@ -194,20 +201,6 @@ void score_surveys(const std::vector<nudge::candidates_t>& surveys, const std::v
   }
 }
 
-fs::path own_directory() {
-  char path[4096];
-  const ssize_t n = readlink("/proc/self/exe", path, sizeof(path) - 1);
-  if (n <= 0) throw std::runtime_error("cannot find this program's directory");
-  path[n] = '\0';
-  return fs::path(path).parent_path();
-}
-
-std::string shell_quote(const std::string& s) {
-  std::string quoted = "'";
-  for (char c : s) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return quoted + "'";
-}
-
 }  // namespace
 
 int main(int argc, char** argv) try {
@@ -217,6 +210,8 @@ int main(int argc, char** argv) try {
   std::vector<int> published;     // empty: as recorded
   std::vector<std::string> columns{""};  // "": the service's default
   bool published_column_uncounted = false;
+  std::vector<std::string> symmetry_flags{""};  // "": the recorded lines
+  std::vector<std::string> triangulation_flags{""};
   std::vector<double> explored_px{0};  // 0: the service's default
   double real_radius = 0.03;
   std::string name = "survey_line_tilt";
@@ -229,6 +224,15 @@ int main(int argc, char** argv) try {
     else if (arg == "--published" && has_value)
       for (double n : parse_list(argv[++i], arg)) published.push_back(static_cast<int>(n));
     else if (arg == "--published-column-uncounted") published_column_uncounted = true;
+    else if (arg == "--symmetry" && has_value) {
+      std::stringstream in(argv[++i]);
+      for (std::string flags; std::getline(in, flags, ';');) symmetry_flags.push_back(flags == "recorded" ? "" : flags);
+      symmetry_flags.erase(symmetry_flags.begin());  // the default "" is replaced by the list given
+    } else if (arg == "--triangulation" && has_value) {
+      triangulation_flags.clear();
+      std::stringstream in(argv[++i]);
+      for (std::string flags; std::getline(in, flags, ';');) triangulation_flags.push_back(flags == "none" ? "" : flags);
+    }
     else if (arg == "--explored-px" && has_value) explored_px = parse_list(argv[++i], arg);
     else if (arg == "--column" && has_value) {
       columns.clear();
@@ -244,7 +248,8 @@ int main(int argc, char** argv) try {
   }
   if (run_sets.empty()) {
     std::cerr << "usage: nudge-exp-survey-line-tilt RUNS_DIR [RUNS_DIR...] [--tilts 1,2,3] [--lines 3,5] [--published 5,8] "
-                 "[--published-column-uncounted] [--explored-px 8,12] [--column counted,dropped,uncounted] [--real-radius 0.03] [--name STEM]\n";
+                 "[--published-column-uncounted] [--explored-px 8,12] [--column counted,dropped,uncounted] "
+                 "[--symmetry \"recorded;FLAGS...\"] [--triangulation \"none;FLAGS...\"] [--real-radius 0.03] [--name STEM]\n";
     return 2;
   }
   const fs::path source = NUDGE_SOURCE_DIR;
@@ -262,26 +267,16 @@ int main(int argc, char** argv) try {
       for (int lines : survey_lines.empty() ? std::vector<int>{0} : survey_lines)
         for (const std::string& column : columns)
           for (double explored : explored_px)
-            for (double tilt : tilts) variants.push_back({tilt, lines, kept, uncounted, column, explored});
+            for (const std::string& flags : symmetry_flags)
+              for (const std::string& more : triangulation_flags)
+                for (double tilt : tilts) variants.push_back({tilt, lines, kept, uncounted, column, explored, flags, more});
     }
   const nudge::geometry::Workspace place = nudge::geometry::load_workspace(calibration);
   if (!place.table || !place.arm_base) throw std::runtime_error(calibration + " needs table_plane and arm_base");
   const ColumnPlace column_place{nudge::geometry::load_rig(calibration), *place.table,
                                  nudge::geometry::TableFrame(*place.table, *place.arm_base).origin()};
 
-  // Each run is named by its set's number (the RUNS_DIRs in order) and its scene.
-  std::vector<std::pair<std::string, fs::path>> logs;
-  for (size_t k = 0; k < run_sets.size(); ++k) {
-    std::vector<std::pair<std::string, fs::path>> in_set;
-    for (const auto& entry : fs::directory_iterator(run_sets[k])) {
-      const std::string scene = entry.path().filename().string();
-      const fs::path log = entry.path() / scene / (scene + ".lcmlog");
-      if (fs::exists(log)) in_set.emplace_back(std::to_string(k + 1) + ":" + scene, log);
-    }
-    std::sort(in_set.begin(), in_set.end());
-    logs.insert(logs.end(), in_set.begin(), in_set.end());
-  }
-  if (logs.empty()) throw std::runtime_error("no run logs under the RUNS_DIRs given");
+  const auto logs = nudge::experiments::run_logs(run_sets);
 
   // variant -> run -> score
   std::map<Variant, std::map<std::string, Score>> scores;
@@ -291,11 +286,17 @@ int main(int argc, char** argv) try {
     const auto states = read_channel<nudge::sim_state_t>(log, "SIM_STATE");
     if (states.empty()) throw std::runtime_error(log.string() + ": no SIM_STATE (a simulated run's log is needed)");
     std::string line = run + ":";
-    std::tuple<int, int, bool> rewritten_as{0, 0, false};
+    std::tuple<int, int, bool, std::string> rewritten_as{0, 0, false, ""};
+    std::map<std::string, ReplayedLines> replays;  // symmetry flags -> the lines they give on this run
     for (const Variant& variant : variants) {
       if (variant.rewritten() && variant.rewrite() != rewritten_as) {
+        if (!variant.symmetry.empty() && !replays.count(variant.symmetry)) {
+          nudge::experiments::replay_symmetry(log, variant.symmetry, replay);
+          replays[variant.symmetry] = replayed_lines(replay);
+        }
         write_with_survey_lines(log, rewritten, variant.lines, variant.published,
-                                variant.published_column_uncounted ? &column_place : nullptr);
+                                variant.published_column_uncounted ? &column_place : nullptr,
+                                variant.symmetry.empty() ? nullptr : &replays[variant.symmetry]);
         rewritten_as = variant.rewrite();
       }
       const fs::path& input = variant.rewritten() ? rewritten : log;
@@ -305,6 +306,7 @@ int main(int argc, char** argv) try {
                                   " --candidate-line-tilt " + std::to_string(variant.tilt) +
                                   (variant.column.empty() ? std::string() : " --candidate-column-lines " + variant.column) +
                                   (variant.explored_px > 0 ? " --candidate-explored-px " + std::to_string(variant.explored_px) : std::string()) +
+                                  (variant.triangulation.empty() ? std::string() : " " + variant.triangulation) +
                                   " >/dev/null 2>&1";
       if (std::system(command.c_str()) != 0) throw std::runtime_error("nudge-triangulation failed on " + log.string());
       Score& s = scores[variant][run];
@@ -331,20 +333,23 @@ int main(int argc, char** argv) try {
   for (size_t i = 0; i < run_sets.size(); ++i) md << (i ? ", " : "") << i + 1 << ": `" << run_sets[i] << "`";
   md << " (" << logs.size() << " runs). " << nudge::experiments::machine_description() << ", "
      << nudge::experiments::today() << ".\n\n"
-     << "| tilt (deg) | lines per image | lines published | column's lines | explored objects' lines within (px) | real candidates | phantoms | objects ever a candidate |\n|---|---|---|---|---|---|---|---|\n";
+     << "| symmetry replayed with | tilt (deg) | lines per image | lines published | column's lines | explored objects' lines within (px) | more triangulation flags | real candidates | phantoms | objects ever a candidate |\n|---|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& [variant, runs] : scores) {
     int real = 0, phantom = 0, found = 0, objects = 0;
     for (const auto& [run, s] : runs) real += s.real, phantom += s.phantom, found += static_cast<int>(s.objects_found.size()), objects += s.objects;
-    md << "| " << variant.tilt << " | " << (variant.lines ? std::to_string(variant.lines) : "as recorded") << " | "
+    md << "| " << (variant.symmetry.empty() ? std::string("(as recorded)") : "`" + variant.symmetry + "`") << " | "
+       << variant.tilt << " | " << (variant.lines ? std::to_string(variant.lines) : "as recorded") << " | "
        << (variant.published ? std::to_string(variant.published) + (variant.published_column_uncounted ? " + column" : "")
                              : "as recorded") << " | "
        << (variant.column.empty() ? "default" : variant.column) << " | "
-       << (variant.explored_px > 0 ? std::to_string(std::lround(variant.explored_px)) : std::string("default")) << " | " << real
+       << (variant.explored_px > 0 ? std::to_string(std::lround(variant.explored_px)) : std::string("default")) << " | "
+       << (variant.triangulation.empty() ? std::string("–") : "`" + variant.triangulation + "`") << " | " << real
        << " | " << phantom << " | " << found << "/" << objects << " |\n";
     json.begin_object().field("tilt_deg", variant.tilt).field("lines_per_image", variant.lines).field("lines_published", variant.published);
     json.field("published_column_uncounted", variant.published_column_uncounted);
     json.field("column_lines", variant.column.empty() ? std::string("default") : variant.column);
-    json.field("explored_line_px", variant.explored_px);
+    json.field("explored_line_px", variant.explored_px).field("symmetry_flags", variant.symmetry);
+    json.field("triangulation_flags", variant.triangulation);
     json.field("real", real).field("phantoms", phantom);
     json.field("objects_found", found).field("objects", objects).end_object();
   }

@@ -64,6 +64,7 @@ struct Options {
     double inner_radius = 0.0;
     int keep = 0;
     double column_px = 0;
+    double max_tilt_deg = 0;  // > 0: drop lines that cannot be an upright axis's image before the keep
   };
   std::optional<Reach> reach;
 };

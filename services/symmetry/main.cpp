@@ -93,6 +93,9 @@ int main(int argc, char** argv) {
     f.add_double("reach-column-px", &reach.column_px,
                  "with --reach-keep: a line within this many pixels of the image of the arm's base column (the "
                  "upright axis at arm_base) is published without counting among the kept (0: it counts)");
+    f.add_double("reach-max-tilt", &reach.max_tilt_deg,
+                 "with --reach-calibration: drop lines whose plane leans more than this many degrees from the table's "
+                 "normal (none can be an upright object's axis) before --reach-keep; 0: keep them");
     f.add_bool("colour-edges", &edge.colour, "Canny on the colour image (the channel that changes most)");
     f.add_int("contours", &options.contours, "also segment the contours of the top N lines (CONTOURS_*); 0: off");
     if (!service.parse(argc, argv)) return 0;
@@ -176,6 +179,8 @@ int main(int argc, char** argv) {
           throw std::invalid_argument("--reach-inner-radius must be >= 0 and below --reach-radius");
         if (reach.keep < 0) throw std::invalid_argument("--reach-keep must be >= 0");
         if (!(reach.column_px >= 0)) throw std::invalid_argument("--reach-column-px must be >= 0");
+        if (!(reach.max_tilt_deg >= 0 && reach.max_tilt_deg <= 90))
+          throw std::invalid_argument("--reach-max-tilt must be in [0, 90]");
         reach.rig = geometry::load_rig(reach_calibration);
         const geometry::Workspace scene = geometry::load_workspace(reach_calibration);
         if (!scene.table || !scene.arm_base) throw std::invalid_argument(reach_calibration + " needs table_plane and arm_base");
