@@ -4,10 +4,11 @@
 # of the development set (experiments/scenes/nudge_segmentation/), then nudge-exp-nudge-segmentation
 # scores the runs into docs/results/nudge_segmentation.{json,md}. Runs land in OUT/<set>/<scene>/
 # (--out, default out/experiments/nudge_segmentation). About a minute per single-object scene.
-#   experiments/nudge_segmentation.sh [--out DIR] [--set heldout|heldout2|development|both] [SCENE_NAME...]
+#   experiments/nudge_segmentation.sh [--out DIR] [--set heldout|heldout2|development|development2|both] [SCENE_NAME...]
 # Scene names run only those scenes of the one set chosen with --set (and score that set alone).
 # --set heldout2 runs the second held-out set (seeds 620001-620015, fixed 2026-11-25) and writes
-# docs/results/nudge_segmentation_heldout2.{json,md}.
+# docs/results/nudge_segmentation_heldout2.{json,md}. --set development2 runs the second development
+# set (seeds 630001-630015, fixed 2026-11-30; tuned on) into nudge_segmentation_development2.{json,md}.
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/../scripts/lib.sh"
 out_dir="$NUDGE_ROOT/out/experiments/nudge_segmentation"
@@ -17,21 +18,22 @@ while [ $# -gt 0 ]; do
   case "$1" in
     --out) out_dir="$(realpath -m "$2")"; shift 2 ;;
     --set) which_set="$2"; shift 2 ;;
-    -*) echo "unknown option $1 (--out DIR, --set heldout|heldout2|development|both)" >&2; exit 2 ;;
+    -*) echo "unknown option $1 (--out DIR, --set heldout|heldout2|development|development2|both)" >&2; exit 2 ;;
     *) names+=("$1"); shift ;;
   esac
 done
 case "$which_set" in
-  heldout|heldout2|development) ;;
+  heldout|heldout2|development|development2) ;;
   both) [ ${#names[@]} -eq 0 ] || { echo "scene names need --set heldout or --set development" >&2; exit 2; } ;;
-  *) echo "--set: heldout, heldout2, development or both, not '$which_set'" >&2; exit 2 ;;
+  *) echo "--set: heldout, heldout2, development, development2 or both, not '$which_set'" >&2; exit 2 ;;
 esac
 nudge_install_packages
 nudge_build
 calibration="$NUDGE_ROOT/config/calibration_sim.yaml"
 declare -A scene_dirs=([heldout]="$NUDGE_ROOT/experiments/scenes/nudge_segmentation_heldout"
                        [heldout2]="$NUDGE_ROOT/experiments/scenes/nudge_segmentation_heldout2"
-                       [development]="$NUDGE_ROOT/experiments/scenes/nudge_segmentation")
+                       [development]="$NUDGE_ROOT/experiments/scenes/nudge_segmentation"
+                       [development2]="$NUDGE_ROOT/experiments/scenes/nudge_segmentation_dev2")
 nudge_export_loop
 
 # run_set SET [SCENE_NAME...]: every scene of the set (or the ones named) into OUT/SET/.
@@ -68,5 +70,6 @@ else
   run_set "$which_set" "${names[@]}"
   result_name=nudge_segmentation
   [ "$which_set" = heldout2 ] && result_name=nudge_segmentation_heldout2
+  [ "$which_set" = development2 ] && result_name=nudge_segmentation_development2
   "${score[@]}" "$out_dir/$which_set" "${scene_dirs[$which_set]}" "${names[@]}" --name "$result_name"
 fi

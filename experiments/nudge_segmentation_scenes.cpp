@@ -8,6 +8,10 @@
 // (the first set's failures had been looked into by then, so it no longer tests what changed for
 // them):
 //   nudge-exp-nudge-segmentation-scenes --first-seed 620001 --out experiments/scenes/nudge_segmentation_heldout2
+// A second development set of the same plans, seeds 630001-630015 fixed 2026-11-30 (tuned on, like
+// experiments/scenes/nudge_segmentation/: the first development set holds only three multi-object
+// scenes, too few to choose the survey's settings on):
+//   nudge-exp-nudge-segmentation-scenes --first-seed 630001 --out experiments/scenes/nudge_segmentation_dev2
 // The objects are the learning experiment's (labelled bottles, cups, mugs: learning_scenes.hpp);
 // the files are written by the simulator's own scene writer (sim::scene_yaml).
 #include <Eigen/Core>
@@ -34,6 +38,23 @@ namespace sim = nudge::sim;
 namespace {
 
 constexpr uint64_t kFirstSeed = 610001;  // scene i (1-based) uses kFirstSeed + i - 1; fixed 2026-11-24
+constexpr uint64_t kSecondHeldOutSeed = 620001;  // fixed 2026-11-25
+constexpr uint64_t kSecondDevelopmentSeed = 630001;  // fixed 2026-11-30
+
+// The first line of a written scene's comment: which set it belongs to, and the rule it is kept by.
+std::string scene_comment(uint64_t first_seed, uint64_t seed) {
+  const std::string from = "(seed " + std::to_string(seed);
+  if (first_seed == kFirstSeed)
+    return "Held-out scene of nudge-exp-nudge-segmentation, written by nudge-exp-nudge-segmentation-scenes\n" + from +
+           ", fixed 2026-11-24 before any tuning; never re-staged).";
+  if (first_seed == kSecondDevelopmentSeed)
+    return "Development scene of nudge-exp-nudge-segmentation (the second development set), written by\n"
+           "nudge-exp-nudge-segmentation-scenes " + from + "; seeds 630001-630015 fixed 2026-11-30; tuned on).";
+  if (first_seed == kSecondHeldOutSeed)
+    return "Held-out scene of nudge-exp-nudge-segmentation, written by nudge-exp-nudge-segmentation-scenes\n" + from +
+           "; seeds 620001-620015 fixed 2026-11-25 before any run on them; never re-staged).";
+  return "Scene of nudge-exp-nudge-segmentation, written by nudge-exp-nudge-segmentation-scenes\n" + from + ").";
+}
 
 class Draw {
  public:
@@ -185,7 +206,8 @@ int main(int argc, char** argv) {
   nudge::Flags flags("nudge-exp-nudge-segmentation-scenes",
                      "Write the held-out scenes of the autonomous segmentation experiment (seeds fixed in advance).");
   flags.add_string("out", &out, "output directory (created)");
-  flags.add_int("first-seed", &first_seed, "scene i (1-based) is drawn from this seed + i - 1 (610001: the first held-out set; 620001: the second)");
+  flags.add_int("first-seed", &first_seed, "scene i (1-based) is drawn from this seed + i - 1 (610001: the first held-out set; 620001: the second; "
+                 "630001: the second development set)");
   try {
     if (!flags.parse(argc, argv)) return 0;
     if (out.empty()) throw nudge::FlagError("--out DIR is required");
@@ -203,12 +225,7 @@ int main(int argc, char** argv) {
       const uint64_t seed = static_cast<uint64_t>(first_seed) + i;
       const sim::Scene scene = make_scene(plan, seed);
       const std::string file = out + "/" + plan.name + ".yaml";
-      const std::string text = sim::scene_yaml(
-          scene, "Held-out scene of nudge-exp-nudge-segmentation, written by nudge-exp-nudge-segmentation-scenes\n"
-                 "(seed " + std::to_string(seed) +
-                 (first_seed == static_cast<int>(kFirstSeed) ? ", fixed 2026-11-24 before any tuning; never re-staged)."
-                                                             : "; seeds 620001-620015 fixed 2026-11-25 before any run on them; never re-staged)."),
-          "");
+      const std::string text = sim::scene_yaml(scene, scene_comment(static_cast<uint64_t>(first_seed), seed), "");
       {
         std::ofstream f(file + ".tmp");
         f << text;
