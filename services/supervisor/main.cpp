@@ -576,6 +576,9 @@ void add_flags(Flags& f, Options& o) {
   f.add_int("max-attempts", &o.config.max_attempts, "nudges per run");
   f.add_int("segmentation-retries", &o.config.segmentation_retries,
             "a push that moved something but gave no segmentation: nudge the object again from its rest, this many times");
+  f.add_double("retry-still-line-px", &o.config.retry_still_line_px,
+               "but not when the segmentation is empty and the target's line stands within this many px (1280x960) "
+               "and 1 deg of where it stood: nothing there moved (0: retried all the same)");
   f.add_double("settle", &o.config.settle_s, "after the nudge, wait this long for the object to rest, s");
   f.add_double("max-settle", &o.config.max_settle_s,
                "with too few settled axes near the push line, settle on up to this long after the nudge, s");

@@ -1808,6 +1808,47 @@ TEST_F(SupervisorTest, AnObjectWhoseSegmentationFailedIsNudgedAgainFromItsRestOn
   EXPECT_THROW(sv::Supervisor(bad, scene_, sv::ArmSetup{}, failing), std::invalid_argument);
 }
 
+// An empty segmentation where the target's line stood still in the stills (Config::
+// retry_still_line_px): something moved during the push, but not what stands at the target, so the
+// place is not pushed again; with the check off it is (second development set's hm3: a phantom
+// pushed twice).
+TEST_F(SupervisorTest, AnEmptySegmentationWhoseLineStoodStillIsNotNudgedAgain) {
+  auto failing = [](const cv::Mat&, const cv::Mat&, const auto&, const auto&) {
+    sv::Segmentation nothing;
+    nothing.error = "segmentation empty";
+    return nothing;
+  };
+  for (const double still_px : {2.0, 0.0}) {
+    SCOPED_TRACE("retry_still_line_px " + std::to_string(still_px));
+    sv::Config config;
+    config.retry_still_line_px = still_px;
+    sv::Supervisor s(config, scene_, sv::ArmSetup{}, failing);
+    const Eigen::Vector3d object(0.28, -0.05, 0);
+    const sv::NudgeCommand nudge = nudge_command_for(s, object);
+    play_nudge(s, nudge.seq, object, object + 0.03 * nudge.direction);  // motion seen while the arm pushed
+    settle_with_axes(s, {object + 0.005 * nudge.direction});  // yet it settles 5 mm on, and the still
+                                                             // shows its line where it stood
+    park(s);
+    s.on_right_still(draw_scene(scene_, {1280, 960}, {object}), now_, now_);
+    const auto ended = outputs_of<sv::AttemptEnded>(s.take_outputs());
+    ASSERT_EQ(ended.at(0).attempt->outcome, sv::Outcome::SegmentationFailed) << ended.at(0).attempt->reason;
+    const std::string& reason = ended.at(0).attempt->reason;
+    answer_survey(s, {object});
+    if (still_px > 0) {
+      EXPECT_NE(reason.find("its line stood still"), std::string::npos) << reason;
+      EXPECT_EQ(reason.find("will be nudged again"), std::string::npos) << reason;
+      EXPECT_EQ(s.state(), sv::State::Done) << s.report().reason;
+      EXPECT_EQ(s.summary().rejections.count("already explored"), 1u);
+    } else {
+      EXPECT_NE(reason.find("its rest will be nudged again"), std::string::npos) << reason;
+      EXPECT_EQ(s.state(), sv::State::SnapshotBefore) << s.report().reason;
+    }
+  }
+  sv::Config bad;
+  bad.retry_still_line_px = -1;
+  EXPECT_THROW(sv::Supervisor(bad, scene_, sv::ArmSetup{}, failing), std::invalid_argument);
+}
+
 // A striped object's other lines pair into candidates off its axis at other depths: one whose line
 // in the right camera runs through the segmented object's mask is that object (development s06:
 // the striped bottle nudged twice), one beside it is not.

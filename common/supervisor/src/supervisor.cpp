@@ -91,6 +91,7 @@ Supervisor::Supervisor(Config config, SceneGeometry scene, ArmSetup arm, Segment
   if (!(config_.settle_s >= 0 && config_.max_settle_s >= config_.settle_s))
     throw std::invalid_argument("supervisor: settle_s must be >= 0 and max_settle_s >= settle_s");
   if (config_.segmentation_retries < 0) throw std::invalid_argument("supervisor: segmentation_retries must be >= 0");
+  if (!(config_.retry_still_line_px >= 0)) throw std::invalid_argument("supervisor: retry_still_line_px must be >= 0");
   validate(config_.height);
   joints_ = arm_.home();
 }
@@ -912,6 +913,10 @@ void Supervisor::end_attempt(Outcome outcome, const std::string& reason, int64_t
 // at both places, so a rest estimated in the wrong place cannot restart the count.
 bool Supervisor::retry_from_rest(Attempt& a) {
   if (a.outcome != Outcome::SegmentationFailed || !a.rest) return false;
+  if (target_line_stood_still(a)) {
+    a.reason += "; its line stood still in the stills: not nudged again";
+    return false;
+  }
   int failures = 1;
   for (const auto& [place, count] : retries_)
     if ((place - a.target.position).head<2>().norm() < config_.targets.same_object_radius)
@@ -921,6 +926,13 @@ bool Supervisor::retry_from_rest(Attempt& a) {
   retries_.emplace_back(*a.rest, failures);
   a.reason += "; its rest will be nudged again";
   return true;
+}
+
+// An empty segmentation whose before and after lines are one line (Config::retry_still_line_px).
+bool Supervisor::target_line_stood_still(const Attempt& a) const {
+  if (config_.retry_still_line_px <= 0 || !a.before_line || !a.after_line) return false;
+  const bool empty = a.segmentation.mask.empty() || cv::countNonZero(a.segmentation.mask) < config_.min_mask_pixels;
+  return empty && lines_agree(*a.after_line, *a.before_line, M_PI / 180, config_.retry_still_line_px);
 }
 
 int64_t Supervisor::awaited_arm_seq() const {

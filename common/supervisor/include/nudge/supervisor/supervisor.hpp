@@ -187,6 +187,12 @@ struct Config {
   // this many times for one object (a nudge from the new place is a new view of it; held-out h11:
   // a clear bottle's first push gave a lopsided mask, and its new place then counted as explored).
   int segmentation_retries = 1;
+  // Not when the segmentation came out empty and the target's own line stands in the after still
+  // within this many pixels (1280x960) and 1 deg of where it stood before: nothing standing there
+  // moved, so the same push from the same place would move nothing again (second development set's
+  // hm3: a phantom 6 cm behind every object pushed twice, its line 0.2 px apart; the motion seen
+  // was an unfound bottle the arm knocked over). 0: retried all the same.
+  double retry_still_line_px = 2;
   double min_object_radius_m = 0.025, min_object_height_m = 0.06;
   // Rows watched for motion: from the table to this height. The object's foot moves when it is
   // pushed; the arm's links, higher up, may pass beyond the line in the image, the pad never does.
@@ -514,6 +520,7 @@ class Supervisor {
   std::vector<Eigen::Vector3d> places_seen_by_right_lines() const;
   History history() const;
   bool retry_from_rest(Attempt& attempt);
+  bool target_line_stood_still(const Attempt& attempt) const;
   // How tall the explored object of `attempt` stands, with HeightParams::margin_m (0: not measured).
   double explored_object_height(const Attempt& attempt) const;
   // The smallest object expected standing at a foot, as the right still shows it (px; 0 x 0 when
