@@ -5,7 +5,7 @@
 //   * as the run published them (SYMMETRY_LEFT/RIGHT, recorded), and
 //   * as nudge-symmetry finds them on the same recorded camera frames when it cuts nothing after its
 //     peaks (the run's own flags from its launch.json, then --reach-keep 0 --min-peak-ratio 0, or
-//     --deep-flags): the peaks the reach filter keeps, with their votes.
+//     --deep-flags; "none": no deep replay): the peaks the reach filter keeps, with their votes.
 // Each such miss is put in the first class that holds (a camera "has" the line in at least a third
 // of the survey's frames):
 //   paired-but-dropped  published in both cameras: the survey's pairing or clustering lost it
