@@ -219,10 +219,10 @@ nudge_run_loop() {
       # The arm's base column's lines are paired but do not take one of a survey's lines per
       # image (--candidate-column-lines uncounted; docs/supervisor.md, "The column's line").
       triangulation_flags=', "--candidate-line-tilt", "2", "--candidate-column-lines", "uncounted"'
-      # NUDGE_LOOP_CLUSTER_MIN_FRACTION=F: a survey's place needs F of its intersects (the service's
-      # default, the thesis' 1/9, unless set; docs/supervisor.md, "Weaker clusters").
-      [ -n "${NUDGE_LOOP_CLUSTER_MIN_FRACTION:-}" ] &&
-        triangulation_flags+=', "--cluster-min-fraction", "'"$NUDGE_LOOP_CLUSTER_MIN_FRACTION"'"'
+      # A survey's place needs 0.05 of its intersects, not the thesis' 1/9: chosen on the development
+      # runs' replays (docs/supervisor.md, "Weaker clusters": 26 of 34 objects a candidate against
+      # 24, none lost). NUDGE_LOOP_CLUSTER_MIN_FRACTION=F sets another.
+      triangulation_flags+=', "--cluster-min-fraction", "'"${NUDGE_LOOP_CLUSTER_MIN_FRACTION:-0.05}"'"'
       if [ "${NUDGE_LOOP_REACH:-1}" = 1 ]; then
         symmetry_flags='"--lines", "20", "--reach-calibration", "'"$calibration"'", "--reach-inner-radius", "0.10", "--reach-keep", "5",
                         "--reach-column-px", "8"'
