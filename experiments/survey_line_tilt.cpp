@@ -225,9 +225,9 @@ int main(int argc, char** argv) try {
       for (double n : parse_list(argv[++i], arg)) published.push_back(static_cast<int>(n));
     else if (arg == "--published-column-uncounted") published_column_uncounted = true;
     else if (arg == "--symmetry" && has_value) {
+      symmetry_flags.clear();  // the list given replaces the default (the recorded lines alone)
       std::stringstream in(argv[++i]);
       for (std::string flags; std::getline(in, flags, ';');) symmetry_flags.push_back(flags == "recorded" ? "" : flags);
-      symmetry_flags.erase(symmetry_flags.begin());  // the default "" is replaced by the list given
     } else if (arg == "--triangulation" && has_value) {
       triangulation_flags.clear();
       std::stringstream in(argv[++i]);
