@@ -63,6 +63,17 @@ struct InProcess {
   Latest<nudge::contours_t> contours;
 };
 
+// What a fresh service publishes on SYMMETRY_RIGHT for one right-camera image (no error counted).
+nudge::symmetry_lines_t right_lines_of(const nudge::symmetry_service::Options& options, const cv::Mat& img) {
+  InProcess run(options);
+  Latest<nudge::symmetry_lines_t> right(run.probe, "SYMMETRY_RIGHT");
+  nudge::image_t image = nudge::bus::to_message(img, nudge::image_t::FORMAT_GRAY8, 1, 1, "right");
+  run.bus.publish("CAMERA_RIGHT", &image);
+  run.service.handle_pending();
+  EXPECT_EQ(run.service.counters().errors, 0);
+  return right.get();
+}
+
 // Lines within reach for a level 320x240 camera (f 300 px) 0.3 m above the table, one line kept,
 // the reach 5 m around the place each test sets.
 nudge::symmetry_service::Options::Reach level_reach() {
@@ -351,14 +362,8 @@ TEST(SymmetryHandlers, TheArmBaseColumnsLineDoesNotTakeAPlaceAmongTheLinesKept) 
     reach.column_px = column_px;
     reach.centre = column;
     options.reach = reach;
-    InProcess run(options);
-    Latest<nudge::symmetry_lines_t> right(run.probe, "SYMMETRY_RIGHT");
-    nudge::image_t image = nudge::bus::to_message(img, nudge::image_t::FORMAT_GRAY8, 1, 1, "right");
-    run.bus.publish("CAMERA_RIGHT", &image);
-    run.service.handle_pending();
-    EXPECT_EQ(run.service.counters().errors, 0);
     std::vector<double> r;
-    for (const auto& line : right.get().lines) r.push_back(line.r);
+    for (const auto& line : right_lines_of(options, img).lines) r.push_back(line.r);
     return r;
   };
   const std::vector<double> counted = published(0, column_at(60));
@@ -388,13 +393,7 @@ TEST(SymmetryHandlers, LeaningLinesDoNotTakeThePlacesOfUprightOnes) {
   auto published = [&](double max_tilt_deg) {
     reach.max_tilt_deg = max_tilt_deg;
     options.reach = reach;
-    InProcess run(options);
-    Latest<nudge::symmetry_lines_t> right(run.probe, "SYMMETRY_RIGHT");
-    nudge::image_t image = nudge::bus::to_message(img, nudge::image_t::FORMAT_GRAY8, 1, 1, "right");
-    run.bus.publish("CAMERA_RIGHT", &image);
-    run.service.handle_pending();
-    EXPECT_EQ(run.service.counters().errors, 0);
-    return right.get();
+    return right_lines_of(options, img);
   };
   const nudge::symmetry_lines_t unchecked = published(0);
   ASSERT_EQ(unchecked.num_lines, 1);
