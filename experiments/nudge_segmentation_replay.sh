@@ -2,7 +2,7 @@
 # Replays recorded runs of experiments/nudge_segmentation.sh through today's supervisor and scores the
 # replayed segmentations: a change to the supervisor's decisions (line search, segmentation, checks)
 # measured on the very messages and stills a set's runs recorded, everything else held fixed.
-#   experiments/nudge_segmentation_replay.sh --runs DIR --set heldout|heldout2|development --out DIR [-- SUPERVISOR_FLAGS...]
+#   experiments/nudge_segmentation_replay.sh --runs DIR --set heldout|heldout2|development|development2 --out DIR [-- SUPERVISOR_FLAGS...]
 # --runs: a set's folder of a recorded experiment (OUT/<set> of nudge_segmentation.sh); every run in it
 # with a finished log is fed to nudge-supervisor (--lcm-in file://RUN.lcmlog?speed=0, the run's own
 # first ARM_COMMAND seq, the survey flags of NUDGE_LOOP_TABLE) with SUPERVISOR_FLAGS added. The
@@ -24,14 +24,15 @@ while [ $# -gt 0 ]; do
     --set) which_set="$2"; shift 2 ;;
     --out) out_dir="$(realpath -m "$2")"; shift 2 ;;
     --) shift; flags=("$@"); break ;;
-    *) echo "unknown option $1 (--runs DIR --set heldout|heldout2|development --out DIR [-- FLAGS])" >&2; exit 2 ;;
+    *) echo "unknown option $1 (--runs DIR --set heldout|heldout2|development|development2 --out DIR [-- FLAGS])" >&2; exit 2 ;;
   esac
 done
 declare -A scene_dirs=([heldout]="$NUDGE_ROOT/experiments/scenes/nudge_segmentation_heldout"
                        [heldout2]="$NUDGE_ROOT/experiments/scenes/nudge_segmentation_heldout2"
-                       [development]="$NUDGE_ROOT/experiments/scenes/nudge_segmentation")
+                       [development]="$NUDGE_ROOT/experiments/scenes/nudge_segmentation"
+                       [development2]="$NUDGE_ROOT/experiments/scenes/nudge_segmentation_dev2")
 [ -n "$runs_dir" ] && [ -d "$runs_dir" ] || { echo "--runs: no such folder '$runs_dir'" >&2; exit 2; }
-[ -n "${scene_dirs[$which_set]:-}" ] || { echo "--set: heldout, heldout2 or development, not '$which_set'" >&2; exit 2; }
+[ -n "${scene_dirs[$which_set]:-}" ] || { echo "--set: heldout, heldout2, development or development2, not '$which_set'" >&2; exit 2; }
 [ -n "$out_dir" ] || { echo "--out is required" >&2; exit 2; }
 [ "$out_dir" != "$runs_dir" ] && [ "$out_dir/$which_set" != "$runs_dir" ] || { echo "--out must not be the recorded runs' folder" >&2; exit 2; }
 nudge_install_packages

@@ -51,6 +51,13 @@ sv::SceneGeometry make_scene() {
   return sv::SceneGeometry(rig, table, arm_to_right.t, arm_to_right);
 }
 
+// A segmenter that never finds the object (a push that moved nothing it could cut out).
+sv::Segmentation segment_nothing(const cv::Mat&, const cv::Mat&, const nudge::symmetry::Line&, const nudge::symmetry::Line&) {
+  sv::Segmentation nothing;
+  nothing.error = "segmentation empty";
+  return nothing;
+}
+
 // A grey box 7 cm wide and 12 cm tall standing at `foot` (world), drawn into a textured background.
 // `shapes`: each object's height and half width, when given (0.12 and 0.035 m otherwise).
 struct Shape {
@@ -798,6 +805,14 @@ TEST_F(SupervisorTest, SegmentsTheObjectThenFindsNothingLeftToNudge) {
   // high (its top face seen from above) and carries the 2 cm margin.
   EXPECT_GT(a.standing_height, 0.115 + sv::HeightParams{}.margin_m);
   EXPECT_LT(a.standing_height, 0.20);
+  // The readings it came from are kept: the box's edges in the after still and the mask's top;
+  // the height the arm is told is the higher plus the margin.
+  ASSERT_TRUE(a.height_from_edges && a.height_from_mask);
+  for (const double reading : {*a.height_from_edges, *a.height_from_mask}) {
+    EXPECT_GT(reading, 0.115);
+    EXPECT_LT(reading, 0.18);
+  }
+  EXPECT_NEAR(a.standing_height, std::max(*a.height_from_edges, *a.height_from_mask) + sv::HeightParams{}.margin_m, 1e-9);
   // The next survey leaves the segmented object's lines out, where it now stands.
   const auto surveys = outputs_of<sv::CandidatesRequest>(out);
   ASSERT_EQ(surveys.size(), 1u);
@@ -1742,11 +1757,7 @@ TEST_F(SupervisorTest, ACandidateOnTheRestedObjectsLineInACameraIsThatObjectNotN
 // a phantom's push barely moved a neighbour, and leaving out the phantom's lines - the cup's and
 // the bottle's - left the cup no candidate again).
 TEST_F(SupervisorTest, AFailedSegmentationsRestIsNoObjectToLeaveOut) {
-  sv::Supervisor s(sv::Config{}, scene_, sv::ArmSetup{}, [](const cv::Mat&, const cv::Mat&, const auto&, const auto&) {
-    sv::Segmentation nothing;
-    nothing.error = "segmentation empty";
-    return nothing;
-  });
+  sv::Supervisor s(sv::Config{}, scene_, sv::ArmSetup{}, segment_nothing);
   const Eigen::Vector3d object(0.28, -0.05, 0);
   const Eigen::Vector3d rest = nudge_and_park(s, object);
   s.on_right_still(draw_scene(scene_, {1280, 960}, {rest}), now_, now_);
@@ -1764,16 +1775,11 @@ TEST_F(SupervisorTest, AFailedSegmentationsRestIsNoObjectToLeaveOut) {
 // (Config::segmentation_retries): a second failure there leaves the new rest explored. With no
 // retries the first rest is explored at once (held-out h11: a clear bottle's lopsided first mask).
 TEST_F(SupervisorTest, AnObjectWhoseSegmentationFailedIsNudgedAgainFromItsRestOnce) {
-  auto failing = [](const cv::Mat&, const cv::Mat&, const auto&, const auto&) {
-    sv::Segmentation nothing;
-    nothing.error = "segmentation empty";
-    return nothing;
-  };
   for (const int retries : {1, 0}) {
     SCOPED_TRACE("segmentation_retries " + std::to_string(retries));
     sv::Config config;
     config.segmentation_retries = retries;
-    sv::Supervisor s(config, scene_, sv::ArmSetup{}, failing);
+    sv::Supervisor s(config, scene_, sv::ArmSetup{}, segment_nothing);
     const Eigen::Vector3d object(0.28, -0.05, 0);
     const Eigen::Vector3d rest = nudge_and_park(s, object);
     s.on_right_still(draw_scene(scene_, {1280, 960}, {rest}), now_, now_);
@@ -1805,7 +1811,7 @@ TEST_F(SupervisorTest, AnObjectWhoseSegmentationFailedIsNudgedAgainFromItsRestOn
   }
   sv::Config bad;
   bad.segmentation_retries = -1;
-  EXPECT_THROW(sv::Supervisor(bad, scene_, sv::ArmSetup{}, failing), std::invalid_argument);
+  EXPECT_THROW(sv::Supervisor(bad, scene_, sv::ArmSetup{}, segment_nothing), std::invalid_argument);
 }
 
 // An empty segmentation where the target's line stood still in the stills (Config::
@@ -1813,16 +1819,11 @@ TEST_F(SupervisorTest, AnObjectWhoseSegmentationFailedIsNudgedAgainFromItsRestOn
 // place is not pushed again; with the check off it is (second development set's hm3: a phantom
 // pushed twice).
 TEST_F(SupervisorTest, AnEmptySegmentationWhoseLineStoodStillIsNotNudgedAgain) {
-  auto failing = [](const cv::Mat&, const cv::Mat&, const auto&, const auto&) {
-    sv::Segmentation nothing;
-    nothing.error = "segmentation empty";
-    return nothing;
-  };
   for (const double still_px : {2.0, 0.0}) {
     SCOPED_TRACE("retry_still_line_px " + std::to_string(still_px));
     sv::Config config;
     config.retry_still_line_px = still_px;
-    sv::Supervisor s(config, scene_, sv::ArmSetup{}, failing);
+    sv::Supervisor s(config, scene_, sv::ArmSetup{}, segment_nothing);
     const Eigen::Vector3d object(0.28, -0.05, 0);
     const sv::NudgeCommand nudge = nudge_command_for(s, object);
     play_nudge(s, nudge.seq, object, object + 0.03 * nudge.direction);  // motion seen while the arm pushed
@@ -1846,7 +1847,7 @@ TEST_F(SupervisorTest, AnEmptySegmentationWhoseLineStoodStillIsNotNudgedAgain) {
   }
   sv::Config bad;
   bad.retry_still_line_px = -1;
-  EXPECT_THROW(sv::Supervisor(bad, scene_, sv::ArmSetup{}, failing), std::invalid_argument);
+  EXPECT_THROW(sv::Supervisor(bad, scene_, sv::ArmSetup{}, segment_nothing), std::invalid_argument);
 }
 
 // A striped object's other lines pair into candidates off its axis at other depths: one whose line

@@ -1210,19 +1210,21 @@ void Supervisor::on_lines(bool left, const std::vector<symmetry::Line>& lines, i
 // m for a cup and a bottle before a cluttered wall, development m02), so it may lower the tallest
 // expected but not raise it; and the top of its mask, which may (a mask cut short errs low, and is
 // never trusted alone). 0 when the edge pairs give no height: the tallest expected is assumed.
-double Supervisor::explored_object_height(const Attempt& a) const {
+double Supervisor::explored_object_height(Attempt& a) const {
   const bool moved = a.outcome == Outcome::Segmented && a.rest;
   const cv::Mat& still = moved ? a.after : a.before;
   const std::optional<symmetry::Line>& line = moved ? a.after_line : a.before_line;
   const Eigen::Vector3d foot = moved ? *a.rest : a.target.position;
   std::optional<double> edges = moved ? std::nullopt : a.measured_height;
   if (!edges && line && !still.empty()) edges = measure_object_height(scene_, still, *line, foot, config_.height);
-  if (!edges || !std::isfinite(*edges) || *edges <= 0) return 0;
-  const double margin = config_.height.margin_m, tallest = config_.targets.obstacle_height;
-  double height = tallest > 0 ? std::min(*edges + margin, tallest) : *edges + margin;
+  if (edges && std::isfinite(*edges) && *edges > 0) a.height_from_edges = edges;
   if (moved && a.top[1])
-    if (const auto top = ray_height_over(scene_, foot, *a.top[1], still.size()); top && std::isfinite(*top))
-      height = std::max(height, *top + margin);
+    if (const auto top = ray_height_over(scene_, foot, *a.top[1], still.size()); top && std::isfinite(*top) && *top > 0)
+      a.height_from_mask = top;
+  if (!a.height_from_edges) return 0;
+  const double margin = config_.height.margin_m, tallest = config_.targets.obstacle_height;
+  double height = tallest > 0 ? std::min(*a.height_from_edges + margin, tallest) : *a.height_from_edges + margin;
+  if (a.height_from_mask) height = std::max(height, *a.height_from_mask + margin);
   return height;
 }
 

@@ -325,6 +325,11 @@ struct Attempt {
   // The object left standing (segmented, known, refused): how tall it was measured, margin
   // included; later pushes' links keep clear of that (0: not measured, the tallest expected).
   double standing_height = 0;
+  // The readings it was taken from, without the margin: the edge pairs about the line in the
+  // still (measure_object_height; a moved object's after still) and the segmentation's top
+  // (ray_height_over the rest). Neither alone is safe (docs/supervisor.md, "How tall explored
+  // objects stand"): the edges read high in clutter, the mask reads low when its top is cut.
+  std::optional<double> height_from_edges, height_from_mask;
   std::vector<Candidate> candidates;       // the survey it was chosen from
   std::vector<Rejection> rejected;         // candidates passed over for it
   // Config::rival_by_foot: how far the target stands beyond its before line's foot (depth_beyond_line_foot),
@@ -521,8 +526,9 @@ class Supervisor {
   History history() const;
   bool retry_from_rest(Attempt& attempt);
   bool target_line_stood_still(const Attempt& attempt) const;
-  // How tall the explored object of `attempt` stands, with HeightParams::margin_m (0: not measured).
-  double explored_object_height(const Attempt& attempt) const;
+  // How tall the explored object of `attempt` stands, with HeightParams::margin_m (0: not
+  // measured); the readings it came from are kept in `attempt`.
+  double explored_object_height(Attempt& attempt) const;
   // The smallest object expected standing at a foot, as the right still shows it (px; 0 x 0 when
   // it cannot be projected).
   cv::Size2d smallest_object_image(const Eigen::Vector3d& foot) const;
