@@ -23,6 +23,7 @@
 // scores the lines each tilt keeps, not a new run. Choose on development runs only.
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -63,6 +64,9 @@ struct Score {
   int surveys = 0, real = 0, phantom = 0;
   std::set<std::string> objects_found;  // objects some survey's candidate stood on
   int objects = 0;
+  // Surveys with a real candidate, and of them those whose first candidate is real when the
+  // candidates go nearest the right camera first (the thesis' order) or most intersects first.
+  int surveys_with_real = 0, first_real_nearest = 0, first_real_strongest = 0;
 };
 
 // One replayed setting: the survey-line tilt, the lines per image the surveys pair (0: as the log's
@@ -179,10 +183,17 @@ void write_with_survey_lines(const fs::path& from, const fs::path& to, int lines
 
 void score_surveys(const std::vector<nudge::candidates_t>& surveys, const std::vector<nudge::sim_state_t>& states,
                    const SceneGeometry& scene, double real_radius, Score* score) {
+  const Eigen::Vector3d camera = scene.right_camera_in_world();
   for (const auto& survey : surveys) {
     const nudge::sim_state_t* state = state_at(states, survey.utime);
     if (!state) continue;
     ++score->surveys;
+    struct Scored {
+      bool real;
+      double from_camera;
+      int intersects;
+    };
+    std::vector<Scored> scored;
     for (int i = 0; i < survey.num_candidates; ++i) {
       const Eigen::Vector3d p = scene.table_to_world({survey.position[i][0], survey.position[i][1], survey.position[i][2]});
       double nearest = real_radius;
@@ -191,6 +202,7 @@ void score_surveys(const std::vector<nudge::candidates_t>& surveys, const std::v
         const double d = std::hypot(o.pose.position[0] - p.x(), o.pose.position[1] - p.y());
         if (d <= nearest) nearest = d, object = o.name;
       }
+      scored.push_back({!object.empty(), (p - camera).head<2>().norm(), survey.cluster_size[i]});
       if (object.empty()) {
         ++score->phantom;
       } else {
@@ -198,6 +210,14 @@ void score_surveys(const std::vector<nudge::candidates_t>& surveys, const std::v
         score->objects_found.insert(object);
       }
     }
+    if (std::none_of(scored.begin(), scored.end(), [](const Scored& c) { return c.real; })) continue;
+    ++score->surveys_with_real;
+    auto nearer = [](const Scored& a, const Scored& b) { return a.from_camera < b.from_camera; };
+    auto stronger = [&](const Scored& a, const Scored& b) {
+      return a.intersects != b.intersects ? a.intersects > b.intersects : nearer(a, b);
+    };
+    score->first_real_nearest += std::min_element(scored.begin(), scored.end(), nearer)->real;
+    score->first_real_strongest += std::min_element(scored.begin(), scored.end(), stronger)->real;
   }
 }
 
@@ -333,10 +353,13 @@ int main(int argc, char** argv) try {
   for (size_t i = 0; i < run_sets.size(); ++i) md << (i ? ", " : "") << i + 1 << ": `" << run_sets[i] << "`";
   md << " (" << logs.size() << " runs). " << nudge::experiments::machine_description() << ", "
      << nudge::experiments::today() << ".\n\n"
-     << "| symmetry replayed with | tilt (deg) | lines per image | lines published | column's lines | explored objects' lines within (px) | more triangulation flags | real candidates | phantoms | objects ever a candidate |\n|---|---|---|---|---|---|---|---|---|---|\n";
+     << "| symmetry replayed with | tilt (deg) | lines per image | lines published | column's lines | explored objects' lines within (px) | more triangulation flags | real candidates | phantoms | objects ever a candidate | first candidate real, nearest the camera first / most intersects first (of surveys with a real one) |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& [variant, runs] : scores) {
-    int real = 0, phantom = 0, found = 0, objects = 0;
-    for (const auto& [run, s] : runs) real += s.real, phantom += s.phantom, found += static_cast<int>(s.objects_found.size()), objects += s.objects;
+    int real = 0, phantom = 0, found = 0, objects = 0, with_real = 0, nearest = 0, strongest = 0;
+    for (const auto& [run, s] : runs) {
+      real += s.real, phantom += s.phantom, found += static_cast<int>(s.objects_found.size()), objects += s.objects;
+      with_real += s.surveys_with_real, nearest += s.first_real_nearest, strongest += s.first_real_strongest;
+    }
     md << "| " << (variant.symmetry.empty() ? std::string("(as recorded)") : "`" + variant.symmetry + "`") << " | "
        << variant.tilt << " | " << (variant.lines ? std::to_string(variant.lines) : "as recorded") << " | "
        << (variant.published ? std::to_string(variant.published) + (variant.published_column_uncounted ? " + column" : "")
@@ -344,14 +367,16 @@ int main(int argc, char** argv) try {
        << (variant.column.empty() ? "default" : variant.column) << " | "
        << (variant.explored_px > 0 ? std::to_string(std::lround(variant.explored_px)) : std::string("default")) << " | "
        << (variant.triangulation.empty() ? std::string("–") : "`" + variant.triangulation + "`") << " | " << real
-       << " | " << phantom << " | " << found << "/" << objects << " |\n";
+       << " | " << phantom << " | " << found << "/" << objects << " | " << nearest << " / " << strongest << " of "
+       << with_real << " |\n";
     json.begin_object().field("tilt_deg", variant.tilt).field("lines_per_image", variant.lines).field("lines_published", variant.published);
     json.field("published_column_uncounted", variant.published_column_uncounted);
     json.field("column_lines", variant.column.empty() ? std::string("default") : variant.column);
     json.field("explored_line_px", variant.explored_px).field("symmetry_flags", variant.symmetry);
     json.field("triangulation_flags", variant.triangulation);
     json.field("real", real).field("phantoms", phantom);
-    json.field("objects_found", found).field("objects", objects).end_object();
+    json.field("objects_found", found).field("objects", objects);
+    json.field("surveys_with_real", with_real).field("first_real_nearest", nearest).field("first_real_strongest", strongest).end_object();
   }
   json.end_array().end_object();
   md << "\nPer run (set:scene; real/phantoms, and objects ever a candidate):\n\n| run |";

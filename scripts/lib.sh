@@ -162,10 +162,14 @@ nudge_in_private_network() {
 # (nudge-supervisor --wide-survey-tilt 5): a label can lean a lone bottle's line past 2 deg.
 # The supervisor's survey flags for NUDGE_LOOP_TABLE: nudge_run_loop's, and a replay's of its runs
 # (experiments/nudge_segmentation_replay.sh).
+# NUDGE_LOOP_CANDIDATE_ORDER=nearest|support sets nudge-supervisor --candidate-order (default: the
+# supervisor's, nearest the right camera first).
 nudge_loop_survey_flags() {
+  local order=
+  [ -n "${NUDGE_LOOP_CANDIDATE_ORDER:-}" ] && order=" --candidate-order $NUDGE_LOOP_CANDIDATE_ORDER"
   case "${NUDGE_LOOP_TABLE:-plain}" in
-    verified|busy) echo "--survey-lines 8" ;;
-    *) echo "--wide-survey-tilt 5" ;;
+    verified|busy) echo "--survey-lines 8$order" ;;
+    *) echo "--wide-survey-tilt 5$order" ;;
   esac
 }
 

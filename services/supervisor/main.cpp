@@ -63,6 +63,7 @@ struct Options {
   double nudge_speed_scale = 0.25;
   bool keep_running = false;
   std::string line_pick = "strongest";  // strongest, nearest (LineSearchParams::strongest)
+  std::string candidate_order = "nearest";  // nearest, support (TargetParams::order)
   int rest_from_still = 1;               // Config::rest_from_still
   int rival_by_foot = 1;                 // Config::rival_by_foot
   int graspable_push_first = 1;          // Config::graspable_push_first
@@ -645,6 +646,9 @@ void add_flags(Flags& f, Options& o) {
                "this tall, m (0: not checked); a push that cannot is made only when none can");
   f.add_double("height-margin", &o.config.height.margin_m,
                "added to the object's measured height before the arm is told to clear it, m");
+  f.add_string("candidate-order", &o.candidate_order,
+               "the order candidates seen by both cameras are tried in: nearest (the right camera; the thesis) or support "
+               "(most intersects first, nearest first among equals)");
   f.add_string("learn", &o.learn,
                "learning by interaction (thesis ch. 7: recognise before nudging; grasp, turn, learn, put back after a "
                "segmentation): on, off, or auto (while the learner's heartbeat is heard)");
@@ -699,6 +703,10 @@ int main(int argc, char** argv) {
     if (opt.line_pick != "strongest" && opt.line_pick != "nearest")
       throw FlagError("--line-pick: strongest or nearest, not '" + opt.line_pick + "'");
     opt.config.line_search.strongest = opt.line_pick == "strongest";
+    if (opt.candidate_order != "nearest" && opt.candidate_order != "support")
+      throw FlagError("--candidate-order: nearest or support, not '" + opt.candidate_order + "'");
+    opt.config.targets.order =
+        opt.candidate_order == "support" ? sv::TargetParams::Order::MostSupport : sv::TargetParams::Order::NearestCamera;
     if (opt.rest_from_still != 0 && opt.rest_from_still != 1) throw FlagError("--rest-from-still must be 0 or 1");
     if (!(opt.config.far_rest_m >= 0 && opt.config.far_rest_m <= opt.config.max_travel_m))
       throw FlagError("--far-rest must lie in [0, " + std::to_string(opt.config.max_travel_m) + "] m");

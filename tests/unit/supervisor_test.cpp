@@ -458,6 +458,32 @@ bool chosen_strictly(const sv::TargetChoice& c) { return c.found && c.note.find(
 
 // An explored object is kept clear of as tall as the stills measured it: a short one frees pushes
 // whose links pass over it, a tall one is cleared in full. Unmeasured, it is the tallest expected.
+// Beyond the thesis' order (nearest the right camera first): with TargetParams::Order::MostSupport
+// the candidate with the most intersects goes first, nearest first among equals; candidates both
+// cameras did not see still go last.
+TEST(Targets, MostSupportFirstWhenAskedNearestAmongEquals) {
+  const sv::SceneGeometry scene = make_scene();
+  const sv::ArmSetup arm;
+  sv::TargetParams params;
+  params.obstacle_height = 0;  // the links are not what this is about
+  // 0: nearer the camera, fewer intersects (a phantom's); 1: farther, the most; 2: as strong as 1,
+  // nearer still, but seen by one camera only.
+  std::vector<sv::Candidate> candidates = {{0, Eigen::Vector3d(0.30, -0.10, 0), 12},
+                                           {1, Eigen::Vector3d(0.20, 0.12, 0), 25},
+                                           {2, Eigen::Vector3d(0.31, 0.12, 0), 25, 0.2}};
+  const Eigen::Vector3d camera = scene.right_camera_in_world();
+  auto first = [&](const sv::TargetParams& p) {
+    const auto choice = sv::choose_target(candidates, {}, camera, arm, arm_state_joints(), p);
+    EXPECT_TRUE(choice.found);
+    return choice.target.index;
+  };
+  EXPECT_EQ(first(params), 0);  // nearest the camera (the thesis)
+  params.order = sv::TargetParams::Order::MostSupport;
+  EXPECT_EQ(first(params), 1);
+  candidates[0].support = 25;  // equals: the nearest again
+  EXPECT_EQ(first(params), 0);
+}
+
 TEST(Targets, AnExploredObjectIsKeptClearOfAsTallAsItWasMeasured) {
   const sv::SceneGeometry scene = make_scene();
   const sv::ArmSetup arm;

@@ -353,6 +353,8 @@ TargetChoice choose_target(const std::vector<Candidate>& candidates, const Histo
     const bool seen_a = candidates[a].stereo_agreement >= params.min_stereo_agreement;
     const bool seen_b = candidates[b].stereo_agreement >= params.min_stereo_agreement;
     if (seen_a != seen_b) return seen_a;
+    if (params.order == TargetParams::Order::MostSupport && candidates[a].support != candidates[b].support)
+      return candidates[a].support > candidates[b].support;
     return (candidates[a].position - right_camera).norm() < (candidates[b].position - right_camera).norm();
   });
   const Eigen::Vector3d camera_base = arm.point_to_base(right_camera);

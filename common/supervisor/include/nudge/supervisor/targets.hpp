@@ -49,6 +49,12 @@ struct TargetParams {
   double same_object_radius = 0.06;
   // Candidates whose stereo agreement is below this are tried last and are no obstacle to others.
   double min_stereo_agreement = 0.5;
+  // The order the others are tried in. Nearest the right camera first is the thesis'. Beyond it:
+  // the most intersects first (Candidate::support, nearest first among equals). A phantom, made
+  // by lines of two objects, holds in fewer of a survey's frames than an object's own lines, and
+  // a phantom's push sweeps the gap between objects the survey may not have found.
+  enum class Order { NearestCamera, MostSupport };
+  Order order = Order::NearestCamera;
   // Below this, not nudged at all: in no frame of the survey did both cameras show a line where
   // an upright axis standing there projects. Held-out runs (2026-11-25): every candidate seen 0%
   // was nowhere near an object, and two of their pushes moved a neighbour and gave false
