@@ -15,6 +15,9 @@
 // the lines as recorded), and those lines stand in for the recorded ones. Writes
 // docs/results/NAME.{json,md} (default survey_line_tilt). With --triangulation, each ';'-separated
 // flag set ("none": none) is added to the replayed nudge-triangulation's command.
+// For every survey with a real candidate it also counts whether the first candidate is real when
+// they go nearest the right camera first (the thesis) or most intersects first (nudge-supervisor
+// --candidate-order support).
 //   nudge-exp-survey-line-tilt RUNS_DIR [RUNS_DIR...] [--tilts 1,2,3] [--lines 3,5] [--published 5,8]
 //                              [--published-column-uncounted] [--explored-px 8,12] [--column counted,uncounted]
 //                              [--symmetry "recorded;--reach-max-tilt 15"] [--triangulation "none;--cluster-min-fraction 0.04"]
