@@ -162,14 +162,13 @@ nudge_in_private_network() {
 # (nudge-supervisor --wide-survey-tilt 5): a label can lean a lone bottle's line past 2 deg.
 # The supervisor's survey flags for NUDGE_LOOP_TABLE: nudge_run_loop's, and a replay's of its runs
 # (experiments/nudge_segmentation_replay.sh).
-# NUDGE_LOOP_CANDIDATE_ORDER=nearest|support sets nudge-supervisor --candidate-order (default: the
-# supervisor's, nearest the right camera first).
+# NUDGE_LOOP_SUPERVISOR_FLAGS adds nudge-supervisor flags to the loop's and a replay's (e.g.
+# "--candidate-order support" or "--refine-target 0.05": options tried on the development scenes).
 nudge_loop_survey_flags() {
-  local order=
-  [ -n "${NUDGE_LOOP_CANDIDATE_ORDER:-}" ] && order=" --candidate-order $NUDGE_LOOP_CANDIDATE_ORDER"
+  local extra=${NUDGE_LOOP_SUPERVISOR_FLAGS:+ $NUDGE_LOOP_SUPERVISOR_FLAGS}
   case "${NUDGE_LOOP_TABLE:-plain}" in
-    verified|busy) echo "--survey-lines 8$order" ;;
-    *) echo "--wide-survey-tilt 5$order" ;;
+    verified|busy) echo "--survey-lines 8$extra" ;;
+    *) echo "--wide-survey-tilt 5$extra" ;;
   esac
 }
 

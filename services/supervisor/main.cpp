@@ -577,6 +577,11 @@ void add_flags(Flags& f, Options& o) {
   f.add_int("max-attempts", &o.config.max_attempts, "nudges per run");
   f.add_int("segmentation-retries", &o.config.segmentation_retries,
             "a push that moved something but gave no segmentation: nudge the object again from its rest, this many times");
+  f.add_double("refine-target", &o.config.refine_target_max_m,
+               "place the target anew from its lines in both cameras' before stills when that moves it at most this "
+               "far, m, and plan its push there (0: off, the survey's place)");
+  f.add_double("refine-window", &o.config.refine_window_px,
+               "--refine-target: the lines searched for within this many px of the target's projected axis (stills' pixels)");
   f.add_double("retry-still-line-px", &o.config.retry_still_line_px,
                "but not when the segmentation is empty and the target's line stands within this many px (1280x960) "
                "and 1 deg of where it stood: nothing there moved (0: retried all the same)");

@@ -1840,6 +1840,50 @@ TEST_F(SupervisorTest, AnObjectWhoseSegmentationFailedIsNudgedAgainFromItsRestOn
   EXPECT_THROW(sv::Supervisor(bad, scene_, sv::ArmSetup{}, segment_nothing), std::invalid_argument);
 }
 
+// Config::refine_target_max_m: a survey's place 3 cm off its object along the right camera's ray
+// (a label's edges pull the two cameras' lines apart) is placed anew from the object's lines in
+// both before stills, and the push is planned there; off, or with the left still missing, the
+// survey's place is pushed. A place farther than the bound (another object's lines) is not taken.
+TEST_F(SupervisorTest, TheTargetIsPlacedAnewFromItsLinesInBothBeforeStills) {
+  const Eigen::Vector3d object(0.28, -0.05, 0);
+  const Eigen::Vector3d surveyed = object + 0.03 * along_ray(object);
+  struct Case {
+    double max_m;
+    bool left_still;
+    bool placed_anew;
+  };
+  for (const Case& c : {Case{0.05, true, true}, Case{0.0, true, false}, Case{0.02, true, false}, Case{0.05, false, false}}) {
+    SCOPED_TRACE("refine_target_max_m " + std::to_string(c.max_m) + (c.left_still ? "" : ", no left still"));
+    sv::Config config;
+    config.refine_target_max_m = c.max_m;
+    sv::Supervisor s = make(config);
+    const auto survey = start_with(s, {surveyed});
+    const auto requests = outputs_of<sv::SnapshotRequest>(survey);
+    ASSERT_EQ(requests.size(), 1u);
+    EXPECT_EQ(requests[0].both, c.max_m > 0) << "the left before still is asked for only to place the target anew";
+    s.on_right_still(draw_scene(scene_, {1280, 960}, {object}), now_, now_);
+    if (c.max_m > 0 && c.left_still) {
+      EXPECT_EQ(s.state(), sv::State::SnapshotBefore) << "waits for the left still";
+      s.on_left_still(draw_scene(scene_, {1280, 960}, {object}, true), now_, now_);
+    } else if (c.max_m > 0) {
+      for (int i = 0; i < 200 && s.state() == sv::State::SnapshotBefore; ++i) s.on_time(now_ += kSecond / 10);
+    }
+    const auto nudges = outputs_of<sv::NudgeCommand>(s.take_outputs());
+    ASSERT_EQ(nudges.size(), 1u) << s.report().reason;
+    const double off = (nudges[0].target - object).head<2>().norm();
+    if (c.placed_anew) {
+      EXPECT_LT(off, 0.01);
+      const Eigen::Vector3d ray = along_ray(nudges[0].target);
+      EXPECT_NEAR(nudges[0].direction.head<2>().dot(ray.head<2>()), 0.0, 1e-6) << "across the ray at the new place";
+    } else {
+      EXPECT_NEAR((nudges[0].target - surveyed).norm(), 0.0, 1e-9);
+    }
+  }
+  sv::Config bad;
+  bad.refine_target_max_m = -0.01;
+  EXPECT_THROW(make(bad), std::invalid_argument);
+}
+
 // An empty segmentation where the target's line stood still in the stills (Config::
 // retry_still_line_px): something moved during the push, but not what stands at the target, so the
 // place is not pushed again; with the check off it is (second development set's hm3: a phantom

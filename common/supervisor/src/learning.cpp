@@ -28,7 +28,8 @@ bool Supervisor::learning_enabled() const {
 
 bool Supervisor::stills_complete() const {
   const Attempt& a = *attempt_;
-  if (state_ == State::SnapshotBefore) return !a.before.empty() && (!a.learn || !a.before_left.empty());
+  if (state_ == State::SnapshotBefore)
+    return !a.before.empty() && (!(a.learn || before_stills_of_both_cameras()) || !a.before_left.empty());
   return !a.after.empty() && (!a.learn || !a.after_left.empty());
 }
 
@@ -37,6 +38,7 @@ void Supervisor::stills_arrived(int64_t now) {
     segment(now);
     return;
   }
+  refine_target_by_stills();
   before_lines();
   prefer_rival_at_the_lines_foot();
   if (attempt_->learn) {
@@ -47,7 +49,7 @@ void Supervisor::stills_arrived(int64_t now) {
 }
 
 void Supervisor::on_left_still(const cv::Mat& still, int64_t utime, int64_t now) {
-  if (!attempt_ || !attempt_->learn || utime < request_time_) return;
+  if (!attempt_ || !(attempt_->learn || before_stills_of_both_cameras()) || utime < request_time_) return;
   if (state_ != State::SnapshotBefore && state_ != State::SnapshotAfter) return;
   if (still.size() != config_.still_size)
     throw std::invalid_argument("left still of " + std::to_string(still.cols) + "x" + std::to_string(still.rows) +

@@ -170,6 +170,7 @@ std::string attempt_json(const Attempt& a) {
   if (a.standing_height > 0) j.field("standing_height_m", a.standing_height);
   if (a.height_from_edges) j.field("height_from_edges_m", *a.height_from_edges);
   if (a.height_from_mask) j.field("height_from_mask_m", *a.height_from_mask);
+  if (a.surveyed_at) write_point(j, "surveyed_at", *a.surveyed_at);
   if (a.foot_depth_m) j.field("foot_depth_m", *a.foot_depth_m);
   if (a.replaced) {
     j.key("replaced").begin_object().field("candidate_index", a.replaced->index).field("foot_depth_m", a.replaced_foot_depth_m);

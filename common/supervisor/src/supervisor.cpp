@@ -9,6 +9,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "nudge/geometry/plane.hpp"
+#include "nudge/geometry/triangulation.hpp"
 #include "nudge/robot/command_planner.hpp"
 #include "nudge/segmentation/motion.hpp"
 #include "nudge/supervisor/grasp.hpp"
@@ -92,6 +94,9 @@ Supervisor::Supervisor(Config config, SceneGeometry scene, ArmSetup arm, Segment
     throw std::invalid_argument("supervisor: settle_s must be >= 0 and max_settle_s >= settle_s");
   if (config_.segmentation_retries < 0) throw std::invalid_argument("supervisor: segmentation_retries must be >= 0");
   if (!(config_.retry_still_line_px >= 0)) throw std::invalid_argument("supervisor: retry_still_line_px must be >= 0");
+  if (!(config_.refine_target_max_m >= 0 && config_.refine_target_max_m <= 0.2))
+    throw std::invalid_argument("supervisor: refine_target_max_m must be in [0, 0.2] m");
+  if (!(config_.refine_window_px > 0)) throw std::invalid_argument("supervisor: refine_window_px must be > 0");
   validate(config_.height);
   joints_ = arm_.home();
 }
@@ -229,6 +234,58 @@ void Supervisor::prefer_rival_at_the_lines_foot() {
   before_lines();  // the new target's prediction
 }
 
+bool Supervisor::before_stills_of_both_cameras() const {
+  return state_ == State::SnapshotBefore && config_.refine_target_max_m > 0;
+}
+
+namespace {
+
+// `line`, found in a still of `size`, in the camera's calibration image (the stills are the same
+// camera at another resolution).
+symmetry::Line at_calibration(const geometry::Camera& camera, const symmetry::Line& line, cv::Size size) {
+  const Eigen::Vector2d a = to_calibration(camera, line.end1, size), b = to_calibration(camera, line.end2, size);
+  return line_through({a.x(), a.y()}, {b.x(), b.y()}, {camera.width, camera.height});
+}
+
+}  // namespace
+
+// Config::refine_target_max_m: the target placed anew from its lines in both before stills, and
+// its push planned again there.
+void Supervisor::refine_target_by_stills() {
+  Attempt& a = *attempt_;
+  if (config_.refine_target_max_m <= 0 || a.before.empty() || a.before_left.empty()) return;
+  const auto predicted_left = scene_.left_axis_line(a.target.position, config_.object_height_m, config_.still_size);
+  const auto predicted_right = scene_.right_axis_line(a.target.position, config_.object_height_m, config_.still_size);
+  if (!predicted_left || !predicted_right) return;
+  LineSearchParams search = config_.line_search;
+  search.window_px = config_.refine_window_px;
+  const auto left = find_line_near(a.before_left, *predicted_left, search, base_column_lines(0));
+  const auto right = find_line_near(a.before, *predicted_right, search, base_column_lines(1));
+  if (!left || !right) return;
+  const geometry::StereoRig& rig = scene_.rig();
+  const auto axis = geometry::triangulate_axis(rig, at_calibration(rig.left, *left, config_.still_size),
+                                               at_calibration(rig.right, *right, config_.still_size));
+  if (!axis) return;
+  const auto hit = geometry::check_axis(*axis, scene_.table());
+  if (!hit) return;
+  Eigen::Vector3d place = scene_.right_to_world(hit->point);
+  place.z() = 0;
+  if ((place - a.target.position).head<2>().norm() > config_.refine_target_max_m) return;  // another object's lines
+  std::vector<Candidate> candidates = a.candidates;
+  const auto target = std::find_if(candidates.begin(), candidates.end(), [&](const Candidate& c) { return c.index == a.target.index; });
+  if (target == candidates.end()) return;
+  target->position = place;
+  const TargetChoice choice = choose_push_for(candidates, static_cast<size_t>(target - candidates.begin()), history(),
+                                              scene_.right_camera_in_world(), arm_, joints_, target_params());
+  if (!choice.found) return;  // no push plans there: the survey's stands
+  a.surveyed_at = a.target.position;
+  a.target = choice.target;
+  a.direction = choice.direction;
+  a.plan = choice.plan;
+  a.height_limit = choice.height_limit;
+  report_.target = choice.target.position;
+}
+
 // Sets the attempt's foot_depth_m and rivals (the survey's candidates on the target's right-camera
 // line, with their depths beyond its before line's foot); the index of the rival nearest the
 // typical depth, or nothing.
@@ -354,7 +411,7 @@ void Supervisor::request_still(State state, int64_t now, const std::string& note
 void Supervisor::ask_for_still(int64_t now, bool first) {
   still_asked_ = now;
   still_requests_ = first ? 1 : still_requests_ + 1;
-  outputs_.push_back(SnapshotRequest{state_ != State::Rotate && attempt_->learn});
+  outputs_.push_back(SnapshotRequest{state_ != State::Rotate && (attempt_->learn || before_stills_of_both_cameras())});
 }
 
 // Asks again for a still that has not come within snapshot_retry_s of the last request, while
@@ -967,11 +1024,14 @@ void Supervisor::on_time(int64_t now) {
     case State::SnapshotBefore:
     case State::SnapshotAfter:
       if (!still_overdue(now)) break;
-      // Learning without the left still: the attempt goes on as a segmentation only.
+      // Learning without the left still: the attempt goes on as a segmentation only. Placing the
+      // target anew without it: the survey's place is pushed.
       if (attempt_->learn && !(state_ == State::SnapshotBefore ? attempt_->before : attempt_->after).empty()) {
         attempt_->learn = false;
         attempt_->learning = "not grasped";
         attempt_->learning_reason = "the left still never came" + still_requests_text();
+        stills_arrived(now);
+      } else if (state_ == State::SnapshotBefore && !attempt_->before.empty()) {
         stills_arrived(now);
       } else {
         end_attempt(Outcome::SnapshotLost, std::string("the ") + (state_ == State::SnapshotBefore ? "before" : "after") + " still never came" + still_requests_text(), now);

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <numeric>
+#include <stdexcept>
 #include <optional>
 #include <string>
 #include <utility>
@@ -345,6 +346,27 @@ TargetChoice choose_pass(const std::vector<Candidate>& candidates, const std::ve
 
 }  // namespace
 
+namespace {
+
+// The strict pass over the candidates in `order`, then the relaxed ones when it finds nothing.
+TargetChoice choose_in_order(const std::vector<Candidate>& candidates, const std::vector<size_t>& order, const History& history,
+                             const Eigen::Vector3d& right_camera, const ArmSetup& arm, const robot::JointVector& seed,
+                             const TargetParams& params) {
+  const Eigen::Vector3d camera_base = arm.point_to_base(right_camera);
+  TargetChoice strict = choose_pass(candidates, order, history, camera_base, arm, seed, params, Tolerance::None);
+  if (strict.found) return strict;
+  TargetChoice relaxed = choose_pass(candidates, order, history, camera_base, arm, seed, params, Tolerance::Slide);
+  if (!relaxed.found) relaxed = choose_pass(candidates, order, history, camera_base, arm, seed, params, Tolerance::SlideAndLinks);
+  if (!relaxed.found) return strict;  // the strict pass's reasons say why each was passed over
+  // Keep the strict pass's reasons for the candidates passed over before the chosen one.
+  relaxed.rejected.clear();
+  for (const Rejection& r : strict.rejected)
+    if (r.index != relaxed.target.index) relaxed.rejected.push_back(r);
+  return relaxed;
+}
+
+}  // namespace
+
 TargetChoice choose_target(const std::vector<Candidate>& candidates, const History& history, const Eigen::Vector3d& right_camera,
                            const ArmSetup& arm, const robot::JointVector& seed, const TargetParams& params) {
   std::vector<size_t> order(candidates.size());
@@ -357,17 +379,15 @@ TargetChoice choose_target(const std::vector<Candidate>& candidates, const Histo
       return candidates[a].support > candidates[b].support;
     return (candidates[a].position - right_camera).norm() < (candidates[b].position - right_camera).norm();
   });
-  const Eigen::Vector3d camera_base = arm.point_to_base(right_camera);
-  TargetChoice strict = choose_pass(candidates, order, history, camera_base, arm, seed, params, Tolerance::None);
-  if (strict.found) return strict;
-  TargetChoice relaxed = choose_pass(candidates, order, history, camera_base, arm, seed, params, Tolerance::Slide);
-  if (!relaxed.found) relaxed = choose_pass(candidates, order, history, camera_base, arm, seed, params, Tolerance::SlideAndLinks);
-  if (!relaxed.found) return strict;  // the strict pass's reasons say why each was passed over
-  // Keep the strict pass's reasons for the candidates passed over before the chosen one.
-  relaxed.rejected.clear();
-  for (const Rejection& r : strict.rejected)
-    if (r.index != relaxed.target.index) relaxed.rejected.push_back(r);
-  return relaxed;
+  return choose_in_order(candidates, order, history, right_camera, arm, seed, params);
+}
+
+TargetChoice choose_push_for(const std::vector<Candidate>& candidates, size_t which, const History& history,
+                             const Eigen::Vector3d& right_camera, const ArmSetup& arm, const robot::JointVector& seed,
+                             const TargetParams& params) {
+  if (which >= candidates.size())
+    throw std::out_of_range("choose_push_for: candidate " + std::to_string(which) + " of " + std::to_string(candidates.size()));
+  return choose_in_order(candidates, {which}, history, right_camera, arm, seed, params);
 }
 
 }  // namespace nudge::supervisor

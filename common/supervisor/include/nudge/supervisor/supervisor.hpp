@@ -155,6 +155,17 @@ struct Config {
   // bottle and the segmentation failed.) Off: the survey's choice stands.
   bool rival_by_foot = true;
   double foot_depth_typical_m = 0.03, rival_margin_m = 0.03, rival_max_misfit_m = 0.05;
+  // Beyond the thesis: the target placed again from its lines in both before stills. A survey's
+  // place can stand centimetres off its object along the right camera's ray (a label's edges pull
+  // the two cameras' lines to opposite sides of the axis: the disparity changes), and the push runs
+  // across that ray. When > 0, the before stills are taken with both cameras; the object's line is
+  // searched for in each within refine_window_px of the target's projected axis (at the stills'
+  // resolution; the still search's other parameters), the two are triangulated and met with the
+  // table, and a place within refine_target_max_m of the survey's becomes the target, its push
+  // planned again as the survey's was (choose_push_for; the survey's push stands when none plans).
+  // 0: off, the survey's place is pushed (the thesis).
+  double refine_target_max_m = 0;
+  double refine_window_px = 60;
   // With learning on (the attempt's), of the two ways across the view the one that leaves the
   // object where the arm can grasp it is tried first (TargetParams::rest_travel, set to
   // push_travel_m for the choice). Off: the first way across the view first, as without learning.
@@ -337,6 +348,9 @@ struct Attempt {
   std::optional<double> foot_depth_m;
   std::optional<Candidate> replaced;
   double replaced_foot_depth_m = 0;
+  // Config::refine_target_max_m: where the survey placed the target, when its lines in the before
+  // stills placed it anew (the target then stands there).
+  std::optional<Eigen::Vector3d> surveyed_at;
   std::vector<std::pair<Candidate, double>> rivals;  // on the target's right-camera line, with their depths beyond its foot
   Outcome outcome = Outcome::Aborted;
   std::string reason;
@@ -591,6 +605,8 @@ class Supervisor {
   void stills_arrived(int64_t now);
   void before_lines();
   void prefer_rival_at_the_lines_foot();
+  void refine_target_by_stills();
+  bool before_stills_of_both_cameras() const;
   std::optional<size_t> rivals_at_the_lines_foot(Attempt& a) const;
   void segment_left(Attempt& attempt) const;
   SegmentFunction segment_left_;

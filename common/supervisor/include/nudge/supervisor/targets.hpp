@@ -158,6 +158,13 @@ struct History {
 TargetChoice choose_target(const std::vector<Candidate>& candidates, const History& history, const Eigen::Vector3d& right_camera,
                            const ArmSetup& arm, const robot::JointVector& seed, const TargetParams& params = {});
 
+// The push choose_target would plan for candidates[which] alone (the same passes and obstacles: the
+// other candidates and `history`), whatever the order would have tried first. Not found when it
+// has none. Throws std::out_of_range for an index past the list.
+TargetChoice choose_push_for(const std::vector<Candidate>& candidates, size_t which, const History& history,
+                             const Eigen::Vector3d& right_camera, const ArmSetup& arm, const robot::JointVector& seed,
+                             const TargetParams& params = {});
+
 // Whether pushing `target` along `direction` would touch `other`, and how: the pad itself on its
 // way down at P1 and along P1 -> P2 (never acceptable), or the pushed object sliding into it
 // (acceptable on a crowded table where `other` may be a phantom), or (links_conflict) the arm's
