@@ -35,6 +35,7 @@
 namespace fs = std::filesystem;
 namespace sv = nudge::supervisor;
 namespace geo = nudge::geometry;
+using nudge::experiments::parse_list;
 using nudge::experiments::read_channel;
 using nudge::experiments::state_at;
 
@@ -100,14 +101,6 @@ double median(std::vector<double> v) {
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-std::vector<double> parse_list(const std::string& text) {
-  std::vector<double> out;
-  std::stringstream ss(text);
-  for (std::string item; std::getline(ss, item, ',');) out.push_back(std::stod(item));
-  if (out.empty()) throw std::invalid_argument("empty list '" + text + "'");
-  return out;
-}
-
 // A summary of one way of placing: candidates placed, the median |error| along the ray, and how
 // many within 15 mm and beyond 40 mm along it.
 struct Summary {
@@ -140,7 +133,7 @@ int main(int argc, char** argv) try {
     const std::string arg = argv[i];
     const bool has_value = i + 1 < argc;
     if (arg == "--real-radius" && has_value) real_radius = std::stod(argv[++i]);
-    else if (arg == "--windows" && has_value) windows = parse_list(argv[++i]);
+    else if (arg == "--windows" && has_value) windows = parse_list(argv[++i], arg);
     else if (arg == "--max-move" && has_value) max_move = std::stod(argv[++i]);
     else if (arg == "--name" && has_value) name = argv[++i];
     else if (!arg.empty() && arg[0] != '-') run_sets.push_back(arg);

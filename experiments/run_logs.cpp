@@ -85,4 +85,17 @@ void replay_symmetry(const fs::path& log, const std::string& extra, const fs::pa
   if (std::system(command.c_str()) != 0) throw std::runtime_error("nudge-symmetry failed on " + log.string());
 }
 
+std::vector<double> parse_list(const std::string& text, const std::string& flag) {
+  std::vector<double> values;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    char* end = nullptr;
+    const double v = std::strtod(item.c_str(), &end);
+    if (item.empty() || *end != '\0' || !(v > 0)) throw std::invalid_argument(flag + ": not a positive number: '" + item + "'");
+    values.push_back(v);
+  }
+  return values;
+}
+
 }  // namespace nudge::experiments

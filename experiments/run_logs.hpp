@@ -38,6 +38,8 @@ const sim_state_t* state_at(const std::vector<sim_state_t>& states, int64_t utim
 
 // The directory of the running program (where the services' binaries are built beside it).
 std::filesystem::path own_directory();
+// A comma-separated list of positive numbers given to `flag`; throws naming the flag and the item.
+std::vector<double> parse_list(const std::string& text, const std::string& flag);
 // `s` as one word for /bin/sh.
 std::string shell_quote(const std::string& s);
 

@@ -56,6 +56,7 @@
 
 namespace fs = std::filesystem;
 using nudge::experiments::own_directory;
+using nudge::experiments::parse_list;
 using nudge::experiments::read_channel;
 using nudge::experiments::shell_quote;
 using nudge::experiments::state_at;
@@ -103,19 +104,6 @@ struct Variant {
     return text.str();
   }
 };
-
-std::vector<double> parse_list(const std::string& text, const std::string& flag) {
-  std::vector<double> values;
-  std::stringstream in(text);
-  std::string item;
-  while (std::getline(in, item, ',')) {
-    char* end = nullptr;
-    const double v = std::strtod(item.c_str(), &end);
-    if (item.empty() || *end != '\0' || !(v > 0)) throw std::invalid_argument(flag + ": not a positive number: '" + item + "'");
-    values.push_back(v);
-  }
-  return values;
-}
 
 // A copy of the log whose CANDIDATES_REQUESTs ask for `lines` lines per image (0: as recorded) and
 // whose SYMMETRY messages hold their first `published` lines (0: all): the recorded surveys replayed
