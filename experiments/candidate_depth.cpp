@@ -26,6 +26,7 @@
 #include "nudge/geometry/triangulation.hpp"
 #include "nudge/image_t.hpp"
 #include "nudge/json.hpp"
+#include "nudge/progress.hpp"
 #include "nudge/sim_state_t.hpp"
 #include "nudge/supervisor/line_search.hpp"
 #include "nudge/supervisor/scene.hpp"
@@ -146,7 +147,10 @@ int main(int argc, char** argv) try {
   const Eigen::Vector3d camera = scene.right_camera_in_world();
 
   std::vector<Row> rows;
-  for (const auto& [run, log] : nudge::experiments::run_logs(run_sets)) {
+  const auto logs = nudge::experiments::run_logs(run_sets);
+  nudge::Progress progress("nudge-exp-candidate-depth", static_cast<int>(logs.size()));
+  for (const auto& [run, log] : logs) {
+    progress.step(run);
     const auto states = read_channel<nudge::sim_state_t>(log, "SIM_STATE");
     const auto lefts = read_channel<nudge::image_t>(log, "CAMERA_LEFT");
     const auto rights = read_channel<nudge::image_t>(log, "CAMERA_RIGHT");
@@ -180,8 +184,9 @@ int main(int argc, char** argv) try {
         rows.push_back(row);
       }
     }
-    std::cerr << run << ": " << rows.size() << " real candidates so far\n";
+    progress.note(run + ": " + std::to_string(rows.size()) + " real candidates so far");
   }
+  progress.finish(std::to_string(rows.size()) + " real candidates of " + std::to_string(logs.size()) + " runs");
 
   std::ostringstream md;
   md << "# Candidates' depth along the right camera's ray: surveyed, and the lines found again\n\n"
