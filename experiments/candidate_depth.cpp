@@ -36,6 +36,8 @@
 namespace fs = std::filesystem;
 namespace sv = nudge::supervisor;
 namespace geo = nudge::geometry;
+using nudge::experiments::latest_at;
+using nudge::experiments::median;
 using nudge::experiments::parse_list;
 using nudge::experiments::read_channel;
 using nudge::experiments::state_at;
@@ -53,16 +55,6 @@ PlaceError place_error(const Eigen::Vector3d& place, const Eigen::Vector3d& trut
   const Eigen::Vector2d ray = (place - camera).head<2>().normalized();
   const Eigen::Vector2d off = (truth - place).head<2>();
   return {off.dot(ray), off.norm()};
-}
-
-// The newest frame of `frames` at or before `utime` (log order, utime rising); null before the first.
-const nudge::image_t* frame_at(const std::vector<nudge::image_t>& frames, int64_t utime) {
-  const nudge::image_t* found = nullptr;
-  for (const auto& f : frames) {
-    if (f.utime > utime) break;
-    found = &f;
-  }
-  return found;
 }
 
 // Where the object's lines, found again near the candidate's projected axis in both images, put it
@@ -93,13 +85,6 @@ struct Row {
 std::string mm(const std::optional<PlaceError>& e) {
   if (!e) return "–";
   return std::to_string(std::lround(1000 * e->along)) + " / " + std::to_string(std::lround(1000 * e->total));
-}
-
-double median(std::vector<double> v) {
-  if (v.empty()) return NAN;
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
 // A summary of one way of placing: candidates placed, the median |error| along the ray, and how
@@ -158,8 +143,8 @@ int main(int argc, char** argv) try {
     for (const auto& survey : read_channel<nudge::candidates_t>(log, "CANDIDATES")) {
       ++survey_number;
       const nudge::sim_state_t* state = state_at(states, survey.utime);
-      const nudge::image_t* left = frame_at(lefts, survey.utime);
-      const nudge::image_t* right = left ? frame_at(rights, left->utime) : nullptr;
+      const nudge::image_t* left = latest_at(lefts, survey.utime);
+      const nudge::image_t* right = left ? latest_at(rights, left->utime) : nullptr;
       if (!state || !right || right->utime != left->utime) continue;
       const cv::Mat left_image = nudge::bus::to_mat(*left), right_image = nudge::bus::to_mat(*right);
       for (int i = 0; i < survey.num_candidates; ++i) {

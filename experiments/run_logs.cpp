@@ -28,15 +28,6 @@ std::vector<std::pair<std::string, fs::path>> run_logs(const std::vector<std::st
   return logs;
 }
 
-const sim_state_t* state_at(const std::vector<sim_state_t>& states, int64_t utime) {
-  const sim_state_t* found = nullptr;
-  for (const auto& s : states) {
-    if (s.utime > utime) break;
-    found = &s;
-  }
-  return found;
-}
-
 fs::path own_directory() {
   char path[4096];
   const ssize_t n = readlink("/proc/self/exe", path, sizeof(path) - 1);

@@ -33,8 +33,20 @@ std::vector<Message> read_channel(const std::filesystem::path& log_path, const s
   return messages;
 }
 
-// The latest state at or before `utime` (states in log order, utime rising); null before the first.
-const sim_state_t* state_at(const std::vector<sim_state_t>& states, int64_t utime);
+// The latest message at or before `utime` (messages in log order, utime rising); null before the
+// first.
+template <typename Message>
+const Message* latest_at(const std::vector<Message>& messages, int64_t utime) {
+  const Message* found = nullptr;
+  for (const auto& m : messages) {
+    if (m.utime > utime) break;
+    found = &m;
+  }
+  return found;
+}
+
+// The simulator's state at `utime` (latest_at).
+inline const sim_state_t* state_at(const std::vector<sim_state_t>& states, int64_t utime) { return latest_at(states, utime); }
 
 // The directory of the running program (where the services' binaries are built beside it).
 std::filesystem::path own_directory();

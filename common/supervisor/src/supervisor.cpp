@@ -208,6 +208,17 @@ void Supervisor::choose(int64_t now) {
   request_still(State::SnapshotBefore, now, choice.note);
 }
 
+// The attempt's target and push become `choice`'s (a target chosen again before the nudge).
+void Supervisor::take_choice(const TargetChoice& choice) {
+  Attempt& a = *attempt_;
+  a.target = choice.target;
+  a.direction = choice.direction;
+  a.plan = choice.plan;
+  a.height_limit = choice.height_limit;
+  report_.candidate_index = choice.target.index;
+  report_.target = choice.target.position;
+}
+
 // Config::rival_by_foot: the target's depth checked against its before line's foot, and a
 // candidate on the same right-camera line at the depth the foot shows nudged instead.
 void Supervisor::prefer_rival_at_the_lines_foot() {
@@ -222,12 +233,7 @@ void Supervisor::prefer_rival_at_the_lines_foot() {
   a.replaced = a.target;
   a.replaced_foot_depth_m = *a.foot_depth_m;
   a.foot_depth_m = depth;
-  a.target = choice.target;
-  a.direction = choice.direction;
-  a.plan = choice.plan;
-  a.height_limit = choice.height_limit;
-  report_.candidate_index = choice.target.index;
-  report_.target = choice.target.position;
+  take_choice(choice);
   a.before_line.reset();
   a.measured_height.reset();
   a.before_line_left.reset();
@@ -279,11 +285,7 @@ void Supervisor::refine_target_by_stills() {
                                               scene_.right_camera_in_world(), arm_, joints_, target_params());
   if (!choice.found) return;  // no push plans there: the survey's stands
   a.surveyed_at = a.target.position;
-  a.target = choice.target;
-  a.direction = choice.direction;
-  a.plan = choice.plan;
-  a.height_limit = choice.height_limit;
-  report_.target = choice.target.position;
+  take_choice(choice);
 }
 
 // Sets the attempt's foot_depth_m and rivals (the survey's candidates on the target's right-camera

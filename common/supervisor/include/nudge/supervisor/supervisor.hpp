@@ -604,6 +604,7 @@ class Supervisor {
   bool stills_complete() const;
   void stills_arrived(int64_t now);
   void before_lines();
+  void take_choice(const TargetChoice& choice);
   void prefer_rival_at_the_lines_foot();
   void refine_target_by_stills();
   bool before_stills_of_both_cameras() const;
