@@ -219,7 +219,12 @@ class SupervisorTest : public ::testing::Test {
   }
   // The object at rest for two seconds (frames and, for the loop without trackers, upright AXES).
   std::vector<sv::Output> slide_without_symmetry(sv::Supervisor& s);
-  Eigen::Vector3d nudged_of_rivals_on_one_right_line(const sv::Config& config, double behind_m);
+  std::optional<sv::NudgeCommand> nudge_of_rivals_on_one_right_line(const sv::Config& config, double behind_m,
+                                                                    const std::optional<Eigen::Vector3d>& third = std::nullopt);
+  Eigen::Vector3d nudged_of_rivals_on_one_right_line(const sv::Config& config, double behind_m) {
+    const auto nudge = nudge_of_rivals_on_one_right_line(config, behind_m);
+    return nudge ? nudge->target : Eigen::Vector3d::Zero();
+  }
   std::pair<std::optional<sv::NudgeCommand>, std::string> nudge_beside_an_unpaired_object(const sv::Config& config,
                                                                                           const Eigen::Vector3d& beside);
   // A run started on `object` alone, its before still taken: the nudge the supervisor commands.
@@ -1983,9 +1988,10 @@ TEST_F(SupervisorTest, ACandidateHiddenBehindTheArmsBaseIsPassedOverWithItsReaso
 
 // A survey that paired the object's right line with another left line: a candidate `behind_m`
 // beyond the object at (0.22, -0.05) on its right-camera line (negative: before it), seen in 9 of
-// 10 frames, and the object's own, seen in 4 (not "seen": the other is chosen first). The
-// candidate the nudge is commanded for.
-Eigen::Vector3d SupervisorTest::nudged_of_rivals_on_one_right_line(const sv::Config& config, double behind_m) {
+// 10 frames, and the object's own, seen in 4 (not "seen": the other is chosen first); and, when
+// given, a `third` candidate both cameras see in every frame. The nudge commanded, if any.
+std::optional<sv::NudgeCommand> SupervisorTest::nudge_of_rivals_on_one_right_line(const sv::Config& config, double behind_m,
+                                                                                  const std::optional<Eigen::Vector3d>& third) {
   sv::Supervisor s = make(config);
   const Eigen::Vector3d object(0.22, -0.05, 0);
   const Eigen::Vector3d mismatch = object + behind_m * along_ray(object);
@@ -1997,24 +2003,32 @@ Eigen::Vector3d SupervisorTest::nudged_of_rivals_on_one_right_line(const sv::Con
   EXPECT_TRUE(right && left_object && left_mismatch);
   EXPECT_TRUE(sv::lines_agree(*scene_.right_axis_line(mismatch, 0.25, {640, 480}), *right, 0.01, 1));
   for (int i = 0; i < 10; ++i) {
-    std::vector<nudge::symmetry::Line> left;
+    std::vector<nudge::symmetry::Line> left, rights{*right};
     if (i < 9) left.push_back(*left_mismatch);
     if (i < 4) left.push_back(*left_object);
+    if (third) {
+      left.push_back(*scene_.left_axis_line(*third, 0.25, {640, 480}));
+      rights.push_back(*scene_.right_axis_line(*third, 0.25, {640, 480}));
+    }
     s.on_lines(true, left, now_ + kSecond / 10, now_ + kSecond / 5);
-    s.on_lines(false, {*right}, now_ + kSecond / 10, now_ + kSecond / 5);
+    s.on_lines(false, rights, now_ + kSecond / 10, now_ + kSecond / 5);
   }
   now_ += kSecond;
   s.take_outputs();
-  s.on_candidates({{0, mismatch, 20}, {1, object, 20}}, now_, now_);
+  std::vector<sv::Candidate> candidates{{0, mismatch, 20}, {1, object, 20}};
+  if (third) candidates.push_back({2, *third, 20});
+  s.on_candidates(candidates, now_, now_);
   EXPECT_EQ(s.state(), sv::State::SnapshotBefore) << s.report().reason;
   EXPECT_NEAR((s.report().target - mismatch).norm(), 0.0, 1e-9) << "the mismatch is chosen first";
-  s.on_right_still(draw_scene(scene_, {1280, 960}, {object}), now_, now_);
+  std::vector<Eigen::Vector3d> drawn{object};
+  if (third) drawn.push_back(*third);
+  s.on_right_still(draw_scene(scene_, {1280, 960}, drawn), now_, now_);
   const auto nudges = outputs_of<sv::NudgeCommand>(s.take_outputs());
   if (nudges.size() != 1u) {
     ADD_FAILURE() << "no nudge: " << s.report().reason;
-    return Eigen::Vector3d::Zero();
+    return std::nullopt;
   }
-  return nudges[0].target;
+  return nudges[0];
 }
 
 TEST_F(SupervisorTest, ACandidateBeyondTheFootOfItsLineGivesWayToTheOneOnThatLineTheFootShows) {
@@ -2027,6 +2041,23 @@ TEST_F(SupervisorTest, ACandidateBeyondTheFootOfItsLineGivesWayToTheOneOnThatLin
   EXPECT_NEAR((nudged_of_rivals_on_one_right_line(off, -0.10) - object).norm(), 0.10, 1e-9);
   // 5 cm behind fits the foot better than the object does: the survey's choice stands.
   EXPECT_NEAR((nudged_of_rivals_on_one_right_line({}, 0.05) - object).norm(), 0.05, 1e-9);
+}
+
+// The push of the candidate nudged in place of the survey's choice keeps clear of the survey's
+// other candidates, as every push does: a third candidate 15 cm to one side across the view sits
+// where the pad would come down if the object were pushed away from it, and beyond where the
+// object slides if pushed towards it. Whichever side it stands on, the push goes towards it.
+TEST_F(SupervisorTest, TheCandidateNudgedInsteadIsPushedClearOfTheOtherCandidates) {
+  const Eigen::Vector3d object(0.22, -0.05, 0);
+  const Eigen::Vector3d ray = along_ray(object);
+  const Eigen::Vector3d across(-ray.y(), ray.x(), 0);
+  for (const double side : {1.0, -1.0}) {
+    const Eigen::Vector3d third = object + side * 0.15 * across;
+    const auto nudge = nudge_of_rivals_on_one_right_line({}, -0.10, third);
+    ASSERT_TRUE(nudge) << "side " << side;
+    EXPECT_NEAR((nudge->target - object).norm(), 0.0, 1e-9) << "side " << side;
+    EXPECT_GT(nudge->direction.dot(third - object), 0.0) << "side " << side << ": the pad came down by the third";
+  }
 }
 
 // A survey whose only candidate is the object at (0.22, -0.05); the right camera's lines also show

@@ -228,8 +228,16 @@ void Supervisor::prefer_rival_at_the_lines_foot() {
   auto misfit = [&](double d) { return std::abs(d - config_.foot_depth_typical_m); };
   const auto& [candidate, depth] = a.rivals[*rival];
   if (misfit(depth) > config_.rival_max_misfit_m || misfit(depth) > misfit(*a.foot_depth_m) - config_.rival_margin_m) return;
-  const TargetChoice choice = choose_target({candidate}, history(), scene_.right_camera_in_world(), arm_, joints_, target_params());
-  if (!choice.found) return;  // the rival is explored or out of reach: the survey's choice stands
+  // Planned as the survey plans every push: the other candidates are obstacles, all but the target
+  // it replaces (on the hypothesis that both are this one object, placed once wrongly).
+  std::vector<Candidate> others;
+  for (const Candidate& c : a.candidates)
+    if (c.index != a.target.index) others.push_back(c);
+  const auto at = std::find_if(others.begin(), others.end(), [&](const Candidate& c) { return c.index == candidate.index; });
+  if (at == others.end()) return;
+  const TargetChoice choice = choose_push_for(others, static_cast<size_t>(at - others.begin()), history(),
+                                              scene_.right_camera_in_world(), arm_, joints_, target_params());
+  if (!choice.found) return;  // the rival is explored or has no clear push: the survey's choice stands
   a.replaced = a.target;
   a.replaced_foot_depth_m = *a.foot_depth_m;
   a.foot_depth_m = depth;
