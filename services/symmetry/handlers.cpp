@@ -8,6 +8,7 @@
 #include "nudge/bus/symmetry_convert.hpp"
 #include "nudge/contours_t.hpp"
 #include "nudge/geometry/interesting_locations.hpp"
+#include "nudge/geometry/self_mask.hpp"
 #include "nudge/geometry/upright.hpp"
 #include "nudge/log.hpp"
 #include "nudge/timing.hpp"
@@ -78,8 +79,8 @@ Handlers::Handlers(bus::Service& service, const Options& options)
   for (const auto& channel : options_.inputs) {
     const std::string out = bus::channel::derived(channel, bus::channel::SYMMETRY);
     const std::string contours_out = bus::channel::derived(channel, bus::channel::CONTOURS);
-    const bool needs_side =
-        options_.upright || !options_.column_mask_left.empty() || options_.table_texture || options_.reach;
+    const bool needs_side = options_.upright || !options_.column_mask_left.empty() || options_.table_texture ||
+                            options_.reach || options_.explored;
     const Output output{out, contours_out, needs_side ? side_of_channel(channel) : geometry::Side::Left};
     service_.subscriptions().subscribe<image_t>(channel, [this, output](const image_t& msg, const std::string&) {
       if (options_.table_texture)
@@ -89,6 +90,28 @@ Handlers::Handlers(bus::Service& service, const Options& options)
     });
     log::info() << channel << " -> " << out;
   }
+  if (options_.explored)
+    service_.subscriptions().subscribe<candidates_request_t>(
+        bus::channel::CANDIDATES_REQUEST, [this](const candidates_request_t& m, const std::string&) { on_request(m); });
+}
+
+void Handlers::on_request(const candidates_request_t& request) {
+  const Options::Explored& e = *options_.explored;
+  const geometry::TableFrame frame(e.table, e.arm_base);
+  std::vector<geometry::Column> columns;
+  for (int i = 0; i < request.num_explored && i < static_cast<int>(request.explored.size()); ++i) {
+    const Eigen::Vector3d place(request.explored[i][0], request.explored[i][1], request.explored[i][2]);
+    if (!place.allFinite()) {
+      log::warn() << bus::channel::CANDIDATES_REQUEST << " of " << request.utime << ": explored place " << i
+                  << " is not finite; its edges are kept";
+      continue;
+    }
+    columns.push_back({frame.to_camera(place), e.radius, e.height});
+  }
+  for (const geometry::Side side : {geometry::Side::Left, geometry::Side::Right})
+    explored_mask_[side == geometry::Side::Left ? 0 : 1] =
+        columns.empty() ? cv::Mat() : geometry::columns_mask(e.rig, side, e.table, columns, e.margin_px, e.band_px);
+  if (!columns.empty()) log::info() << "survey: the edges of " << columns.size() << " explored object(s) left out";
 }
 
 geometry::Side side_of_channel(const std::string& channel) {
@@ -144,6 +167,13 @@ void Handlers::detect_and_publish(const cv::Mat& image, const image_t& msg, cons
       throw std::runtime_error(out + " frame " + std::to_string(msg.frame_id) + ": image " + std::to_string(image.cols) +
                                "x" + std::to_string(image.rows) + " differs from the column mask's calibration");
     symmetry::remove_edges(edges, column);
+  }
+  const cv::Mat& explored = explored_mask_[side == geometry::Side::Left ? 0 : 1];
+  if (!explored.empty()) {
+    if (explored.size() != image.size())
+      throw std::runtime_error(out + " frame " + std::to_string(msg.frame_id) + ": image " + std::to_string(image.cols) +
+                               "x" + std::to_string(image.rows) + " differs from the explored objects' calibration");
+    symmetry::remove_edges(edges, explored);
   }
   if (!other.empty()) {
     const Options::TableTexture& texture = *options_.table_texture;

@@ -7,6 +7,7 @@
 
 #include "nudge/bus/channels.hpp"
 #include "nudge/bus/service.hpp"
+#include "nudge/candidates_request_t.hpp"
 #include "nudge/image_t.hpp"
 #include "nudge/segmentation/segment.hpp"
 #include "nudge/symmetry/detector.hpp"
@@ -67,6 +68,23 @@ struct Options {
     double max_tilt_deg = 0;  // > 0: drop lines that cannot be an upright axis's image before the keep
   };
   std::optional<Reach> reach;
+  // Objects already explored left out of the edges (geometry::columns_mask): each
+  // CANDIDATES_REQUEST names the places of the objects a survey has explored and that still
+  // stand (table frame); from then on, until the next request, each is taken as an upright
+  // cylinder of `radius` and `height` there and its image region (band_px 0) or its outline's
+  // band (band_px either side) leaves each camera's edges. Their own lines, and the phantoms
+  // their edges make with a neighbour's, then no longer take the places of the objects still to
+  // find. Needs the channels' cameras; the image must be the calibration's size.
+  struct Explored {
+    geometry::StereoRig rig;
+    geometry::Plane table;
+    Eigen::Vector3d arm_base = Eigen::Vector3d::Zero();  // right camera frame: the table frame's origin
+    double radius = 0.05;
+    double height = 0.25;
+    int margin_px = 4;
+    int band_px = 0;
+  };
+  std::optional<Explored> explored;
 };
 
 // The camera of an input channel for the upright check: LEFT or RIGHT at the end of its name.
@@ -88,6 +106,8 @@ class Handlers {
     geometry::Side side = geometry::Side::Left;
   };
   void on_image(const image_t& msg, const Output& out);
+  // With Options::explored: the masks of the request's explored places.
+  void on_request(const candidates_request_t& request);
   // With Options::table_texture: holds an image until the other camera's partner comes.
   void on_stereo_image(const image_t& msg, const Output& out);
   // Detects and publishes. `other`: the other camera's image of the same moment, whose agreement
@@ -100,6 +120,7 @@ class Handlers {
     Output out;
   };
   std::optional<Held> held_;
+  cv::Mat explored_mask_[2];  // left, right; empty: nothing explored
 
   bus::Service& service_;
   Options options_;

@@ -96,6 +96,16 @@ int main(int argc, char** argv) {
     f.add_double("reach-max-tilt", &reach.max_tilt_deg,
                  "with --reach-calibration: drop lines whose plane leans more than this many degrees from the table's "
                  "normal (none can be an upright object's axis) before --reach-keep; 0: keep them");
+    std::string explored_calibration;
+    symmetry_service::Options::Explored explored;
+    f.add_string("explored-calibration", &explored_calibration,
+                 "leave the objects a survey has explored out of the edges: each CANDIDATES_REQUEST's explored places, "
+                 "on this rig file's table_plane, its arm_base the table frame's origin (input channels must end in LEFT / RIGHT)");
+    f.add_double("explored-radius", &explored.radius, "with --explored-calibration: each explored object's radius, m "
+                                                      "(the largest expected and the place's error)");
+    f.add_double("explored-height", &explored.height, "with --explored-calibration: its height above the table, m");
+    f.add_int("explored-band", &explored.band_px, "with --explored-calibration: leave out only a band this many px either "
+                                                  "side of each explored object's outline; 0: its whole image region");
     f.add_bool("colour-edges", &edge.colour, "Canny on the colour image (the channel that changes most)");
     f.add_int("contours", &options.contours, "also segment the contours of the top N lines (CONTOURS_*); 0: off");
     if (!service.parse(argc, argv)) return 0;
@@ -142,11 +152,9 @@ int main(int argc, char** argv) {
           throw std::invalid_argument(column_calibration + " needs table_plane and arm_base");
         column.foot = *scene.arm_base;
         if (column_band < 0) throw std::invalid_argument("--column-band must be >= 0");
-        for (const geometry::Side side : {geometry::Side::Left, geometry::Side::Right}) {
-          cv::Mat mask = geometry::column_mask(rig, side, *scene.table, column, column_band > 0 ? 0 : 4);
-          if (column_band > 0) mask = geometry::outline_band(mask, column_band);
-          (side == geometry::Side::Left ? options.column_mask_left : options.column_mask_right) = mask;
-        }
+        for (const geometry::Side side : {geometry::Side::Left, geometry::Side::Right})
+          (side == geometry::Side::Left ? options.column_mask_left : options.column_mask_right) =
+              geometry::columns_mask(rig, side, *scene.table, {column}, 4, column_band);
         for (const auto& channel : options.inputs) symmetry_service::side_of_channel(channel);
       } catch (const std::exception& e) {
         throw FlagError(std::string("--column-calibration: ") + e.what());
@@ -170,6 +178,22 @@ int main(int argc, char** argv) {
             static_cast<int64_t>(table_texture_skew_ms * 1000)};
       } catch (const std::exception& e) {
         throw FlagError(std::string("--table-texture-calibration: ") + e.what());
+      }
+    }
+    if (!explored_calibration.empty()) {
+      try {
+        if (!(explored.radius > 0) || !(explored.height > 0))
+          throw std::invalid_argument("--explored-radius and --explored-height must be > 0");
+        if (explored.band_px < 0) throw std::invalid_argument("--explored-band must be >= 0");
+        explored.rig = geometry::load_rig(explored_calibration);
+        const geometry::Workspace scene = geometry::load_workspace(explored_calibration);
+        if (!scene.table || !scene.arm_base) throw std::invalid_argument(explored_calibration + " needs table_plane and arm_base");
+        explored.table = *scene.table;
+        explored.arm_base = *scene.arm_base;
+        for (const auto& channel : options.inputs) symmetry_service::side_of_channel(channel);
+        options.explored = explored;
+      } catch (const std::exception& e) {
+        throw FlagError(std::string("--explored-calibration: ") + e.what());
       }
     }
     if (!reach_calibration.empty()) {

@@ -11,7 +11,9 @@
 
 #include "nudge/bus/image.hpp"
 #include "nudge/bus/latest.hpp"
+#include "nudge/candidates_request_t.hpp"
 #include "nudge/contours_t.hpp"
+#include "nudge/geometry/interesting_locations.hpp"
 #include "nudge/symmetry/synthetic.hpp"
 #include "nudge/symmetry_lines_t.hpp"
 #include "nudge/test/lcm_log.hpp"
@@ -405,4 +407,56 @@ TEST(SymmetryHandlers, LeaningLinesDoNotTakeThePlacesOfUprightOnes) {
   const nudge::symmetry_lines_t loose = published(15);
   ASSERT_EQ(loose.num_lines, 1);
   EXPECT_NEAR(loose.lines[0].theta, 12 * kDeg, 1.5 * kDeg) << "a 15 deg check lets a 12 deg lean through";
+}
+
+// The objects a survey has explored leave the edges (Options::explored): once a CANDIDATES_REQUEST
+// names the strongest bottle's place, the one line kept within reach is the other bottle's; a
+// request naming nothing brings the first back, and a place that is not finite is passed over.
+TEST(SymmetryHandlers, ExploredObjectsLeaveTheEdgesFromTheSurveyThatNamesThem) {
+  nudge::symmetry_service::Options options = mono_options();
+  options.inputs = {"CAMERA_RIGHT"};
+  options.params.dmax = 70;  // no pairs across the two bottles: only their own lines
+  nudge::symmetry_service::Options::Reach reach = level_reach();
+  reach.centre = Eigen::Vector3d(0, 0.3, 1.0);
+  options.reach = reach;
+  nudge::symmetry_service::Options::Explored explored;
+  explored.rig = reach.rig;
+  explored.table = reach.table;
+  explored.arm_base = reach.centre;
+  explored.radius = 0.12;  // the bottle is 60 px (0.2 m) wide at 1 m
+  explored.height = 0.6;
+  options.explored = explored;
+  cv::Mat img(240, 320, CV_8UC3, cv::Scalar(200, 210, 220));
+  syn::draw_shape(img, syn::bottle_profile(160, 30), 60, 0, 0, cv::Scalar(40, 60, 90));   // the strongest
+  syn::draw_shape(img, syn::bottle_profile(110, 30), -80, 0, 0, cv::Scalar(40, 60, 90));  // the next
+
+  InProcess run(options);
+  Latest<nudge::symmetry_lines_t> right(run.probe, "SYMMETRY_RIGHT");
+  nudge::image_t image = nudge::bus::to_message(img, nudge::image_t::FORMAT_GRAY8, 1, 1, "right");
+  auto top_line = [&] {
+    run.bus.publish("CAMERA_RIGHT", &image);
+    run.service.handle_pending();
+    EXPECT_EQ(run.service.counters().errors, 0);
+    const nudge::symmetry_lines_t lines = right.get();
+    EXPECT_EQ(lines.num_lines, 1);
+    return lines.num_lines > 0 ? lines.lines[0].r : NAN;
+  };
+  auto request = [&](const std::vector<Eigen::Vector3d>& places) {
+    nudge::candidates_request_t msg{};
+    msg.utime = 2;
+    msg.num_explored = static_cast<int32_t>(places.size());
+    for (const Eigen::Vector3d& p : places) msg.explored.push_back({p.x(), p.y(), p.z()});
+    run.bus.publish("CANDIDATES_REQUEST", &msg);
+    run.service.handle_pending();
+  };
+  const nudge::geometry::TableFrame frame(explored.table, explored.arm_base);
+  // An upright axis at x = Z r / f projects to the vertical line at r (the camera is level).
+  const Eigen::Vector3d strongest = frame.to_table(Eigen::Vector3d(60 / 300.0, 0.3, 1.0));
+  EXPECT_NEAR(top_line(), 60, 1.0) << "nothing explored yet";
+  request({strongest});
+  EXPECT_NEAR(top_line(), -80, 1.0) << "the explored bottle's edges are left out";
+  request({});
+  EXPECT_NEAR(top_line(), 60, 1.0) << "a survey that names nothing explored";
+  request({Eigen::Vector3d(NAN, 0, 0)});
+  EXPECT_NEAR(top_line(), 60, 1.0) << "a place that is not finite is passed over";
 }

@@ -56,4 +56,17 @@ cv::Mat outline_band(const cv::Mat& region, int band_px) {
   return outer - inner;
 }
 
+cv::Mat columns_mask(const StereoRig& rig, Side side, const Plane& table, const std::vector<Column>& columns,
+                     int margin_px, int band_px) {
+  if (band_px < 0) throw std::invalid_argument("column band must be >= 0 px");
+  const Camera& camera = side == Side::Left ? rig.left : rig.right;
+  cv::Mat mask(camera.height, camera.width, CV_8UC1, cv::Scalar(0));
+  for (const Column& column : columns) {
+    // Each outline on its own: the band of a union would lose where two columns overlap.
+    const cv::Mat region = column_mask(rig, side, table, column, band_px > 0 ? 0 : margin_px);
+    mask |= band_px > 0 ? outline_band(region, band_px) : region;
+  }
+  return mask;
+}
+
 }  // namespace nudge::geometry

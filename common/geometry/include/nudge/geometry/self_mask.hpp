@@ -6,6 +6,8 @@
 // region, known from the calibration, is left out of the edges the detector votes with.
 #include <opencv2/core.hpp>
 
+#include <vector>
+
 #include <Eigen/Core>
 
 #include "nudge/geometry/plane.hpp"
@@ -33,5 +35,11 @@ cv::Mat column_mask(const StereoRig& rig, Side side, const Plane& table, const C
 // the region, which the whole region would take away too. Throws std::invalid_argument for a
 // band < 1 px or a mask that is not 8-bit single channel.
 cv::Mat outline_band(const cv::Mat& region, int band_px);
+
+// What to leave out of `side`'s edges for several columns: with band_px > 0 the union of their
+// outline bands, else the union of their regions widened by margin_px. Empty columns: all 0.
+// Throws as column_mask and outline_band do.
+cv::Mat columns_mask(const StereoRig& rig, Side side, const Plane& table, const std::vector<Column>& columns,
+                     int margin_px, int band_px);
 
 }  // namespace nudge::geometry
