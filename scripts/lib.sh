@@ -236,6 +236,10 @@ nudge_run_loop() {
   # nudge-symmetry --column-calibration): a robot self-filter.
   [ "$column_mask" = 1 ] && symmetry_flags+=', "--column-calibration", "'"$calibration"'"'
   [ "${NUDGE_LOOP_TABLE_TEXTURE:-1}" = 1 ] && symmetry_flags+=', "--table-texture-calibration", "'"$calibration"'"'
+  # NUDGE_LOOP_EXPLORED_MASK=1: the objects each survey names as explored leave the symmetry
+  # service's edges (nudge-symmetry --explored-calibration; docs/supervisor.md, "Explored objects
+  # left out of the edges").
+  [ "${NUDGE_LOOP_EXPLORED_MASK:-0}" = 1 ] && symmetry_flags+=', "--explored-calibration", "'"$calibration"'"'
 
   local viewer=
   [ -n "${NUDGE_VIEWER:-}" ] && viewer=",
