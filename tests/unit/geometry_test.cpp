@@ -941,6 +941,33 @@ TEST(GeometryColumnMask, CoversTheArmsBaseColumnInBothCameras) {
   EXPECT_THROW(column_mask(rig, Side::Right, *scene.table, column, -1), std::invalid_argument);
 }
 
+// Several columns (the objects a survey has explored): the union of each one's region, or of each
+// one's outline band, so that where two overlap neither loses its silhouette.
+TEST(GeometryColumnMask, SeveralColumnsMaskEachOnesRegionOrOutline) {
+  const std::string shipped = std::string(NUDGE_SOURCE_DIR) + "/config/calibration_sim.yaml";
+  const StereoRig rig = load_rig(shipped);
+  const Workspace scene = load_workspace(shipped);
+  ASSERT_TRUE(scene.table && scene.arm_base);
+  const Eigen::Vector3d toward_camera = -scene.arm_base->normalized();  // the base from the right camera, reversed
+  Column a, b;
+  a.foot = *scene.arm_base + 0.25 * toward_camera;
+  b.foot = a.foot + 0.06 * scene.table->normal.normalized().cross(toward_camera).normalized();  // beside a, overlapping
+  a.radius = b.radius = 0.04;
+  a.height = b.height = 0.12;
+  for (const Side side : {Side::Left, Side::Right}) {
+    const cv::Mat region_a = column_mask(rig, side, *scene.table, a, 4), region_b = column_mask(rig, side, *scene.table, b, 4);
+    ASSERT_GT(cv::countNonZero(region_a & region_b), 0) << "the two overlap in the image";
+    EXPECT_EQ(cv::countNonZero(columns_mask(rig, side, *scene.table, {a, b}, 4, 0) != (region_a | region_b)), 0);
+    const cv::Mat bands = outline_band(column_mask(rig, side, *scene.table, a, 0), 3) |
+                          outline_band(column_mask(rig, side, *scene.table, b, 0), 3);
+    const cv::Mat banded = columns_mask(rig, side, *scene.table, {a, b}, 4, 3);
+    EXPECT_EQ(cv::countNonZero(banded != bands), 0);
+    EXPECT_GT(cv::countNonZero(banded & region_a & region_b), 0) << "the outlines inside the overlap are kept out too";
+    EXPECT_EQ(cv::countNonZero(columns_mask(rig, side, *scene.table, {}, 4, 0)), 0) << "nothing explored";
+  }
+  EXPECT_THROW(columns_mask(rig, Side::Right, *scene.table, {a}, 4, -1), std::invalid_argument);
+}
+
 // The band either side of a region's outline: the silhouette's edges, not what lies inside.
 TEST(GeometryColumnMask, OutlineBandKeepsTheSilhouetteNotTheInside) {
   cv::Mat region(100, 100, CV_8UC1, cv::Scalar(0));
