@@ -11,6 +11,24 @@
 
 using namespace nudge;
 
+namespace {
+
+// A rig file's cameras, table and arm base, for the options that place things on the table; every
+// input channel must name its camera. Throws std::invalid_argument naming what is missing.
+struct RigOnTable {
+  geometry::StereoRig rig;
+  geometry::Plane table;
+  Eigen::Vector3d arm_base;
+};
+RigOnTable rig_on_table(const std::string& path, const std::vector<std::string>& inputs) {
+  const geometry::Workspace scene = geometry::load_workspace(path);
+  if (!scene.table || !scene.arm_base) throw std::invalid_argument(path + " needs table_plane and arm_base");
+  for (const auto& channel : inputs) symmetry_service::side_of_channel(channel);
+  return {geometry::load_rig(path), *scene.table, *scene.arm_base};
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   return bus::guarded_main("symmetry", [&] {
     bus::Service service("symmetry", "Fast bilateral symmetry detection (thesis ch. 3) on camera images.");
@@ -146,16 +164,12 @@ int main(int argc, char** argv) {
     }
     if (!column_calibration.empty()) {
       try {
-        const geometry::StereoRig rig = geometry::load_rig(column_calibration);
-        const geometry::Workspace scene = geometry::load_workspace(column_calibration);
-        if (!scene.table || !scene.arm_base)
-          throw std::invalid_argument(column_calibration + " needs table_plane and arm_base");
-        column.foot = *scene.arm_base;
         if (column_band < 0) throw std::invalid_argument("--column-band must be >= 0");
+        const RigOnTable on_table = rig_on_table(column_calibration, options.inputs);
+        column.foot = on_table.arm_base;
         for (const geometry::Side side : {geometry::Side::Left, geometry::Side::Right})
           (side == geometry::Side::Left ? options.column_mask_left : options.column_mask_right) =
-              geometry::columns_mask(rig, side, *scene.table, {column}, 4, column_band);
-        for (const auto& channel : options.inputs) symmetry_service::side_of_channel(channel);
+              geometry::columns_mask(on_table.rig, side, on_table.table, {column}, 4, column_band);
       } catch (const std::exception& e) {
         throw FlagError(std::string("--column-calibration: ") + e.what());
       }
@@ -185,12 +199,10 @@ int main(int argc, char** argv) {
         if (!(explored.radius > 0) || !(explored.height > 0))
           throw std::invalid_argument("--explored-radius and --explored-height must be > 0");
         if (explored.band_px < 0) throw std::invalid_argument("--explored-band must be >= 0");
-        explored.rig = geometry::load_rig(explored_calibration);
-        const geometry::Workspace scene = geometry::load_workspace(explored_calibration);
-        if (!scene.table || !scene.arm_base) throw std::invalid_argument(explored_calibration + " needs table_plane and arm_base");
-        explored.table = *scene.table;
-        explored.arm_base = *scene.arm_base;
-        for (const auto& channel : options.inputs) symmetry_service::side_of_channel(channel);
+        const RigOnTable on_table = rig_on_table(explored_calibration, options.inputs);
+        explored.rig = on_table.rig;
+        explored.table = on_table.table;
+        explored.arm_base = on_table.arm_base;
         options.explored = explored;
       } catch (const std::exception& e) {
         throw FlagError(std::string("--explored-calibration: ") + e.what());
@@ -205,12 +217,10 @@ int main(int argc, char** argv) {
         if (!(reach.column_px >= 0)) throw std::invalid_argument("--reach-column-px must be >= 0");
         if (!(reach.max_tilt_deg >= 0 && reach.max_tilt_deg <= 90))
           throw std::invalid_argument("--reach-max-tilt must be in [0, 90]");
-        reach.rig = geometry::load_rig(reach_calibration);
-        const geometry::Workspace scene = geometry::load_workspace(reach_calibration);
-        if (!scene.table || !scene.arm_base) throw std::invalid_argument(reach_calibration + " needs table_plane and arm_base");
-        reach.table = *scene.table;
-        reach.centre = *scene.arm_base;
-        for (const auto& channel : options.inputs) symmetry_service::side_of_channel(channel);
+        const RigOnTable on_table = rig_on_table(reach_calibration, options.inputs);
+        reach.rig = on_table.rig;
+        reach.table = on_table.table;
+        reach.centre = on_table.arm_base;
         options.reach = reach;
       } catch (const std::exception& e) {
         throw FlagError(std::string("--reach-calibration: ") + e.what());

@@ -92,6 +92,23 @@ nudge::symmetry_service::Options::Reach level_reach() {
   return reach;
 }
 
+// Two bottles in a right-camera image: the strongest (`strongest_height` px tall, leaning
+// `strongest_tilt`) at r = 60 and an upright one, 110 px tall, at r = -80.
+cv::Mat two_bottles(double strongest_tilt, int strongest_height = 160) {
+  cv::Mat img(240, 320, CV_8UC3, cv::Scalar(200, 210, 220));
+  syn::draw_shape(img, syn::bottle_profile(strongest_height, 30), 60, strongest_tilt, 0, cv::Scalar(40, 60, 90));
+  syn::draw_shape(img, syn::bottle_profile(110, 30), -80, 0, 0, cv::Scalar(40, 60, 90));
+  return img;
+}
+
+// The right camera's options for two_bottles: no pairs across the two, only their own lines.
+nudge::symmetry_service::Options two_bottle_options() {
+  nudge::symmetry_service::Options options = mono_options();
+  options.inputs = {"CAMERA_RIGHT"};
+  options.params.dmax = 70;
+  return options;
+}
+
 }  // namespace
 
 TEST(SymmetryHandlers, EveryImageGetsItsLinesAtTheKnownAxis) {
@@ -351,13 +368,9 @@ TEST(SymmetryHandlers, OnlyLinesStandingWithinReachArePublished) {
 // no longer keeps the next object's line out. A column line ranked after the kept lines is not
 // added, and with column_px 0 the column counts (as before).
 TEST(SymmetryHandlers, TheArmBaseColumnsLineDoesNotTakeAPlaceAmongTheLinesKept) {
-  nudge::symmetry_service::Options options = mono_options();
-  options.inputs = {"CAMERA_RIGHT"};
-  options.params.dmax = 70;  // no pairs across the two bottles: only their own lines
+  nudge::symmetry_service::Options options = two_bottle_options();
   nudge::symmetry_service::Options::Reach reach = level_reach();
-  cv::Mat img(240, 320, CV_8UC3, cv::Scalar(200, 210, 220));
-  syn::draw_shape(img, syn::bottle_profile(160, 30), 60, 0, 0, cv::Scalar(40, 60, 90));   // the strongest
-  syn::draw_shape(img, syn::bottle_profile(110, 30), -80, 0, 0, cv::Scalar(40, 60, 90));  // the next
+  const cv::Mat img = two_bottles(0);
   // An upright axis at x = Z r / f projects to the vertical line at r (the camera is level).
   const auto column_at = [](double r) { return Eigen::Vector3d(r / 300.0, 0.3, 1.0); };
   auto published = [&](double column_px, const Eigen::Vector3d& column) {
@@ -384,14 +397,10 @@ TEST(SymmetryHandlers, TheArmBaseColumnsLineDoesNotTakeAPlaceAmongTheLinesKept) 
 // chosen (Reach::max_tilt_deg): with one line kept, a leaning bottle (12 deg in a level camera)
 // that outvotes an upright one takes the place without the check, and gives it up with it.
 TEST(SymmetryHandlers, LeaningLinesDoNotTakeThePlacesOfUprightOnes) {
-  nudge::symmetry_service::Options options = mono_options();
-  options.inputs = {"CAMERA_RIGHT"};
-  options.params.dmax = 70;  // no pairs across the two bottles: only their own lines
+  nudge::symmetry_service::Options options = two_bottle_options();
   nudge::symmetry_service::Options::Reach reach = level_reach();
   reach.centre = Eigen::Vector3d(0, 0.3, 1.0);
-  cv::Mat img(240, 320, CV_8UC3, cv::Scalar(200, 210, 220));
-  syn::draw_shape(img, syn::bottle_profile(170, 30), 60, 12 * kDeg, 0, cv::Scalar(40, 60, 90));  // the strongest
-  syn::draw_shape(img, syn::bottle_profile(110, 30), -80, 0, 0, cv::Scalar(40, 60, 90));         // upright
+  const cv::Mat img = two_bottles(12 * kDeg, 170);
   auto published = [&](double max_tilt_deg) {
     reach.max_tilt_deg = max_tilt_deg;
     options.reach = reach;
@@ -413,9 +422,7 @@ TEST(SymmetryHandlers, LeaningLinesDoNotTakeThePlacesOfUprightOnes) {
 // names the strongest bottle's place, the one line kept within reach is the other bottle's; a
 // request naming nothing brings the first back, and a place that is not finite is passed over.
 TEST(SymmetryHandlers, ExploredObjectsLeaveTheEdgesFromTheSurveyThatNamesThem) {
-  nudge::symmetry_service::Options options = mono_options();
-  options.inputs = {"CAMERA_RIGHT"};
-  options.params.dmax = 70;  // no pairs across the two bottles: only their own lines
+  nudge::symmetry_service::Options options = two_bottle_options();
   nudge::symmetry_service::Options::Reach reach = level_reach();
   reach.centre = Eigen::Vector3d(0, 0.3, 1.0);
   options.reach = reach;
@@ -426,9 +433,7 @@ TEST(SymmetryHandlers, ExploredObjectsLeaveTheEdgesFromTheSurveyThatNamesThem) {
   explored.radius = 0.12;  // the bottle is 60 px (0.2 m) wide at 1 m
   explored.height = 0.6;
   options.explored = explored;
-  cv::Mat img(240, 320, CV_8UC3, cv::Scalar(200, 210, 220));
-  syn::draw_shape(img, syn::bottle_profile(160, 30), 60, 0, 0, cv::Scalar(40, 60, 90));   // the strongest
-  syn::draw_shape(img, syn::bottle_profile(110, 30), -80, 0, 0, cv::Scalar(40, 60, 90));  // the next
+  const cv::Mat img = two_bottles(0);
 
   InProcess run(options);
   Latest<nudge::symmetry_lines_t> right(run.probe, "SYMMETRY_RIGHT");
