@@ -51,6 +51,19 @@ using namespace nudge;
 namespace {
 
 constexpr int kRight = 1;
+// An object whose axis leans more than this in the simulator has fallen over (upright objects lean
+// a degree or two at most; one lying on its side, 90).
+constexpr double kFallenDeg = 45;
+
+// Each object's lean in a recorded state: the angle between its body's z axis and the world's.
+std::vector<double> object_tilts_deg(const sim_state_t& state) {
+  std::vector<double> tilts;
+  for (const sim::ObjectPose& pose : bus::poses_of(state).objects) {
+    const double cosine = std::clamp((pose.orientation * Eigen::Vector3d::UnitZ()).z(), -1.0, 1.0);
+    tilts.push_back(std::acos(cosine) * 180 / M_PI);
+  }
+  return tilts;
+}
 
 struct Segmented {
   int attempt = 0;
@@ -59,6 +72,7 @@ struct Segmented {
   int effector_pixels = 0;
   int tool_changed_pixels = 0;  // effector pixels and the tool's shadow
   int mask_pixels = 0;
+  double object_tilt_deg = 0;  // the segmented object's lean in the simulator at the after still
   cv::Mat gallery;           // before | after | mask over after
 };
 
@@ -66,10 +80,14 @@ struct Run {
   std::string name;
   int objects_present = 0;
   int attempts = 0, no_motion = 0, tipped = 0, other_failures = 0;
+  // Segmentations whose object lay fallen (leaning beyond kFallenDeg in the simulator) when the
+  // after still was taken: the supervisor should have called the attempt tipped, not segmented.
+  int segmented_fallen = 0;
+  std::set<int> objects_fallen;  // scene indices lying fallen at the run's last recorded state
   double wall_s = 0;
   std::string end_reason;
   std::vector<Segmented> segmented;
-  std::set<int> objects_found;  // scene indices segmented with IoU >= 0.5
+  std::set<int> objects_found;  // scene indices segmented with IoU >= 0.5, standing
   // Scene indices of the objects the scene stages outside the arm's workspace ring (the object's
   // axis nearer the base than ring_inner or farther than ring_outer): the candidates the
   // triangulation gives are within the ring, so the loop cannot be expected to find these.
@@ -191,12 +209,20 @@ Run evaluate(const std::string& name, const fs::path& run_dir, const fs::path& s
       const Truth truth = render_truth(world, *last_state);
       Segmented s = score(mask, truth, run.objects_present);
       s.attempt = seg.attempt;
+      const std::vector<double> tilts = object_tilts_deg(*last_state);
+      if (s.object >= 0 && s.object < static_cast<int>(tilts.size())) s.object_tilt_deg = tilts[s.object];
+      run.segmented_fallen += s.object_tilt_deg > kFallenDeg;
       char folder[32];
       std::snprintf(folder, sizeof folder, "attempt_%02d", seg.attempt);
       s.gallery = gallery_row(run_dir / folder, mask);
-      if (s.iou >= 0.5) run.objects_found.insert(s.object);
+      if (s.iou >= 0.5 && s.object_tilt_deg <= kFallenDeg) run.objects_found.insert(s.object);  // a fallen one: tipped
       run.segmented.push_back(std::move(s));
     }
+  }
+  if (last_state) {
+    const std::vector<double> tilts = object_tilts_deg(*last_state);
+    for (size_t i = 0; i < tilts.size(); ++i)
+      if (tilts[i] > kFallenDeg) run.objects_fallen.insert(static_cast<int>(i));
   }
   run.other_failures = run.attempts - static_cast<int>(run.segmented.size()) - run.no_motion - run.tipped;
   return run;
@@ -237,6 +263,7 @@ struct SetScore {
   std::vector<Run> runs;
   std::vector<fs::path> attempt_dirs;
   int single_runs = 0, successes = 0, effector = 0, tool_changed = 0, phantoms = 0, multi_found = 0, multi_present = 0;
+  int segmented_fallen = 0, objects_fallen = 0;  // Run's, summed
   int multi_in_reach = 0, multi_found_in_reach = 0;  // the same, over the objects within the workspace ring
   std::vector<std::string> beyond_reach;             // "run: object i at r mm" for the objects outside it
   std::vector<double> ious;
@@ -317,8 +344,8 @@ SetScore score_set(const fs::path& runs_dir, const fs::path& scene_dir, std::vec
   std::sort(set.attempt_dirs.begin(), set.attempt_dirs.end());
 
   std::ostringstream table;
-  table << "| run | objects | attempts | segmented (object: IoU) | effector px | no motion | tipped | other | wall s | end |\n"
-        << "|---|---|---|---|---|---|---|---|---|---|\n";
+  table << "| run | objects | attempts | segmented (object: IoU) | effector px | no motion | tipped | other | fallen: segmented, at the end | wall s | end |\n"
+        << "|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const Run& r : set.runs) {
     if (r.objects_present > 1) {
       set.multi_found += static_cast<int>(r.objects_found.size());
@@ -332,6 +359,8 @@ SetScore score_set(const fs::path& runs_dir, const fs::path& scene_dir, std::vec
       set.successes += r.success();
     }
     set.phantoms += r.no_motion;
+    set.segmented_fallen += r.segmented_fallen;
+    set.objects_fallen += static_cast<int>(r.objects_fallen.size());
     std::string segmented;
     int run_effector = 0;
     for (const Segmented& s : r.segmented) {
@@ -348,7 +377,7 @@ SetScore score_set(const fs::path& runs_dir, const fs::path& scene_dir, std::vec
     std::snprintf(wall, sizeof wall, "%.0f", r.wall_s);
     table << "| " << r.name << " | " << r.objects_present << " | " << r.attempts << " | "
           << (segmented.empty() ? "–" : segmented) << " | " << run_effector << " | " << r.no_motion << " | " << r.tipped
-          << " | " << r.other_failures << " | " << wall << " | " << r.end_reason << " |\n";
+          << " | " << r.other_failures << " | " << r.segmented_fallen << ", " << r.objects_fallen.size() << " | " << wall << " | " << r.end_reason << " |\n";
   }
   set.table = table.str();
   return set;
@@ -361,6 +390,7 @@ void json_fields(JsonWriter& j, const SetScore& s, double ms) {
   j.field("mean_ms_motion_segmentation", ms).field("multi_object_found", s.multi_found).field("multi_object_present", s.multi_present);
   j.field("multi_object_in_reach", s.multi_in_reach).field("multi_object_found_in_reach", s.multi_found_in_reach);
   j.field("phantoms_rejected", s.phantoms);
+  j.field("segmentations_of_fallen_objects", s.segmented_fallen).field("objects_fallen", s.objects_fallen);
 }
 
 std::string join(const std::vector<std::string>& parts, const std::string& separator) {
@@ -382,7 +412,10 @@ std::string figures_table(const SetScore& s, double ms) {
      << "| objects of the multi-object scenes segmented | (one object per scene) | " << s.multi_found << "/" << s.multi_present << " |\n"
      << "| of them standing within the arm's workspace ring, segmented | – | " << s.multi_found_in_reach << "/" << s.multi_in_reach
      << (s.beyond_reach.empty() ? std::string() : " (outside the ring: " + join(s.beyond_reach, ", ") + ")") << " |\n"
-     << "| attempts that found no motion (phantoms, out-of-view) | – | " << s.phantoms << " |\n";
+     << "| attempts that found no motion (phantoms, out-of-view) | – | " << s.phantoms << " |\n"
+     << "| segmentations of an object lying fallen (leaning over " << kFallenDeg << " deg in the simulator; not counted as segmented) | – | "
+     << s.segmented_fallen << " |\n"
+     << "| objects lying fallen at the runs' ends | – | " << s.objects_fallen << " |\n";
   return md.str();
 }
 

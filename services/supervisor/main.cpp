@@ -597,6 +597,9 @@ void add_flags(Flags& f, Options& o) {
                "candidates that both cameras show upright in a smaller share of the survey's frames are not nudged (0: all are)");
   f.add_double("min-mask-share", &o.config.min_mask_share,
                "a mask smaller than this share of the smallest object's image at the rest (its pixels, rows or mean width) is no segmentation (0: any)");
+  f.add_double("max-object-half-width", &o.config.max_object_half_width_m,
+               "mask pixels farther than this from the object's after line (m, projected at its rest) are something else "
+               "that moved and are cleared (0: kept)");
   f.add_double("after-line-lean-window", &o.config.line_search.lean_window_deg,
                "the after still's object line is looked for first within this many deg of the before line's lean carried to "
                "the rest (0: only about the upright prediction)");
@@ -744,6 +747,8 @@ int main(int argc, char** argv) {
     if (!(opt.config.targets.min_nudge_agreement >= 0 && opt.config.targets.min_nudge_agreement <= 1))
       throw FlagError("--min-nudge-agreement must lie in [0, 1]");
     if (!(opt.config.min_mask_share >= 0 && opt.config.min_mask_share <= 1)) throw FlagError("--min-mask-share must lie in [0, 1]");
+    if (!(opt.config.max_object_half_width_m >= 0 && opt.config.max_object_half_width_m <= 0.5))
+      throw FlagError("--max-object-half-width must lie in [0, 0.5] m");
     if (!(opt.config.min_mask_mirror_agreement >= 0 && opt.config.min_mask_mirror_agreement <= 1))
       throw FlagError("--min-mask-mirror must lie in [0, 1]");
     if (!(opt.config.grip_width_low >= 0 && opt.config.grip_width_low < 1)) throw FlagError("--grip-width-low must lie in [0, 1)");

@@ -531,3 +531,38 @@ TEST(MirrorAgreement, BadMasksAreNamed) {
   EXPECT_THROW(mirror_agreement(cv::Mat(), line_at(0, 0)), std::invalid_argument);
   EXPECT_THROW(mirror_agreement(cv::Mat::zeros(10, 10, CV_8UC3), line_at(0, 0)), std::invalid_argument);
 }
+
+TEST(KeepNearLine, MotionBeyondTheWidestHalfWidthIsCleared) {
+  // An object about x = 400 (R = 80.5, theta = 0) 120 px wide, and a neighbour that moved with it
+  // joined to its right side (x 460..560).
+  cv::Mat mask = cv::Mat::zeros(480, 640, CV_8U);
+  cv::rectangle(mask, cv::Rect(340, 100, 121, 200), cv::Scalar(255), cv::FILLED);
+  cv::rectangle(mask, cv::Rect(461, 150, 100, 150), cv::Scalar(255), cv::FILLED);
+  const int neighbour = 100 * 150;
+  cv::Mat kept = mask.clone();
+  EXPECT_EQ(keep_near_line(kept, line_at(80.5, 0), 60.5), neighbour);
+  EXPECT_EQ(cv::countNonZero(kept), 121 * 200) << "the object itself is kept whole";
+  EXPECT_EQ(cv::countNonZero(kept(cv::Rect(461, 0, 179, 480))), 0);
+  // Wide enough for both: nothing cleared.
+  cv::Mat wide = mask.clone();
+  EXPECT_EQ(keep_near_line(wide, line_at(80.5, 0), 200), 0);
+  // About a tilted line the band turns with it: a column of pixels along the line is kept, the
+  // same column 40 px to its side is not.
+  cv::Mat tilted = cv::Mat::zeros(480, 640, CV_8U);
+  const sym::Line line = line_at(0, 20);  // through the centre, normal at 20 deg
+  for (int y = 0; y < 480; ++y) {
+    const double x_on_line = 319.5 - (y - 239.5) * std::tan(20 * M_PI / 180);
+    for (int x : {static_cast<int>(std::lround(x_on_line)), static_cast<int>(std::lround(x_on_line + 40 / std::cos(20 * M_PI / 180)))})
+      if (x >= 0 && x < 640) tilted.at<uint8_t>(y, x) = 255;
+  }
+  const int before = cv::countNonZero(tilted);
+  const int cleared = keep_near_line(tilted, line, 20);
+  EXPECT_NEAR(cleared, before / 2, 2);
+}
+
+TEST(KeepNearLine, BadMasksAreNamed) {
+  cv::Mat colour = cv::Mat::zeros(10, 10, CV_8UC3), empty, grey = cv::Mat::zeros(10, 10, CV_8U);
+  EXPECT_THROW(keep_near_line(colour, line_at(0, 0), 5), std::invalid_argument);
+  EXPECT_THROW(keep_near_line(empty, line_at(0, 0), 5), std::invalid_argument);
+  EXPECT_THROW(keep_near_line(grey, line_at(0, 0), -1), std::invalid_argument);
+}

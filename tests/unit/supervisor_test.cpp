@@ -1522,6 +1522,43 @@ TEST_F(SupervisorTest, MotionFarAboveTheObjectIsNotKeptInItsMask) {
   EXPECT_GT(cv::countNonZero(mask), 1000) << "the object stays";
 }
 
+// A neighbour pushed along with the object moves rigidly with it and is attached to its mask
+// (development m02: a bottle's mask with the mug beside it, IoU 0.42-0.55). Nothing of an
+// upright object lies farther from its line than the widest object's half-width (a mug's handle,
+// 7.5 cm): what does is cleared, and the attempt counts the pixels.
+TEST_F(SupervisorTest, MotionBesideTheObjectBeyondTheWidestObjectIsNotKeptInItsMask) {
+  cv::Rect object_box, neighbour;
+  cv::Mat object_mask;
+  auto with_neighbour = [&](const cv::Mat& before, const cv::Mat& after, const nudge::symmetry::Line& l0,
+                            const nudge::symmetry::Line& l1) {
+    sv::Segmentation s = mask_of_difference(before, after, l0, l1);
+    object_mask = s.mask.clone();
+    object_box = cv::boundingRect(s.mask);
+    // A neighbour joined to the object's right side, 300 px wide, over the object's lowest fifth.
+    neighbour = cv::Rect(object_box.br().x, object_box.br().y - object_box.height / 5, 300, object_box.height / 5);
+    s.mask(neighbour).setTo(255);
+    return s;
+  };
+  const sv::Attempt a = attempt_segmented_by(with_neighbour);
+  ASSERT_EQ(a.outcome, sv::Outcome::Segmented) << a.reason;
+  const cv::Mat& mask = a.segmentation.mask;
+  EXPECT_EQ(cv::countNonZero(mask(cv::Rect(neighbour.x + 200, neighbour.y, 100, neighbour.height))), 0)
+      << "the neighbour's far part is gone";
+  EXPECT_EQ(cv::countNonZero(object_mask & ~mask), 0) << "the object's own pixels stay";
+  EXPECT_GT(a.mask_pixels_beside, 200 * neighbour.height) << "the cleared pixels are counted";
+
+  // Turned off, the neighbour stays, and the mask is too lopsided to be an object's.
+  sv::Config keep;
+  keep.max_object_half_width_m = 0;
+  sv::Supervisor s(keep, scene_, sv::ArmSetup{}, with_neighbour);
+  const Eigen::Vector3d rest = nudge_and_park(s, Eigen::Vector3d(0.28, -0.05, 0));
+  s.on_right_still(draw_scene(scene_, {1280, 960}, {rest}), now_, now_);
+  const auto ended = outputs_of<sv::AttemptEnded>(s.take_outputs());
+  ASSERT_EQ(ended.size(), 1u);
+  EXPECT_EQ(cv::countNonZero(ended[0].attempt->segmentation.mask(neighbour)), neighbour.area());
+  EXPECT_EQ(ended[0].attempt->outcome, sv::Outcome::SegmentationFailed) << ended[0].attempt->reason;
+}
+
 // A few hundred pixels of motion (a cup's mask has ~20 000 in the still) are no object: the
 // attempt fails with its reason rather than reporting a segmentation of nothing (held-out hm1).
 TEST_F(SupervisorTest, AMaskTooSmallForAnyObjectIsNoSegmentation) {

@@ -609,4 +609,20 @@ double mirror_agreement(const cv::Mat& mask, const symmetry::Line& line) {
   return either > 0 ? static_cast<double>(both) / either : 0.0;
 }
 
+int keep_near_line(cv::Mat& mask, const symmetry::Line& line, double half_width_px) {
+  if (mask.empty() || mask.type() != CV_8UC1) throw std::invalid_argument("keep_near_line: the mask must be 8-bit, one channel");
+  if (!(half_width_px >= 0)) throw std::invalid_argument("keep_near_line: half_width_px must be >= 0");
+  const double cx = (mask.cols - 1) / 2.0, cy = (mask.rows - 1) / 2.0;
+  const double c = std::cos(line.theta), s = std::sin(line.theta);
+  int cleared = 0;
+  for (int y = 0; y < mask.rows; ++y) {
+    uint8_t* row = mask.ptr<uint8_t>(y);
+    // The signed distance of pixel x from the line is (x - cx) c + (y - cy) s - r: linear in x.
+    const double offset = (y - cy) * s - line.r - cx * c;
+    for (int x = 0; x < mask.cols; ++x)
+      if (row[x] && std::abs(x * c + offset) > half_width_px) row[x] = 0, ++cleared;
+  }
+  return cleared;
+}
+
 }  // namespace nudge::segmentation

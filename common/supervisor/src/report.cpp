@@ -203,6 +203,7 @@ std::string attempt_json(const Attempt& a) {
   write_line(j, "line_before", a.before_line);
   write_line(j, "line_after", a.after_line);
   j.field("mask_pixels", a.segmentation.mask.empty() ? 0 : cv::countNonZero(a.segmentation.mask));
+  j.field("mask_pixels_beside", a.mask_pixels_beside);
   j.field("started_s", a.started / 1e6).field("ended_s", a.ended / 1e6);
   j.key("rejected").begin_array();
   for (const Rejection& r : a.rejected) j.begin_object().field("candidate_index", r.index).field("reason", r.reason).end_object();

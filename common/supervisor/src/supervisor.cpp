@@ -714,6 +714,7 @@ void Supervisor::segment(int64_t now) {
   const bool stages_later = a.learn && segment_stageless_;
   a.segmentation = (stages_later ? segment_stageless_ : segment_)(a.before, a.after, *a.before_line, *a.after_line);
   keep_object_rows(a);
+  keep_object_columns(a);
   if (left.valid()) left.get();  // joined before the attempt can end
   // Fig. 6.7's stages for the attempt's files when the segmentation went without them: drawn
   // after the grasp is planned, off its clock (an attempt that ended meanwhile waits in outputs_,
@@ -911,6 +912,22 @@ void Supervisor::keep_object_rows(Attempt& a) const {
   const int last = std::clamp(static_cast<int>(lowest) + margin, 0, mask.rows);
   mask.rowRange(0, first).setTo(0);
   mask.rowRange(last, mask.rows).setTo(0);
+}
+
+// Only pixels within the widest object's half-width of the after line can be the object: a
+// neighbour that moved with it, attached to the mask as a rigid part, is not kept.
+void Supervisor::keep_object_columns(Attempt& a) const {
+  cv::Mat& mask = a.segmentation.mask;
+  if (mask.empty() || !a.rest || !a.after_line || config_.max_object_half_width_m <= 0) return;
+  // The rest may be nearer the camera by the stereo depth error: the object's image is widest there.
+  const Eigen::Vector2d ray = viewing_ray(*a.rest);
+  const Eigen::Vector3d foot = *a.rest - config_.max_depth_error_m * Eigen::Vector3d(ray.x(), ray.y(), 0);
+  const Eigen::Vector3d across = config_.max_object_half_width_m * Eigen::Vector3d(-ray.y(), ray.x(), 0);
+  const auto centre = scene_.project_right(foot, mask.size());
+  const auto side = scene_.project_right(foot + across, mask.size());
+  if (!centre || !side) return;
+  const int margin = mask.cols / 128;  // 10 px at 1280 columns: the line's error, rounding
+  a.mask_pixels_beside = segmentation::keep_near_line(mask, *a.after_line, cv::norm(*side - *centre) + margin);
 }
 
 void Supervisor::end_attempt(Outcome outcome, const std::string& reason, int64_t now) {

@@ -145,6 +145,14 @@ cv::Mat mirror_image(const cv::Mat& image, const symmetry::Line& line);
 // std::invalid_argument for an empty image or one that is not 8-bit single-channel.
 double mirror_agreement(const cv::Mat& mask, const symmetry::Line& line);
 
+// Clears the pixels of `mask` (8-bit, one channel) farther than `half_width_px` from `line`
+// ((R, theta) about the image centre), measured along the line's normal; returns how many were
+// cleared. Every part of an upright object lies within its widest half-width of its symmetry line:
+// motion beyond that is something else that moved (a neighbour pushed along with the object and
+// attached to its mask as a rigid part, an object that fell across the line). Throws
+// std::invalid_argument for an empty mask, one that is not 8-bit single-channel, or a negative width.
+int keep_near_line(cv::Mat& mask, const symmetry::Line& line, double half_width_px);
+
 // One-shot convenience around MotionSegmenter.
 MotionSegmentation segment_by_motion(const cv::Mat& before, const cv::Mat& after, const symmetry::Line& line_before,
                                      const symmetry::Line& line_after, const MotionParams& params = {},
