@@ -42,6 +42,7 @@
 #include "nudge/sim/mask_score.hpp"
 #include "nudge/sim/world.hpp"
 #include "nudge/sim_state_t.hpp"
+#include "nudge/supervisor_state_t.hpp"
 #include "report.hpp"
 
 namespace fs = std::filesystem;
@@ -54,6 +55,32 @@ constexpr int kRight = 1;
 // An object whose axis leans more than this in the simulator has fallen over (upright objects lean
 // a degree or two at most; one lying on its side, 90).
 constexpr double kFallenDeg = 45;
+constexpr double kTippingDeg = 5;  // a lean past this that goes on to kFallenDeg: when the fall began
+
+// "object 2 in attempt 3 (NUDGE, its target)": the object fell after `before` (the last state that
+// showed it standing) while the supervisor was as `supervisor` last said. The target is the
+// object when the attempt's target lay within 6 cm of where the object stood.
+std::string fall_description(int object, const sim_state_t& before, const sim_state_t& tipping,
+                             const std::optional<supervisor_state_t>& supervisor) {
+  std::string text = "object " + std::to_string(object);
+  // Where the pad was when it began to lean: beside it, the pad pushed it; far off, the arm's links.
+  if (object < tipping.num_objects) {
+    const auto& at = tipping.objects[static_cast<size_t>(object)].pose.position;
+    const auto& pad = tipping.pusher.position;
+    char where[96];
+    std::snprintf(where, sizeof where, " (the pad %.0f mm from its foot, %.0f mm up, as it began to lean)",
+                  1000 * std::hypot(pad[0] - at[0], pad[1] - at[1]), 1000 * pad[2]);
+    text += where;
+  }
+  if (!supervisor) return text + " before the supervisor's first state";
+  text += " in attempt " + std::to_string(supervisor->attempt) + " (" + supervisor->state_name;
+  if (object < before.num_objects && supervisor->attempt > 0) {
+    const auto& stood = before.objects[static_cast<size_t>(object)].pose.position;
+    const double apart = std::hypot(stood[0] - supervisor->target[0], stood[1] - supervisor->target[1]);
+    text += apart < 0.06 ? ", its target" : ", not its target";
+  }
+  return text + ")";
+}
 
 // Each object's lean in a recorded state: the angle between its body's z axis and the world's.
 std::vector<double> object_tilts_deg(const sim_state_t& state) {
@@ -84,6 +111,9 @@ struct Run {
   // after still was taken: the supervisor should have called the attempt tipped, not segmented.
   int segmented_fallen = 0;
   std::set<int> objects_fallen;  // scene indices lying fallen at the run's last recorded state
+  // When each of those fell: "object 2 in attempt 3 (NUDGE, its target)", from the supervisor's
+  // state published last before the first recorded state that shows it fallen.
+  std::vector<std::string> falls;
   double wall_s = 0;
   std::string end_reason;
   std::vector<Segmented> segmented;
@@ -197,10 +227,25 @@ Run evaluate(const std::string& name, const fs::path& run_dir, const fs::path& s
   lcm::LogFile log((run_dir / (run_dir.filename().string() + ".lcmlog")).string(), "r");
   if (!log.good()) throw std::runtime_error(run_dir.string() + ": no run log");
   std::optional<sim_state_t> last_state;
+  std::optional<supervisor_state_t> supervisor;
+  std::map<int, std::string> fell;  // object -> when it fell
+  std::map<int, sim_state_t> tipping;  // object -> the first state of its latest lean past kTippingDeg
   while (const lcm::LogEvent* e = log.readNextEvent()) {
     if (e->channel == "SIM_STATE") {
       sim_state_t state;
-      if (state.decode(e->data, 0, e->datalen) >= 0) last_state = state;
+      if (state.decode(e->data, 0, e->datalen) < 0) continue;
+      const std::vector<double> tilts = object_tilts_deg(state);
+      for (size_t i = 0; i < tilts.size(); ++i) {
+        const int object = static_cast<int>(i);
+        if (tilts[i] <= kTippingDeg) tipping.erase(object);
+        else if (!tipping.count(object)) tipping[object] = state;
+        if (tilts[i] > kFallenDeg && !fell.count(object) && last_state)
+          fell[object] = fall_description(object, *last_state, tipping.at(object), supervisor);
+      }
+      last_state = state;
+    } else if (e->channel == "SUPERVISOR_STATE") {
+      supervisor_state_t state;
+      if (state.decode(e->data, 0, e->datalen) >= 0) supervisor = state;
     } else if (e->channel == "SEGMENTATION" && last_state) {
       segmentation_t seg;
       if (seg.decode(e->data, 0, e->datalen) < 0) continue;
@@ -222,7 +267,10 @@ Run evaluate(const std::string& name, const fs::path& run_dir, const fs::path& s
   if (last_state) {
     const std::vector<double> tilts = object_tilts_deg(*last_state);
     for (size_t i = 0; i < tilts.size(); ++i)
-      if (tilts[i] > kFallenDeg) run.objects_fallen.insert(static_cast<int>(i));
+      if (tilts[i] > kFallenDeg) {
+        run.objects_fallen.insert(static_cast<int>(i));
+        if (fell.count(static_cast<int>(i))) run.falls.push_back(fell[static_cast<int>(i)]);
+      }
   }
   run.other_failures = run.attempts - static_cast<int>(run.segmented.size()) - run.no_motion - run.tipped;
   return run;
@@ -324,6 +372,12 @@ Detection detection_of(const fs::path& runs_dir) {
   return d;
 }
 
+std::string join(const std::vector<std::string>& parts, const std::string& separator) {
+  std::string out;
+  for (const std::string& p : parts) out += (out.empty() ? "" : separator) + p;
+  return out;
+}
+
 SetScore score_set(const fs::path& runs_dir, const fs::path& scene_dir, std::vector<std::string> names,
                    const robot::Workspace& workspace) {
   if (names.empty()) names = scene_names(scene_dir);
@@ -379,6 +433,10 @@ SetScore score_set(const fs::path& runs_dir, const fs::path& scene_dir, std::vec
           << (segmented.empty() ? "–" : segmented) << " | " << run_effector << " | " << r.no_motion << " | " << r.tipped
           << " | " << r.other_failures << " | " << r.segmented_fallen << ", " << r.objects_fallen.size() << " | " << wall << " | " << r.end_reason << " |\n";
   }
+  std::vector<std::string> falls;
+  for (const Run& r : set.runs)
+    for (const std::string& fall : r.falls) falls.push_back(r.name + ": " + fall);
+  if (!falls.empty()) table << "\nObjects that fell (the first recorded state showing each lying): " << join(falls, "; ") << ".\n";
   set.table = table.str();
   return set;
 }
@@ -391,12 +449,6 @@ void json_fields(JsonWriter& j, const SetScore& s, double ms) {
   j.field("multi_object_in_reach", s.multi_in_reach).field("multi_object_found_in_reach", s.multi_found_in_reach);
   j.field("phantoms_rejected", s.phantoms);
   j.field("segmentations_of_fallen_objects", s.segmented_fallen).field("objects_fallen", s.objects_fallen);
-}
-
-std::string join(const std::vector<std::string>& parts, const std::string& separator) {
-  std::string out;
-  for (const std::string& p : parts) out += (out.empty() ? "" : separator) + p;
-  return out;
 }
 
 std::string figures_table(const SetScore& s, double ms) {

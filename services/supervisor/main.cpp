@@ -597,6 +597,9 @@ void add_flags(Flags& f, Options& o) {
                "candidates that both cameras show upright in a smaller share of the survey's frames are not nudged (0: all are)");
   f.add_double("min-mask-share", &o.config.min_mask_share,
                "a mask smaller than this share of the smallest object's image at the rest (its pixels, rows or mean width) is no segmentation (0: any)");
+  f.add_double("doubtful-tilt", &o.config.doubtful_tilt_deg,
+               "a rest leaning more than this (deg, within the upright limit) must show an upright object's base in its mask, "
+               "or the attempt is tipped (0: off)");
   f.add_double("max-object-half-width", &o.config.max_object_half_width_m,
                "mask pixels farther than this from the object's after line (m, projected at its rest) are something else "
                "that moved and are cleared (0: kept)");
@@ -747,6 +750,8 @@ int main(int argc, char** argv) {
     if (!(opt.config.targets.min_nudge_agreement >= 0 && opt.config.targets.min_nudge_agreement <= 1))
       throw FlagError("--min-nudge-agreement must lie in [0, 1]");
     if (!(opt.config.min_mask_share >= 0 && opt.config.min_mask_share <= 1)) throw FlagError("--min-mask-share must lie in [0, 1]");
+    if (!(opt.config.doubtful_tilt_deg >= 0 && opt.config.doubtful_tilt_deg <= 90))
+      throw FlagError("--doubtful-tilt must lie in [0, 90] deg");
     if (!(opt.config.max_object_half_width_m >= 0 && opt.config.max_object_half_width_m <= 0.5))
       throw FlagError("--max-object-half-width must lie in [0, 0.5] m");
     if (!(opt.config.min_mask_mirror_agreement >= 0 && opt.config.min_mask_mirror_agreement <= 1))

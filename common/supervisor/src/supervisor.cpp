@@ -739,6 +739,11 @@ void Supervisor::segment(int64_t now) {
   const std::optional<MaskOnLine> right_mask = read_mask_on_line(a.segmentation.mask, *a.after_line);
   if (right_mask) a.top[1] = right_mask->top;
   check_rest_with_mask(a, right_mask);
+  if (const std::string fell = fallen_over(a); !fell.empty()) {
+    draw_stages();
+    end_attempt(Outcome::Tipped, fell, now);
+    return;
+  }
   if (a.learn) {
     plan_grasp(now);
     if (state_ == State::Grasp)
@@ -869,24 +874,40 @@ cv::Size2d Supervisor::smallest_object_image(const Eigen::Vector3d& foot) const 
 // reads the rest).
 void Supervisor::check_rest_with_mask(Attempt& a, const std::optional<MaskOnLine>& right_mask) const {
   if (right_mask) a.rest_from_mask = foot_from_mask(scene_, *right_mask);
-  if (!a.rest_from_mask || !a.rest || config_.rest_mask_disagreement_m <= 0) return;
-  // A known object standing in front of the base hides it: the mask ends at its outline. Its
-  // place is known to a couple of centimetres (a rest, or where it was put back), and the line
-  // may run along its edge (the demo's bottle behind the mug), so it is taken that much wider.
-  constexpr double kPlaceUncertainty = 0.02;
-  for (const ExploredObject& object : standing_) {
-    if ((object.place - *a.rest).head<2>().norm() < config_.targets.same_object_radius) continue;  // the object itself
-    const double height = object.height > 0 ? object.height : config_.targets.obstacle_height;
-    if (mask_front_hidden_by(scene_, *right_mask, *a.rest, object.place, config_.targets.object_radius + kPlaceUncertainty,
-                             height)) {
-      a.mask_front_hidden_behind = object.place;
-      return;
-    }
-  }
+  if (right_mask && a.rest) a.mask_front_hidden_behind = known_object_hiding_base(*right_mask, *a.rest);
+  if (!a.rest_from_mask || !a.rest || config_.rest_mask_disagreement_m <= 0 || a.mask_front_hidden_behind) return;
   const double apart = (*a.rest_from_mask - *a.rest).head<2>().norm();
   if (apart <= config_.rest_mask_disagreement_m || apart > config_.max_lateral_m + config_.max_depth_error_m) return;
   a.rest_from_axes = a.rest;
   a.rest = a.rest_from_mask;
+}
+
+// A known object standing in front of the base hides it: the mask ends at its outline. Its place
+// is known to a couple of centimetres (a rest, or where it was put back), and the line may run
+// along its edge (the demo's bottle behind the mug), so it is taken that much wider.
+std::optional<Eigen::Vector3d> Supervisor::known_object_hiding_base(const MaskOnLine& right_mask,
+                                                                    const Eigen::Vector3d& rest) const {
+  constexpr double kPlaceUncertainty = 0.02;
+  for (const ExploredObject& object : standing_) {
+    if ((object.place - rest).head<2>().norm() < config_.targets.same_object_radius) continue;  // the object itself
+    const double height = object.height > 0 ? object.height : config_.targets.obstacle_height;
+    if (mask_front_hidden_by(scene_, right_mask, rest, object.place, config_.targets.object_radius + kPlaceUncertainty, height))
+      return object.place;
+  }
+  return std::nullopt;
+}
+
+// Config::doubtful_tilt_deg: the settled axes lean enough to doubt that they are the pushed
+// object's, and its mask shows no upright object's base that a known object could be hiding.
+// Why the attempt is "tipped", or empty.
+std::string Supervisor::fallen_over(const Attempt& a) const {
+  if (config_.doubtful_tilt_deg <= 0 || !a.rest_tilt_deg || *a.rest_tilt_deg <= config_.doubtful_tilt_deg ||
+      a.rest_from_mask || a.mask_front_hidden_behind)
+    return "";
+  char text[160];
+  std::snprintf(text, sizeof text,
+                "object tipped: its settled axes lean %.1f deg and its mask shows no upright object's base", *a.rest_tilt_deg);
+  return text;
 }
 
 // Only rows between the object's foot and the tallest object's top can be the object: motion

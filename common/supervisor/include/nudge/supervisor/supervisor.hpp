@@ -113,6 +113,15 @@ struct Config {
   // axes within 15 deg (ch. 4), as the triangulation service's AXES do: an object that tips over
   // shows no upright axis at all.
   double upright_max_tilt_deg = 15;
+  // A rest leaning more than this (though within upright_max_tilt_deg) is doubtful: the settled
+  // axes may be another object's (one standing behind the pushed one, a stereo mismatch) while
+  // the pushed object fell. The mask must then confirm it: an upright object's mask has a base as
+  // wide as its body (foot_from_mask). A doubtful lean whose mask shows no base, with no known
+  // object standing in front to hide it, is "tipped". Development runs (2026-11-30): both pushes
+  // that toppled a bottle yet were called segmented (IoU 0.24, 0.29) leaned 10.9 and 11.2 deg and
+  // showed no base; upright objects whose mask showed none leaned 6.2 deg at most, and those that
+  // leaned 10-15 deg all showed one. 0: off.
+  double doubtful_tilt_deg = 8;
   double min_displacement_m = 0.004; // a smaller slide gives no difference to segment
   // An after line where the before line stood while the rest moved less than
   // standing_line_max_travel_m along the push, and lies off the push line in depth (beyond
@@ -510,6 +519,8 @@ class Supervisor {
   void parked(int64_t now, const std::string& how);
   void keep_object_rows(Attempt& attempt) const;
   void keep_object_columns(Attempt& attempt) const;
+  std::optional<Eigen::Vector3d> known_object_hiding_base(const MaskOnLine& right_mask, const Eigen::Vector3d& rest) const;
+  std::string fallen_over(const Attempt& attempt) const;
   void check_rest_with_mask(Attempt& attempt, const std::optional<MaskOnLine>& right_mask) const;
   void finish(State state, const std::string& reason, int64_t now);
   bool timed_out(double seconds, int64_t now) const;
