@@ -906,7 +906,7 @@ std::string Supervisor::fallen_over(const Attempt& a) const {
     return "";
   char text[160];
   std::snprintf(text, sizeof text,
-                "object tipped: its settled axes lean %.1f deg and its mask shows no upright object's base", *a.rest_tilt_deg);
+                "object tipped or lost: its settled axes lean %.1f deg and its mask shows no upright object's base", *a.rest_tilt_deg);
   return text;
 }
 
