@@ -599,7 +599,7 @@ void add_flags(Flags& f, Options& o) {
                "a mask smaller than this share of the smallest object's image at the rest (its pixels, rows or mean width) is no segmentation (0: any)");
   f.add_double("doubtful-tilt", &o.config.doubtful_tilt_deg,
                "a rest leaning more than this (deg, within the upright limit) must show an upright object's base in its mask, "
-               "or the attempt is tipped (0: off)");
+               "or the attempt ends tipped or lost (0: off)");
   f.add_double("max-object-half-width", &o.config.max_object_half_width_m,
                "mask pixels farther than this from the object's after line (m, projected at its rest) are something else "
                "that moved and are cleared (0: kept)");

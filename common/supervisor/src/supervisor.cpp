@@ -899,7 +899,7 @@ std::optional<Eigen::Vector3d> Supervisor::known_object_hiding_base(const MaskOn
 
 // Config::doubtful_tilt_deg: the settled axes lean enough to doubt that they are the pushed
 // object's, and its mask shows no upright object's base that a known object could be hiding.
-// Why the attempt is "tipped", or empty.
+// Why the attempt is "tipped or lost", or empty.
 std::string Supervisor::fallen_over(const Attempt& a) const {
   if (config_.doubtful_tilt_deg <= 0 || !a.rest_tilt_deg || *a.rest_tilt_deg <= config_.doubtful_tilt_deg ||
       a.rest_from_mask || a.mask_front_hidden_behind)

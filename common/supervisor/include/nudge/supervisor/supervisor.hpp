@@ -114,13 +114,14 @@ struct Config {
   // shows no upright axis at all.
   double upright_max_tilt_deg = 15;
   // A rest leaning more than this (though within upright_max_tilt_deg) is doubtful: the settled
-  // axes may be another object's (one standing behind the pushed one, a stereo mismatch) while
-  // the pushed object fell. The mask must then confirm it: an upright object's mask has a base as
-  // wide as its body (foot_from_mask). A doubtful lean whose mask shows no base, with no known
-  // object standing in front to hide it, is "tipped". Development runs (2026-11-30): both pushes
-  // that toppled a bottle yet were called segmented (IoU 0.24, 0.29) leaned 10.9 and 11.2 deg and
-  // showed no base; upright objects whose mask showed none leaned 6.2 deg at most, and those that
-  // leaned 10-15 deg all showed one. 0: off.
+  // axes may be another object's (one standing behind, a stereo mismatch) while an object the
+  // push toppled (the pushed one, or a bystander the arm struck) made the mask. The mask must then
+  // confirm the rest: an upright object's mask has a base as wide as its body (foot_from_mask).
+  // A doubtful lean whose mask shows no base, with no known object standing in front to hide it,
+  // ends "tipped or lost". Development runs (2026-11-30): both pushes that toppled a bottle yet
+  // were called segmented (IoU 0.24, 0.29) leaned 10.9 and 11.2 deg and showed no base; upright
+  // objects whose mask showed none leaned 6.2 deg at most, and those that leaned 10-15 deg all
+  // showed one. 0: off.
   double doubtful_tilt_deg = 8;
   double min_displacement_m = 0.004; // a smaller slide gives no difference to segment
   // An after line where the before line stood while the rest moved less than
@@ -219,7 +220,7 @@ struct Config {
   // this, projected at its rest (nearer by the depth error, plus 10 px), are something else that
   // moved and are cleared (segmentation::keep_near_line). Development runs: a neighbour pushed
   // along with the object was attached to its mask as a rigid part (m02: IoU 0.42-0.55, 0.56-0.67
-  // without it); no correct mask lost a pixel. 0: kept.
+  // with it cleared); no correct mask lost a pixel. 0: kept.
   double max_object_half_width_m = 0.075;
   // Rows watched for motion: from the table to this height. The object's foot moves when it is
   // pushed; the arm's links, higher up, may pass beyond the line in the image, the pad never does.
