@@ -7,7 +7,9 @@
 // Per segmentation: the SIM_STATE at the after still is re-rendered at 1280x960 with the scene's
 // own World (label mask: the simulator's truth, a mug's handle included); the object the mask
 // overlaps most is the one segmented; IoU with it, and the mask's pixels on the end effector (pad
-// or gripper: the pixels that change when it is hidden) are counted.
+// or gripper: the pixels that change when it is hidden) are counted. A segmentation of an object
+// lying fallen (over 45 deg) does not count as segmented; every state is read for the objects that
+// fell, when, and where the pad was as each began to lean.
 //   nudge-exp-nudge-segmentation RUNS_DIR SCENE_DIR [RUN...] [--development RUNS_DIR SCENE_DIR]
 //                                [--name STEM] [--workspace FILE]
 // (default: every scene in SCENE_DIR). Objects a scene stages outside the workspace ring (FILE's,
@@ -57,8 +59,9 @@ constexpr int kRight = 1;
 constexpr double kFallenDeg = 45;
 constexpr double kTippingDeg = 5;  // a lean past this that goes on to kFallenDeg: when the fall began
 
-// "object 2 in attempt 3 (NUDGE, its target)": the object fell after `before` (the last state that
-// showed it standing) while the supervisor was as `supervisor` last said. The target is the
+// "object 2 (the pad 18 mm from its foot, 122 mm up, as it began to lean) in attempt 3 (NUDGE, its
+// target)": the object fell after `before` (the last state that showed it standing), having begun
+// to lean at `tipping`, while the supervisor was as `supervisor` last said. The target is the
 // object when the attempt's target lay within 6 cm of where the object stood.
 std::string fall_description(int object, const sim_state_t& before, const sim_state_t& tipping,
                              const std::optional<supervisor_state_t>& supervisor) {
@@ -111,8 +114,8 @@ struct Run {
   // after still was taken: the supervisor should have called the attempt tipped, not segmented.
   int segmented_fallen = 0;
   std::set<int> objects_fallen;  // scene indices lying fallen at the run's last recorded state
-  // When each of those fell: "object 2 in attempt 3 (NUDGE, its target)", from the supervisor's
-  // state published last before the first recorded state that shows it fallen.
+  // When each of those fell (fall_description), from the supervisor's state published last before
+  // the first recorded state that shows it fallen.
   std::vector<std::string> falls;
   double wall_s = 0;
   std::string end_reason;
