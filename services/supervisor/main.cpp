@@ -620,6 +620,9 @@ void add_flags(Flags& f, Options& o) {
   f.add_double("far-rest", &o.config.far_rest_m,
                "with --rest-from-still 1: a settled axes' rest farther than this along the push, about whose line the stills "
                "show no change, gives way to a new line along the push when one is found, m (0: never)");
+  f.add_double("weak-after-line", &o.config.weak_after_line_share,
+               "with --rest-from-still 1: an after line found about the settled axes' rest with less than this share of the "
+               "before line's votes gives way to a stronger new line along the push when one is found (0: never)");
   f.add_int("rival-by-foot", &o.rival_by_foot,
             "1: a candidate on the target's right-camera line whose depth beyond the foot of the line in the before still is "
             "nearer --foot-depth-typical by --rival-margin is nudged instead; 0: the survey's choice stands");
@@ -721,6 +724,8 @@ int main(int argc, char** argv) {
     if (opt.rest_from_still != 0 && opt.rest_from_still != 1) throw FlagError("--rest-from-still must be 0 or 1");
     if (!(opt.config.far_rest_m >= 0 && opt.config.far_rest_m <= opt.config.max_travel_m))
       throw FlagError("--far-rest must lie in [0, " + std::to_string(opt.config.max_travel_m) + "] m");
+    if (!(opt.config.weak_after_line_share >= 0 && opt.config.weak_after_line_share <= 1))
+      throw FlagError("--weak-after-line must lie in [0, 1]");
     opt.config.rest_from_still = opt.rest_from_still == 1;
     if (opt.rival_by_foot != 0 && opt.rival_by_foot != 1) throw FlagError("--rival-by-foot must be 0 or 1");
     if (!(opt.config.line_obstacle_share >= 0 && opt.config.line_obstacle_share <= 1))

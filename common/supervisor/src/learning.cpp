@@ -98,11 +98,12 @@ void Supervisor::on_recognition(int64_t seq, const std::string& label, const std
   start_nudge(now);
 }
 
-// The left stills' lines and motion segmentation (possibly on another thread: it touches only
-// the attempt's left fields and the left segmenter).
-void Supervisor::segment_left(Attempt& a) const {
+// The left stills' lines and motion segmentation about the object's `rest` (possibly on another
+// thread: it touches only the attempt's left fields and the left segmenter; the rest is the
+// caller's copy, as the right still may yet move the attempt's).
+void Supervisor::segment_left(Attempt& a, const Eigen::Vector3d& rest) const {
   const auto predicted_before = scene_.left_axis_line(a.target.position, config_.object_height_m, config_.still_size);
-  const auto predicted_after = scene_.left_axis_line(*a.rest, config_.object_height_m, config_.still_size);
+  const auto predicted_after = scene_.left_axis_line(rest, config_.object_height_m, config_.still_size);
   if (!predicted_before || !predicted_after) return;
   const std::vector<symmetry::Line> column = base_column_lines(0);
   if (!a.before_line_left) a.before_line_left = find_line_near(a.before_left, *predicted_before, config_.line_search, column);

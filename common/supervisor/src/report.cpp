@@ -190,6 +190,7 @@ std::string attempt_json(const Attempt& a) {
   if (a.rest_from_axes) write_point(j, "rest_from_axes", *a.rest_from_axes);
   if (a.mask_front_hidden_behind) write_point(j, "mask_front_hidden_behind", *a.mask_front_hidden_behind);
   if (a.rest_from_still) j.field("rest_from_still", true);
+  if (a.weak_after_line_votes) j.field("weak_after_line_votes", *a.weak_after_line_votes);
   j.field("motion_frames", a.motion_frames).field("motion_blocks", a.motion_blocks);
   j.field("tracking_started_s", a.tracking_started / 1e6);
   j.key("track_trace").begin_object();

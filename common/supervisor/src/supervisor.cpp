@@ -701,13 +701,19 @@ void Supervisor::segment(int64_t now) {
   // Learning: the left camera's segmentation (for the object's top) alongside the right one's, on
   // the second core when the shell gave it its own segmenter (the grasp is planned sooner).
   std::future<void> left;
-  if (a.learn) left = std::async(segment_left_ ? std::launch::async : std::launch::deferred, [this, &a] { segment_left(a); });
+  if (a.learn)
+    left = std::async(segment_left_ ? std::launch::async : std::launch::deferred,
+                      [this, &a, rest = *a.rest] { segment_left(a, rest); });
   // The object's own lines in the stills; the calibration's prediction where none is detected.
   // (The before still's line was searched for while the arm nudged: see before_lines.)
   if (!a.before_line) a.before_line = find_line_near(a.before, *predicted_before, config_.line_search, column);
   if (!a.rest_from_still) {
     a.after_line = find_moved_line(a.after, *predicted_after, *predicted_before, a.before_line, config_.line_search, column);
     if (const auto pushed = line_along_the_push(a, *predicted_before, column)) a.after_line = pushed;
+    if (look_past_a_weak_after_line(a, *predicted_before, column) && left.valid()) {
+      left.get();  // the left camera's segmentation was about the old rest: again about the new
+      left = std::async(std::launch::deferred, [this, &a, rest = *a.rest] { segment_left(a, rest); });
+    }
   }
   if (!a.before_line) a.before_line = predicted_before;
   if (!a.after_line) a.after_line = predicted_after;
@@ -832,6 +838,29 @@ bool Supervisor::place_by_after_still(Attempt& a, const symmetry::Line& predicte
   return true;
 }
 
+// Config::weak_after_line_share: the after line found about the settled axes' rest has few of the
+// before line's votes; a stronger new line along the push (place_by_after_still) replaces it and
+// its rest. True when it did.
+bool Supervisor::look_past_a_weak_after_line(Attempt& a, const symmetry::Line& predicted_before,
+                                             const std::vector<symmetry::Line>& column) const {
+  if (config_.weak_after_line_share <= 0 || !config_.rest_from_still || !a.before_line || !a.after_line || !a.rest)
+    return false;
+  const double weak = a.after_line->votes;
+  if (weak >= config_.weak_after_line_share * a.before_line->votes) return false;
+  const Eigen::Vector3d from_axes = *a.rest;
+  const symmetry::Line kept = *a.after_line;
+  if (!place_by_after_still(a, predicted_before, column)) return false;
+  if (a.after_line->votes <= weak) {
+    a.rest = from_axes;
+    a.after_line = kept;
+    return false;
+  }
+  a.rest_from_axes = from_axes;
+  a.rest_from_still = true;
+  a.weak_after_line_votes = weak;
+  return true;
+}
+
 std::string Supervisor::mask_shape_problem(const cv::Mat& mask, const Eigen::Vector3d& rest, const symmetry::Line& line) const {
   const int pixels = cv::countNonZero(mask);
   const cv::Size2d smallest = smallest_object_image(rest);
@@ -860,14 +889,22 @@ std::string Supervisor::mask_shape_problem(const cv::Mat& mask, const Eigen::Vec
 // camera's view and its height, both projected.
 cv::Size2d Supervisor::smallest_object_image(const Eigen::Vector3d& foot) const {
   const Eigen::Vector3d base(foot.x(), foot.y(), 0.0);
-  const Eigen::Vector2d ray = viewing_ray(base);
-  const Eigen::Vector3d across = config_.min_object_radius_m * Eigen::Vector3d(-ray.y(), ray.x(), 0.0);
-  const auto left = scene_.project_right(base - across, config_.still_size);
-  const auto right = scene_.project_right(base + across, config_.still_size);
+  const auto width = width_across_view_px(base, 2 * config_.min_object_radius_m, config_.still_size);
   const auto top = scene_.project_right(base + Eigen::Vector3d(0, 0, config_.min_object_height_m), config_.still_size);
   const auto bottom = scene_.project_right(base, config_.still_size);
-  if (!left || !right || !top || !bottom) return {0.0, 0.0};
-  return {cv::norm(*left - *right), cv::norm(*top - *bottom)};
+  if (!width || !top || !bottom) return {0.0, 0.0};
+  return {*width, cv::norm(*top - *bottom)};
+}
+
+// The right camera's image (of `size`) of `width_m` across its view, centred at `at` (world): px
+// between the images of its two ends; nothing when either is out of the camera's sight.
+std::optional<double> Supervisor::width_across_view_px(const Eigen::Vector3d& at, double width_m, cv::Size size) const {
+  const Eigen::Vector2d ray = viewing_ray(at);
+  const Eigen::Vector3d half = 0.5 * width_m * Eigen::Vector3d(-ray.y(), ray.x(), 0.0);
+  const auto left = scene_.project_right(at - half, size);
+  const auto right = scene_.project_right(at + half, size);
+  if (!left || !right) return std::nullopt;
+  return cv::norm(*left - *right);
 }
 
 // The settled axes' rest against the mask's foot (after the left segmentation has joined: it
@@ -943,12 +980,10 @@ void Supervisor::keep_object_columns(Attempt& a) const {
   // The rest may be nearer the camera by the stereo depth error: the object's image is widest there.
   const Eigen::Vector2d ray = viewing_ray(*a.rest);
   const Eigen::Vector3d foot = *a.rest - config_.max_depth_error_m * Eigen::Vector3d(ray.x(), ray.y(), 0);
-  const Eigen::Vector3d across = config_.max_object_half_width_m * Eigen::Vector3d(-ray.y(), ray.x(), 0);
-  const auto centre = scene_.project_right(foot, mask.size());
-  const auto side = scene_.project_right(foot + across, mask.size());
-  if (!centre || !side) return;
+  const auto widest = width_across_view_px(foot, 2 * config_.max_object_half_width_m, mask.size());
+  if (!widest) return;
   const int margin = mask.cols / 128;  // 10 px at 1280 columns: the line's error, rounding
-  a.mask_pixels_beside = segmentation::keep_near_line(mask, *a.after_line, cv::norm(*side - *centre) + margin);
+  a.mask_pixels_beside = segmentation::keep_near_line(mask, *a.after_line, 0.5 * *widest + margin);
 }
 
 void Supervisor::end_attempt(Outcome outcome, const std::string& reason, int64_t now) {

@@ -150,6 +150,14 @@ struct Config {
   // development runs an object nudged at its axis slid at most 5 cm along the push (the pad stops
   // 2 cm short of the target's axis).
   double far_rest_m = 0.06;
+  // With rest_from_still, an after line found about the settled axes' rest with less than this
+  // share of the before line's votes is seldom the object's own: the same object before the same
+  // camera at about the same distance shows about as many mirror pairs. The axes were something
+  // else's, or a stereo mismatch (held-out h03: a cup's after line 19 votes against 123 before,
+  // 40 px off the cup, the axes leaning 13 deg). The object is then looked for as a new line along
+  // the push (as with rest_from_still), and taken there when that line has more votes than the
+  // weak one; otherwise the axes' rest stays. 0: off.
+  double weak_after_line_share = 0.25;
   // The before still says how deep the target stands: the ray through the lower end of its line's
   // support meets the table at the front of the object's base, about its radius before the axis
   // (depth_beyond_line_foot; foot_depth_typical_m). The candidates of the same survey on the same
@@ -393,6 +401,9 @@ struct Attempt {
   // Config::rest_from_still: the settled axes did not place the object (settle_note says how
   // few there were); its rest is the after still's line along the push.
   bool rest_from_still = false;
+  // Config::weak_after_line_share: the votes of the weak after line found about the settled axes'
+  // rest, when a stronger new line along the push replaced it (and rest_from_axes holds that rest).
+  std::optional<double> weak_after_line_votes;
   std::string settle_note;
   cv::Mat before, after;                   // right stills
   int64_t after_utime = 0;                 // when the right after still was taken (segmentation_t.utime)
@@ -567,6 +578,7 @@ class Supervisor {
   // The smallest object expected standing at a foot, as the right still shows it (px; 0 x 0 when
   // it cannot be projected).
   cv::Size2d smallest_object_image(const Eigen::Vector3d& foot) const;
+  std::optional<double> width_across_view_px(const Eigen::Vector3d& at, double width_m, cv::Size size) const;
   // Why a non-empty right mask (the still's size) is no object standing at `rest`, upright about
   // `line`: too small, too flat, too thin, or not its own mirror image; "" when it may be one.
   std::string mask_shape_problem(const cv::Mat& mask, const Eigen::Vector3d& rest, const symmetry::Line& line) const;
@@ -616,6 +628,8 @@ class Supervisor {
   bool rest_from_still_allowed() const;
   bool far_rest_where_nothing_changed(const Attempt& a) const;
   bool place_by_after_still(Attempt& a, const symmetry::Line& predicted_before, const std::vector<symmetry::Line>& column) const;
+  bool look_past_a_weak_after_line(Attempt& a, const symmetry::Line& predicted_before,
+                                   const std::vector<symmetry::Line>& column) const;
   std::optional<symmetry::Line> line_along_the_push(const Attempt& a, const symmetry::Line& predicted_before,
                                                     const std::vector<symmetry::Line>& column) const;
   bool settling_longer(int64_t now) const;
@@ -630,7 +644,7 @@ class Supervisor {
   void refine_target_by_stills();
   bool before_stills_of_both_cameras() const;
   std::optional<size_t> rivals_at_the_lines_foot(Attempt& a) const;
-  void segment_left(Attempt& attempt) const;
+  void segment_left(Attempt& attempt, const Eigen::Vector3d& rest) const;
   SegmentFunction segment_left_;
   SegmentFunction segment_stageless_;
   void recognise(int64_t now);
