@@ -578,6 +578,7 @@ class Supervisor {
   // The smallest object expected standing at a foot, as the right still shows it (px; 0 x 0 when
   // it cannot be projected).
   cv::Size2d smallest_object_image(const Eigen::Vector3d& foot) const;
+  // The right camera's image (px, in an image of `size`) of `width_m` across its view centred at `at`.
   std::optional<double> width_across_view_px(const Eigen::Vector3d& at, double width_m, cv::Size size) const;
   // Why a non-empty right mask (the still's size) is no object standing at `rest`, upright about
   // `line`: too small, too flat, too thin, or not its own mirror image; "" when it may be one.
