@@ -686,13 +686,8 @@ void Supervisor::segment(int64_t now) {
                                      ", and no new upright line along the push in the after still", now);
     return;
   }
-  if (predicted_before && !a.rest_from_still && far_rest_where_nothing_changed(a)) {
-    const Eigen::Vector3d from_axes = *a.rest;
-    if (place_by_after_still(a, *predicted_before, column)) {
-      a.rest_from_axes = from_axes;
-      a.rest_from_still = true;
-    }
-  }
+  if (predicted_before && !a.rest_from_still && far_rest_where_nothing_changed(a))
+    axes_rest_gives_way_to_after_still(a, *predicted_before, column);
   const auto predicted_after = scene_.right_axis_line(*a.rest, config_.object_height_m, config_.still_size);
   if (!predicted_before || !predicted_after) {
     end_attempt(Outcome::SegmentationFailed, "the object left the right camera's view", now);
@@ -847,17 +842,27 @@ bool Supervisor::look_past_a_weak_after_line(Attempt& a, const symmetry::Line& p
     return false;
   const double weak = a.after_line->votes;
   if (weak >= config_.weak_after_line_share * a.before_line->votes) return false;
+  if (!axes_rest_gives_way_to_after_still(a, predicted_before, column, weak)) return false;
+  a.weak_after_line_votes = weak;
+  return true;
+}
+
+// The settled axes' rest replaced by the after still's new line along the push
+// (place_by_after_still), when one is found with more than `more_votes_than` votes: the axes' rest
+// kept as rest_from_axes. False, and the attempt as it was, otherwise.
+bool Supervisor::axes_rest_gives_way_to_after_still(Attempt& a, const symmetry::Line& predicted_before,
+                                                    const std::vector<symmetry::Line>& column,
+                                                    double more_votes_than) const {
   const Eigen::Vector3d from_axes = *a.rest;
-  const symmetry::Line kept = *a.after_line;
+  const std::optional<symmetry::Line> line_before_search = a.after_line;
   if (!place_by_after_still(a, predicted_before, column)) return false;
-  if (a.after_line->votes <= weak) {
+  if (a.after_line->votes <= more_votes_than) {
     a.rest = from_axes;
-    a.after_line = kept;
+    a.after_line = line_before_search;
     return false;
   }
   a.rest_from_axes = from_axes;
   a.rest_from_still = true;
-  a.weak_after_line_votes = weak;
   return true;
 }
 

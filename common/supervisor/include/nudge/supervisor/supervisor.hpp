@@ -631,6 +631,9 @@ class Supervisor {
   bool place_by_after_still(Attempt& a, const symmetry::Line& predicted_before, const std::vector<symmetry::Line>& column) const;
   bool look_past_a_weak_after_line(Attempt& a, const symmetry::Line& predicted_before,
                                    const std::vector<symmetry::Line>& column) const;
+  bool axes_rest_gives_way_to_after_still(Attempt& a, const symmetry::Line& predicted_before,
+                                          const std::vector<symmetry::Line>& column,
+                                          double more_votes_than = -1) const;
   std::optional<symmetry::Line> line_along_the_push(const Attempt& a, const symmetry::Line& predicted_before,
                                                     const std::vector<symmetry::Line>& column) const;
   bool settling_longer(int64_t now) const;
