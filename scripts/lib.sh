@@ -144,7 +144,9 @@ nudge_in_private_network() {
 #     Dmin 8, Dmax 90, the accumulator's suppression 3 px and 3 deg, support segments joined across 16 px gaps, no column mask; candidates
 #     stereo-checked at 0.2 overlap, both images agreeing along the axis (0.6, waived at 0.85
 #     overlap), QT clusters of at least 5 % of the intersects).
-# NUDGE_LOOP_COLUMN_MASK=1 adds the column mask to "plain" and "busy" ("verified" has it).
+# NUDGE_LOOP_COLUMN_MASK (1 for "plain" and "verified", 0 for "busy" by default) leaves a band
+# along the arm's base column's outline out of the edges (nudge-symmetry --column-calibration:
+# a robot self-filter; docs/supervisor.md, "The column's outline left out by default").
 # NUDGE_LOOP_TABLE_TEXTURE (1, the default; 0: off) leaves the table's own texture out of the
 # edges (nudge-symmetry --table-texture-calibration: where the two cameras agree through the
 # calibrated table plane; docs/clutter.md, "The table's own texture").
@@ -172,11 +174,67 @@ nudge_loop_survey_flags() {
   esac
 }
 
+# The symmetry service's flags for NUDGE_LOOP_TABLE (a JSON list's items, for launch.json), its
+# rig from CALIBRATION: nudge_loop_symmetry_flags CALIBRATION
+nudge_loop_symmetry_flags() {
+  local calibration=$1 symmetry_flags='"--lines", "5"' column_mask
+  # The accumulator's suppression: 4 px and 4 deg for "verified", 3 for "busy" (docs/clutter.md, fifth round).
+  local suppression=4
+  [ "${NUDGE_LOOP_TABLE:-plain}" = busy ] && suppression=3
+  local verified='"--lines", "80", "--suppress-r", "'$suppression'", "--suppress-theta", "'$suppression'", "--verify", "12",
+                  "--upright-calibration", "'"$calibration"'"'
+  case "${NUDGE_LOOP_TABLE:-plain}" in
+    verified)
+      symmetry_flags=$verified
+      column_mask=${NUDGE_LOOP_COLUMN_MASK:-1} ;;
+    busy)
+      symmetry_flags="$verified"', "--colour-edges", "--blur", "2", "--dmin", "8", "--dmax", "90", "--support-gap", "16"'
+      column_mask=${NUDGE_LOOP_COLUMN_MASK:-0} ;;
+    plain)
+      if [ "${NUDGE_LOOP_REACH:-1}" = 1 ]; then
+        symmetry_flags='"--lines", "20", "--reach-calibration", "'"$calibration"'", "--reach-inner-radius", "0.10", "--reach-keep", "5",
+                        "--reach-column-px", "8"'
+      fi
+      column_mask=${NUDGE_LOOP_COLUMN_MASK:-1} ;;
+    *) echo "NUDGE_LOOP_TABLE: verified, plain or busy, not '$NUDGE_LOOP_TABLE'" >&2; return 2 ;;
+  esac
+  # A band along the arm's base column's outline is left out of the edges (its place from the
+  # calibration: nudge-symmetry --column-calibration): a robot self-filter. The column's two
+  # silhouette edges otherwise pair with the outlines of the objects before it into lines that
+  # outrank theirs (docs/supervisor.md, "The column's outline left out by default").
+  [ "$column_mask" = 1 ] && symmetry_flags+=', "--column-calibration", "'"$calibration"'"'
+  [ "${NUDGE_LOOP_TABLE_TEXTURE:-1}" = 1 ] && symmetry_flags+=', "--table-texture-calibration", "'"$calibration"'"'
+  # NUDGE_LOOP_EXPLORED_MASK=1: the objects each survey names as explored leave the symmetry
+  # service's edges (nudge-symmetry --explored-calibration; docs/supervisor.md, "Explored objects
+  # left out of the edges").
+  [ "${NUDGE_LOOP_EXPLORED_MASK:-0}" = 1 ] && symmetry_flags+=', "--explored-calibration", "'"$calibration"'"'
+  echo "$symmetry_flags"
+}
+
+# The triangulation service's flags for NUDGE_LOOP_TABLE beyond its calibration and workspace
+# (each item preceded by ", ", for launch.json).
+nudge_loop_triangulation_flags() {
+  case "${NUDGE_LOOP_TABLE:-plain}" in
+    verified) echo ', "--stereo-check", "--cluster-min-fraction", "0.03"' ;;
+    busy)
+      echo ', "--stereo-check", "--min-height-overlap", "0.2", "--stereo-appearance", "0.6",
+                             "--appearance-waived-at-overlap", "0.85", "--cluster-min-fraction", "0.05"' ;;
+    plain)
+      # The arm's base column's lines are paired but do not take one of a survey's lines per
+      # image (--candidate-column-lines uncounted; docs/supervisor.md, "The column's line").
+      # A survey's place needs 0.05 of its intersects, not the thesis' 1/9: chosen on the development
+      # runs' replays (docs/supervisor.md, "Weaker clusters": 26 of 34 objects a candidate against
+      # 24, none lost). NUDGE_LOOP_CLUSTER_MIN_FRACTION=F sets another.
+      echo ', "--candidate-line-tilt", "2", "--candidate-column-lines", "uncounted", "--cluster-min-fraction", "'"${NUDGE_LOOP_CLUSTER_MIN_FRACTION:-0.05}"'"' ;;
+    *) echo "NUDGE_LOOP_TABLE: verified, plain or busy, not '$NUDGE_LOOP_TABLE'" >&2; return 2 ;;
+  esac
+}
+
 # nudge_run_loop runs in a child shell (nudge_in_private_network bash -c ...): it and every
 # function it calls must be exported into it. Call this, not `export -f nudge_run_loop` (a helper
 # left out is "command not found" in the child, and the loop ran without its survey flags).
 nudge_export_loop() {
-  export -f nudge_run_loop nudge_loop_survey_flags
+  export -f nudge_run_loop nudge_loop_survey_flags nudge_loop_symmetry_flags nudge_loop_triangulation_flags
 }
 
 nudge_run_loop() {
@@ -200,46 +258,12 @@ nudge_run_loop() {
   # (nudge-arm --supervisor-timeout; a loaded, shared machine may starve the supervisor that long).
   local arm_watchdog=
   [ -n "${NUDGE_LOOP_ARM_WATCHDOG:-}" ] && arm_watchdog=", \"--supervisor-timeout\", \"$NUDGE_LOOP_ARM_WATCHDOG\""
-  local symmetry_flags='"--lines", "5"' triangulation_flags= column_mask=${NUDGE_LOOP_COLUMN_MASK:-0}
+  local symmetry_flags triangulation_flags
+  symmetry_flags=$(nudge_loop_symmetry_flags "$calibration") || return 2
+  triangulation_flags=$(nudge_loop_triangulation_flags) || return 2
   local survey survey_text
   survey_text=$(nudge_loop_survey_flags) || { echo "nudge_run_loop: no survey flags (a helper of lib.sh not exported to this shell?)" >&2; return 2; }
   read -r -a survey <<<"$survey_text"
-  # The accumulator's suppression: 4 px and 4 deg for "verified", 3 for "busy" (docs/clutter.md, fifth round).
-  local suppression=4
-  [ "${NUDGE_LOOP_TABLE:-plain}" = busy ] && suppression=3
-  local verified='"--lines", "80", "--suppress-r", "'$suppression'", "--suppress-theta", "'$suppression'", "--verify", "12",
-                  "--upright-calibration", "'"$calibration"'"'
-  case "${NUDGE_LOOP_TABLE:-plain}" in
-    verified)
-      symmetry_flags=$verified
-      triangulation_flags=', "--stereo-check", "--cluster-min-fraction", "0.03"'
-      column_mask=1 ;;
-    busy)
-      symmetry_flags="$verified"', "--colour-edges", "--blur", "2", "--dmin", "8", "--dmax", "90", "--support-gap", "16"'
-      triangulation_flags=', "--stereo-check", "--min-height-overlap", "0.2", "--stereo-appearance", "0.6",
-                             "--appearance-waived-at-overlap", "0.85", "--cluster-min-fraction", "0.05"' ;;
-    plain)
-      # The arm's base column's lines are paired but do not take one of a survey's lines per
-      # image (--candidate-column-lines uncounted; docs/supervisor.md, "The column's line").
-      triangulation_flags=', "--candidate-line-tilt", "2", "--candidate-column-lines", "uncounted"'
-      # A survey's place needs 0.05 of its intersects, not the thesis' 1/9: chosen on the development
-      # runs' replays (docs/supervisor.md, "Weaker clusters": 26 of 34 objects a candidate against
-      # 24, none lost). NUDGE_LOOP_CLUSTER_MIN_FRACTION=F sets another.
-      triangulation_flags+=', "--cluster-min-fraction", "'"${NUDGE_LOOP_CLUSTER_MIN_FRACTION:-0.05}"'"'
-      if [ "${NUDGE_LOOP_REACH:-1}" = 1 ]; then
-        symmetry_flags='"--lines", "20", "--reach-calibration", "'"$calibration"'", "--reach-inner-radius", "0.10", "--reach-keep", "5",
-                        "--reach-column-px", "8"'
-      fi ;;
-    *) echo "NUDGE_LOOP_TABLE: verified, plain or busy, not '$NUDGE_LOOP_TABLE'" >&2; return 2 ;;
-  esac
-  # The arm's base column's outline is left out of the edges (its place from the calibration:
-  # nudge-symmetry --column-calibration): a robot self-filter.
-  [ "$column_mask" = 1 ] && symmetry_flags+=', "--column-calibration", "'"$calibration"'"'
-  [ "${NUDGE_LOOP_TABLE_TEXTURE:-1}" = 1 ] && symmetry_flags+=', "--table-texture-calibration", "'"$calibration"'"'
-  # NUDGE_LOOP_EXPLORED_MASK=1: the objects each survey names as explored leave the symmetry
-  # service's edges (nudge-symmetry --explored-calibration; docs/supervisor.md, "Explored objects
-  # left out of the edges").
-  [ "${NUDGE_LOOP_EXPLORED_MASK:-0}" = 1 ] && symmetry_flags+=', "--explored-calibration", "'"$calibration"'"'
 
   local viewer=
   [ -n "${NUDGE_VIEWER:-}" ] && viewer=",

@@ -5,7 +5,7 @@
 # be exported into that child by nudge_export_loop. One was not once: the loop ran without its
 # survey flags (no second, wider look) and only "command not found" in a log said so.
 # Checks, in a child shell as the scripts start it: each function nudge_run_loop names is there,
-# and the survey flags come out for every detection.
+# and the survey and detection flags come out for every detection.
 # usage: loop_exports.sh SOURCE_DIR
 set -euo pipefail
 source_dir=${1:?usage: loop_exports.sh SOURCE_DIR}
@@ -26,5 +26,24 @@ for table in plain verified busy; do
 done
 [ "$(bash -c 'nudge_loop_survey_flags')" = "--wide-survey-tilt 5" ] ||
   { echo "FAIL: the plain detection's survey is not asked once more at 5 deg" >&2; failed=1; }
+# The detection's flags: every table gives some, an unknown one is refused, and the arm's base
+# column's outline is left out of the plain and verified detections' edges unless asked not to.
+for table in plain verified busy; do
+  NUDGE_LOOP_TABLE=$table bash -c 'nudge_loop_symmetry_flags CAL.yaml && nudge_loop_triangulation_flags' >/dev/null ||
+    { echo "FAIL: no detection flags for $table" >&2; failed=1; }
+done
+if NUDGE_LOOP_TABLE=bumpy bash -c 'nudge_loop_symmetry_flags CAL.yaml' >/dev/null 2>&1 ||
+   NUDGE_LOOP_TABLE=bumpy bash -c 'nudge_loop_triangulation_flags' >/dev/null 2>&1; then
+  echo "FAIL: an unknown NUDGE_LOOP_TABLE gave detection flags" >&2
+  failed=1
+fi
+column_masked() { bash -c 'nudge_loop_symmetry_flags CAL.yaml' | grep -q '"--column-calibration", "CAL.yaml"'; }
+for table in plain verified; do
+  NUDGE_LOOP_TABLE=$table column_masked || { echo "FAIL: $table does not leave the column out by default" >&2; failed=1; }
+  ! NUDGE_LOOP_TABLE=$table NUDGE_LOOP_COLUMN_MASK=0 column_masked ||
+    { echo "FAIL: NUDGE_LOOP_COLUMN_MASK=0 does not keep the column in for $table" >&2; failed=1; }
+done
+! NUDGE_LOOP_TABLE=busy column_masked || { echo "FAIL: busy leaves the column out by default" >&2; failed=1; }
+NUDGE_LOOP_TABLE=busy NUDGE_LOOP_COLUMN_MASK=1 column_masked || { echo "FAIL: NUDGE_LOOP_COLUMN_MASK=1 does not mask for busy" >&2; failed=1; }
 [ "$failed" = 0 ] && echo "PASS: every function nudge_run_loop calls reaches its child shell"
 exit "$failed"
