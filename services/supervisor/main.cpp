@@ -67,6 +67,7 @@ struct Options {
   int rest_from_still = 1;               // Config::rest_from_still
   int rival_by_foot = 1;                 // Config::rival_by_foot
   int graspable_push_first = 1;          // Config::graspable_push_first
+  int spare_doubtful = 1;                // TargetParams::spare_doubtful
   std::string learn = "auto";      // on, off, auto (while the learner's heartbeat is heard)
   std::string learner = "learner"; // the learner service's heartbeat name
   sv::Config config;
@@ -629,6 +630,10 @@ void add_flags(Flags& f, Options& o) {
   f.add_int("graspable-push-first", &o.graspable_push_first,
             "1: with learning, of the two ways across the view the one that leaves the object where the arm can grasp "
             "it (--push-travel along it) is tried first; 0: the same way first as without learning");
+  f.add_int("spare-doubtful", &o.spare_doubtful,
+            "1: a push that also keeps its pad, the pushed object's slide and the arm's links clear of the candidates "
+            "seen in too few frames to count as obstacles (--min-nudge-agreement or more) is taken first when the target "
+            "has one; 0: those candidates are no obstacle");
   f.add_double("line-obstacles", &o.config.line_obstacle_share,
                "> 0: a place on the table that the survey's right-camera lines mark (the ray through each line's lowest "
                "pixel, --foot-depth-typical beyond) in at least this share of the frames is an obstacle every push keeps "
@@ -737,6 +742,8 @@ int main(int argc, char** argv) {
     opt.config.rival_by_foot = opt.rival_by_foot == 1;
     if (opt.graspable_push_first != 0 && opt.graspable_push_first != 1) throw FlagError("--graspable-push-first must be 0 or 1");
     opt.config.graspable_push_first = opt.graspable_push_first == 1;
+    if (opt.spare_doubtful != 0 && opt.spare_doubtful != 1) throw FlagError("--spare-doubtful must be 0 or 1");
+    opt.config.targets.spare_doubtful = opt.spare_doubtful == 1;
     if (!(opt.config.line_search.not_object_px >= 0 && opt.config.line_search.not_object_px < 100))
       throw FlagError("--column-line-px must lie in [0, 100)");
     if (!(opt.config.push_travel_m >= 0 && opt.config.push_travel_m <= opt.config.max_travel_m))

@@ -140,6 +140,36 @@ std::vector<Obstacle> obstacles_to(const Candidate& c, const std::vector<Candida
   return obstacles;
 }
 
+// TargetParams::spare_doubtful: the candidates seen in too few of the survey's frames to be
+// obstacles_to's, but often enough to be nudged themselves, that a push of `c` would rather keep
+// clear of (not where `obstacles` already stands).
+std::vector<Obstacle> doubtful_near(const Candidate& c, const std::vector<Candidate>& candidates, const History& history,
+                                    const std::vector<Obstacle>& obstacles, const TargetParams& params) {
+  std::vector<Obstacle> doubtful;
+  if (!params.spare_doubtful) return doubtful;
+  for (const Candidate& other : candidates) {
+    if (other.index == c.index || near_any(other.position, history.empty, params.explored_radius)) continue;
+    if (other.stereo_agreement >= params.min_stereo_agreement || other.stereo_agreement < params.min_nudge_agreement) continue;
+    if (horizontal(other.position - c.position).norm() < params.same_object_radius) continue;
+    if (std::any_of(obstacles.begin(), obstacles.end(), [&](const Obstacle& o) {
+          return horizontal(o.place - other.position).norm() < params.same_object_radius;
+        }))
+      continue;
+    doubtful.push_back({other.position, "doubtful candidate"});
+  }
+  return doubtful;
+}
+
+// Whether a push of `c` along `direction`, its command `push`, keeps clear of every one of
+// `places`: the pad, the pushed object's slide and the arm's links.
+bool keeps_clear_of(const Candidate& c, const Eigen::Vector3d& direction, const robot::MotionPlan& push,
+                    const std::vector<Obstacle>& places, const ArmSetup& arm, const robot::JointVector& seed,
+                    const TargetParams& params) {
+  for (const Obstacle& other : places)
+    if (push_conflict(c.position, direction, other.place, arm, params, other.what)) return false;
+  return !links_conflict(push, seed, places, arm, params);
+}
+
 // A push of `c` along `direction` planned with the arm's links clearing an object `height` tall:
 // the robot library's plan, and the whole command as the arm service will plan it from where the
 // arm is (the move to P0 included): a target it would refuse is not chosen.
@@ -256,6 +286,39 @@ PushConflict either(const PushConflict& pad_or_slide, const PushConflict& links)
   return {links.kind, pad_or_slide.reason + "; " + links.reason};
 }
 
+// The first of `directions` (base frame, with their turns) whose push of `c` at the tallest
+// object's height the `tolerance` accepts against `obstacles` and that keeps clear of every one
+// of `doubtful`: its world direction, turn and conflict, and its plan; nothing when none does (or
+// there is nothing doubtful to spare).
+struct SparedPush {
+  Eigen::Vector3d direction;
+  double turn;
+  PushConflict conflict;
+};
+std::optional<std::pair<SparedPush, PushPlan>> push_sparing(const Candidate& c,
+                                                            const std::vector<std::pair<Eigen::Vector3d, double>>& directions,
+                                                            const std::vector<Obstacle>& obstacles,
+                                                            const std::vector<Obstacle>& doubtful, const ArmSetup& arm,
+                                                            const robot::JointVector& seed, const TargetParams& params,
+                                                            Tolerance tolerance) {
+  if (doubtful.empty()) return std::nullopt;
+  for (const auto& [direction_base, turn] : directions) {
+    const Eigen::Vector3d direction = arm.direction_to_world(direction_base);
+    PushConflict conflict;
+    for (const Obstacle& other : obstacles) {
+      PushConflict found = push_conflict(c.position, direction, other.place, arm, params, other.what);
+      if (found.kind == PushConflict::Kind::Pad || (found && !conflict)) conflict = found;
+    }
+    if (!tolerated(conflict.kind, tolerance)) continue;
+    PushPlan push = plan_push(c, direction_base, direction, arm, seed, arm.nudge.object_height);
+    if (!push.ok() || !keeps_clear_of(c, direction, push.command, doubtful, arm, seed, params)) continue;
+    const PushConflict links = links_conflict(push.command, seed, obstacles, arm, params);
+    if (!tolerated(links.kind, tolerance)) continue;
+    return std::make_pair(SparedPush{direction, turn, either(conflict, links)}, std::move(push));
+  }
+  return std::nullopt;
+}
+
 // One pass over the candidates in camera order: a push whose conflict with another object the
 // `tolerance` does not accept is refused; one it accepts is taken and noted. Per candidate, the
 // first push (in push_directions' order) that clears the tallest object expected is taken; when
@@ -298,7 +361,14 @@ TargetChoice choose_pass(const std::vector<Candidate>& candidates, const std::ve
     };
     const std::vector<Obstacle> obstacles = obstacles_to(c, candidates, history, params);
     const bool swapped = other_way_first(c, camera_base, arm, seed, params);
-    for (const auto& [direction_base, turn] : push_directions(camera_base, arm.point_to_base(c.position), params, swapped)) {
+    const auto directions = push_directions(camera_base, arm.point_to_base(c.position), params, swapped);
+    // TargetParams::spare_doubtful: the first push that also keeps clear of the doubtful candidates.
+    if (auto spared = push_sparing(c, directions, obstacles, doubtful_near(c, candidates, history, obstacles, params),
+                                         arm, seed, params, tolerance)) {
+      const auto& [direction, turn, conflict] = spared->first;
+      return taken(direction, turn, conflict, std::move(spared->second), 0.0);
+    }
+    for (const auto& [direction_base, turn] : directions) {
       const Eigen::Vector3d direction = arm.direction_to_world(direction_base);
       auto refuse = [&](const std::string& problem) {
         if (turn > 0) ++turned_refused;

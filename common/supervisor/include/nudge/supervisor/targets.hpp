@@ -49,6 +49,13 @@ struct TargetParams {
   double same_object_radius = 0.06;
   // Candidates whose stereo agreement is below this are tried last and are no obstacle to others.
   double min_stereo_agreement = 0.5;
+  // Beyond the thesis: some of those doubtful candidates are real objects (a cup seen in 28 % of
+  // the frames, development2 hm1), and a push that passes its pad or the arm's links beside one
+  // knocks it over. With this on, each candidate's pushes are tried first keeping clear of the
+  // doubtful candidates (seen in at least min_nudge_agreement) as of the others: pad, slide and
+  // links alike. When none of its pushes can, its pushes are chosen as without them. So the
+  // doubtful ones change only which way a candidate is pushed, never whether or in which order.
+  bool spare_doubtful = true;
   // The order the others are tried in. Nearest the right camera first is the thesis'. Beyond it:
   // the most intersects first (Candidate::support, nearest first among equals). A phantom, made
   // by lines of two objects, holds in fewer of a survey's frames than an object's own lines, and
