@@ -9,6 +9,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "nudge/flags.hpp"
 #include "nudge/json.hpp"
 #include "nudge/progress.hpp"
 #include "nudge/symmetry/detector.hpp"
@@ -78,8 +79,13 @@ cv::Mat to_picture(const cv::Mat& magnitude) {
 
 }  // namespace
 
-int main() {
+int main(int argc, char** argv) {
+  // No options; --help says what it does (and, like any unknown flag, must not run it: the flag
+  // list test asks every binary for --help).
+  nudge::Flags flags("nudge-exp-gst", "Thesis sec. 3.5: fast symmetry against the Generalized Symmetry Transform "
+                                      "(writes docs/results/gst_comparison.json and .md).");
   try {
+    if (!flags.parse(argc, argv)) return 0;
     const std::vector<std::pair<std::string, cv::Mat>> images = {{"dark_rectangle", dark_rectangle()},
                                                                   {"grey_on_ramp", grey_rectangle_on_ramp()}};
     JsonWriter j;

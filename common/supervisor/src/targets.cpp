@@ -286,6 +286,19 @@ PushConflict either(const PushConflict& pad_or_slide, const PushConflict& links)
   return {links.kind, pad_or_slide.reason + "; " + links.reason};
 }
 
+// The conflict with `obstacles` that decides a push of `c` along `direction` (pad and slide): a
+// pad's, else the first found.
+PushConflict pad_or_slide_conflict(const Candidate& c, const Eigen::Vector3d& direction, const std::vector<Obstacle>& obstacles,
+                                   const ArmSetup& arm, const TargetParams& params) {
+  PushConflict conflict;
+  for (const Obstacle& other : obstacles) {
+    PushConflict found = push_conflict(c.position, direction, other.place, arm, params, other.what);
+    if (found.kind == PushConflict::Kind::Pad) return found;
+    if (found && !conflict) conflict = found;
+  }
+  return conflict;
+}
+
 // The first of `directions` (base frame, with their turns) whose push of `c` at the tallest
 // object's height the `tolerance` accepts against `obstacles` and that keeps clear of every one
 // of `doubtful`: its world direction, turn and conflict, and its plan; nothing when none does (or
@@ -304,11 +317,7 @@ std::optional<std::pair<SparedPush, PushPlan>> push_sparing(const Candidate& c,
   if (doubtful.empty()) return std::nullopt;
   for (const auto& [direction_base, turn] : directions) {
     const Eigen::Vector3d direction = arm.direction_to_world(direction_base);
-    PushConflict conflict;
-    for (const Obstacle& other : obstacles) {
-      PushConflict found = push_conflict(c.position, direction, other.place, arm, params, other.what);
-      if (found.kind == PushConflict::Kind::Pad || (found && !conflict)) conflict = found;
-    }
+    const PushConflict conflict = pad_or_slide_conflict(c, direction, obstacles, arm, params);
     if (!tolerated(conflict.kind, tolerance)) continue;
     PushPlan push = plan_push(c, direction_base, direction, arm, seed, arm.nudge.object_height);
     if (!push.ok() || !keeps_clear_of(c, direction, push.command, doubtful, arm, seed, params)) continue;
@@ -363,8 +372,8 @@ TargetChoice choose_pass(const std::vector<Candidate>& candidates, const std::ve
     const bool swapped = other_way_first(c, camera_base, arm, seed, params);
     const auto directions = push_directions(camera_base, arm.point_to_base(c.position), params, swapped);
     // TargetParams::spare_doubtful: the first push that also keeps clear of the doubtful candidates.
-    if (auto spared = push_sparing(c, directions, obstacles, doubtful_near(c, candidates, history, obstacles, params),
-                                         arm, seed, params, tolerance)) {
+    if (auto spared = push_sparing(c, directions, obstacles, doubtful_near(c, candidates, history, obstacles, params), arm,
+                                   seed, params, tolerance)) {
       const auto& [direction, turn, conflict] = spared->first;
       return taken(direction, turn, conflict, std::move(spared->second), 0.0);
     }
@@ -374,12 +383,7 @@ TargetChoice choose_pass(const std::vector<Candidate>& candidates, const std::ve
         if (turn > 0) ++turned_refused;
         else why_not += std::string(why_not.empty() ? "" : "; the other way: ") + problem;
       };
-      PushConflict conflict;
-      for (const Obstacle& other : obstacles) {
-        PushConflict found = push_conflict(c.position, direction, other.place, arm, params, other.what);
-        if (found.kind == PushConflict::Kind::Pad || (found && !conflict)) conflict = found;
-        if (conflict.kind == PushConflict::Kind::Pad) break;
-      }
+      const PushConflict conflict = pad_or_slide_conflict(c, direction, obstacles, arm, params);
       if (!tolerated(conflict.kind, tolerance)) {
         refuse(conflict.reason);
         continue;
