@@ -630,6 +630,9 @@ void add_flags(Flags& f, Options& o) {
   f.add_int("graspable-push-first", &o.graspable_push_first,
             "1: with learning, of the two ways across the view the one that leaves the object where the arm can grasp "
             "it (--push-travel along it) is tried first; 0: the same way first as without learning");
+  f.add_double("pad-half-width", &o.config.targets.pad_half_width,
+               "half the pad's width across the push, m: no other object may stand within it and --object-radius of "
+               "the pad's path (the simulated pad's 0.04)");
   f.add_int("spare-doubtful", &o.spare_doubtful,
             "1: a push that also keeps its pad, the pushed object's slide and the arm's links clear of the candidates "
             "seen in too few frames to count as obstacles (--min-nudge-agreement or more) is taken first when the target "
@@ -743,6 +746,8 @@ int main(int argc, char** argv) {
     if (opt.graspable_push_first != 0 && opt.graspable_push_first != 1) throw FlagError("--graspable-push-first must be 0 or 1");
     opt.config.graspable_push_first = opt.graspable_push_first == 1;
     if (opt.spare_doubtful != 0 && opt.spare_doubtful != 1) throw FlagError("--spare-doubtful must be 0 or 1");
+    if (!(opt.config.targets.pad_half_width > 0 && opt.config.targets.pad_half_width <= 0.2))
+      throw FlagError("--pad-half-width must lie in (0, 0.2] m");
     opt.config.targets.spare_doubtful = opt.spare_doubtful == 1;
     if (!(opt.config.line_search.not_object_px >= 0 && opt.config.line_search.not_object_px < 100))
       throw FlagError("--column-line-px must lie in [0, 100)");

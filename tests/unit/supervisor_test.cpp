@@ -384,6 +384,12 @@ TEST(Targets, PushPathConflictsOnlyWithCandidatesInTheSweep) {
   EXPECT_EQ(sv::push_conflict(target, direction, Eigen::Vector3d(0.25, 0.06, 0), arm, params).kind, Kind::Slide);  // ahead
   EXPECT_EQ(sv::push_conflict(target, direction, Eigen::Vector3d(0.25, -0.10, 0), arm, params).kind, Kind::Pad);   // where the pad descends
   EXPECT_EQ(sv::push_conflict(target, direction, Eigen::Vector3d(0.21, -0.03, 0), arm, params).kind, Kind::Pad);   // beside the pad's path
+  // 7 cm beside the pad's path: the 8 cm wide pad's edge passes 3 cm from the axis of an object
+  // up to 4.5 cm in radius (with a 4 cm pad this was no conflict).
+  EXPECT_EQ(sv::push_conflict(target, direction, Eigen::Vector3d(0.32, -0.06, 0), arm, params).kind, Kind::Pad);
+  sv::TargetParams narrow = params;
+  narrow.pad_half_width = 0.02;
+  EXPECT_EQ(sv::push_conflict(target, direction, Eigen::Vector3d(0.32, -0.06, 0), arm, narrow).kind, Kind::None);
   EXPECT_EQ(sv::push_conflict(target, direction, Eigen::Vector3d(0.35, 0.0, 0), arm, params).kind, Kind::None);    // beside
   EXPECT_EQ(sv::push_conflict(target, direction, Eigen::Vector3d(0.25, 0.30, 0), arm, params).kind, Kind::None);   // far ahead
 }

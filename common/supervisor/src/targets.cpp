@@ -54,10 +54,13 @@ PushConflict push_conflict(const Eigen::Vector3d& target, const Eigen::Vector3d&
   const Eigen::Vector3d offset = horizontal(other - target);
   const double along = offset.dot(d);
   const double across = (offset - along * d).norm();
-  // The pad: a segment from P1 (start_distance before the axis) to P2 (stop_distance before it).
-  const double nearest_along = std::clamp(along, -arm.nudge.start_distance, -arm.nudge.stop_distance);
-  const double to_pad = std::hypot(along - nearest_along, across);
-  if (to_pad < params.object_radius + params.pad_half_width)
+  // The pad sweeps a rectangle: from P1 (start_distance before the axis) to P2 (stop_distance
+  // before it), as thick as its face is ahead of the tool point (pad_front) either side, and
+  // pad_half_width either side of the push line.
+  const double back = -arm.nudge.start_distance - arm.nudge.pad_front, front = -arm.nudge.stop_distance + arm.nudge.pad_front;
+  const double gap_along = std::max({0.0, back - along, along - front});
+  const double to_pad = std::hypot(gap_along, std::max(0.0, across - params.pad_half_width));
+  if (to_pad < params.object_radius)
     return {PushConflict::Kind::Pad, "the pad would touch the " + what + " at " + millimetres(other)};
   // The pushed object slides up to `travel` ahead: a band two object radii wide.
   if (along >= 0 && along <= params.travel + 2 * params.object_radius && across < 2 * params.object_radius)

@@ -42,7 +42,11 @@ struct TargetParams {
   // A candidate this close to a place where a push moved nothing is that phantom seen again. A
   // phantom lies between the objects whose lines make it, 4 cm from them on a crowded table.
   double phantom_radius = 0.025;
-  double pad_half_width = 0.02;   // the sponge pad across the push direction
+  // Half the pad's width across the push direction: the simulated pad is 8 cm wide
+  // (sim::pusher_pad_half_size().y(); a test keeps the two equal). It was 0.02 until 2026-12-01,
+  // so the planner let the pad come down 2 cm nearer other objects than it could without touching
+  // them (development2 hm1: a cup 54 mm from the pad's centre knocked over).
+  double pad_half_width = 0.04;
   // Two candidates closer than this cannot both be objects: one is the other seen through a stereo
   // mismatch (it lies along the same viewing ray). Neither is an obstacle to the other's push, and
   // nudging one explores both.
