@@ -1,8 +1,9 @@
 // The pad the planners assume is the pad the simulated world pushes with. The supervisor keeps
-// other objects TargetParams::object_radius + pad_half_width from the pad's path, and the robot
-// library puts the pad's face NudgeParams::pad_front ahead of the tool point; the world's pad is a
-// box of sim::pusher_pad_half_size() (x: along the push, y: across it). The supervisor once
-// assumed a pad half as wide as the world's, and its pushes knocked over neighbours it had found.
+// other objects' axes TargetParams::object_radius from the rectangle the pad sweeps,
+// pad_half_width either side of the push line, and the robot library puts the pad's face
+// NudgeParams::pad_front ahead of the tool point; the world's pad is a box of
+// sim::pusher_pad_half_size() (x: along the push, y: across it). The supervisor once assumed a pad
+// half as wide as the world's, and let it pass within 3 cm of a neighbour's axis.
 #include <gtest/gtest.h>
 
 #include "nudge/robot/motions.hpp"

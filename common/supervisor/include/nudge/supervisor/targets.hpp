@@ -44,8 +44,7 @@ struct TargetParams {
   double phantom_radius = 0.025;
   // Half the pad's width across the push direction: the simulated pad is 8 cm wide
   // (sim::pusher_pad_half_size().y(); a test keeps the two equal). It was 0.02 until 2026-12-01,
-  // so the planner let the pad come down 2 cm nearer other objects than it could without touching
-  // them (development2 hm1: a cup 54 mm from the pad's centre knocked over).
+  // so the planner let the pad pass within 3 cm of the axis of a candidate 7 cm beside its path.
   double pad_half_width = 0.04;
   // Two candidates closer than this cannot both be objects: one is the other seen through a stereo
   // mismatch (it lies along the same viewing ray). Neither is an obstacle to the other's push, and
