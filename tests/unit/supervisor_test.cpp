@@ -1151,8 +1151,9 @@ TEST_F(SupervisorTest, ADoubtfulLeanWhoseMaskShowsNoBaseIsTipped) {
     ASSERT_TRUE(a);
     EXPECT_EQ(a->outcome, c.outcome) << a->reason;
     EXPECT_EQ(a->rest_from_mask.has_value(), c.base) << "the base gives the mask's foot";
-    if (c.outcome == sv::Outcome::Tipped)
+    if (c.outcome == sv::Outcome::Tipped) {
       EXPECT_NE(a->reason.find("shows no upright object's base"), std::string::npos) << a->reason;
+    }
   }
   // Off, the doubtful lean is segmented as before.
   sv::Config off;

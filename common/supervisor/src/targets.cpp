@@ -111,6 +111,12 @@ PushConflict links_conflict(const robot::MotionPlan& plan, const robot::JointVec
 
 namespace {
 
+// The first of `obstacles` within `radius` of `p` (horizontally), or their end.
+template <typename Obstacles>
+auto obstacle_near(Obstacles& obstacles, const Eigen::Vector3d& p, double radius) {
+  return std::find_if(obstacles.begin(), obstacles.end(), [&](const Obstacle& o) { return horizontal(o.place - p).norm() < radius; });
+}
+
 // The places a push must keep clear of: the other candidates that count as objects, the
 // explored objects standing where no candidate is (their lines left out of the survey), and the
 // objects only one camera's lines show.
@@ -118,11 +124,9 @@ std::vector<Obstacle> obstacles_to(const Candidate& c, const std::vector<Candida
                                    const TargetParams& params) {
   std::vector<Obstacle> obstacles;
   auto far_from_target = [&](const Eigen::Vector3d& p) { return horizontal(p - c.position).norm() >= params.same_object_radius; };
-  auto obstacle_near = [&](const Eigen::Vector3d& p) {
-    return std::find_if(obstacles.begin(), obstacles.end(),
-                        [&](const Obstacle& o) { return horizontal(o.place - p).norm() < params.same_object_radius; });
+  auto near_an_obstacle = [&](const Eigen::Vector3d& p) {
+    return obstacle_near(obstacles, p, params.same_object_radius) != obstacles.end();
   };
-  auto near_an_obstacle = [&](const Eigen::Vector3d& p) { return obstacle_near(p) != obstacles.end(); };
   for (const Candidate& other : candidates) {
     if (other.index == c.index || near_any(other.position, history.empty, params.explored_radius)) continue;
     if (other.stereo_agreement < params.min_stereo_agreement) continue;
@@ -130,7 +134,7 @@ std::vector<Obstacle> obstacles_to(const Candidate& c, const std::vector<Candida
   }
   for (const ExploredObject& object : history.standing) {
     if (!far_from_target(object.place)) continue;
-    const auto near = obstacle_near(object.place);
+    const auto near = obstacle_near(obstacles, object.place, params.same_object_radius);
     if (near == obstacles.end()) {
       obstacles.push_back({object.place, "explored object", object.height, true});
     } else if (near->height <= 0) {
@@ -154,23 +158,10 @@ std::vector<Obstacle> doubtful_near(const Candidate& c, const std::vector<Candid
     if (other.index == c.index || near_any(other.position, history.empty, params.explored_radius)) continue;
     if (other.stereo_agreement >= params.min_stereo_agreement || other.stereo_agreement < params.min_nudge_agreement) continue;
     if (horizontal(other.position - c.position).norm() < params.same_object_radius) continue;
-    if (std::any_of(obstacles.begin(), obstacles.end(), [&](const Obstacle& o) {
-          return horizontal(o.place - other.position).norm() < params.same_object_radius;
-        }))
-      continue;
+    if (obstacle_near(obstacles, other.position, params.same_object_radius) != obstacles.end()) continue;
     doubtful.push_back({other.position, "doubtful candidate"});
   }
   return doubtful;
-}
-
-// Whether a push of `c` along `direction`, its command `push`, keeps clear of every one of
-// `places`: the pad, the pushed object's slide and the arm's links.
-bool keeps_clear_of(const Candidate& c, const Eigen::Vector3d& direction, const robot::MotionPlan& push,
-                    const std::vector<Obstacle>& places, const ArmSetup& arm, const robot::JointVector& seed,
-                    const TargetParams& params) {
-  for (const Obstacle& other : places)
-    if (push_conflict(c.position, direction, other.place, arm, params, other.what)) return false;
-  return !links_conflict(push, seed, places, arm, params);
 }
 
 // A push of `c` along `direction` planned with the arm's links clearing an object `height` tall:
@@ -302,31 +293,77 @@ PushConflict pad_or_slide_conflict(const Candidate& c, const Eigen::Vector3d& di
   return conflict;
 }
 
-// The first of `directions` (base frame, with their turns) whose push of `c` at the tallest
-// object's height the `tolerance` accepts against `obstacles` and that keeps clear of every one
-// of `doubtful`: its world direction, turn and conflict, and its plan; nothing when none does (or
-// there is nothing doubtful to spare).
-struct SparedPush {
-  Eigen::Vector3d direction;
-  double turn;
-  PushConflict conflict;
+// Whether a push of `c` along `direction`, its command `push`, keeps clear of every one of
+// `places`: the pad, the pushed object's slide and the arm's links.
+bool keeps_clear_of(const Candidate& c, const Eigen::Vector3d& direction, const robot::MotionPlan& push,
+                    const std::vector<Obstacle>& places, const ArmSetup& arm, const robot::JointVector& seed,
+                    const TargetParams& params) {
+  return !pad_or_slide_conflict(c, direction, places, arm, params) && !links_conflict(push, seed, places, arm, params);
+}
+
+// The pushes of a candidate along each of its directions (push_directions), each worked out once,
+// when first asked for: the doubtful-sparing search and the pass that follows it ask for the same
+// directions, and planning a push (the robot library's plan and the arm service's) is the costly
+// part. A push is planned only when the pass's tolerance accepts its pad and slide conflict, and
+// its links are checked only when it plans.
+class PushTrials {
+ public:
+  struct Trial {
+    Eigen::Vector3d direction_base, direction;  // base and world frame
+    double turn = 0;
+    PushConflict conflict;  // the pad's or the slide's
+    bool planned = false;   // whether `push` was planned (the conflict tolerated)
+    PushPlan push;          // at the tallest object's height
+    PushConflict links;     // when `push` planned
+    // Whether the pass takes this push as it is (the tallest object cleared).
+    bool accepted(Tolerance tolerance) const { return planned && push.ok() && tolerated(links.kind, tolerance); }
+  };
+
+  PushTrials(const Candidate& c, std::vector<std::pair<Eigen::Vector3d, double>> directions, const std::vector<Obstacle>& obstacles,
+             const ArmSetup& arm, const robot::JointVector& seed, const TargetParams& params, Tolerance tolerance)
+      : c_(c), directions_(std::move(directions)), obstacles_(obstacles), arm_(arm), seed_(seed), params_(params),
+        tolerance_(tolerance), trials_(directions_.size()) {}
+
+  size_t size() const { return directions_.size(); }
+
+  const Trial& operator[](size_t i) {
+    if (!trials_[i]) trials_[i] = work_out(i);
+    return *trials_[i];
+  }
+
+ private:
+  Trial work_out(size_t i) const {
+    Trial t;
+    t.direction_base = directions_[i].first;
+    t.turn = directions_[i].second;
+    t.direction = arm_.direction_to_world(t.direction_base);
+    t.conflict = pad_or_slide_conflict(c_, t.direction, obstacles_, arm_, params_);
+    if (!tolerated(t.conflict.kind, tolerance_)) return t;
+    t.planned = true;
+    t.push = plan_push(c_, t.direction_base, t.direction, arm_, seed_, arm_.nudge.object_height);
+    if (t.push.ok()) t.links = links_conflict(t.push.command, seed_, obstacles_, arm_, params_);
+    return t;
+  }
+
+  const Candidate& c_;
+  const std::vector<std::pair<Eigen::Vector3d, double>> directions_;
+  const std::vector<Obstacle>& obstacles_;
+  const ArmSetup& arm_;
+  const robot::JointVector& seed_;
+  const TargetParams& params_;
+  const Tolerance tolerance_;
+  std::vector<std::optional<Trial>> trials_;
 };
-std::optional<std::pair<SparedPush, PushPlan>> push_sparing(const Candidate& c,
-                                                            const std::vector<std::pair<Eigen::Vector3d, double>>& directions,
-                                                            const std::vector<Obstacle>& obstacles,
-                                                            const std::vector<Obstacle>& doubtful, const ArmSetup& arm,
-                                                            const robot::JointVector& seed, const TargetParams& params,
-                                                            Tolerance tolerance) {
+
+// The first of `trials` the `tolerance` accepts that also keeps clear of every one of
+// `doubtful`; nothing when none does (or there is nothing doubtful to spare).
+std::optional<size_t> push_sparing(const Candidate& c, PushTrials& trials, const std::vector<Obstacle>& doubtful,
+                                   const ArmSetup& arm, const robot::JointVector& seed, const TargetParams& params,
+                                   Tolerance tolerance) {
   if (doubtful.empty()) return std::nullopt;
-  for (const auto& [direction_base, turn] : directions) {
-    const Eigen::Vector3d direction = arm.direction_to_world(direction_base);
-    const PushConflict conflict = pad_or_slide_conflict(c, direction, obstacles, arm, params);
-    if (!tolerated(conflict.kind, tolerance)) continue;
-    PushPlan push = plan_push(c, direction_base, direction, arm, seed, arm.nudge.object_height);
-    if (!push.ok() || !keeps_clear_of(c, direction, push.command, doubtful, arm, seed, params)) continue;
-    const PushConflict links = links_conflict(push.command, seed, obstacles, arm, params);
-    if (!tolerated(links.kind, tolerance)) continue;
-    return std::make_pair(SparedPush{direction, turn, either(conflict, links)}, std::move(push));
+  for (size_t i = 0; i < trials.size(); ++i) {
+    const PushTrials::Trial& t = trials[i];
+    if (t.accepted(tolerance) && keeps_clear_of(c, t.direction, t.push.command, doubtful, arm, seed, params)) return i;
   }
   return std::nullopt;
 }
@@ -353,12 +390,7 @@ TargetChoice choose_pass(const std::vector<Candidate>& candidates, const std::ve
     }
     std::string why_not;  // the two pushes across the view: their reasons in full
     int turned_refused = 0;
-    struct Refused {
-      Eigen::Vector3d direction_base, direction;
-      double turn;
-      PushConflict conflict;
-    };
-    std::vector<Refused> too_near;  // planned only for a shorter object, perhaps
+    std::vector<const PushTrials::Trial*> too_near;  // planned only for a shorter object, perhaps
     auto taken = [&](const Eigen::Vector3d& direction, double turn, const PushConflict& conflict, PushPlan push, double limit) {
       TargetChoice t = choice;
       t.found = true;
@@ -373,45 +405,42 @@ TargetChoice choose_pass(const std::vector<Candidate>& candidates, const std::ve
     };
     const std::vector<Obstacle> obstacles = obstacles_to(c, candidates, history, params);
     const bool swapped = other_way_first(c, camera_base, arm, seed, params);
-    const auto directions = push_directions(camera_base, arm.point_to_base(c.position), params, swapped);
+    PushTrials trials(c, push_directions(camera_base, arm.point_to_base(c.position), params, swapped), obstacles, arm, seed,
+                      params, tolerance);
     // TargetParams::spare_doubtful: the first push that also keeps clear of the doubtful candidates.
-    if (auto spared = push_sparing(c, directions, obstacles, doubtful_near(c, candidates, history, obstacles, params), arm,
-                                   seed, params, tolerance)) {
-      const auto& [direction, turn, conflict] = spared->first;
-      return taken(direction, turn, conflict, std::move(spared->second), 0.0);
+    if (auto spared = push_sparing(c, trials, doubtful_near(c, candidates, history, obstacles, params), arm, seed, params,
+                                   tolerance)) {
+      const PushTrials::Trial& t = trials[*spared];
+      return taken(t.direction, t.turn, either(t.conflict, t.links), t.push, 0.0);
     }
-    for (const auto& [direction_base, turn] : directions) {
-      const Eigen::Vector3d direction = arm.direction_to_world(direction_base);
+    for (size_t k = 0; k < trials.size(); ++k) {
+      const PushTrials::Trial& t = trials[k];
       auto refuse = [&](const std::string& problem) {
-        if (turn > 0) ++turned_refused;
+        if (t.turn > 0) ++turned_refused;
         else why_not += std::string(why_not.empty() ? "" : "; the other way: ") + problem;
       };
-      const PushConflict conflict = pad_or_slide_conflict(c, direction, obstacles, arm, params);
-      if (!tolerated(conflict.kind, tolerance)) {
-        refuse(conflict.reason);
+      if (!t.planned) {
+        refuse(t.conflict.reason);
         continue;
       }
-      PushPlan push = plan_push(c, direction_base, direction, arm, seed, arm.nudge.object_height);
-      if (push.ok()) {
-        // The links are checked only when the pad and slide allow the push: they need its plan.
-        const PushConflict links = links_conflict(push.command, seed, obstacles, arm, params);
-        if (!tolerated(links.kind, tolerance)) {
-          refuse(links.reason);
+      if (t.push.ok()) {
+        if (!tolerated(t.links.kind, tolerance)) {
+          refuse(t.links.reason);
           continue;
         }
-        return taken(direction, turn, either(conflict, links), std::move(push), 0.0);
+        return taken(t.direction, t.turn, either(t.conflict, t.links), t.push, 0.0);
       }
-      refuse(push.problem);
-      too_near.push_back({direction_base, direction, turn, conflict});
+      refuse(t.push.problem);
+      too_near.push_back(&t);
     }
     std::optional<TargetChoice> limited;
-    for (const Refused& r : too_near) {
-      auto shorter = push_for_shorter_object(c, r.direction_base, r.direction, arm, seed, params);
+    for (const PushTrials::Trial* r : too_near) {
+      auto shorter = push_for_shorter_object(c, r->direction_base, r->direction, arm, seed, params);
       if (!shorter) continue;
       const PushConflict links = links_conflict(shorter->second.command, seed, obstacles, arm, params);
       if (!tolerated(links.kind, tolerance)) continue;
       if (!limited || shorter->first > limited->height_limit)
-        limited = taken(r.direction, r.turn, either(r.conflict, links), std::move(shorter->second), shorter->first);
+        limited = taken(r->direction, r->turn, either(r->conflict, links), std::move(shorter->second), shorter->first);
     }
     if (limited) return *limited;
     if (turned_refused > 0)
