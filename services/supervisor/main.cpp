@@ -68,6 +68,7 @@ struct Options {
   int rival_by_foot = 1;                 // Config::rival_by_foot
   int graspable_push_first = 1;          // Config::graspable_push_first
   int spare_doubtful = 1;                // TargetParams::spare_doubtful
+  int defer_for_doubtful = 1;            // TargetParams::defer_for_doubtful
   std::string learn = "auto";      // on, off, auto (while the learner's heartbeat is heard)
   std::string learner = "learner"; // the learner service's heartbeat name
   sv::Config config;
@@ -637,6 +638,9 @@ void add_flags(Flags& f, Options& o) {
             "1: a push that also keeps its pad, the pushed object's slide and the arm's links clear of the candidates "
             "seen in too few frames to count as obstacles (--min-nudge-agreement or more) is taken first when the target "
             "has one; 0: those candidates are no obstacle");
+  f.add_int("defer-for-doubtful", &o.defer_for_doubtful,
+            "1: a candidate seen in enough frames, none of whose pushes keeps clear of a doubtful candidate not yet "
+            "nudged, is tried after the other candidates (the doubtful ones among them); 0: in its place in the order");
   f.add_double("line-obstacles", &o.config.line_obstacle_share,
                "> 0: a place on the table that the survey's right-camera lines mark (the ray through each line's lowest "
                "pixel, --foot-depth-typical beyond) in at least this share of the frames is an obstacle every push keeps "
@@ -749,6 +753,8 @@ int main(int argc, char** argv) {
     if (!(opt.config.targets.pad_half_width > 0 && opt.config.targets.pad_half_width <= 0.2))
       throw FlagError("--pad-half-width must lie in (0, 0.2] m");
     opt.config.targets.spare_doubtful = opt.spare_doubtful == 1;
+    if (opt.defer_for_doubtful != 0 && opt.defer_for_doubtful != 1) throw FlagError("--defer-for-doubtful must be 0 or 1");
+    opt.config.targets.defer_for_doubtful = opt.defer_for_doubtful == 1;
     if (!(opt.config.line_search.not_object_px >= 0 && opt.config.line_search.not_object_px < 100))
       throw FlagError("--column-line-px must lie in [0, 100)");
     if (!(opt.config.push_travel_m >= 0 && opt.config.push_travel_m <= opt.config.max_travel_m))

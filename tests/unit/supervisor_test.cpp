@@ -523,10 +523,64 @@ TEST(Targets, APushKeepsClearOfDoubtfulCandidatesWhenOneCan) {
     everywhere.push_back(doubtful_at(target.position + pad * Eigen::Vector3d(std::cos(a), std::sin(a), 0), 0.28));
     everywhere.back().index = 10 + k;
   }
-  const auto crowded = sv::choose_target(everywhere, {}, scene.right_camera_in_world(), arm, arm_state_joints(), sv::TargetParams{});
+  sv::TargetParams no_waiting;  // the target waits for such neighbours by default (next test)
+  no_waiting.defer_for_doubtful = false;
+  const auto crowded = sv::choose_target(everywhere, {}, scene.right_camera_in_world(), arm, arm_state_joints(), no_waiting);
   ASSERT_TRUE(crowded.found);
   EXPECT_EQ(crowded.target.index, 1);
   EXPECT_NEAR(crowded.direction.dot(first.direction), 1.0, 1e-9);
+}
+
+// TargetParams::defer_for_doubtful: a candidate every push of which would endanger a doubtful
+// candidate not yet nudged waits, and a doubtful one is nudged first; once they are explored (or
+// with the rule off) the candidate's push is chosen as without them.
+TEST(Targets, ACandidateWaitsForTheDoubtfulOnesEveryPushWouldEndanger) {
+  const sv::SceneGeometry scene = make_scene();
+  const sv::ArmSetup arm;
+  const Eigen::Vector3d camera = scene.right_camera_in_world();
+  sv::TargetParams params;  // the two pushes across the view only: two neighbours block them both
+  params.obstacle_height = 0;  // the links are not what this is about
+  params.max_push_turn_deg = 0;
+  const sv::Candidate target{1, Eigen::Vector3d(0.20, 0.0, 0), 9};
+  const auto alone = sv::choose_target({target}, {}, camera, arm, arm_state_joints(), params);
+  ASSERT_TRUE(chosen_strictly(alone)) << alone.note;
+  // A doubtful neighbour just beyond where the pad comes down, either way across the view; each
+  // far enough from the target to be pushed towards it without sliding into it.
+  const double apart = arm.nudge.start_distance + 0.035;
+  std::vector<sv::Candidate> candidates = {target};
+  sv::History explored;
+  for (double side : {-1.0, 1.0}) {
+    sv::Candidate c{candidates.size() == 1 ? 10 : 11, target.position + side * apart * alone.direction, 4};
+    c.stereo_agreement = 0.28;
+    candidates.push_back(c);
+    explored.phantoms.push_back(c.position);
+    ASSERT_EQ(sv::push_conflict(target.position, -side * alone.direction, c.position, arm, params).kind,
+              sv::PushConflict::Kind::Pad);
+  }
+  const auto waited = sv::choose_target(candidates, {}, camera, arm, arm_state_joints(), params);
+  ASSERT_TRUE(chosen_strictly(waited)) << waited.note;
+  EXPECT_GE(waited.target.index, 10) << "a doubtful neighbour goes first";
+  EXPECT_FALSE(sv::push_conflict(waited.target.position, waited.direction, target.position, arm, params))
+      << "its push keeps clear of the waiting candidate, which counts as an object";
+
+  sv::TargetParams off = params;
+  off.defer_for_doubtful = false;
+  const auto in_order = sv::choose_target(candidates, {}, camera, arm, arm_state_joints(), off);
+  ASSERT_TRUE(in_order.found);
+  EXPECT_EQ(in_order.target.index, 1);
+
+  // Both neighbours nudged (phantoms): nothing left to wait for.
+  const auto after = sv::choose_target(candidates, explored, camera, arm, arm_state_joints(), params);
+  ASSERT_TRUE(after.found);
+  EXPECT_EQ(after.target.index, 1);
+  EXPECT_NEAR(after.direction.dot(in_order.direction), 1.0, 1e-9);
+
+  // The neighbours never seen by both cameras: not doubtful, no waiting.
+  std::vector<sv::Candidate> unseen = candidates;
+  for (size_t k = 1; k < unseen.size(); ++k) unseen[k].stereo_agreement = 0.0;
+  const auto not_doubtful = sv::choose_target(unseen, {}, camera, arm, arm_state_joints(), params);
+  ASSERT_TRUE(not_doubtful.found);
+  EXPECT_EQ(not_doubtful.target.index, 1);
 }
 
 // An explored object is kept clear of as tall as the stills measured it: a short one frees pushes
@@ -2196,7 +2250,12 @@ TEST_F(SupervisorTest, ACandidateHiddenBehindTheArmsBaseIsPassedOverWithItsReaso
 // given, a `third` candidate both cameras see in every frame. The nudge commanded, if any.
 std::optional<sv::NudgeCommand> SupervisorTest::nudge_of_rivals_on_one_right_line(const sv::Config& config, double behind_m,
                                                                                   const std::optional<Eigen::Vector3d>& third) {
-  sv::Supervisor s = make(config);
+  // The survey's choice must be the mismatch. Every push of it 10 cm before the object passes by
+  // the object, a doubtful candidate (4 of 10 frames), so by default the mismatch would wait and
+  // the object be chosen outright (TargetParams::defer_for_doubtful): not the rule tested here.
+  sv::Config without_waiting = config;
+  without_waiting.targets.defer_for_doubtful = false;
+  sv::Supervisor s = make(without_waiting);
   const Eigen::Vector3d object(0.22, -0.05, 0);
   const Eigen::Vector3d mismatch = object + behind_m * along_ray(object);
   s.start(now_, 100);

@@ -10,6 +10,7 @@
 #include <optional>
 #include <string>
 #include <utility>
+#include <variant>
 
 namespace nudge::supervisor {
 
@@ -368,84 +369,127 @@ std::optional<size_t> push_sparing(const Candidate& c, PushTrials& trials, const
   return std::nullopt;
 }
 
+// Whether the `tolerance` accepts any of `trials` as it is.
+bool any_accepted(PushTrials& trials, Tolerance tolerance) {
+  for (size_t i = 0; i < trials.size(); ++i)
+    if (trials[i].accepted(tolerance)) return true;
+  return false;
+}
+
+// What a pass made of one candidate: the push taken, the candidate rejected (its reason noted),
+// or deferred (TargetParams::defer_for_doubtful).
+struct Rejected {};
+struct Deferred {};
+using CandidateOutcome = std::variant<TargetChoice, Rejected, Deferred>;
+
+// The doubtful places (doubtful_near) where no candidate was nudged yet: the ones a pass may still
+// try.
+std::vector<Obstacle> not_yet_nudged(const std::vector<Obstacle>& doubtful, const History& history, const TargetParams& params) {
+  std::vector<Obstacle> untried;
+  for (const Obstacle& d : doubtful)
+    if (!near_any(d.place, history.explored, params.explored_radius) && !near_any(d.place, history.phantoms, params.phantom_radius))
+      untried.push_back(d);
+  return untried;
+}
+
+// One candidate of a pass (choose_pass): `choice` holds the rejections so far, and a taken push
+// carries them.
+CandidateOutcome try_candidate(const Candidate& c, TargetChoice& choice, const std::vector<Candidate>& candidates,
+                               const History& history, const Eigen::Vector3d& camera_base, const ArmSetup& arm,
+                               const robot::JointVector& seed, const TargetParams& params, Tolerance tolerance, bool may_defer) {
+  auto reject = [&](const std::string& reason) {
+    choice.rejected.push_back({c.index, c.position, reason});
+    return Rejected{};
+  };
+  if (near_any(c.position, history.explored, params.explored_radius) || near_any(c.position, history.phantoms, params.phantom_radius))
+    return reject("already explored");
+  if (c.stereo_agreement < params.min_nudge_agreement) return reject("not seen upright by both cameras (a stereo mismatch)");
+  std::string why_not;  // the two pushes across the view: their reasons in full
+  int turned_refused = 0;
+  std::vector<const PushTrials::Trial*> too_near;  // planned only for a shorter object, perhaps
+  auto taken = [&](const Eigen::Vector3d& direction, double turn, const PushConflict& conflict, PushPlan push, double limit) {
+    TargetChoice t = choice;
+    t.found = true;
+    t.target = c;
+    t.direction = horizontal(direction).normalized();
+    t.plan = std::move(push.plan);
+    t.height_limit = limit;
+    t.push_turn_deg = turn;
+    if (conflict) t.note = "no clear push left: " + conflict.reason;
+    if (turn > 0) t.note += std::string(t.note.empty() ? "" : "; ") + "pushed " + std::to_string(std::lround(turn)) + " deg off across the view";
+    return t;
+  };
+  const std::vector<Obstacle> obstacles = obstacles_to(c, candidates, history, params);
+  const bool swapped = other_way_first(c, camera_base, arm, seed, params);
+  PushTrials trials(c, push_directions(camera_base, arm.point_to_base(c.position), params, swapped), obstacles, arm, seed,
+                    params, tolerance);
+  const std::vector<Obstacle> doubtful = doubtful_near(c, candidates, history, obstacles, params);
+  // TargetParams::defer_for_doubtful: a candidate that counts as an object, every push of which
+  // endangers a doubtful candidate not yet nudged, waits for the rest of the pass.
+  // (One with no push the pass accepts at all is not deferred: it is rejected below.)
+  if (may_defer && params.defer_for_doubtful && c.stereo_agreement >= params.min_stereo_agreement) {
+    const std::vector<Obstacle> untried = not_yet_nudged(doubtful, history, params);
+    if (!untried.empty() && any_accepted(trials, tolerance) && !push_sparing(c, trials, untried, arm, seed, params, tolerance))
+      return Deferred{};
+  }
+  // TargetParams::spare_doubtful: the first push that also keeps clear of the doubtful candidates.
+  if (auto spared = push_sparing(c, trials, doubtful, arm, seed, params, tolerance)) {
+    const PushTrials::Trial& t = trials[*spared];
+    return taken(t.direction, t.turn, either(t.conflict, t.links), t.push, 0.0);
+  }
+  for (size_t k = 0; k < trials.size(); ++k) {
+    const PushTrials::Trial& t = trials[k];
+    auto refuse = [&](const std::string& problem) {
+      if (t.turn > 0) ++turned_refused;
+      else why_not += std::string(why_not.empty() ? "" : "; the other way: ") + problem;
+    };
+    if (!t.planned) {
+      refuse(t.conflict.reason);
+      continue;
+    }
+    if (t.push.ok()) {
+      if (!tolerated(t.links.kind, tolerance)) {
+        refuse(t.links.reason);
+        continue;
+      }
+      return taken(t.direction, t.turn, either(t.conflict, t.links), t.push, 0.0);
+    }
+    refuse(t.push.problem);
+    too_near.push_back(&t);
+  }
+  std::optional<TargetChoice> limited;
+  for (const PushTrials::Trial* r : too_near) {
+    auto shorter = push_for_shorter_object(c, r->direction_base, r->direction, arm, seed, params);
+    if (!shorter) continue;
+    const PushConflict links = links_conflict(shorter->second.command, seed, obstacles, arm, params);
+    if (!tolerated(links.kind, tolerance)) continue;
+    if (!limited || shorter->first > limited->height_limit)
+      limited = taken(r->direction, r->turn, either(r->conflict, links), std::move(shorter->second), shorter->first);
+  }
+  if (limited) return *limited;
+  if (turned_refused > 0)
+    why_not += "; pushes turned up to " + std::to_string(std::lround(params.max_push_turn_deg)) + " deg off across the view: none planned";
+  return reject(why_not);
+}
+
 // One pass over the candidates in camera order: a push whose conflict with another object the
 // `tolerance` does not accept is refused; one it accepts is taken and noted. Per candidate, the
 // first push (in push_directions' order) that clears the tallest object expected is taken; when
 // none does, the one that clears the tallest shorter object (TargetChoice::height_limit).
+// Candidates deferred for a doubtful one are tried after the rest, in order.
 TargetChoice choose_pass(const std::vector<Candidate>& candidates, const std::vector<size_t>& order, const History& history,
                          const Eigen::Vector3d& camera_base, const ArmSetup& arm, const robot::JointVector& seed,
                          const TargetParams& params, Tolerance tolerance) {
   TargetChoice choice;
+  std::vector<size_t> deferred;
   for (size_t i : order) {
-    const Candidate& c = candidates[i];
-    auto reject = [&](const std::string& reason) { choice.rejected.push_back({c.index, c.position, reason}); };
-    if (near_any(c.position, history.explored, params.explored_radius) ||
-        near_any(c.position, history.phantoms, params.phantom_radius)) {
-      reject("already explored");
-      continue;
-    }
-    if (c.stereo_agreement < params.min_nudge_agreement) {
-      reject("not seen upright by both cameras (a stereo mismatch)");
-      continue;
-    }
-    std::string why_not;  // the two pushes across the view: their reasons in full
-    int turned_refused = 0;
-    std::vector<const PushTrials::Trial*> too_near;  // planned only for a shorter object, perhaps
-    auto taken = [&](const Eigen::Vector3d& direction, double turn, const PushConflict& conflict, PushPlan push, double limit) {
-      TargetChoice t = choice;
-      t.found = true;
-      t.target = c;
-      t.direction = horizontal(direction).normalized();
-      t.plan = std::move(push.plan);
-      t.height_limit = limit;
-      t.push_turn_deg = turn;
-      if (conflict) t.note = "no clear push left: " + conflict.reason;
-      if (turn > 0) t.note += std::string(t.note.empty() ? "" : "; ") + "pushed " + std::to_string(std::lround(turn)) + " deg off across the view";
-      return t;
-    };
-    const std::vector<Obstacle> obstacles = obstacles_to(c, candidates, history, params);
-    const bool swapped = other_way_first(c, camera_base, arm, seed, params);
-    PushTrials trials(c, push_directions(camera_base, arm.point_to_base(c.position), params, swapped), obstacles, arm, seed,
-                      params, tolerance);
-    // TargetParams::spare_doubtful: the first push that also keeps clear of the doubtful candidates.
-    if (auto spared = push_sparing(c, trials, doubtful_near(c, candidates, history, obstacles, params), arm, seed, params,
-                                   tolerance)) {
-      const PushTrials::Trial& t = trials[*spared];
-      return taken(t.direction, t.turn, either(t.conflict, t.links), t.push, 0.0);
-    }
-    for (size_t k = 0; k < trials.size(); ++k) {
-      const PushTrials::Trial& t = trials[k];
-      auto refuse = [&](const std::string& problem) {
-        if (t.turn > 0) ++turned_refused;
-        else why_not += std::string(why_not.empty() ? "" : "; the other way: ") + problem;
-      };
-      if (!t.planned) {
-        refuse(t.conflict.reason);
-        continue;
-      }
-      if (t.push.ok()) {
-        if (!tolerated(t.links.kind, tolerance)) {
-          refuse(t.links.reason);
-          continue;
-        }
-        return taken(t.direction, t.turn, either(t.conflict, t.links), t.push, 0.0);
-      }
-      refuse(t.push.problem);
-      too_near.push_back(&t);
-    }
-    std::optional<TargetChoice> limited;
-    for (const PushTrials::Trial* r : too_near) {
-      auto shorter = push_for_shorter_object(c, r->direction_base, r->direction, arm, seed, params);
-      if (!shorter) continue;
-      const PushConflict links = links_conflict(shorter->second.command, seed, obstacles, arm, params);
-      if (!tolerated(links.kind, tolerance)) continue;
-      if (!limited || shorter->first > limited->height_limit)
-        limited = taken(r->direction, r->turn, either(r->conflict, links), std::move(shorter->second), shorter->first);
-    }
-    if (limited) return *limited;
-    if (turned_refused > 0)
-      why_not += "; pushes turned up to " + std::to_string(std::lround(params.max_push_turn_deg)) + " deg off across the view: none planned";
-    reject(why_not);
+    CandidateOutcome outcome = try_candidate(candidates[i], choice, candidates, history, camera_base, arm, seed, params, tolerance, true);
+    if (auto* taken = std::get_if<TargetChoice>(&outcome)) return std::move(*taken);
+    if (std::holds_alternative<Deferred>(outcome)) deferred.push_back(i);
+  }
+  for (size_t i : deferred) {
+    CandidateOutcome outcome = try_candidate(candidates[i], choice, candidates, history, camera_base, arm, seed, params, tolerance, false);
+    if (auto* taken = std::get_if<TargetChoice>(&outcome)) return std::move(*taken);
   }
   return choice;
 }

@@ -57,8 +57,15 @@ struct TargetParams {
   // knocks it over. With this on, each candidate's pushes are tried first keeping clear of the
   // doubtful candidates (seen in at least min_nudge_agreement) as of the others: pad, slide and
   // links alike. When none of its pushes can, its pushes are chosen as without them. So the
-  // doubtful ones change only which way a candidate is pushed, never whether or in which order.
+  // doubtful ones change only which way a candidate is pushed (the order: defer_for_doubtful).
   bool spare_doubtful = true;
+  // Beyond the thesis: when no push of a candidate that counts as an object keeps clear of the
+  // doubtful candidates not yet nudged, it waits: the pass tries the candidates after it first
+  // (the doubtful ones among them), and it only when none of them is taken. A doubtful candidate
+  // that is real is then nudged before a push can knock it over (hm1's cup); one that is a phantom
+  // costs one push that moves nothing, after which the waiting candidate's push is chosen as
+  // without the rule. Candidates with no push the pass accepts are not deferred.
+  bool defer_for_doubtful = true;
   // The order the others are tried in. Nearest the right camera first is the thesis'. Beyond it:
   // the most intersects first (Candidate::support, nearest first among equals). A phantom, made
   // by lines of two objects, holds in fewer of a survey's frames than an object's own lines, and
