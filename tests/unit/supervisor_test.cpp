@@ -560,6 +560,9 @@ TEST(Targets, ACandidateWaitsForTheDoubtfulOnesEveryPushWouldEndanger) {
   const auto waited = sv::choose_target(candidates, {}, camera, arm, arm_state_joints(), params);
   ASSERT_TRUE(chosen_strictly(waited)) << waited.note;
   EXPECT_GE(waited.target.index, 10) << "a doubtful neighbour goes first";
+  const auto note = std::find_if(waited.rejected.begin(), waited.rejected.end(), [](const sv::Rejection& r) { return r.index == 1; });
+  ASSERT_NE(note, waited.rejected.end()) << "the waiting candidate's reason is noted";
+  EXPECT_NE(note->reason.find("doubtful candidate not yet nudged"), std::string::npos) << note->reason;
   EXPECT_FALSE(sv::push_conflict(waited.target.position, waited.direction, target.position, arm, params))
       << "its push keeps clear of the waiting candidate, which counts as an object";
 

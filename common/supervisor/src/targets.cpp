@@ -425,7 +425,7 @@ CandidateOutcome try_candidate(const Candidate& c, TargetChoice& choice, const s
                     params, tolerance);
   const std::vector<Obstacle> doubtful = doubtful_near(c, candidates, history, obstacles, params);
   // TargetParams::defer_for_doubtful: a candidate that counts as an object, every push of which
-  // endangers a doubtful candidate not yet nudged, waits for the rest of the pass.
+  // endangers a doubtful candidate not yet nudged, waits (choose_in_order says till when).
   // (One with no push the pass accepts at all is not deferred: it is rejected below.)
   if (may_defer && params.defer_for_doubtful && c.stereo_agreement >= params.min_stereo_agreement) {
     const std::vector<Obstacle> untried = not_yet_nudged(doubtful, history, params);
@@ -476,20 +476,19 @@ CandidateOutcome try_candidate(const Candidate& c, TargetChoice& choice, const s
 // `tolerance` does not accept is refused; one it accepts is taken and noted. Per candidate, the
 // first push (in push_directions' order) that clears the tallest object expected is taken; when
 // none does, the one that clears the tallest shorter object (TargetChoice::height_limit).
-// Candidates deferred for a doubtful one are tried after the rest, in order.
+// With `waiting`, a candidate that waits for a doubtful one (TargetParams::defer_for_doubtful) is
+// passed over, noted, and added to it (once); without, none waits.
 TargetChoice choose_pass(const std::vector<Candidate>& candidates, const std::vector<size_t>& order, const History& history,
                          const Eigen::Vector3d& camera_base, const ArmSetup& arm, const robot::JointVector& seed,
-                         const TargetParams& params, Tolerance tolerance) {
+                         const TargetParams& params, Tolerance tolerance, std::vector<size_t>* waiting) {
   TargetChoice choice;
-  std::vector<size_t> deferred;
   for (size_t i : order) {
-    CandidateOutcome outcome = try_candidate(candidates[i], choice, candidates, history, camera_base, arm, seed, params, tolerance, true);
+    const Candidate& c = candidates[i];
+    CandidateOutcome outcome = try_candidate(c, choice, candidates, history, camera_base, arm, seed, params, tolerance, waiting != nullptr);
     if (auto* taken = std::get_if<TargetChoice>(&outcome)) return std::move(*taken);
-    if (std::holds_alternative<Deferred>(outcome)) deferred.push_back(i);
-  }
-  for (size_t i : deferred) {
-    CandidateOutcome outcome = try_candidate(candidates[i], choice, candidates, history, camera_base, arm, seed, params, tolerance, false);
-    if (auto* taken = std::get_if<TargetChoice>(&outcome)) return std::move(*taken);
+    if (!std::holds_alternative<Deferred>(outcome)) continue;
+    choice.rejected.push_back({c.index, c.position, "waits: every push would pass by a doubtful candidate not yet nudged"});
+    if (std::find(waiting->begin(), waiting->end(), i) == waiting->end()) waiting->push_back(i);
   }
   return choice;
 }
@@ -499,15 +498,28 @@ TargetChoice choose_pass(const std::vector<Candidate>& candidates, const std::ve
 namespace {
 
 // The strict pass over the candidates in `order`, then the relaxed ones when it finds nothing.
+// Candidates waiting for a doubtful one (TargetParams::defer_for_doubtful) are tried after the
+// others' strict and slide passes (a push that may slide an object into a candidate risks less
+// than one whose pad comes down by a real object the survey doubted), and before the pass that
+// lets the links pass near candidates.
 TargetChoice choose_in_order(const std::vector<Candidate>& candidates, const std::vector<size_t>& order, const History& history,
                              const Eigen::Vector3d& right_camera, const ArmSetup& arm, const robot::JointVector& seed,
                              const TargetParams& params) {
   const Eigen::Vector3d camera_base = arm.point_to_base(right_camera);
-  TargetChoice strict = choose_pass(candidates, order, history, camera_base, arm, seed, params, Tolerance::None);
+  auto pass = [&](const std::vector<size_t>& which, Tolerance tolerance, std::vector<size_t>* waiting) {
+    return choose_pass(candidates, which, history, camera_base, arm, seed, params, tolerance, waiting);
+  };
+  std::vector<size_t> waiting;
+  TargetChoice strict = pass(order, Tolerance::None, &waiting);
   if (strict.found) return strict;
-  TargetChoice relaxed = choose_pass(candidates, order, history, camera_base, arm, seed, params, Tolerance::Slide);
-  if (!relaxed.found) relaxed = choose_pass(candidates, order, history, camera_base, arm, seed, params, Tolerance::SlideAndLinks);
-  if (!relaxed.found) return strict;  // the strict pass's reasons say why each was passed over
+  TargetChoice relaxed = pass(order, Tolerance::Slide, &waiting);
+  for (Tolerance tolerance : {Tolerance::None, Tolerance::Slide})
+    if (!relaxed.found && !waiting.empty()) relaxed = pass(waiting, tolerance, nullptr);
+  if (!relaxed.found) relaxed = pass(order, Tolerance::SlideAndLinks, nullptr);
+  if (!relaxed.found) {
+    // The strict pass's reasons say why each was passed over (none waiting: all were tried).
+    return waiting.empty() ? strict : pass(order, Tolerance::None, nullptr);
+  }
   // Keep the strict pass's reasons for the candidates passed over before the chosen one.
   relaxed.rejected.clear();
   for (const Rejection& r : strict.rejected)

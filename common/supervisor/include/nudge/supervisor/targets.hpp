@@ -60,11 +60,13 @@ struct TargetParams {
   // doubtful ones change only which way a candidate is pushed (the order: defer_for_doubtful).
   bool spare_doubtful = true;
   // Beyond the thesis: when no push of a candidate that counts as an object keeps clear of the
-  // doubtful candidates not yet nudged, it waits: the pass tries the candidates after it first
-  // (the doubtful ones among them), and it only when none of them is taken. A doubtful candidate
-  // that is real is then nudged before a push can knock it over (hm1's cup); one that is a phantom
-  // costs one push that moves nothing, after which the waiting candidate's push is chosen as
-  // without the rule. Candidates with no push the pass accepts are not deferred.
+  // doubtful candidates not yet nudged, it waits: the other candidates (the doubtful ones among
+  // them) are tried first, with clear pushes and then with pushes that may slide the object into
+  // another candidate, and the waiting ones only when none of those is taken (before pushes whose
+  // links pass near a candidate). A doubtful candidate that is real is then nudged before a push
+  // can knock it over (hm1's cup, under the bottle's pad); one that is a phantom costs one push
+  // that moves nothing, after which the waiting candidate's push is chosen as without the rule.
+  // Candidates with no push the pass accepts do not wait. Needs spare_doubtful.
   bool defer_for_doubtful = true;
   // The order the others are tried in. Nearest the right camera first is the thesis'. Beyond it:
   // the most intersects first (Candidate::support, nearest first among equals). A phantom, made
