@@ -173,7 +173,9 @@ struct History {
 // candidate whose push only risks sliding it into another candidate is nudged anyway (the nudge
 // is gentle and short) and `note` says which; failing that, the nearest whose arm links may also
 // pass near another object (TargetParams::obstacle_height). The pad itself never descends onto
-// or sweeps through another candidate, and the strict rule decides whenever it can.
+// or sweeps through another candidate, and the strict rule decides whenever it can. A candidate
+// waiting for a doubtful one (TargetParams::defer_for_doubtful) comes after the other candidates'
+// clear and slide-risking pushes.
 TargetChoice choose_target(const std::vector<Candidate>& candidates, const History& history, const Eigen::Vector3d& right_camera,
                            const ArmSetup& arm, const robot::JointVector& seed, const TargetParams& params = {});
 
