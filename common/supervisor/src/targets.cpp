@@ -382,13 +382,17 @@ struct Rejected {};
 struct Deferred {};
 using CandidateOutcome = std::variant<TargetChoice, Rejected, Deferred>;
 
+// Whether a candidate at `p` was nudged already (the place explored, or a phantom's).
+bool nudged_already(const Eigen::Vector3d& p, const History& history, const TargetParams& params) {
+  return near_any(p, history.explored, params.explored_radius) || near_any(p, history.phantoms, params.phantom_radius);
+}
+
 // The doubtful places (doubtful_near) where no candidate was nudged yet: the ones a pass may still
 // try.
 std::vector<Obstacle> not_yet_nudged(const std::vector<Obstacle>& doubtful, const History& history, const TargetParams& params) {
   std::vector<Obstacle> untried;
   for (const Obstacle& d : doubtful)
-    if (!near_any(d.place, history.explored, params.explored_radius) && !near_any(d.place, history.phantoms, params.phantom_radius))
-      untried.push_back(d);
+    if (!nudged_already(d.place, history, params)) untried.push_back(d);
   return untried;
 }
 
@@ -401,8 +405,7 @@ CandidateOutcome try_candidate(const Candidate& c, TargetChoice& choice, const s
     choice.rejected.push_back({c.index, c.position, reason});
     return Rejected{};
   };
-  if (near_any(c.position, history.explored, params.explored_radius) || near_any(c.position, history.phantoms, params.phantom_radius))
-    return reject("already explored");
+  if (nudged_already(c.position, history, params)) return reject("already explored");
   if (c.stereo_agreement < params.min_nudge_agreement) return reject("not seen upright by both cameras (a stereo mismatch)");
   std::string why_not;  // the two pushes across the view: their reasons in full
   int turned_refused = 0;
@@ -427,13 +430,17 @@ CandidateOutcome try_candidate(const Candidate& c, TargetChoice& choice, const s
   // TargetParams::defer_for_doubtful: a candidate that counts as an object, every push of which
   // endangers a doubtful candidate not yet nudged, waits (choose_in_order says till when).
   // (One with no push the pass accepts at all is not deferred: it is rejected below.)
+  std::optional<size_t> spared;  // TargetParams::spare_doubtful: the first push clear of them all
   if (may_defer && params.defer_for_doubtful && c.stereo_agreement >= params.min_stereo_agreement) {
     const std::vector<Obstacle> untried = not_yet_nudged(doubtful, history, params);
-    if (!untried.empty() && any_accepted(trials, tolerance) && !push_sparing(c, trials, untried, arm, seed, params, tolerance))
-      return Deferred{};
+    if (!untried.empty() && any_accepted(trials, tolerance)) {
+      const std::optional<size_t> spares_untried = push_sparing(c, trials, untried, arm, seed, params, tolerance);
+      if (!spares_untried) return Deferred{};
+      if (untried.size() == doubtful.size()) spared = spares_untried;  // the same places: not searched again
+    }
   }
-  // TargetParams::spare_doubtful: the first push that also keeps clear of the doubtful candidates.
-  if (auto spared = push_sparing(c, trials, doubtful, arm, seed, params, tolerance)) {
+  if (!spared) spared = push_sparing(c, trials, doubtful, arm, seed, params, tolerance);
+  if (spared) {
     const PushTrials::Trial& t = trials[*spared];
     return taken(t.direction, t.turn, either(t.conflict, t.links), t.push, 0.0);
   }

@@ -110,7 +110,7 @@ struct TargetParams {
 
 struct Candidate {
   int index = 0;                   // in the CANDIDATES message
-  Eigen::Vector3d position;        // world frame, on the table
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();  // world frame, on the table
   int support = 0;                 // intersects in its cluster
   // Fraction of the survey's stereo pairs in which BOTH cameras detected a line where this axis
   // projects. A stereo mismatch (a left line paired with the wrong right line) gives a candidate
