@@ -4,10 +4,12 @@
 #include <array>
 #include <random>
 
+#include "nudge/robot/command_planner.hpp"
 #include "nudge/robot/kinematics.hpp"
 #include "nudge/robot/motions.hpp"
 #include "nudge/robot/puma260.hpp"
 #include "nudge/robot/safety.hpp"
+#include "nudge/sim/arm_motion.hpp"
 
 using namespace nudge::sim;
 using namespace nudge::sim::test;
@@ -210,8 +212,75 @@ TEST(SimArm, TheNudgeKeepsTheWristOffATallBottle) {
   EXPECT_LT(leaned.tilt(), 5 * kDeg) << "and stayed upright";
   nudge::robot::NudgeParams straight_down;
   straight_down.object_height = 0;  // no clearance check: the tool points straight down
+  // Pushing 10 mm up puts the wrist at 160 mm, at the shoulder (the default's 180 mm passes by the
+  // narrow neck of this bottle; a taller object meets it there).
+  straight_down.push_height = 0.010;
   const ObjectState struck = play_planned_nudge(scene, target, direction.normalized(), straight_down, &before);
   EXPECT_GT(struck.tilt(), 30 * kDeg) << "the straight-down tool's wrist knocks the bottle over";
+}
+
+// The arm service's own plans (robot::plan_command, the default workspace) played on the servos:
+// home from the scene's start, then a nudge with the given push height. Returns the object's
+// largest tilt during the nudge and where it settled.
+struct PlayedNudge {
+  double max_tilt = 0;
+  ObjectState before, after;
+};
+static PlayedNudge play_service_nudge(const Scene& scene, const Eigen::Vector2d& target, const Eigen::Vector2d& direction,
+                                      double push_height) {
+  namespace robot = nudge::robot;
+  const robot::PlannerConfig config = robot::planner_config(robot::Workspace{});
+  World world(scene);
+  world.mount_tools_on_arm(config.model.tool.translation().norm());
+  auto targets = [&world] { return as_joint_vector(world.arm_targets()); };
+  robot::Command home;
+  home.kind = robot::CommandKind::Home;
+  play_motion(world, config, robot::plan_command(config, home, targets()));
+  world.step_for(0.3);
+  PlayedNudge played;
+  played.before = world.object(0);
+  robot::Command nudge;
+  nudge.kind = robot::CommandKind::Nudge;
+  nudge.target_position = Eigen::Vector3d(target.x(), target.y(), 0);
+  nudge.direction = Eigen::Vector3d(direction.x(), direction.y(), 0);
+  nudge.height = push_height;
+  const robot::MotionPlan plan = robot::plan_command(config, nudge, targets());
+  EXPECT_TRUE(plan.ok()) << plan.reason;
+  MotionPlayback playback;
+  playback.each_period = [&played](const World& w) { played.max_tilt = std::max(played.max_tilt, w.object(0).tilt()); };
+  play_motion(world, config, plan, playback);
+  world.step_for(1.5);
+  played.after = world.object(0);
+  return played;
+}
+
+TEST(SimArm, TheDefaultPushHeightSlidesAnEmptyBottleThatALowPushLaysDown) {
+  // The learning experiment's half-transparent bottle (empty), pushed where its survey put it: at
+  // the old 10 mm push height the pad laid it down; at the default it slides, upright.
+  Scene scene = with_arm(one_object("bottle", 0.2682, 0.03364));
+  scene.objects[0].yaw = 321.7 * kDeg;
+  const Eigen::Vector2d target(0.2695, 0.0341), direction(0.153, -0.988);
+  const PlayedNudge low = play_service_nudge(scene, target, direction.normalized(), 0.010);
+  EXPECT_GT(low.after.tilt(), 30 * kDeg) << "a 10 mm push lays the bottle down";
+  const PlayedNudge standard = play_service_nudge(scene, target, direction.normalized(), 0);  // 0: the default
+  EXPECT_LT(standard.max_tilt, 5 * kDeg) << "the default push height keeps it upright";
+  const double moved = (standard.after.position - standard.before.position).head<2>().norm();
+  EXPECT_GT(moved, 0.01) << "and slides it the thesis' 1-3 cm";
+  EXPECT_LT(moved, 0.03);
+}
+
+TEST(SimArm, PlayingAMotionRefusesARefusedPlanAndAWorldWithoutAnArm) {
+  namespace robot = nudge::robot;
+  const robot::PlannerConfig config = robot::planner_config(robot::Workspace{});
+  World world(with_arm(default_scene()));
+  robot::MotionPlan refused;
+  refused.reason = "nudge target: outside the ring";
+  EXPECT_THROW(play_motion(world, config, refused), std::invalid_argument);
+  MotionPlayback no_time;
+  no_time.period = 0;
+  EXPECT_THROW(play_motion(world, config, robot::MotionPlan{}, no_time), std::invalid_argument);
+  World armless(default_scene());
+  EXPECT_THROW(play_motion(armless, config, robot::MotionPlan{}), SimError);
 }
 
 TEST(SimArm, TheTableStopsALinkCommandedThroughIt) {

@@ -51,7 +51,12 @@ JointPath cartesian_line(const ArmModel& model, const Eigen::Isometry3d& from,
 // symmetry axis (the effector never crosses it).
 struct NudgeParams {
   double approach_height = 0.32;  // P0: tool point above the table, well above the tallest object
-  double push_height = 0.010;     // P1, P2: tool point above the table (sponge near the table)
+  // P1, P2: the tool point (the pad's centre) above the table. The pad is 30 mm tall, so at 30 mm
+  // it spans 15-45 mm: near the table (the thesis' sponge), its lower edge above the objects'
+  // rounded bases. At 10 mm, in the simulated world, a push laid down an empty bottle that pushes
+  // from 20 to 50 mm up slide upright, and more nudges were refused for the leaned tool nearing the
+  // table (docs/results/push_height.md).
+  double push_height = 0.030;
   double start_distance = 0.110;  // Dmax: P1's horizontal distance from the target axis
   double stop_distance = 0.020;   // Dmin: P2 stops this far before the target axis
   double cartesian_step = 0.005;  // IK every this many metres along each line (see above)
