@@ -783,7 +783,7 @@ TEST(Targets, WithLearningThePushThatLeavesTheObjectGraspableComesFirst) {
     return nudge::robot::plan_command(arm.planner(), grasp, arm_state_joints()).ok();
   };
   int mended = 0, places = 0;
-  for (double radius = 0.16; radius <= 0.34; radius += 0.03)
+  for (double radius = 0.16; radius <= 0.34; radius += 0.015)
     for (double bearing = -90; bearing <= 90; bearing += 15) {
       const double b = bearing * M_PI / 180;
       const std::vector<sv::Candidate> candidates = {{0, Eigen::Vector3d(radius * std::cos(b), radius * std::sin(b), 0), 9}};
@@ -867,9 +867,9 @@ TEST(ObjectHeight, TheLinesFootTellsHowFarACandidateStandsBeyondTheFrontOfTheObj
   EXPECT_FALSE(sv::depth_beyond_line_foot(scene, line, foot, size));
 }
 
-// Where the arm with its leaning tool clears an object only up to about 0.15 m (behind the base,
-// at the ring's edge: the lean cannot take the wrist far enough off the object).
-const Eigen::Vector3d kLeanedWristNearTallObject(-0.04, 0.28, 0);
+// Where the arm with its leaning tool clears an object only up to about 0.15 m (behind the base:
+// the lean cannot take the wrist far enough off the object).
+const Eigen::Vector3d kLeanedWristNearTallObject(-0.0561, 0.2641, 0);
 
 TEST_F(SupervisorTest, APushClearingOnlyAShortObjectIsMadeWhenTheStillMeasuresItShorter) {
   const auto choice = sv::choose_target({{0, kLeanedWristNearTallObject, 9}}, {}, scene_.right_camera_in_world(), sv::ArmSetup{},
