@@ -99,13 +99,8 @@ Outcome push_once(const Trial& t, const robot::PlannerConfig& config, double hei
   // The arm goes home first, as the supervisor sends it, then nudges from there.
   robot::Command home;
   home.kind = robot::CommandKind::Home;
-  auto joints = [&] {
-    const std::array<double, 6> a = world.arm_targets();
-    return robot::JointVector(Eigen::Map<const robot::JointVector>(a.data()));
-  };
-  const robot::MotionPlan to_home = robot::plan_command(config, home, joints());
+  const robot::MotionPlan to_home = sim::plan_and_play(world, config, home);
   if (!to_home.ok()) throw std::runtime_error("the move home was refused: " + to_home.reason);
-  sim::play_motion(world, config, to_home);
   world.step_for(0.3);
   const sim::ObjectState before = world.object(0);
 
@@ -115,15 +110,14 @@ Outcome push_once(const Trial& t, const robot::PlannerConfig& config, double hei
   nudge.direction = Eigen::Vector3d(t.direction.x(), t.direction.y(), 0);
   nudge.height = height;
   nudge.object_height = sim::make_object(t.kind).height;
-  const robot::MotionPlan plan = robot::plan_command(config, nudge, joints());
+  sim::MotionPlayback playback;
+  playback.each_period = [&](const sim::World& w) { out.max_tilt = std::max(out.max_tilt, w.object(0).tilt()); };
+  const robot::MotionPlan plan = sim::plan_and_play(world, config, nudge, playback);
   if (!plan.ok()) {
     out.refusal = plan.reason;
     return out;
   }
   out.planned = true;
-  sim::MotionPlayback playback;
-  playback.each_period = [&](const sim::World& w) { out.max_tilt = std::max(out.max_tilt, w.object(0).tilt()); };
-  sim::play_motion(world, config, plan, playback);
   world.step_for(1.5);
   const sim::ObjectState after = world.object(0);
   out.final_tilt = after.tilt();

@@ -77,4 +77,11 @@ void play_motion(World& world, const robot::PlannerConfig& config, const robot::
   }
 }
 
+robot::MotionPlan plan_and_play(World& world, const robot::PlannerConfig& config, const robot::Command& command,
+                                const MotionPlayback& playback) {
+  const robot::MotionPlan plan = robot::plan_command(config, command, targets_of(world));
+  if (plan.ok()) play_motion(world, config, plan, playback);
+  return plan;
+}
+
 }  // namespace nudge::sim

@@ -232,10 +232,9 @@ static PlayedNudge play_service_nudge(const Scene& scene, const Eigen::Vector2d&
   const robot::PlannerConfig config = robot::planner_config(robot::Workspace{});
   World world(scene);
   world.mount_tools_on_arm(config.model.tool.translation().norm());
-  auto targets = [&world] { return as_joint_vector(world.arm_targets()); };
   robot::Command home;
   home.kind = robot::CommandKind::Home;
-  play_motion(world, config, robot::plan_command(config, home, targets()));
+  EXPECT_TRUE(plan_and_play(world, config, home).ok());
   world.step_for(0.3);
   PlayedNudge played;
   played.before = world.object(0);
@@ -244,11 +243,10 @@ static PlayedNudge play_service_nudge(const Scene& scene, const Eigen::Vector2d&
   nudge.target_position = Eigen::Vector3d(target.x(), target.y(), 0);
   nudge.direction = Eigen::Vector3d(direction.x(), direction.y(), 0);
   nudge.height = push_height;
-  const robot::MotionPlan plan = robot::plan_command(config, nudge, targets());
-  EXPECT_TRUE(plan.ok()) << plan.reason;
   MotionPlayback playback;
   playback.each_period = [&played](const World& w) { played.max_tilt = std::max(played.max_tilt, w.object(0).tilt()); };
-  play_motion(world, config, plan, playback);
+  const robot::MotionPlan plan = plan_and_play(world, config, nudge, playback);
+  EXPECT_TRUE(plan.ok()) << plan.reason;
   world.step_for(1.5);
   played.after = world.object(0);
   return played;
@@ -281,6 +279,16 @@ TEST(SimArm, PlayingAMotionRefusesARefusedPlanAndAWorldWithoutAnArm) {
   EXPECT_THROW(play_motion(world, config, robot::MotionPlan{}, no_time), std::invalid_argument);
   World armless(default_scene());
   EXPECT_THROW(play_motion(armless, config, robot::MotionPlan{}), SimError);
+  // A command the arm would refuse (a nudge outside the workspace ring) moves nothing.
+  robot::Command too_far;
+  too_far.kind = robot::CommandKind::Nudge;
+  too_far.target_position = Eigen::Vector3d(0.6, 0.0, 0);
+  too_far.direction = Eigen::Vector3d(0, 1, 0);
+  const std::array<double, 6> before = world.arm_targets();
+  const robot::MotionPlan plan = plan_and_play(world, config, too_far);
+  EXPECT_FALSE(plan.ok());
+  EXPECT_NE(plan.reason.find("ring"), std::string::npos) << plan.reason;
+  EXPECT_EQ(world.arm_targets(), before);
 }
 
 TEST(SimArm, TheTableStopsALinkCommandedThroughIt) {

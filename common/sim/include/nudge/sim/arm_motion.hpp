@@ -24,4 +24,9 @@ struct MotionPlayback {
 void play_motion(World& world, const robot::PlannerConfig& config, const robot::MotionPlan& plan,
                  const MotionPlayback& playback = {});
 
+// Plans `command` as the arm service does (robot::plan_command from the joints the servos are
+// sent to) and plays it when it plans. Returns the plan: a refused one moved nothing.
+robot::MotionPlan plan_and_play(World& world, const robot::PlannerConfig& config, const robot::Command& command,
+                                const MotionPlayback& playback = {});
+
 }  // namespace nudge::sim
