@@ -11,7 +11,7 @@
 // lying fallen (over 45 deg) does not count as segmented; every state is read for the objects that
 // fell, when, and where the pad was as each began to lean.
 //   nudge-exp-nudge-segmentation RUNS_DIR SCENE_DIR [RUN...] [--development RUNS_DIR SCENE_DIR]
-//                                [--name STEM] [--workspace FILE]
+//                                [--name STEM] [--workspace FILE] [--development-set]
 // (default: every scene in SCENE_DIR). Objects a scene stages outside the workspace ring (FILE's,
 // default the code's) are counted apart: the loop's candidates are within the ring. The first set gives the headline keys (the held-out scenes); the
 // development set goes under its own key "development".
@@ -491,6 +491,10 @@ int main(int argc, char** argv) {
       args.erase(args.begin() + static_cast<long>(i), args.begin() + static_cast<long>(i) + 2);
       break;
     }
+  // --development-set: the first set is a development set (tuned on), and its report says so.
+  const auto development_flag = std::find(args.begin(), args.end(), "--development-set");
+  const bool first_set_is_development = development_flag != args.end();
+  if (first_set_is_development) args.erase(development_flag);
   robot::Workspace workspace;  // --workspace FILE: the ring the objects are counted in reach by
   for (size_t i = 0; i < args.size(); ++i)
     if (args[i] == "--workspace") {
@@ -519,8 +523,9 @@ int main(int argc, char** argv) {
     }
   if (args.size() < 2) {
     std::cerr << "usage: nudge-exp-nudge-segmentation RUNS_DIR SCENE_DIR [RUN...] [--development RUNS_DIR SCENE_DIR] [--name STEM]\n"
-                 "         [--workspace FILE]  (the workspace ring objects count as in reach by; default: the code's)\n"
-                 "  (the first set gives the headline figures: the held-out scenes; STEM.json, STEM.md in docs/results,\n"
+                 "         [--workspace FILE] [--development-set]  (the workspace ring objects count as in reach by; default: the code's)\n"
+                 "  (the first set gives the headline figures: the held-out scenes, or with --development-set a\n"
+                 "  development set's; STEM.json, STEM.md in docs/results,\n"
                  "  default nudge_segmentation)\n";
     return 2;
   }
@@ -538,6 +543,7 @@ int main(int argc, char** argv) {
   const Detection detection = detection_of(runs_dir);
   j.field("scenes", scene_dir.filename().string()).field("detection", detection.pipeline);
   json_fields(j, main_set, ms);
+  j.field("set_kind", first_set_is_development ? "development" : "held-out");
   j.field("machine", ex::machine_description()).field("date", ex::today());
   if (dev_set) {
     j.key("development").begin_object();
@@ -564,7 +570,7 @@ int main(int argc, char** argv) {
      << ex::machine_description() << ", " << ex::today() << ".\n\n"
      << "Detection: the **" << detection.pipeline << "** pipeline (`NUDGE_LOOP_TABLE`, `scripts/lib.sh`): " << detection.flags
      << ".\n\n"
-     << "## Held-out scenes (`" << scene_dir.filename().string() << "`)\n\n" << figures_table(main_set, ms) << "\n"
+     << (first_set_is_development ? "## Development scenes, tuned on (`" : "## Held-out scenes (`") << scene_dir.filename().string() << "`)\n\n" << figures_table(main_set, ms) << "\n"
      << main_set.table << "\n";
   if (dev_set)
     md << "## Development scenes (`" << development->second.filename().string() << "`)\n\n" << figures_table(*dev_set, ms)
@@ -572,7 +578,8 @@ int main(int argc, char** argv) {
   md << "`segmented`: scene index of the object covered and the mask's IoU with its true mask. `other`: attempts "
         "refused by the arm, segmentations that came out empty, lost stills. The motion segmentation time is over "
         "both sets' stills.\n\n"
-     << "## Gallery\n\nPer segmentation (held-out scenes, then development): before, after, the mask over the after still.\n\n"
+     << "## Gallery\n\nPer segmentation (" << (first_set_is_development ? "development scenes" : "held-out scenes, then development")
+     << "): before, after, the mask over the after still.\n\n"
      << "![gallery](" << name << "_gallery.png)\n";
   ex::write_result(name + ".md", md.str());
   std::vector<cv::Mat> gallery = main_set.gallery;

@@ -71,5 +71,6 @@ else
   result_name=nudge_segmentation
   [ "$which_set" = heldout2 ] && result_name=nudge_segmentation_heldout2
   [ "$which_set" = development2 ] && result_name=nudge_segmentation_development2
+  case "$which_set" in development*) score+=(--development-set) ;; esac
   "${score[@]}" "$out_dir/$which_set" "${scene_dirs[$which_set]}" "${names[@]}" --name "$result_name"
 fi
