@@ -8,7 +8,9 @@
 # Scene names run only those scenes of the one set chosen with --set (and score that set alone).
 # --set heldout2 runs the second held-out set (seeds 620001-620015, fixed 2026-11-25) and writes
 # docs/results/nudge_segmentation_heldout2.{json,md}. --set development2 runs the second development
-# set (seeds 630001-630015, fixed 2026-11-30; tuned on) into nudge_segmentation_development2.{json,md}.
+# set (seeds 630001-630015, fixed 2026-11-30; tuned on) into nudge_segmentation_development2.{json,md};
+# --set development the first (tuned on) into nudge_segmentation_development.{json,md}. Only the
+# held-out set alone or both sets (--set heldout, both) write the headline nudge_segmentation.*.
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/../scripts/lib.sh"
 out_dir="$NUDGE_ROOT/out/experiments/nudge_segmentation"
@@ -70,6 +72,7 @@ else
   run_set "$which_set" "${names[@]}"
   result_name=nudge_segmentation
   [ "$which_set" = heldout2 ] && result_name=nudge_segmentation_heldout2
+  [ "$which_set" = development ] && result_name=nudge_segmentation_development
   [ "$which_set" = development2 ] && result_name=nudge_segmentation_development2
   case "$which_set" in development*) score+=(--development-set) ;; esac
   "${score[@]}" "$out_dir/$which_set" "${scene_dirs[$which_set]}" "${names[@]}" --name "$result_name"
