@@ -554,6 +554,9 @@ int main(int argc, char** argv) {
   j.end_object();
   ex::write_result(name + ".json", j.str() + "\n");
 
+  // The first set's heading and the gallery's order name what kind of set it is.
+  const std::string first_set_heading = first_set_is_development ? "Development scenes, tuned on" : "Held-out scenes";
+  const std::string gallery_order = first_set_is_development ? "development scenes" : "held-out scenes, then development";
   std::ostringstream md;
   md << "# Autonomous segmentation by a robotic nudge (thesis sec. 6.5, in simulation)\n\n"
      << "`experiments/nudge_segmentation.sh` runs the whole loop (world, camera with stills, symmetry, triangulation, "
@@ -570,7 +573,7 @@ int main(int argc, char** argv) {
      << ex::machine_description() << ", " << ex::today() << ".\n\n"
      << "Detection: the **" << detection.pipeline << "** pipeline (`NUDGE_LOOP_TABLE`, `scripts/lib.sh`): " << detection.flags
      << ".\n\n"
-     << (first_set_is_development ? "## Development scenes, tuned on (`" : "## Held-out scenes (`") << scene_dir.filename().string() << "`)\n\n" << figures_table(main_set, ms) << "\n"
+     << "## " << first_set_heading << " (`" << scene_dir.filename().string() << "`)\n\n" << figures_table(main_set, ms) << "\n"
      << main_set.table << "\n";
   if (dev_set)
     md << "## Development scenes (`" << development->second.filename().string() << "`)\n\n" << figures_table(*dev_set, ms)
@@ -578,8 +581,7 @@ int main(int argc, char** argv) {
   md << "`segmented`: scene index of the object covered and the mask's IoU with its true mask. `other`: attempts "
         "refused by the arm, segmentations that came out empty, lost stills. The motion segmentation time is over "
         "both sets' stills.\n\n"
-     << "## Gallery\n\nPer segmentation (" << (first_set_is_development ? "development scenes" : "held-out scenes, then development")
-     << "): before, after, the mask over the after still.\n\n"
+     << "## Gallery\n\nPer segmentation (" << gallery_order << "): before, after, the mask over the after still.\n\n"
      << "![gallery](" << name << "_gallery.png)\n";
   ex::write_result(name + ".md", md.str());
   std::vector<cv::Mat> gallery = main_set.gallery;

@@ -70,10 +70,10 @@ if [ "$which_set" = both ]; then
   "${score[@]}" "$out_dir/heldout" "${scene_dirs[heldout]}" --development "$out_dir/development" "${scene_dirs[development]}"
 else
   run_set "$which_set" "${names[@]}"
-  result_name=nudge_segmentation
-  [ "$which_set" = heldout2 ] && result_name=nudge_segmentation_heldout2
-  [ "$which_set" = development ] && result_name=nudge_segmentation_development
-  [ "$which_set" = development2 ] && result_name=nudge_segmentation_development2
-  case "$which_set" in development*) score+=(--development-set) ;; esac
+  case "$which_set" in
+    heldout) result_name=nudge_segmentation ;;
+    heldout2) result_name=nudge_segmentation_heldout2 ;;
+    development*) result_name=nudge_segmentation_$which_set; score+=(--development-set) ;;
+  esac
   "${score[@]}" "$out_dir/$which_set" "${scene_dirs[$which_set]}" "${names[@]}" --name "$result_name"
 fi
