@@ -940,15 +940,23 @@ std::optional<Eigen::Vector3d> Supervisor::known_object_hiding_base(const MaskOn
 }
 
 // Config::doubtful_tilt_deg: the settled axes lean enough to doubt that they are the pushed
-// object's, and its mask shows no upright object's base that a known object could be hiding.
-// Why the attempt is "tipped or lost", or empty.
+// object's, and its mask shows no upright object's base, nor one a known object in front hides
+// of a target the survey counted as an object. Why the attempt is "tipped or lost", or empty.
 std::string Supervisor::fallen_over(const Attempt& a) const {
-  if (config_.doubtful_tilt_deg <= 0 || !a.rest_tilt_deg || *a.rest_tilt_deg <= config_.doubtful_tilt_deg ||
-      a.rest_from_mask || a.mask_front_hidden_behind)
-    return "";
-  char text[160];
-  std::snprintf(text, sizeof text,
-                "object tipped or lost: its settled axes lean %.1f deg and its mask shows no upright object's base", *a.rest_tilt_deg);
+  if (config_.doubtful_tilt_deg <= 0 || !a.rest_tilt_deg || *a.rest_tilt_deg <= config_.doubtful_tilt_deg) return "";
+  // With the front hidden, the foot read from the mask is the hider's outline, not a base.
+  if (a.rest_from_mask && !a.mask_front_hidden_behind) return "";
+  const bool counted = a.target.stereo_agreement >= config_.targets.min_stereo_agreement;
+  if (a.mask_front_hidden_behind && counted) return "";
+  char text[256];
+  if (a.mask_front_hidden_behind)
+    std::snprintf(text, sizeof text,
+                  "object tipped or lost: its settled axes lean %.1f deg, its mask's base is hidden by the known object at %s, "
+                  "and the survey saw the target in only %.0f%% of its stereo pairs",
+                  *a.rest_tilt_deg, millimetres(*a.mask_front_hidden_behind).c_str(), 100 * a.target.stereo_agreement);
+  else
+    std::snprintf(text, sizeof text,
+                  "object tipped or lost: its settled axes lean %.1f deg and its mask shows no upright object's base", *a.rest_tilt_deg);
   return text;
 }
 

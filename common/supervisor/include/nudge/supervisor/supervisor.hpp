@@ -121,7 +121,12 @@ struct Config {
   // ends "tipped or lost". Development runs (2026-11-30): both pushes that toppled a bottle yet
   // were called segmented (IoU 0.24, 0.29) leaned 10.9 and 11.2 deg and showed no base; upright
   // objects whose mask showed none leaned 6.2 deg at most, and those that leaned 10-15 deg all
-  // showed one. 0: off.
+  // showed one. A base hidden by a known object vouches for the lean only when the survey
+  // counted the target as an object (targets.min_stereo_agreement): the second development set's
+  // hm2 (2026-12-02) pushed a candidate seen in 1 of 25 pairs, its axes leaned 11.9 deg, and the
+  // mask behind the clear bottle in front was two labels the push stirred (IoU 0.136), where the
+  // development runs' two upright objects with a hidden base and a lean over 8 deg (8.4, 8.5;
+  // IoU 0.94, 0.89) were seen in every pair. 0: off.
   double doubtful_tilt_deg = 8;
   double min_displacement_m = 0.004; // a smaller slide gives no difference to segment
   // An after line where the before line stood while the rest moved less than
