@@ -521,6 +521,10 @@ int main(int argc, char** argv) {
       args.erase(args.begin() + static_cast<long>(i), args.begin() + static_cast<long>(i) + 3);
       break;
     }
+  if (first_set_is_development && development) {
+    std::cerr << "--development-set and --development: the first set is already a development set; score one set\n";
+    return 2;
+  }
   if (args.size() < 2) {
     std::cerr << "usage: nudge-exp-nudge-segmentation RUNS_DIR SCENE_DIR [RUN...] [--development RUNS_DIR SCENE_DIR] [--name STEM]\n"
                  "         [--workspace FILE] [--development-set]  (the workspace ring objects count as in reach by; default: the code's)\n"

@@ -230,10 +230,11 @@ class SupervisorTest : public ::testing::Test {
   }
   std::pair<std::optional<sv::NudgeCommand>, std::string> nudge_beside_an_unpaired_object(const sv::Config& config,
                                                                                           const Eigen::Vector3d& beside);
-  // A run started on `object` alone, its before still taken: the nudge the supervisor commands.
-  sv::NudgeCommand nudge_command_for(sv::Supervisor& s, const Eigen::Vector3d& object) {
+  // A run started on `object` alone, its before still taken (drawn as `shape`): the nudge the
+  // supervisor commands.
+  sv::NudgeCommand nudge_command_for(sv::Supervisor& s, const Eigen::Vector3d& object, const Shape& shape = {}) {
     start_with(s, {object});
-    s.on_right_still(draw_scene(scene_, {1280, 960}, {object}), now_, now_);
+    s.on_right_still(draw_scene(scene_, {1280, 960}, {object}, false, {shape}), now_, now_);
     return outputs_of<sv::NudgeCommand>(s.take_outputs()).at(0);
   }
   // A run started on `object` whose before still also shows a neighbour `neighbour_travel_m` along
@@ -1246,9 +1247,7 @@ TEST_F(SupervisorTest, AHiddenBaseVouchesForADoubtfulLeanOnlyOfATargetTheSurveyC
     sv::Supervisor s(sv::Config{}, scene_, sv::ArmSetup{}, segment);
     // First the object in front: nudged, segmented, known where it rests.
     const Eigen::Vector3d found = Eigen::Vector3d(0.22, -0.10, 0) + 0.10 * towards;
-    start_with(s, {found});
-    s.on_right_still(draw_scene(scene_, {1280, 960}, {found}, false, {front_shape}), now_, now_);
-    const sv::NudgeCommand first_nudge = outputs_of<sv::NudgeCommand>(s.take_outputs()).at(0);
+    const sv::NudgeCommand first_nudge = nudge_command_for(s, found, front_shape);
     const Eigen::Vector3d front = found + 0.03 * first_nudge.direction;
     play_nudge(s, first_nudge.seq, found, front);
     settle_with_axes(s, {front});

@@ -944,10 +944,10 @@ std::optional<Eigen::Vector3d> Supervisor::known_object_hiding_base(const MaskOn
 // of a target the survey counted as an object. Why the attempt is "tipped or lost", or empty.
 std::string Supervisor::fallen_over(const Attempt& a) const {
   if (config_.doubtful_tilt_deg <= 0 || !a.rest_tilt_deg || *a.rest_tilt_deg <= config_.doubtful_tilt_deg) return "";
-  // With the front hidden, the foot read from the mask is the hider's outline, not a base.
-  if (a.rest_from_mask && !a.mask_front_hidden_behind) return "";
-  const bool counted = a.target.stereo_agreement >= config_.targets.min_stereo_agreement;
-  if (a.mask_front_hidden_behind && counted) return "";
+  // A base the mask shows vouches for the lean. With the front hidden, the foot read from the mask
+  // is the hider's outline, not a base: only a target the survey counted as an object is believed.
+  if (a.mask_front_hidden_behind ? a.target.stereo_agreement >= config_.targets.min_stereo_agreement : a.rest_from_mask.has_value())
+    return "";
   char text[256];
   if (a.mask_front_hidden_behind)
     std::snprintf(text, sizeof text,
