@@ -634,6 +634,9 @@ int main(int argc, char** argv) {
                    "on|off: the simulated tilts' features matched only when the views as taken recognise nothing");
   flags.add_double("sift-contrast", &o.recognize.sift.contrast_threshold,
                    "SIFT's contrast threshold in recognition and, with --relearn, in learning");
+  flags.add_double("sift-equalise", &o.recognize.sift.equalise_clip,
+                   "CLAHE clip limit before SIFT in recognition and, with --relearn, in learning (0: none)");
+  flags.add_int("sift-equalise-tile", &o.recognize.sift.equalise_tile_px, "CLAHE's tile size, pixels");
   try {
     if (!flags.parse(argc, argv)) return 0;
     if (affine != "on" && affine != "off") throw FlagError("--affine-check must be on or off");

@@ -56,6 +56,7 @@ struct Options {
   std::string name = "learning_views";
   std::string finger_bands;  // ';'-separated sets of comma-separated grip depths below the top, m
   std::string tilts_as_fallback = nudge::learning::RecognizeParams{}.tilts_as_fallback ? "on" : "off";  // the learner's
+  double sift_equalise = nudge::learning::SiftParams{}.equalise_clip;                                     // the learner's
 };
 
 std::vector<double> parse_tilts(const std::string& text) {
@@ -224,6 +225,8 @@ int run(const Options& o) {
   learn.axis_tilts = learning::axis_tilts_from_text(o.axis_tilts);
   learning::RecognizeParams recognize;
   recognize.tilts_as_fallback = o.tilts_as_fallback == "on";
+  recognize.sift.equalise_clip = o.sift_equalise;
+  learn.sift = recognize.sift;  // as the learner: both find the same keypoints
   const std::vector<TestImage> images = read_test_images(o.test_images, o.set);
   const std::vector<sim::ObjectSpec> bottles = learning_bottles();
   nudge::Progress progress("nudge-exp-learning-views", static_cast<int>(bottles.size() * tilts.size()));
@@ -322,6 +325,7 @@ int main(int argc, char** argv) {
   flags.add_string("finger-bands", &o.finger_bands,
                    "';'-separated sets of comma-separated grip depths below the top, m: upright views with the fingers' band "
                    "painted over, one model per set (e.g. '0.09;0.09,0.13')");
+  flags.add_double("sift-equalise", &o.sift_equalise, "CLAHE clip limit before SIFT, learning and recognition (0: none)");
   flags.add_string("name", &o.name, "result name (docs/results/NAME.*)");
   try {
     if (!flags.parse(argc, argv)) return 0;

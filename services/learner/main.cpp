@@ -25,6 +25,8 @@ int main(int argc, char** argv) {
                  "... where a match counts only within this many pixels of the descriptor: the scene stands still (0: anywhere, as the thesis)");
     f.add_double("sift-contrast", &options.recognize.sift.contrast_threshold,
                  "SIFT's contrast threshold, learning and recognition (OpenCV's default 0.04; lower finds more on small labels)");
+    f.add_double("sift-equalise", &options.recognize.sift.equalise_clip,
+                 "local contrast equalisation (CLAHE clip limit) before SIFT, learning and recognition; 0: none");
     std::string axis_tilts = learning::axis_tilts_text(options.learn.axis_tilts);
     f.add_string("axis-tilts", &axis_tilts,
                  "also learn each view squeezed along the held object's axis by these simulated tilts (1/cos: 2 = 60 deg), comma-separated; \"\": none");
@@ -51,6 +53,7 @@ int main(int argc, char** argv) {
     options.recognize.tilts_as_fallback = tilts_as_fallback == "on";
     if (options.view_expiry_s <= 0) throw FlagError("--view-expiry must be > 0");
     if (!(options.recognize.sift.contrast_threshold > 0)) throw FlagError("--sift-contrast must be > 0");
+    if (!(options.recognize.sift.equalise_clip >= 0)) throw FlagError("--sift-equalise must be >= 0");
     options.learn.ratio = options.recognize.ratio;
     options.learn.sift = options.recognize.sift;
     service.start();

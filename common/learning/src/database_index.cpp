@@ -1,9 +1,14 @@
 #include "database_index.hpp"
 
+#include "seeded_rng.hpp"
+
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 
 namespace nudge::learning::detail {
+
+constexpr unsigned kIndexSeed = 20080101;  // any fixed value: the index's trees, reproducibly
 
 void DatabaseIndex::build(const std::vector<IndexedObject>& objects) {
   int total = 0;
@@ -34,7 +39,14 @@ void DatabaseIndex::build(const std::vector<IndexedObject>& objects) {
   }
   index_.reset();
   // Randomised k-d trees, as the per-object FLANN matcher uses (Lowe's usual setting for SIFT).
-  if (total >= 2) index_ = std::make_unique<cv::flann::Index>(descriptors_, cv::flann::KDTreeIndexParams(4));
+  // FLANN draws the trees' split dimensions from cv::theRNG() and shuffles with std::rand():
+  // seeded here, the same database gives the same index, so a query's approximate neighbours (and
+  // a close call between two objects) do not depend on what the process did before.
+  if (total >= 2) {
+    const SeededThreadRng seeded(kIndexSeed);
+    std::srand(kIndexSeed);
+    index_ = std::make_unique<cv::flann::Index>(descriptors_, cv::flann::KDTreeIndexParams(4));
+  }
 }
 
 namespace {

@@ -10,15 +10,19 @@
 
 namespace nudge::learning {
 
-Features detect_features(const cv::Mat& image, const SiftParams& params) {
+namespace {
+
+void check_image_and_settings(const cv::Mat& image, const SiftParams& params) {
   if (image.empty()) throw std::invalid_argument("SIFT: empty image");
   if (image.depth() != CV_8U) throw std::invalid_argument("SIFT: image is not 8-bit");
   if (!(params.contrast_threshold > 0) || !(params.edge_threshold > 0) || params.octave_layers < 1)
     throw std::invalid_argument("SIFT: contrast_threshold and edge_threshold must be positive, octave_layers >= 1");
-  cv::Mat grey;
-  if (image.channels() == 3) cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
-  else if (image.channels() == 4) cv::cvtColor(image, grey, cv::COLOR_BGRA2GRAY);
-  else grey = image;
+  if (!(params.equalise_clip >= 0) || params.equalise_tile_px < 8)
+    throw std::invalid_argument("SIFT: equalise_clip must be >= 0 and equalise_tile_px >= 8");
+}
+
+// SIFT on a grey image as it is (no equalisation: the caller has done what it asked for).
+Features sift_on_grey(const cv::Mat& grey, const SiftParams& params) {
   // One detector per thread (cv::SIFT keeps scratch state), made again when the settings change.
   thread_local cv::Ptr<cv::SIFT> sift;
   thread_local SiftParams made_with;
@@ -33,6 +37,32 @@ Features detect_features(const cv::Mat& image, const SiftParams& params) {
   return features;
 }
 
+}  // namespace
+
+cv::Mat sift_grey(const cv::Mat& image, const SiftParams& params) {
+  check_image_and_settings(image, params);
+  cv::Mat grey;
+  if (image.channels() == 3) cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
+  else if (image.channels() == 4) cv::cvtColor(image, grey, cv::COLOR_BGRA2GRAY);
+  else grey = image;
+  if (params.equalise_clip <= 0) return grey;
+  // Tiles of a fixed size in pixels, not a fixed grid: the same camera's views and queries are
+  // then equalised alike whatever the image's size.
+  const cv::Size grid(std::max(1, (grey.cols + params.equalise_tile_px / 2) / params.equalise_tile_px),
+                      std::max(1, (grey.rows + params.equalise_tile_px / 2) / params.equalise_tile_px));
+  thread_local cv::Ptr<cv::CLAHE> clahe;
+  if (!clahe) clahe = cv::createCLAHE();
+  clahe->setClipLimit(params.equalise_clip);
+  clahe->setTilesGridSize(grid);
+  cv::Mat equalised;
+  clahe->apply(grey, equalised);
+  return equalised;
+}
+
+Features detect_features(const cv::Mat& image, const SiftParams& params) {
+  return sift_on_grey(sift_grey(image, params), params);
+}
+
 Features detect_features_tilted(const cv::Mat& image, double tilt, const SiftParams& params, const cv::Rect& roi) {
   if (!(tilt >= 1)) throw std::invalid_argument("SIFT: simulated tilt " + std::to_string(tilt) + " is below 1");
   if (image.empty()) throw std::invalid_argument("SIFT: empty image");
@@ -43,9 +73,11 @@ Features detect_features_tilted(const cv::Mat& image, double tilt, const SiftPar
     return none;
   }
   const int squeezed_rows = std::max(1, static_cast<int>(std::lround(area.height / tilt)));
+  // Equalised as the whole view is, then squeezed: the layer's grey levels are the view's.
+  const cv::Mat grey = sift_grey(image, params);
   cv::Mat squeezed;
-  cv::resize(image(area), squeezed, cv::Size(area.width, squeezed_rows), 0, 0, cv::INTER_AREA);
-  Features features = detect_features(squeezed, params);
+  cv::resize(grey(area), squeezed, cv::Size(area.width, squeezed_rows), 0, 0, cv::INTER_AREA);
+  Features features = sift_on_grey(squeezed, params);
   const float y_scale = static_cast<float>(area.height) / static_cast<float>(squeezed_rows);
   for (cv::KeyPoint& k : features.keypoints) {
     k.pt.x += static_cast<float>(area.x);

@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "database_index.hpp"
+#include "seeded_rng.hpp"
 #include "nudge/timing.hpp"
 
 namespace nudge::learning {
@@ -67,6 +68,8 @@ cv::Ptr<cv::DescriptorMatcher> make_matcher(MatcherKind kind) {
   return cv::makePtr<cv::FlannBasedMatcher>(cv::makePtr<cv::flann::KDTreeIndexParams>(4),
                                            cv::makePtr<cv::flann::SearchParams>(32));
 }
+
+constexpr uint64_t kRansacSeed = 0x2008, kFlannSeed = 0x2009;  // any fixed values
 
 // Neighbours looked at per query descriptor (see view_ratio_matches).
 constexpr int kNeighbours = detail::kObjectNeighbours;
@@ -144,6 +147,7 @@ std::vector<cv::DMatch> inliers_of(const std::vector<cv::DMatch>& matches, const
 std::vector<cv::DMatch> geometric_inliers(const std::vector<cv::DMatch>& matches, const Features& query,
                                           const Features& view, double ransac_px, int min_support, bool affine) {
   if (matches.size() < 3) return {};
+  const detail::SeededThreadRng seeded(kRansacSeed);  // the same matches, the same inliers
   std::vector<cv::Point2f> from, to;
   for (const auto& m : matches) {
     from.push_back(view.keypoints[m.trainIdx].pt);
@@ -244,7 +248,10 @@ void Recognizer::add(std::shared_ptr<const ObjectModel> model) {
   if (all.rows >= 2 && !shared_) {
     entry->matcher = make_matcher(params_.matcher);
     entry->matcher->add(all);
-    entry->matcher->train();  // builds FLANN's trees now, not on the first query
+    // FLANN's trees built now, not on the first query, from seeded generators (seeded_rng.hpp).
+    const detail::SeededThreadRng seeded(kFlannSeed);
+    std::srand(static_cast<unsigned>(kFlannSeed));
+    entry->matcher->train();
   }
   if (params_.tilts_as_fallback) entry->untilted = without_tilts(*model, &entry->untilted_index);
   entry->model = std::move(model);
@@ -347,7 +354,10 @@ Recognition Recognizer::recognize(const cv::Mat& image, const cv::Rect& roi) con
   if (image.empty()) throw std::invalid_argument("recognize: empty image");
   const cv::Rect area = roi.empty() ? cv::Rect(cv::Point(0, 0), image.size()) : roi & cv::Rect(cv::Point(0, 0), image.size());
   if (area.empty()) throw std::invalid_argument("recognize: the region lies outside the image");
-  Features query = detect_features(image(area), params_.sift);
+  // Equalised over the whole image, as the learner's views are, then cut to the region.
+  SiftParams as_is = params_.sift;
+  as_is.equalise_clip = 0;
+  Features query = detect_features(sift_grey(image, params_.sift)(area), as_is);
   for (auto& k : query.keypoints) k.pt += cv::Point2f(static_cast<float>(area.x), static_cast<float>(area.y));
   Recognition result = recognize(query);
   result.elapsed_ms = watch.elapsed_ms();

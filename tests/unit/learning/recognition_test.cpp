@@ -350,6 +350,29 @@ TEST(LearningRecognizer, SharedIndexDecidesAsPerObjectBruteForce) {
 // ratio test (nearest against second nearest over every object) would find each of red's
 // features twice, once per object, and reject them all. Each object's test uses only its own
 // neighbours, so both keep what red alone gets.
+TEST(LearningRecognizer, TheSameQueryGetsTheSameAnswerWhateverTheProcessDidBefore) {
+  // FLANN's trees and RANSAC's draws come from OpenCV's thread-wide RNG and std::rand(): the
+  // recognizer seeds them, so an answer depends on the database and the image alone. Two objects
+  // with the same descriptors are the closest call there is.
+  const auto red = learned("red", 10, 20);
+  const cv::Mat scene = synthetic::place_in_scene(object_face(10, 6), synthetic::random_texture({640, 480}, 310), 10,
+                                                  1.0, {320, 240});
+  const Features query = detect_features(scene);
+  for (MatcherKind kind : {MatcherKind::SharedFlann, MatcherKind::Flann}) {
+    std::vector<std::vector<int>> answers;
+    for (int history = 0; history < 3; ++history) {
+      for (int i = 0; i < 1000 * history + 7; ++i) cv::theRNG().next(), std::rand();  // another past
+      const Recognizer r = recognizer_of(kind, {learned("blue", 11, 20), red, renamed(*red, "red_twin")});
+      const Recognition got = r.recognize(query);
+      std::vector<int> answer{got.best};
+      for (const auto& s : got.scores) answer.insert(answer.end(), {s.verified_matches, s.best_view});
+      answers.push_back(answer);
+    }
+    EXPECT_EQ(answers[1], answers[0]) << matcher_name(kind);
+    EXPECT_EQ(answers[2], answers[0]) << matcher_name(kind);
+  }
+}
+
 TEST(LearningRecognizer, SharedIndexKeepsAMatchAnotherObjectAlsoHas) {
   const auto red = learned("red", 10, 20);
   const Recognizer alone = recognizer_of(MatcherKind::BruteForce, {red});

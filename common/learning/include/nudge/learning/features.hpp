@@ -24,11 +24,21 @@ struct SiftParams {
   double contrast_threshold = 0.02;  // OpenCV default 0.04
   double edge_threshold = 10;        // OpenCV default
   int octave_layers = 3;             // OpenCV default
+  // Local contrast equalisation of the grey image before SIFT (CLAHE, Zuiderveld 1994): the clip
+  // limit, 0 for none. SIFT's contrast threshold is absolute, so a dark or glossy label (grey levels
+  // within a few tens) gives few keypoints however textured it is; equalising each tile's histogram
+  // stretches such a label to the full range. The learner and the recognizer must agree on it.
+  double equalise_clip = 0;
+  int equalise_tile_px = 64;  // the tiles' size in pixels (the grid follows the image's size)
 };
 
 // SIFT on the grey image (BGR or grey, 8-bit). Throws std::invalid_argument for an empty or
-// non-8-bit image, or settings SIFT refuses (a threshold not positive, fewer than 1 layer).
+// non-8-bit image, or settings SIFT refuses (a threshold not positive, fewer than 1 layer, a
+// negative clip limit, a tile under 8 pixels).
 Features detect_features(const cv::Mat& image, const SiftParams& params = {});
+
+// The grey image SIFT looks at: the image in grey, equalised when `params.equalise_clip` > 0.
+cv::Mat sift_grey(const cv::Mat& image, const SiftParams& params = {});
 
 // SIFT of the image as a camera would see it tilted away about the image's horizontal axis
 // (ASIFT's simulated tilt, Morel & Yu 2009, in one direction): the image (only `roi` of it, when
