@@ -71,6 +71,35 @@ TEST(LearningFeatures, ALowerContrastThresholdFindsMoreOnAFaintTextureAndBadSett
   EXPECT_THROW(detect_features(faint, bad), std::invalid_argument);
 }
 
+TEST(LearningFeatures, EqualisationFindsTheTextureOfALabelInTheDark) {
+  // A label in the dark (grey levels 8-38): SIFT's contrast threshold is absolute and finds little
+  // of it; equalised, it finds about what it finds on the label in full light.
+  const cv::Mat label = synthetic::random_texture(kImage, 3);
+  cv::Mat dark;
+  label.convertTo(dark, -1, 0.12, 8);
+  SiftParams equalised;
+  equalised.equalise_clip = 3;
+  const int plain_dark = detect_features(dark).size(), equalised_dark = detect_features(dark, equalised).size();
+  const int plain_light = detect_features(label).size();
+  EXPECT_LT(plain_dark, plain_light / 2);
+  EXPECT_GT(equalised_dark, 2 * plain_dark);
+  EXPECT_GT(equalised_dark, plain_light / 2);
+  // The grey image SIFT sees is stretched (the dark label spans 30 grey levels); with the clip at
+  // 0 it is the image's grey.
+  double lo = 0, hi = 0;
+  cv::minMaxLoc(sift_grey(dark, equalised), &lo, &hi);
+  EXPECT_GT(hi - lo, 60);
+  cv::Mat grey;
+  cv::cvtColor(dark, grey, cv::COLOR_BGR2GRAY);
+  EXPECT_EQ(cv::norm(sift_grey(dark), grey, cv::NORM_INF), 0);
+  SiftParams bad;
+  bad.equalise_clip = -1;
+  EXPECT_THROW(detect_features(dark, bad), std::invalid_argument);
+  bad = SiftParams{};
+  bad.equalise_tile_px = 4;
+  EXPECT_THROW(detect_features(dark, bad), std::invalid_argument);
+}
+
 TEST(LearningFeatures, RootSiftRowsAreUnitLengthAndTheirDistanceIsHellinger) {
   const Features f = detect_features(synthetic::random_texture(kImage, 7));
   ASSERT_GT(f.size(), 50);
