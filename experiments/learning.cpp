@@ -81,21 +81,41 @@ struct Options {
   // defaults unless flags say otherwise): the database as today's learner would have written it
   // from the same views, so that a change to learning is measured without re-running the arm.
   bool relearn = false;
+  // With relearn: the learner's scene still (the attempt's after still) for pruning, as the
+  // service had it; with table_view the after still is one more view instead (the object standing
+  // on the table, its right mask's box) and the before still prunes (a diagnosis: what a view at
+  // the test images' own scale, with no fingers on the label, would add).
+  bool table_view = false;
   learning::LearnParams learn;
   learning::RecognizeParams recognize;  // the learner's defaults unless flags say otherwise
 };
 
-// The model learn_object makes from a stored model's training images, boxes and wrist angles.
+// The model learn_object makes from a stored model's training images, boxes and wrist angles, with
+// the scene still of its attempt (runs/<run_id>/<run_id>/<object_key>/, as the learner had it) and,
+// with `table_view`, its after still as one more view (see Options::table_view).
 std::shared_ptr<const learning::ObjectModel> relearned(const learning::ObjectModel& stored,
-                                                       const learning::LearnParams& params) {
+                                                       const learning::LearnParams& params, const std::string& runs_dir,
+                                                       bool table_view) {
   std::vector<learning::TrainingImage> images;
   for (const learning::ModelView& v : stored.views) {
     if (v.image.empty()) throw std::runtime_error(stored.info.name + ": a training view without its image");
     images.push_back({v.image, v.box, v.wrist_angle});
   }
+  const fs::path attempt = fs::path(runs_dir) / stored.info.run_id / stored.info.run_id / stored.info.object_key;
+  auto read = [&attempt](const char* file, int flags) {
+    cv::Mat image = cv::imread((attempt / file).string(), flags);
+    if (image.empty()) throw std::runtime_error((attempt / file).string() + ": cannot read");
+    return image;
+  };
+  cv::Mat scene = read("after.png", cv::IMREAD_COLOR);
+  if (table_view) {
+    const cv::Mat mask = read("mask.png", cv::IMREAD_GRAYSCALE);
+    images.push_back({scene, cv::boundingRect(mask), 0});
+    scene = read("before.png", cv::IMREAD_COLOR);
+  }
   learning::LearnStats stats;
   const auto start = std::chrono::steady_clock::now();
-  auto model = std::make_shared<learning::ObjectModel>(learning::learn_object(stored.info, images, params, &stats));
+  auto model = std::make_shared<learning::ObjectModel>(learning::learn_object(stored.info, images, params, &stats, {}, scene));
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   std::cerr << "relearned " << stored.info.name << " in " << std::lround(ms) << " ms: " << stats.detected << " detected, " << stats.outside_box
             << " outside the box, " << stats.background << " background, " << stats.kept << " kept (stored: "
@@ -122,6 +142,7 @@ struct Run {
 struct Judged {
   std::string image, target, variant, label, bottle;  // bottle: what the label is (a learned bottle)
   int verified = 0, good = 0, bad = 0, best_view = -1;
+  bool unjudged = false;  // the best view is the --table-view one, which has no re-rendered truth
   int most_ratio_matches = 0, most_verified = 0;  // over every object, recognised or not (why not: how near)
   int label_pixels = -1;  // the target's label pixels in sight (-1: no target, or it has no label)
   std::vector<double> distances_m;
@@ -262,6 +283,10 @@ Judged recognise_and_judge(const learning::Recognizer& recognizer, const TestIma
   j.best_view = best->best_view;
   const learning::SurfaceTruth query{t.surface, t.mask, 1, t.target.empty() ? t.name : t.target};
   const TrainingTruth& views = training.at(best->name);
+  if (best->best_view == static_cast<int>(views.views.size())) {  // the --table-view view
+    j.unjudged = true;
+    return j;
+  }
   if (best->best_view < 0 || best->best_view >= static_cast<int>(views.views.size()))
     throw std::runtime_error(best->name + ": best view " + std::to_string(best->best_view) + " has no re-rendered truth");
   const learning::MatchVerdicts v =
@@ -287,7 +312,8 @@ cv::Mat thumbnail(cv::Mat view, int k) {
 cv::Mat views_sheet(const learning::ObjectDatabase& db, const learning::ObjectModel& m) {
   std::vector<cv::Mat> thumbs;
   for (size_t k = 0; k < m.views.size(); ++k) {
-    cv::Mat view = db.load_view_image(m.info.name, static_cast<int>(k));
+    // A relearned model holds its images (and --table-view's extra one is only there).
+    cv::Mat view = m.views[k].image.empty() ? db.load_view_image(m.info.name, static_cast<int>(k)) : m.views[k].image.clone();
     if (view.channels() == 1) cv::cvtColor(view, view, cv::COLOR_GRAY2BGR);
     cv::rectangle(view, m.views[k].box, cv::Scalar(0, 200, 0), 3);
     for (const cv::KeyPoint& p : m.views[k].features.keypoints) cv::circle(view, p.pt, 4, cv::Scalar(0, 0, 255), 2);
@@ -510,7 +536,8 @@ std::vector<std::string> write_match_pictures(const Options& o, const std::vecto
     for (size_t i = 0; i < judged.size(); ++i) {
       const Judged& x = judged[i];
       if (x.variant != variant || x.label.empty() || x.bottle != x.target) continue;
-      const cv::Mat training = db.load_view_image(x.label, x.best_view);
+      const cv::Mat& held = recognizer.find(x.label)->views[x.best_view].image;
+      const cv::Mat training = held.empty() ? db.load_view_image(x.label, x.best_view) : held;
       const cv::Mat picture = learning::draw_match_picture(images[i].colour, training,
                                                            recognizer.find(x.label)->views[x.best_view].features, x.recognition);
       const std::string file = o.name + "_match_" + variant + ".png";
@@ -540,14 +567,14 @@ int run(const Options& o) {
   learning::LoadReport loaded = db.load_all(o.relearn);
   for (const std::string& e : loaded.errors) std::cerr << "nudge-exp-learning: database: " << e << "\n";
   if (o.relearn)
-    for (auto& m : loaded.models) m = relearned(*m, o.learn);
+    for (auto& m : loaded.models) m = relearned(*m, o.learn, o.runs, o.table_view);
   learning::Recognizer recognizer(o.recognize);
   std::map<std::string, std::string> bottle_of;  // learned name -> bottle
   std::map<std::string, TrainingTruth> training;
   for (const auto& m : loaded.models) {
     const auto run = std::find_if(runs.begin(), runs.end(), [&](const Run& r) { return r.learned_name == m->info.name; });
     if (run == runs.end()) throw std::runtime_error(db.root() + "/" + m->info.name + ": learned by no run's learning attempt");
-    if (run->view_utimes.size() != m->views.size())
+    if (run->view_utimes.size() + (o.table_view ? 1 : 0) != m->views.size())
       throw std::runtime_error(db.root() + "/" + m->info.name + ": " + std::to_string(m->views.size()) + " views, the run sent " +
                                std::to_string(run->view_utimes.size()));
     recognizer.add(m);
@@ -617,6 +644,9 @@ int main(int argc, char** argv) {
   flags.add_string("name", &o.name, "result name (docs/results/NAME.*)");
   flags.add_string("set", &o.set, "the test images' set: eval (reported) or dev (tuning; nudge-exp-learning-scenes --set dev)");
   flags.add_bool("relearn", &o.relearn, "learn every stored object again from its stored views with today's learning");
+  flags.add_bool("table-view", &o.table_view,
+                 "--relearn: the attempt's after still as one more view (its mask's box), pruned against the before still "
+                 "(diagnosis; its matches are not judged)");
   std::string axis_tilts = learning::axis_tilts_text(o.learn.axis_tilts);
   flags.add_string("axis-tilts", &axis_tilts, "--relearn: simulated tilts along the held object's axis, comma-separated (\"\": none)");
   flags.add_int("background-matches", &o.learn.background_matches, "--relearn: other views a background descriptor matches");

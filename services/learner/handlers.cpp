@@ -42,7 +42,16 @@ Handlers::Handlers(bus::Service& service, const Options& options)
     : service_(service), options_(options), db_(options.db_dir), recognizer_(options.recognize) {
   learning::LoadReport loaded = db_.load_all();
   for (const std::string& error : loaded.errors) report("skipped: " + error);
-  for (auto& model : loaded.models) recognizer_.add(model);
+  for (auto& model : loaded.models) {
+    // Still known, but its matches will be fewer: said once, at load, naming the object.
+    if (model->info.sift_recorded) {
+      const std::string difference = learning::sift_settings_difference(model->info.sift, options.recognize.sift);
+      if (!difference.empty())
+        report("object " + model->info.name + " was learned with other SIFT settings than this learner's (" + difference +
+               "): it will match less well; learn it again or start the learner with its settings");
+    }
+    recognizer_.add(model);
+  }
   recognizer_.build_index();  // once for the whole database, not on the first request
   log::info() << "object database " << db_.root() << ": " << recognizer_.size() << " objects";
   auto& subs = service_.subscriptions();

@@ -16,6 +16,7 @@
 #include "nudge/bus/latest.hpp"
 #include "nudge/heartbeat_t.hpp"
 #include "nudge/learn_result_t.hpp"
+#include "nudge/learning/database.hpp"
 #include "nudge/learning/synthetic.hpp"
 #include "nudge/recognition_t.hpp"
 
@@ -275,6 +276,27 @@ TEST(LearnerHandlers, BadInputIsReportedAndTheServiceKeepsAnswering) {
   EXPECT_EQ(run.recognition.get().reason, "empty database");
   EXPECT_EQ(run.recognition.get().match_picture.size, 0);
   EXPECT_TRUE(fs::is_empty(db)) << "nothing stored from bad input";
+  fs::remove_all(db);
+}
+
+TEST(LearnerHandlers, AnObjectLearnedWithOtherSiftSettingsIsLoadedAndReportedByName) {
+  const std::string db = fresh_db("sift_settings");
+  namespace learning = nudge::learning;
+  auto stored = [&db](const std::string& name, double contrast) {
+    learning::LearnParams params;
+    params.sift.contrast_threshold = contrast;
+    learning::ObjectInfo info;
+    info.name = name;
+    learning::ObjectDatabase(db).store(
+        learning::learn_object(info, syn::turntable_views(syn::random_texture({400, 200}, 31), syn::random_texture({400, 300}, 32),
+                                                          {150, 50, 100, 200}, 4),
+                               params));
+  };
+  stored("as_this_learner", learning::SiftParams{}.contrast_threshold);
+  stored("at_opencvs_default", 0.04);
+  InProcess run(db);
+  EXPECT_EQ(run.handlers->known_objects(), 2);  // both still known
+  EXPECT_EQ(run.service.counters().errors, 1);  // one said, at load
   fs::remove_all(db);
 }
 

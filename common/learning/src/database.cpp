@@ -52,6 +52,12 @@ std::string metadata_json(const ObjectModel& model) {
   out << "height" << model.info.height;
   out << "radius" << model.info.radius;
   out << "features" << kFeaturesFile;
+  if (model.info.sift_recorded) {
+    const SiftParams& sift = model.info.sift;
+    out << "sift" << "{" << "contrast_threshold" << sift.contrast_threshold << "edge_threshold" << sift.edge_threshold
+        << "octave_layers" << sift.octave_layers << "equalise_clip" << sift.equalise_clip << "equalise_tile_px"
+        << sift.equalise_tile_px << "}";
+  }
   out << "views" << "[";
   for (size_t v = 0; v < model.views.size(); ++v) {
     const ModelView& view = model.views[v];
@@ -90,6 +96,16 @@ ObjectModel parse_metadata(const std::string& path) {
     model.info.learned_utime = std::stoll(static_cast<std::string>(in["learned_utime"]));
     model.info.height = static_cast<double>(in["height"]);
     model.info.radius = static_cast<double>(in["radius"]);
+    // The SIFT settings, recorded since 2026-12-02 (an older object has none: left unknown).
+    const cv::FileNode sift = in["sift"];
+    if (sift.isMap()) {
+      model.info.sift.contrast_threshold = static_cast<double>(sift["contrast_threshold"]);
+      model.info.sift.edge_threshold = static_cast<double>(sift["edge_threshold"]);
+      model.info.sift.octave_layers = static_cast<int>(sift["octave_layers"]);
+      model.info.sift.equalise_clip = static_cast<double>(sift["equalise_clip"]);
+      model.info.sift.equalise_tile_px = static_cast<int>(sift["equalise_tile_px"]);
+      model.info.sift_recorded = true;
+    }
     const cv::FileNode views = in["views"];
     if (!views.isSeq()) throw std::runtime_error("no views list");
     for (const cv::FileNode& node : views) {

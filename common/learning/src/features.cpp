@@ -4,6 +4,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <sstream>
 #include <cmath>
 #include <string>
 #include <stdexcept>
@@ -57,6 +58,23 @@ cv::Mat sift_grey(const cv::Mat& image, const SiftParams& params) {
   cv::Mat equalised;
   clahe->apply(grey, equalised);
   return equalised;
+}
+
+std::string sift_settings_difference(const SiftParams& a, const SiftParams& b) {
+  std::string out;
+  auto compare = [&out](const char* what, double x, double y) {
+    if (x == y) return;
+    std::ostringstream s;
+    s << (out.empty() ? "" : ", ") << what << " " << x << " against " << y;
+    out += s.str();
+  };
+  compare("contrast", a.contrast_threshold, b.contrast_threshold);
+  compare("edge threshold", a.edge_threshold, b.edge_threshold);
+  compare("octave layers", a.octave_layers, b.octave_layers);
+  compare("equalisation clip", a.equalise_clip, b.equalise_clip);
+  // The tile size matters only where equalisation is on.
+  if (a.equalise_clip > 0 && b.equalise_clip > 0) compare("equalisation tile", a.equalise_tile_px, b.equalise_tile_px);
+  return out;
 }
 
 Features detect_features(const cv::Mat& image, const SiftParams& params) {

@@ -139,6 +139,8 @@ ObjectModel learn_object(const ObjectInfo& info, const std::vector<TrainingImage
     background.push_back(background_descriptors(layer, params.ratio, params.background_matches, params.background_static_px));
   ObjectModel model;
   model.info = info;
+  model.info.sift = params.sift;  // how its descriptors were found
+  model.info.sift_recorded = true;
   SceneFeatures scene_features(scene, params);
   for (size_t v = 0; v < images.size(); ++v) {
     ModelView view;

@@ -59,6 +59,8 @@ void expect_same(const ObjectModel& a, const ObjectModel& b) {
   EXPECT_EQ(a.info.learned_utime, b.info.learned_utime);
   EXPECT_DOUBLE_EQ(a.info.height, b.info.height);
   EXPECT_DOUBLE_EQ(a.info.radius, b.info.radius);
+  EXPECT_EQ(a.info.sift_recorded, b.info.sift_recorded);
+  EXPECT_EQ(sift_settings_difference(a.info.sift, b.info.sift), "");
   ASSERT_EQ(a.views.size(), b.views.size());
   for (size_t v = 0; v < a.views.size(); ++v) {
     EXPECT_EQ(a.views[v].box, b.views[v].box);
@@ -95,6 +97,25 @@ TEST(ObjectDatabase, StoresAndLoadsAnObjectWithItsImages) {
   EXPECT_TRUE(db.load("cup").views[0].image.empty());  // pictures only on request
   EXPECT_EQ(db.load_view_image("cup", 2).size(), cup.views[2].image.size());
   EXPECT_NE(read(dir + "/cup/object.json").find("\"format_version\": 1"), std::string::npos);
+  fs::remove_all(dir);
+}
+
+TEST(ObjectDatabase, KeepsTheSiftSettingsAnObjectWasLearnedWithAndReadsObjectsStoredWithout) {
+  const std::string dir = fresh_folder("sift_settings");
+  const ObjectDatabase db(dir);
+  ObjectModel dark = small_model("dark_jar", 2, 5);
+  dark.info.sift.contrast_threshold = 0.03;
+  dark.info.sift.equalise_clip = 2.5;
+  dark.info.sift.equalise_tile_px = 48;
+  dark.info.sift_recorded = true;
+  db.store(dark);
+  const ObjectModel loaded = db.load("dark_jar");
+  expect_same(dark, loaded);
+  EXPECT_EQ(sift_settings_difference(loaded.info.sift, SiftParams{}), "contrast 0.03 against 0.02, equalisation clip 2.5 against 0");
+  // Stored before the settings were recorded: read, settings unknown.
+  db.store(small_model("old_cup", 2, 6));
+  EXPECT_EQ(read(dir + "/old_cup/object.json").find("sift"), std::string::npos);
+  EXPECT_FALSE(db.load("old_cup").info.sift_recorded);
   fs::remove_all(dir);
 }
 

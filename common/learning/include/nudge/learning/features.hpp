@@ -2,6 +2,7 @@
 // SIFT features of one image (thesis sec. 7.3.2), optionally only those inside a box.
 #include <opencv2/core.hpp>
 
+#include <string>
 #include <vector>
 
 namespace nudge::learning {
@@ -36,6 +37,9 @@ struct SiftParams {
 // non-8-bit image, or settings SIFT refuses (a threshold not positive, fewer than 1 layer, a
 // negative clip limit, a tile under 8 pixels).
 Features detect_features(const cv::Mat& image, const SiftParams& params = {});
+
+// "" when `a` and `b` find the same keypoints, else what differs, e.g. "contrast 0.04 against 0.02".
+std::string sift_settings_difference(const SiftParams& a, const SiftParams& b);
 
 // The grey image SIFT looks at: the image in grey, equalised when `params.equalise_clip` > 0.
 cv::Mat sift_grey(const cv::Mat& image, const SiftParams& params = {});

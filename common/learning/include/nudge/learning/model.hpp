@@ -33,6 +33,11 @@ struct ObjectInfo {
   std::string run_id, object_key;  // the run that learned it
   int64_t learned_utime = 0;
   double height = 0, radius = 0;   // metres; 0: unknown
+  // The SIFT settings its descriptors were found with (learn_object fills them in). A recognizer
+  // with other settings finds other keypoints in a query, and fewer of them match: the learner
+  // warns when it loads such an object. False for an object stored before they were recorded.
+  SiftParams sift;
+  bool sift_recorded = false;
 };
 
 struct ObjectModel {
