@@ -107,12 +107,13 @@ std::shared_ptr<const learning::ObjectModel> relearned(const learning::ObjectMod
     if (image.empty()) throw std::runtime_error((attempt / file).string() + ": cannot read");
     return image;
   };
-  cv::Mat scene = read("after.png", cv::IMREAD_COLOR);
-  if (table_view) {
-    const cv::Mat mask = read("mask.png", cv::IMREAD_GRAYSCALE);
-    images.push_back({scene, cv::boundingRect(mask), 0});
-    scene = read("before.png", cv::IMREAD_COLOR);
-  }
+  // The supervisor's standing view (its after still as the last view, Config::standing_view) was
+  // pruned against the before still; without it the learner had the after still.
+  const cv::Mat after = read("after.png", cv::IMREAD_COLOR);
+  const cv::Mat& last = images.back().image;
+  const bool standing = last.size() == after.size() && last.type() == after.type() && cv::norm(last, after, cv::NORM_INF) == 0;
+  if (table_view && !standing) images.push_back({after, cv::boundingRect(read("mask.png", cv::IMREAD_GRAYSCALE)), 0});
+  const cv::Mat scene = standing || table_view ? read("before.png", cv::IMREAD_COLOR) : after;
   learning::LearnStats stats;
   const auto start = std::chrono::steady_clock::now();
   auto model = std::make_shared<learning::ObjectModel>(learning::learn_object(stored.info, images, params, &stats, {}, scene));
@@ -574,7 +575,8 @@ int run(const Options& o) {
   for (const auto& m : loaded.models) {
     const auto run = std::find_if(runs.begin(), runs.end(), [&](const Run& r) { return r.learned_name == m->info.name; });
     if (run == runs.end()) throw std::runtime_error(db.root() + "/" + m->info.name + ": learned by no run's learning attempt");
-    if (run->view_utimes.size() + (o.table_view ? 1 : 0) != m->views.size())
+    const bool extra_view = o.table_view && m->views.size() == run->view_utimes.size() + 1;  // --table-view's
+    if (run->view_utimes.size() != m->views.size() && !extra_view)
       throw std::runtime_error(db.root() + "/" + m->info.name + ": " + std::to_string(m->views.size()) + " views, the run sent " +
                                std::to_string(run->view_utimes.size()));
     recognizer.add(m);
@@ -645,8 +647,8 @@ int main(int argc, char** argv) {
   flags.add_string("set", &o.set, "the test images' set: eval (reported) or dev (tuning; nudge-exp-learning-scenes --set dev)");
   flags.add_bool("relearn", &o.relearn, "learn every stored object again from its stored views with today's learning");
   flags.add_bool("table-view", &o.table_view,
-                 "--relearn: the attempt's after still as one more view (its mask's box), pruned against the before still "
-                 "(diagnosis; its matches are not judged)");
+                 "--relearn, runs recorded without the supervisor's standing view: the attempt's after still as one more "
+                 "view (its mask's box), pruned against the before still (its matches are not judged)");
   std::string axis_tilts = learning::axis_tilts_text(o.learn.axis_tilts);
   flags.add_string("axis-tilts", &axis_tilts, "--relearn: simulated tilts along the held object's axis, comma-separated (\"\": none)");
   flags.add_int("background-matches", &o.learn.background_matches, "--relearn: other views a background descriptor matches");

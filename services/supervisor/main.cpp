@@ -62,6 +62,7 @@ struct Options {
   // A gentle push: tall objects (bottles) tip when the pad meets them at the arm's usual speed.
   double nudge_speed_scale = 0.25;
   bool keep_running = false;
+  std::string standing_view = "on";      // Config::standing_view
   std::string line_pick = "strongest";  // strongest, nearest (LineSearchParams::strongest)
   std::string candidate_order = "nearest";  // nearest, support (TargetParams::order)
   int rest_from_still = 1;               // Config::rest_from_still
@@ -681,6 +682,8 @@ void add_flags(Flags& f, Options& o) {
   f.add_string("learner", &o.learner, "the learner service's heartbeat name (--learn auto)");
   f.add_int("views", &o.config.views, "training views per learned object (thesis 12)");
   f.add_double("view-step", &o.config.view_step_deg, "wrist turn between training views, deg (thesis 30)");
+  f.add_string("standing-view", &o.standing_view,
+               "on|off: also learn the after still (the object standing where the nudge left it) as the last view, pruned against the before still");
   f.add_double("recognise-timeout", &o.config.recognise_timeout_s, "for a RECOGNITION answer, s of the task clock (then the nudge goes ahead)");
   f.add_double("learn-timeout", &o.config.learn_timeout_s, "for a LEARNED answer, s of the task clock (then the object is put back); counted from the learner's last heartbeat saying it learns the object");
   f.add_double("learn-max-wait", &o.config.learn_max_wait_s, "for a LEARNED answer however long the learner's heartbeat says it is learning the object, s of the task clock");
@@ -786,6 +789,8 @@ int main(int argc, char** argv) {
     if (!(opt.config.held_min_opening_m >= 0 && opt.config.held_min_opening_m < 0.1)) throw FlagError("--held-min-opening must lie in [0, 0.1) m");
     if (opt.config.views <= 0 || opt.config.views > 36) throw FlagError("--views must lie in [1, 36]");
     if (!(opt.config.view_step_deg > 0 && opt.config.view_step_deg <= 90)) throw FlagError("--view-step must lie in (0, 90] deg");
+    if (opt.standing_view != "on" && opt.standing_view != "off") throw FlagError("--standing-view must be on or off");
+    opt.config.standing_view = opt.standing_view == "on";
     Shell shell(service, opt);  // loads the calibration: a bad file ends here, naming the field
     service.start();
     shell.subscribe();

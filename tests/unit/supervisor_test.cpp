@@ -2737,10 +2737,11 @@ TEST_F(LearningTest, GraspsTurnsTwelveTimesLearnsAndPutsTheObjectBack) {
     s.on_right_still(draw_scene(scene_, {1280, 960}, {}), now_, now_);
     out = s.take_outputs();
     const auto taken = outputs_of<sv::LearnView>(out);
-    // With the last view, before the commit, the after still: the scene without the object held.
-    ASSERT_EQ(taken.size(), view < 11 ? 1u : 2u);
+    // With the last view, before the commit: the standing view (the after still, Config::
+    // standing_view) and the before still as the scene (the object stood elsewhere in it).
+    ASSERT_EQ(taken.size(), view < 11 ? 1u : 3u);
     views.push_back(taken[0]);
-    if (view == 11) scene_still = taken[1];
+    if (view == 11) views.push_back(taken[1]), scene_still = taken[2];
     commits = outputs_of<sv::LearnCommit>(out);
     if (view < 11) {
       ASSERT_EQ(outputs_of<sv::RotateCommand>(out).size(), 1u) << view << ": " << s.report().reason;
@@ -2757,11 +2758,14 @@ TEST_F(LearningTest, GraspsTurnsTwelveTimesLearnsAndPutsTheObjectBack) {
     EXPECT_GT(views[i].box.area(), 0);
     EXPECT_FALSE(views[i].scene);
   }
+  const sv::LearnView& standing = views[12];
+  EXPECT_EQ(standing.index, 12);
+  EXPECT_FALSE(standing.scene);
   EXPECT_TRUE(scene_still.scene);
   EXPECT_EQ(scene_still.object_key, "attempt_01");
   ASSERT_EQ(commits.size(), 1u);
   const sv::LearnCommit commit = commits[0];
-  EXPECT_EQ(commit.views, 12);
+  EXPECT_EQ(commit.views, 13);
   EXPECT_GT(commit.height, 0.06);
   EXPECT_EQ(commit.object_key, "attempt_01");
   s.on_learned(commit.seq + 1, true, "other", "", now_);  // not ours
@@ -2778,9 +2782,13 @@ TEST_F(LearningTest, GraspsTurnsTwelveTimesLearnsAndPutsTheObjectBack) {
   EXPECT_EQ(a->outcome, sv::Outcome::Segmented);
   EXPECT_EQ(a->learning, "learned");
   EXPECT_EQ(a->learned_name, "object_1");
-  EXPECT_EQ(a->views.size(), 12u);
-  ASSERT_EQ(scene_still.image.size(), a->after.size());
-  EXPECT_EQ(cv::norm(scene_still.image, a->after, cv::NORM_INF), 0.0) << "the scene still is the after still";
+  EXPECT_EQ(a->views.size(), 13u);
+  ASSERT_EQ(scene_still.image.size(), a->before.size());
+  EXPECT_EQ(cv::norm(scene_still.image, a->before, cv::NORM_INF), 0.0) << "the scene still is the before still";
+  ASSERT_EQ(standing.image.size(), a->after.size());
+  EXPECT_EQ(cv::norm(standing.image, a->after, cv::NORM_INF), 0.0) << "the standing view is the after still";
+  EXPECT_EQ(standing.box, cv::boundingRect(a->segmentation.mask)) << "boxed by the right segmentation";
+  EXPECT_EQ(standing.utime, a->after_utime);
   ASSERT_TRUE(a->top[0] && a->top[1] && a->grasp);
   EXPECT_GE(a->grasp_plan_ms, 0.0) << "the grasp's plan time is recorded for the report";
   EXPECT_EQ(outputs_of<sv::HomeCommand>(out).size(), 1u) << "the arm parks after putting it back";
@@ -2804,6 +2812,37 @@ TEST_F(LearningTest, GraspsTurnsTwelveTimesLearnsAndPutsTheObjectBack) {
 // small neighbour's axes the only settled group, as in the test of the rule above), the left
 // segmentation is run again about the new rest: the grasp is planned on the object, its fingers
 // half way up it, not on the neighbour's top.
+TEST_F(LearningTest, WithoutTheStandingViewTwelveViewsArePrunedAgainstTheAfterStill) {
+  sv::Config config;
+  config.standing_view = false;
+  sv::Supervisor s = make_learning(config);
+  done(s, to_grasp(s).seq);
+  std::vector<sv::LearnView> sent;
+  for (int view = 0; view < 12; ++view) {
+    ASSERT_EQ(s.state(), sv::State::Rotate) << s.report().reason;
+    s.take_outputs();
+    now_ += kSecond / 5;
+    s.on_right_still(draw_scene(scene_, {1280, 960}, {}), now_, now_);
+    auto out = s.take_outputs();
+    for (const auto& v : outputs_of<sv::LearnView>(out)) sent.push_back(v);
+    if (view < 11) {
+      done(s, outputs_of<sv::RotateCommand>(out).at(0).seq);
+      continue;
+    }
+    const sv::LearnCommit commit = outputs_of<sv::LearnCommit>(out).at(0);
+    EXPECT_EQ(commit.views, 12);
+    s.on_learned(commit.seq, true, "object_1", "", now_ += kSecond);
+  }
+  done(s, outputs_of<sv::PlaceCommand>(s.take_outputs()).at(0).seq);
+  auto out = s.take_outputs();
+  const auto a = ended(out);
+  ASSERT_TRUE(a);
+  EXPECT_EQ(a->views.size(), 12u);
+  ASSERT_EQ(sent.size(), 13u);  // twelve views, then the scene still
+  EXPECT_TRUE(sent.back().scene);
+  EXPECT_EQ(cv::norm(sent.back().image, a->after, cv::NORM_INF), 0.0) << "the scene still is the after still";
+}
+
 TEST_F(LearningTest, AWeakAfterLineMovesTheLeftCamerasSegmentationWithTheRest) {
   const Shape small{0.025, 0.022, /*grey=*/true};  // outside these tests' masks of coloured pixels
   sv::Config config;

@@ -1,6 +1,8 @@
 // The supervisor's learning states (thesis ch. 7, sec. 7.2): recognition before the nudge, and
 // after a segmentation the grasp, the twelve turns in front of the right camera, the learner's
 // commit and the object put back where it stood before the nudge.
+#include <opencv2/imgproc.hpp>
+
 #include <cmath>
 #include <cstdio>
 
@@ -231,14 +233,36 @@ void Supervisor::take_view(const cv::Mat& still, int64_t utime, int64_t now) {
   outputs_.push_back(RotateCommand{learn_seq_, wrist_step_});
 }
 
+// Config::standing_view: the after still as the last view, boxed by the right segmentation.
+bool Supervisor::add_standing_view(Attempt& a) {
+  if (a.after.empty() || a.before.empty() || a.segmentation.mask.empty() || a.after.size() != a.views.front().image.size())
+    return false;
+  const cv::Rect box = cv::boundingRect(a.segmentation.mask);
+  if (box.empty()) return false;
+  LearnView view;
+  view.index = static_cast<int>(a.views.size());
+  view.angle = 0;  // not turned: standing as the nudge left it
+  view.box = box;
+  view.image = a.after.clone();
+  view.utime = a.after_utime;
+  view.object_key = a.object_key();
+  a.views.push_back(view);
+  outputs_.push_back(view);
+  return true;
+}
+
 void Supervisor::commit_views(int64_t now) {
   Attempt& a = *attempt_;
   if (a.views.empty()) return place(now, "not learned", "no view was taken");
-  if (!a.after.empty()) {  // the scene still; without it the learner prunes across the views only
+  const bool standing = config_.standing_view && add_standing_view(a);
+  // The scene still; without it the learner prunes across the views only. With the standing view
+  // the before still: the after still would prune that view's object as scene.
+  const cv::Mat& scene_still = standing ? a.before : a.after;
+  if (!scene_still.empty()) {
     LearnView scene;
     scene.scene = true;
-    scene.image = a.after;
-    scene.utime = a.after_utime;
+    scene.image = scene_still;
+    scene.utime = standing ? a.before_utime : a.after_utime;
     scene.object_key = a.object_key();
     outputs_.push_back(scene);
   }

@@ -1343,7 +1343,7 @@ void Supervisor::on_right_still(const cv::Mat& still, int64_t utime, int64_t now
     cv::Mat& kept = state_ == State::SnapshotBefore ? attempt_->before : attempt_->after;
     if (!kept.empty()) return;  // a second answer to the same request
     kept = still.clone();
-    if (state_ == State::SnapshotAfter) attempt_->after_utime = utime;
+    (state_ == State::SnapshotAfter ? attempt_->after_utime : attempt_->before_utime) = utime;
     if (stills_complete()) stills_arrived(now);
   } else if (state_ == State::Rotate && learn_seq_ == 0) {
     take_view(still, utime, now);

@@ -277,6 +277,12 @@ struct Config {
   GraspTargetParams grasp;
   int views = 12;                    // training views per object (sec. 7.2.3)
   double view_step_deg = 30;         // wrist turn between views (SIFT tolerates +-15 deg)
+  // One more view after the turned ones: the right after still, the object standing on the table
+  // where the nudge left it, boxed by its segmentation. It shows the label at the scale and in the
+  // light a later scene shows it, with no fingers across it. The before still is then the scene
+  // still the learner prunes with: the table stands in place in it, the object does not (it was
+  // pushed). On the learning experiment's tuning images 20 -> 22 of 28 (docs/learning.md).
+  bool standing_view = true;
   double held_min_opening_m = 0.004; // the gripper closed tighter than this holds nothing
   // After the grasp the fingers should be as far apart as the object is wide where they closed
   // (its right segmentation at the grasp height). Closed to less than `grip_width_low` of that,
@@ -411,6 +417,7 @@ struct Attempt {
   std::optional<double> weak_after_line_votes;
   std::string settle_note;
   cv::Mat before, after;                   // right stills
+  int64_t before_utime = 0;                // when the right before still was taken
   int64_t after_utime = 0;                 // when the right after still was taken (segmentation_t.utime)
   std::optional<symmetry::Line> before_line, after_line;  // in the stills
   Segmentation segmentation;
@@ -664,6 +671,7 @@ class Supervisor {
   Eigen::Vector3d where_it_stood(const Attempt& a) const;
   void take_view(const cv::Mat& still, int64_t utime, int64_t now);
   void commit_views(int64_t now);
+  bool add_standing_view(Attempt& a);
   void place(int64_t now, const std::string& learning, const std::string& reason);  // where it stood before the nudge
   void put_down(const Eigen::Vector3d& where, const std::string& what, int64_t now, const std::string& learning,
                 const std::string& reason);
