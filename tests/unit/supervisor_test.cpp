@@ -2716,7 +2716,9 @@ class LearningTest : public SupervisorTest {
 }  // namespace
 
 TEST_F(LearningTest, GraspsTurnsTwelveTimesLearnsAndPutsTheObjectBack) {
-  sv::Supervisor s = make_learning();
+  sv::Config config;
+  config.standing_view = true;  // off by default; the test without it follows
+  sv::Supervisor s = make_learning(config);
   const sv::GraspCommand grasp = to_grasp(s);
   EXPECT_EQ(s.awaited_arm_seq(), grasp.seq);
   // Above the axis' foot where the object came to rest, the fingers half way up this short object
@@ -2813,9 +2815,7 @@ TEST_F(LearningTest, GraspsTurnsTwelveTimesLearnsAndPutsTheObjectBack) {
 // segmentation is run again about the new rest: the grasp is planned on the object, its fingers
 // half way up it, not on the neighbour's top.
 TEST_F(LearningTest, WithoutTheStandingViewTwelveViewsArePrunedAgainstTheAfterStill) {
-  sv::Config config;
-  config.standing_view = false;
-  sv::Supervisor s = make_learning(config);
+  sv::Supervisor s = make_learning();  // the default
   done(s, to_grasp(s).seq);
   std::vector<sv::LearnView> sent;
   for (int view = 0; view < 12; ++view) {
