@@ -14,7 +14,8 @@ scene=${2:?usage: sim_pipeline.sh BIN_DIR SCENE}
 # 5 Hz: the symmetry service takes 40-70 ms per image, so at 10 Hz a stereo pair's 80-140 ms of
 # work filled the period, and with ctest's other job on the second core its backlog overflowed the
 # receive buffer (3 of 21 right images lost, 2026-12-02 CI). The real-time rates are measured by
-# the benchmarks, not here.
+# the benchmarks, not here. ctest runs this test alone (RUN_SERIAL): at 5 Hz beside another test it
+# still lost 2 of 21 right images once (2026-12-02 CI).
 seconds=4 rate=5
 frames=$((seconds * rate + 1))  # the state at t = 0, then one per period
 
