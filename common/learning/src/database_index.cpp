@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 
 namespace nudge::learning::detail {
 
@@ -44,7 +43,6 @@ void DatabaseIndex::build(const std::vector<IndexedObject>& objects) {
   // a close call between two objects) do not depend on what the process did before.
   if (total >= 2) {
     const SeededThreadRng seeded(kIndexSeed);
-    std::srand(kIndexSeed);
     index_ = std::make_unique<cv::flann::Index>(descriptors_, cv::flann::KDTreeIndexParams(4));
   }
 }

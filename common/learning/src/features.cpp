@@ -4,10 +4,10 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
-#include <sstream>
 #include <cmath>
-#include <string>
+#include <sstream>
 #include <stdexcept>
+#include <string>
 
 namespace nudge::learning {
 

@@ -250,7 +250,6 @@ void Recognizer::add(std::shared_ptr<const ObjectModel> model) {
     entry->matcher->add(all);
     // FLANN's trees built now, not on the first query, from seeded generators (seeded_rng.hpp).
     const detail::SeededThreadRng seeded(kFlannSeed);
-    std::srand(static_cast<unsigned>(kFlannSeed));
     entry->matcher->train();
   }
   if (params_.tilts_as_fallback) entry->untilted = without_tilts(*model, &entry->untilted_index);
@@ -354,10 +353,12 @@ Recognition Recognizer::recognize(const cv::Mat& image, const cv::Rect& roi) con
   if (image.empty()) throw std::invalid_argument("recognize: empty image");
   const cv::Rect area = roi.empty() ? cv::Rect(cv::Point(0, 0), image.size()) : roi & cv::Rect(cv::Point(0, 0), image.size());
   if (area.empty()) throw std::invalid_argument("recognize: the region lies outside the image");
-  // Equalised over the whole image, as the learner's views are, then cut to the region.
+  // With equalisation: over the whole image, as the learner's views are, then cut to the region.
+  // Without: only the region is turned grey.
   SiftParams as_is = params_.sift;
   as_is.equalise_clip = 0;
-  Features query = detect_features(sift_grey(image, params_.sift)(area), as_is);
+  const cv::Mat source = params_.sift.equalise_clip > 0 ? sift_grey(image, params_.sift) : image;
+  Features query = detect_features(source(area), as_is);
   for (auto& k : query.keypoints) k.pt += cv::Point2f(static_cast<float>(area.x), static_cast<float>(area.y));
   Recognition result = recognize(query);
   result.elapsed_ms = watch.elapsed_ms();
