@@ -86,6 +86,9 @@ struct Options {
   // on the table, its right mask's box) and the before still prunes (a diagnosis: what a view at
   // the test images' own scale, with no fingers on the label, would add).
   bool table_view = false;
+  // With relearn: the standing (or table) view keeps only the keypoints inside the right
+  // segmentation (learn_view_t::mask); off: the box alone, as before the mask was sent.
+  bool view_mask = true;
   learning::LearnParams learn;
   learning::RecognizeParams recognize;  // the learner's defaults unless flags say otherwise
 };
@@ -95,11 +98,11 @@ struct Options {
 // with `table_view`, its after still as one more view (see Options::table_view).
 std::shared_ptr<const learning::ObjectModel> relearned(const learning::ObjectModel& stored,
                                                        const learning::LearnParams& params, const std::string& runs_dir,
-                                                       bool table_view) {
+                                                       bool table_view, bool view_mask) {
   std::vector<learning::TrainingImage> images;
   for (const learning::ModelView& v : stored.views) {
     if (v.image.empty()) throw std::runtime_error(stored.info.name + ": a training view without its image");
-    images.push_back({v.image, v.box, v.wrist_angle});
+    images.push_back({v.image, v.box, v.wrist_angle, v.mask});
   }
   const fs::path attempt = fs::path(runs_dir) / stored.info.run_id / stored.info.run_id / stored.info.object_key;
   auto read = [&attempt](const char* file, int flags) {
@@ -112,14 +115,24 @@ std::shared_ptr<const learning::ObjectModel> relearned(const learning::ObjectMod
   const cv::Mat after = read("after.png", cv::IMREAD_COLOR);
   const cv::Mat& last = images.back().image;
   const bool standing = last.size() == after.size() && last.type() == after.type() && cv::norm(last, after, cv::NORM_INF) == 0;
-  if (table_view && !standing) images.push_back({after, cv::boundingRect(read("mask.png", cv::IMREAD_GRAYSCALE)), 0});
+  // The standing view's keypoints are kept only inside the right segmentation (as the learner does
+  // with the mask the supervisor sends); a run stored before the mask was sent has it in mask.png.
+  if (table_view && !standing) {
+    const cv::Mat mask = read("mask.png", cv::IMREAD_GRAYSCALE);
+    images.push_back({after, cv::boundingRect(mask), 0, view_mask ? mask : cv::Mat()});
+  } else if (standing && view_mask && images.back().mask.empty()) {
+    images.back().mask = read("mask.png", cv::IMREAD_GRAYSCALE);
+  } else if (!view_mask) {
+    images.back().mask = cv::Mat();
+  }
   const cv::Mat scene = standing || table_view ? read("before.png", cv::IMREAD_COLOR) : after;
   learning::LearnStats stats;
   const auto start = std::chrono::steady_clock::now();
   auto model = std::make_shared<learning::ObjectModel>(learning::learn_object(stored.info, images, params, &stats, {}, scene));
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   std::cerr << "relearned " << stored.info.name << " in " << std::lround(ms) << " ms: " << stats.detected << " detected, " << stats.outside_box
-            << " outside the box, " << stats.background << " background, " << stats.kept << " kept (stored: "
+            << " outside the box, " << stats.outside_mask << " off the mask, " << stats.background << " background, "
+            << stats.scene << " in the scene still, " << stats.kept << " kept (stored: "
             << stored.descriptor_count() << ")\n";
   return model;
 }
@@ -351,10 +364,40 @@ cv::Mat at_most_wide(const cv::Mat& image, int width) {
 
 double max_of(const std::vector<double>& v) { return v.empty() ? 0 : *std::max_element(v.begin(), v.end()); }
 
+// The question the supervisor asks before it nudges a candidate, asked of every training scene:
+// the attempt's before still (the bottle standing where the run found it, the arm's base column
+// behind it) recognised against every learned object but the bottle's own. Taken for another
+// object, the bottle would count as known and never be learned in a run after that object's
+// (the standing view's first chain run, docs/learning.md rule 5).
+struct SceneCheck {
+  std::string bottle, taken_for;  // taken_for: "" when nothing else was recognised
+  int verified = 0;
+};
+
+std::vector<SceneCheck> check_training_scenes(learning::Recognizer& recognizer, const std::vector<std::shared_ptr<const learning::ObjectModel>>& models,
+                                              const std::map<std::string, std::string>& bottle_of, const std::string& runs_dir) {
+  std::vector<SceneCheck> checks;
+  for (const auto& m : models) {
+    const fs::path file = fs::path(runs_dir) / m->info.run_id / m->info.run_id / m->info.object_key / "before.png";
+    const cv::Mat before = cv::imread(file.string(), cv::IMREAD_COLOR);
+    if (before.empty()) throw std::runtime_error(file.string() + ": cannot read");
+    recognizer.remove(m->info.name);
+    const learning::Recognition r = recognizer.recognize(before);
+    recognizer.add(m);
+    SceneCheck c;
+    c.bottle = bottle_of.at(m->info.name);
+    if (const learning::ObjectScore* best = r.best_score()) c.taken_for = bottle_of.at(best->name), c.verified = best->verified_matches;
+    checks.push_back(c);
+  }
+  return checks;
+}
+
 struct Totals {
   int objects_learned = 0, test_images = 0, correct = 0, wrong = 0, unrecognised = 0, good = 0, bad = 0;
   int unknown_images = 0, false_recognitions = 0, correct_of_learned = 0, test_images_of_learned = 0;
   std::vector<double> grasp_plan_ms, distances_m;
+  std::vector<SceneCheck> training_scenes;
+  int training_scenes_taken = 0;  // of them, taken for another object
 };
 
 Totals add_up(const std::vector<Run>& runs, const std::vector<Judged>& judged) {
@@ -398,6 +441,8 @@ std::string json_report(const Options& o, const std::vector<Run>& runs, const st
   j.field("good_matches", t.good).field("bad_matches", t.bad).field("match_tolerance_mm", o.tolerance_mm);
   j.field("median_match_distance_mm", t.distances_m.empty() ? -1.0 : 1e3 * median(t.distances_m));
   j.field("unknown_images", t.unknown_images).field("false_recognitions", t.false_recognitions);
+  j.field("training_scenes_checked", static_cast<int>(t.training_scenes.size()))
+      .field("training_scenes_taken_for_another_object", t.training_scenes_taken);
   j.key("grasp_plan_ms").begin_object().field("median", t.grasp_plan_ms.empty() ? -1.0 : median(t.grasp_plan_ms))
       .field("max", t.grasp_plan_ms.empty() ? -1.0 : max_of(t.grasp_plan_ms)).field("grasps", static_cast<int>(t.grasp_plan_ms.size()))
       .field("thesis", 160).field("target", 50).end_object();
@@ -439,6 +484,14 @@ std::string json_report(const Options& o, const std::vector<Run>& runs, const st
   return j.str() + "\n";
 }
 
+// " (brown_bottle as white_bottle, 5)" for the training scenes taken for another object; "" if none.
+std::string taken_list(const std::vector<SceneCheck>& checks) {
+  std::string out;
+  for (const SceneCheck& c : checks)
+    if (!c.taken_for.empty()) out += (out.empty() ? " (" : "; ") + c.bottle + " as " + c.taken_for + ", " + std::to_string(c.verified);
+  return out.empty() ? out : out + " verified)";
+}
+
 std::string markdown_report(const Options& o, const std::vector<Run>& runs, const std::vector<Judged>& judged,
                             const Totals& t, const RecognitionTiming& timing, int padded_objects,
                             const std::string& sheet_of, const std::vector<std::string>& match_pictures,
@@ -470,6 +523,8 @@ std::string markdown_report(const Options& o, const std::vector<Run>& runs, cons
      << "| good / bad matches (verified, tolerance " << o.tolerance_mm << " mm) | " << t.good << " / " << t.bad
      << " | 298 / 7 (judged by eye) |\n"
      << "| false recognitions on " << t.unknown_images << " never-learned objects | " << t.false_recognitions << " | 0 |\n"
+     << "| training scenes (before stills) taken for another learned object | " << t.training_scenes_taken << " of "
+     << t.training_scenes.size() << taken_list(t.training_scenes) << " | |\n"
      << "| grasp plan time, median / max of " << t.grasp_plan_ms.size() << " grasps | "
      << (t.grasp_plan_ms.empty() ? std::string("none") : fixed(median(t.grasp_plan_ms)) + " / " + fixed(max_of(t.grasp_plan_ms)) + " ms")
      << " | 160 ms |\n"
@@ -568,7 +623,7 @@ int run(const Options& o) {
   learning::LoadReport loaded = db.load_all(o.relearn);
   for (const std::string& e : loaded.errors) std::cerr << "nudge-exp-learning: database: " << e << "\n";
   if (o.relearn)
-    for (auto& m : loaded.models) m = relearned(*m, o.learn, o.runs, o.table_view);
+    for (auto& m : loaded.models) m = relearned(*m, o.learn, o.runs, o.table_view, o.view_mask);
   learning::Recognizer recognizer(o.recognize);
   std::map<std::string, std::string> bottle_of;  // learned name -> bottle
   std::map<std::string, TrainingTruth> training;
@@ -597,7 +652,13 @@ int run(const Options& o) {
                   std::to_string(x.good) + " good / " + std::to_string(x.bad) + " bad");
   }
   progress.clear_status();
-  const Totals totals = add_up(runs, judged);
+  Totals totals = add_up(runs, judged);
+  totals.training_scenes = check_training_scenes(recognizer, loaded.models, bottle_of, o.runs);
+  for (const SceneCheck& c : totals.training_scenes) {
+    totals.training_scenes_taken += !c.taken_for.empty();
+    if (!c.taken_for.empty())
+      std::cerr << "training scene of the " << c.bottle << " taken for the " << c.taken_for << " (" << c.verified << " verified matches)\n";
+  }
 
   std::vector<std::shared_ptr<const learning::ObjectModel>> padded = loaded.models;
   for (auto& stand_in : learning::synthetic::object_models("stand_in_", kPaddedObjects - static_cast<int>(padded.size()), kStandInSeed))
@@ -649,6 +710,11 @@ int main(int argc, char** argv) {
   flags.add_bool("table-view", &o.table_view,
                  "--relearn, runs recorded without the supervisor's standing view: the attempt's after still as one more "
                  "view (its mask's box), pruned against the before still (its matches are not judged)");
+  std::string view_mask = o.view_mask ? "on" : "off";
+  flags.add_string("view-mask", &view_mask,
+                   "--relearn, on|off: the standing or table view keeps only the keypoints inside the right segmentation");
+  flags.add_double("mask-support", &o.learn.mask_support,
+                   "--relearn: a masked view's keypoint is kept when its disc, this many times SIFT's radius, lies inside (0: centre)");
   std::string axis_tilts = learning::axis_tilts_text(o.learn.axis_tilts);
   flags.add_string("axis-tilts", &axis_tilts, "--relearn: simulated tilts along the held object's axis, comma-separated (\"\": none)");
   flags.add_int("background-matches", &o.learn.background_matches, "--relearn: other views a background descriptor matches");
@@ -672,6 +738,9 @@ int main(int argc, char** argv) {
   try {
     if (!flags.parse(argc, argv)) return 0;
     if (affine != "on" && affine != "off") throw FlagError("--affine-check must be on or off");
+    if (view_mask != "on" && view_mask != "off") throw FlagError("--view-mask must be on or off");
+    o.view_mask = view_mask == "on";
+    if (!(o.learn.mask_support >= 0)) throw FlagError("--mask-support must be >= 0");
     o.recognize.affine_check = affine == "on";
     if (root_sift != "on" && root_sift != "off") throw FlagError("--root-sift must be on or off");
     o.recognize.root_sift = root_sift == "on";

@@ -54,7 +54,7 @@ int main(int argc, char** argv) {
     info.name = "box";
     info.run_id = "opencv-doc";
     learning::LearnStats stats;
-    auto model = std::make_shared<const learning::ObjectModel>(learning::learn_object(info, {{box, {}, 0}}, {}, &stats));
+    auto model = std::make_shared<const learning::ObjectModel>(learning::learn_object(info, {{box, {}, 0, {}}}, {}, &stats));
     learning::Recognizer recognizer;
     recognizer.add(model);
     const learning::Recognition found = recognizer.recognize(scene);

@@ -1,5 +1,7 @@
 #include "learner/handlers.hpp"
 
+#include <opencv2/imgproc.hpp>
+
 #include <algorithm>
 
 #include "nudge/bus/channels.hpp"
@@ -121,6 +123,18 @@ void Handlers::on_view(const learn_view_t& msg) {
     return refuse("box lies outside the image");
   view.box = box.width > 0 ? box : cv::Rect();
   view.wrist_angle = msg.wrist_angle;
+  if (msg.mask.width > 0) {
+    try {
+      view.mask = bus::to_mat(msg.mask);
+    } catch (const bus::ImageError& e) {
+      return refuse(std::string("undecodable mask: ") + e.what());
+    }
+    if (view.mask.channels() == 3) cv::cvtColor(view.mask, view.mask, cv::COLOR_BGR2GRAY);
+    if (view.mask.type() != CV_8UC1 || view.mask.size() != view.image.size())
+      return refuse("mask is not 8-bit grey of the image's size (" + std::to_string(view.mask.cols) + "x" +
+                    std::to_string(view.mask.rows) + " against " + std::to_string(view.image.cols) + "x" +
+                    std::to_string(view.image.rows) + ")");
+  }
   pending.views[msg.view_index] = std::move(view);
 }
 
@@ -218,10 +232,11 @@ void Handlers::learned(const LearnWorker::Ended& ended) {
   }
   out.ok = true;
   out.descriptors = stats.kept;
-  out.descriptors_pruned = stats.outside_box + stats.background;
+  out.descriptors_pruned = stats.outside_box + stats.outside_mask + stats.background;
   out.descriptors_pruned += stats.scene;
   log::info() << "learned " << out.object_name << " from " << out.views_used << " views: " << stats.kept
-              << " descriptors kept, " << stats.outside_box << " outside the box, " << stats.background
+              << " descriptors kept, " << stats.outside_box << " outside the box, " << stats.outside_mask
+              << " off a mask, " << stats.background
               << " background, " << stats.scene << " in place in the scene still";
   service_.publish(bus::channel::LEARNED, out);
 }

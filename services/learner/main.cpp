@@ -23,6 +23,8 @@ int main(int argc, char** argv) {
               "a descriptor matching this many other views is background (thesis 3)");
     f.add_double("background-static-px", &options.learn.background_static_px,
                  "... where a match counts only within this many pixels of the descriptor: the scene stands still (0: anywhere, as the thesis)");
+    f.add_double("mask-support", &options.learn.mask_support,
+                 "a view sent with its object's mask keeps the keypoints whose disc, this many times SIFT's radius, lies inside it (0: the centre)");
     f.add_double("sift-contrast", &options.recognize.sift.contrast_threshold,
                  "SIFT's contrast threshold, learning and recognition (OpenCV's default 0.04; lower finds more on small labels)");
     f.add_double("sift-equalise", &options.recognize.sift.equalise_clip,
@@ -44,6 +46,7 @@ int main(int argc, char** argv) {
     if (options.recognize.ratio <= 0 || options.recognize.ratio > 1) throw FlagError("--ratio must be in (0, 1]");
     if (options.recognize.min_matches < 1) throw FlagError("--min-matches must be >= 1");
     if (options.learn.background_matches < 1) throw FlagError("--background-matches must be >= 1");
+    if (!(options.learn.mask_support >= 0)) throw FlagError("--mask-support must be >= 0");
     try {
       options.learn.axis_tilts = learning::axis_tilts_from_text(axis_tilts);
     } catch (const std::invalid_argument& e) {

@@ -459,9 +459,10 @@ class Shell {
     std::copy(box, box + 4, m.box);
     m.image = bus::to_message(v.image, image_t::FORMAT_PNG, v.utime, v.index, "right");
     m.kind = v.scene ? learn_view_t::KIND_SCENE : learn_view_t::KIND_VIEW;
-    if (v.scene) {  // the after still, already in the attempt's folder
+    if (!v.mask.empty()) m.mask = bus::to_message(v.mask, image_t::FORMAT_PNG, v.utime, v.index, "right");
+    if (v.scene) {  // the after (or, with the standing view, the before) still, already in the attempt's folder
       publish(bus::channel::LEARN_VIEW, m);
-      log::info() << "the scene still (the after still) sent for pruning the views' background";
+      log::info() << "the scene still sent for pruning the views' background";
       return;
     }
     const std::string file = sv::save_view(run_dir_, supervisor_.report().attempt, v);

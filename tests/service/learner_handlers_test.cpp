@@ -210,6 +210,46 @@ TEST(LearnerHandlers, TheSceneStillPrunesWhatStandsBehindTheObject) {
   fs::remove_all(db);
 }
 
+// The supervisor's standing view comes with the object's mask: only what lies inside is learned,
+// the mask is stored with the view, and a mask that does not fit its view is refused by name.
+TEST(LearnerHandlers, AStandingViewsMaskKeepsWhatLiesOnTheObjectAndABadOneIsRefused) {
+  const std::string db = fresh_db("mask");
+  InProcess run(db);
+  const cv::Rect object(170, 80, 60, 150);
+  cv::Mat mask(300, 400, CV_8UC1, cv::Scalar(0));
+  mask(object).setTo(255);
+  nudge::learning::TrainingImage standing;
+  standing.image = syn::random_texture({400, 300}, 600);
+  standing.box = object;
+  auto learn = [&](const std::string& key, const cv::Mat& view_mask, int64_t t0, int64_t seq) {
+    run.teach("run_6", key, 14, t0);
+    auto msg = view_message("run_6", key, 12, standing, t0 + 13 * kSecond);
+    if (!view_mask.empty()) msg.mask = nudge::bus::to_message(view_mask, nudge::image_t::FORMAT_PNG, msg.utime, 12, "right");
+    run.bus.publish(channel::LEARN_VIEW, &msg);
+    const auto commit = commit_message("run_6", key, key, 13, t0 + 14 * kSecond, seq);
+    run.bus.publish(channel::LEARN_COMMIT, &commit);
+    run.service.handle_pending();
+    run.handlers->finish_learning();
+    run.service.handle_pending();
+    return run.learned.get();
+  };
+  const auto boxed = learn("boxed", {}, 100 * kSecond, 1);
+  const auto masked = learn("masked", mask, 200 * kSecond, 2);
+  ASSERT_TRUE(boxed.ok && masked.ok) << boxed.reason << masked.reason;
+  EXPECT_EQ(boxed.views_used, 13);
+  EXPECT_EQ(masked.views_used, 13);
+  EXPECT_LT(masked.descriptors, boxed.descriptors);  // the outline and what stands beside it
+  EXPECT_EQ(masked.descriptors + masked.descriptors_pruned, boxed.descriptors + boxed.descriptors_pruned);
+  EXPECT_TRUE(fs::exists(db + "/masked/view_12_mask.png"));
+  EXPECT_FALSE(fs::exists(db + "/boxed/view_12_mask.png"));
+  const int errors = run.service.counters().errors;
+  const auto small = learn("small", cv::Mat(30, 40, CV_8UC1, cv::Scalar(255)), 300 * kSecond, 3);
+  EXPECT_TRUE(small.ok) << "the turned views still serve";
+  EXPECT_EQ(small.views_used, 12);
+  EXPECT_EQ(run.service.counters().errors, errors + 1) << "the mask of another size is reported";
+  fs::remove_all(db);
+}
+
 TEST(LearnerHandlers, BadInputIsReportedAndTheServiceKeepsAnswering) {
   const std::string db = fresh_db("bad");
   InProcess run(db);

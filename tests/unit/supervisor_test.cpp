@@ -2790,6 +2790,9 @@ TEST_F(LearningTest, GraspsTurnsTwelveTimesLearnsAndPutsTheObjectBack) {
   ASSERT_EQ(standing.image.size(), a->after.size());
   EXPECT_EQ(cv::norm(standing.image, a->after, cv::NORM_INF), 0.0) << "the standing view is the after still";
   EXPECT_EQ(standing.box, cv::boundingRect(a->segmentation.mask)) << "boxed by the right segmentation";
+  ASSERT_EQ(standing.mask.size(), a->segmentation.mask.size()) << "and sent with it, so that its outline is not learned";
+  EXPECT_EQ(cv::norm(standing.mask, a->segmentation.mask, cv::NORM_INF), 0.0);
+  for (int i = 0; i < 12; ++i) EXPECT_TRUE(views[i].mask.empty()) << "the turned views have their box alone";
   EXPECT_EQ(standing.utime, a->after_utime);
   ASSERT_TRUE(a->top[0] && a->top[1] && a->grasp);
   EXPECT_GE(a->grasp_plan_ms, 0.0) << "the grasp's plan time is recorded for the report";

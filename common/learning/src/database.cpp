@@ -33,6 +33,19 @@ std::string view_file(int view) {
   return name;
 }
 
+// A view's object mask (ModelView::mask), stored only for a view learned with one.
+std::string mask_file(int view) {
+  char name[32];
+  std::snprintf(name, sizeof name, "view_%02d_mask.png", view);
+  return name;
+}
+
+std::string png_bytes(const cv::Mat& image, const std::string& what) {
+  std::vector<uchar> png;
+  if (!cv::imencode(".png", image, png)) throw std::runtime_error("cannot encode " + what + " as PNG");
+  return std::string(png.begin(), png.end());
+}
+
 void fsync_directory(const std::string& dir) {
   const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY);
   if (fd < 0) throw std::runtime_error("cannot open folder " + dir + ": " + std::strerror(errno));
@@ -63,6 +76,7 @@ std::string metadata_json(const ObjectModel& model) {
     const ModelView& view = model.views[v];
     out << "{" << "image" << view_file(static_cast<int>(v)) << "wrist_angle" << view.wrist_angle;
     out << "box" << "[:" << view.box.x << view.box.y << view.box.width << view.box.height << "]";
+    if (!view.mask.empty()) out << "mask" << mask_file(static_cast<int>(v));
     out << "descriptors" << view.features.size() << "}";
   }
   out << "]";
@@ -78,8 +92,9 @@ std::string read_whole_file(const std::string& path) {
   return bytes.str();
 }
 
-// Parses object.json into the model's info and views (features come from features.bin).
-ObjectModel parse_metadata(const std::string& path) {
+// Parses object.json into the model's info and views (features come from features.bin);
+// `has_mask[v]`: whether view v lists a mask file.
+ObjectModel parse_metadata(const std::string& path, std::vector<bool>& has_mask) {
   const std::string text = read_whole_file(path);
   ObjectModel model;
   try {
@@ -115,6 +130,7 @@ ObjectModel parse_metadata(const std::string& path) {
       node["box"] >> box;
       if (box.size() != 4) throw std::runtime_error("a view's box is not 4 numbers");
       view.box = cv::Rect(box[0], box[1], box[2], box[3]);
+      has_mask.push_back(!node["mask"].empty());
       model.views.push_back(std::move(view));
     }
   } catch (const cv::Exception& e) {
@@ -192,9 +208,9 @@ void ObjectDatabase::store(const ObjectModel& model) const {
     for (size_t v = 0; v < model.views.size(); ++v) {
       const cv::Mat& image = model.views[v].image;
       if (image.empty()) throw std::runtime_error("view " + std::to_string(v) + " has no image to store");
-      std::vector<uchar> png;
-      if (!cv::imencode(".png", image, png)) throw std::runtime_error("cannot encode view " + std::to_string(v) + " as PNG");
-      writer_(temp + "/" + view_file(static_cast<int>(v)), std::string(png.begin(), png.end()));
+      writer_(temp + "/" + view_file(static_cast<int>(v)), png_bytes(image, "view " + std::to_string(v)));
+      const cv::Mat& mask = model.views[v].mask;
+      if (!mask.empty()) writer_(temp + "/" + mask_file(static_cast<int>(v)), png_bytes(mask, "view " + std::to_string(v) + "'s mask"));
     }
     std::vector<const Features*> features;
     for (const auto& view : model.views) features.push_back(&view.features);
@@ -226,7 +242,8 @@ ObjectModel ObjectDatabase::load(const std::string& name, bool with_images) cons
   const std::string dir = root_ + "/" + name;
   std::string file = dir + "/" + kMetadataFile;
   try {
-    ObjectModel model = parse_metadata(file);
+    std::vector<bool> has_mask;
+    ObjectModel model = parse_metadata(file, has_mask);
     if (model.info.name != name) throw std::runtime_error("names object '" + model.info.name + "', not its folder's name");
     file = dir + "/" + kFeaturesFile;
     std::vector<Features> features = detail::decode_features(read_whole_file(file), kDatabaseFormatVersion);
@@ -239,6 +256,11 @@ ObjectModel ObjectDatabase::load(const std::string& name, bool with_images) cons
         file = dir + "/" + view_file(static_cast<int>(v));
         model.views[v].image = cv::imread(file, cv::IMREAD_UNCHANGED);
         if (model.views[v].image.empty()) throw std::runtime_error("missing or undecodable image");
+        if (!has_mask[v]) continue;
+        file = dir + "/" + mask_file(static_cast<int>(v));
+        model.views[v].mask = cv::imread(file, cv::IMREAD_GRAYSCALE);
+        if (model.views[v].mask.empty()) throw std::runtime_error("missing or undecodable mask");
+        if (model.views[v].mask.size() != model.views[v].image.size()) throw std::runtime_error("the mask is not its view's size");
       }
     }
     return model;

@@ -158,4 +158,22 @@ Features features_inside(const Features& features, const cv::Rect& box) {
   return select_features(features, keep);
 }
 
+Features features_on_mask(const Features& features, const cv::Mat& mask, double support) {
+  if (mask.empty()) return features;
+  if (mask.type() != CV_8UC1) throw std::invalid_argument("the object mask is not 8-bit single-channel");
+  if (!(support >= 0)) throw std::invalid_argument("the mask support " + std::to_string(support) + " is negative");
+  // Each pixel's distance to the nearest pixel outside the mask (the image border counts as outside).
+  cv::Mat inside = mask != 0, distance;
+  cv::copyMakeBorder(inside, inside, 1, 1, 1, 1, cv::BORDER_CONSTANT, 0);
+  cv::distanceTransform(inside, distance, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  std::vector<bool> keep(features.size());
+  for (int i = 0; i < features.size(); ++i) {
+    const cv::KeyPoint& k = features.keypoints[i];
+    const int x = cvRound(k.pt.x) + 1, y = cvRound(k.pt.y) + 1;
+    if (x < 1 || y < 1 || x > mask.cols || y > mask.rows) continue;
+    keep[i] = distance.at<float>(y, x) >= std::max(1.0, support * k.size / 2);
+  }
+  return select_features(features, keep);
+}
+
 }  // namespace nudge::learning

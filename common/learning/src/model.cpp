@@ -113,6 +113,8 @@ ObjectModel learn_object(const ObjectInfo& info, const std::vector<TrainingImage
   if (images.empty()) throw std::invalid_argument("object " + info.name + ": no training views");
   if (!scene.empty() && (scene.depth() != CV_8U || scene.size() != images.front().image.size()))
     throw std::invalid_argument("object " + info.name + ": the scene still is not 8-bit or not the views' size");
+  if (!(params.mask_support >= 0))
+    throw std::invalid_argument("object " + info.name + ": the mask support " + std::to_string(params.mask_support) + " is negative");
   for (double tilt : params.axis_tilts)
     if (!(tilt >= 1)) throw std::invalid_argument("object " + info.name + ": simulated tilt " + std::to_string(tilt) + " is below 1");
   LearnStats counts;
@@ -124,13 +126,17 @@ ObjectModel learn_object(const ObjectInfo& info, const std::vector<TrainingImage
     const TrainingImage& t = images[v];
     if (t.image.empty() || t.image.depth() != CV_8U)
       throw std::invalid_argument("object " + info.name + ": view " + std::to_string(v) + " is empty or not 8-bit");
+    if (!t.mask.empty() && (t.mask.type() != CV_8UC1 || t.mask.size() != t.image.size()))
+      throw std::invalid_argument("object " + info.name + ": view " + std::to_string(v) + "'s mask is not 8-bit single-channel of the view's size");
     const cv::Rect box = t.box.empty() ? cv::Rect() : generous_box(t.box, params.box_margin, t.image.size());
     for (size_t l = 0; l < layers.size(); ++l) {
       const Features all = l == 0 ? detect_features(t.image, params.sift)
                                   : detect_features_tilted(t.image, params.axis_tilts[l - 1], params.sift, box);
-      layers[l][v] = features_inside(all, box);
+      const Features in_box = features_inside(all, box);
+      layers[l][v] = features_on_mask(in_box, t.mask, params.mask_support);
       counts.detected += all.size();
-      counts.outside_box += all.size() - layers[l][v].size();
+      counts.outside_box += all.size() - in_box.size();
+      counts.outside_mask += in_box.size() - layers[l][v].size();
     }
     if (progress) progress(static_cast<int>(v) + 1, static_cast<int>(images.size()));
   }
@@ -162,6 +168,7 @@ ObjectModel learn_object(const ObjectInfo& info, const std::vector<TrainingImage
     view.box = images[v].box;
     view.wrist_angle = images[v].wrist_angle;
     view.image = images[v].image;
+    view.mask = images[v].mask;
     counts.kept += view.features.size();
     model.views.push_back(std::move(view));
   }

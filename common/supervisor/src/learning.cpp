@@ -235,7 +235,8 @@ void Supervisor::take_view(const cv::Mat& still, int64_t utime, int64_t now) {
 
 // Config::standing_view: the after still as the last view, boxed by the right segmentation.
 bool Supervisor::add_standing_view(Attempt& a) {
-  if (a.after.empty() || a.before.empty() || a.segmentation.mask.empty() || a.after.size() != a.views.front().image.size())
+  if (a.after.empty() || a.before.empty() || a.segmentation.mask.empty() || a.after.size() != a.views.front().image.size() ||
+      a.segmentation.mask.size() != a.after.size())
     return false;
   const cv::Rect box = cv::boundingRect(a.segmentation.mask);
   if (box.empty()) return false;
@@ -244,6 +245,9 @@ bool Supervisor::add_standing_view(Attempt& a) {
   view.angle = 0;  // not turned: standing as the nudge left it
   view.box = box;
   view.image = a.after.clone();
+  // The object's outline against its neighbours moves with it from scene to scene: the learner
+  // keeps only what lies inside the segmentation (docs/learning.md rule 5).
+  view.mask = a.segmentation.mask.clone();
   view.utime = a.after_utime;
   view.object_key = a.object_key();
   a.views.push_back(view);

@@ -7,6 +7,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <opencv2/imgcodecs.hpp>
+
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -116,6 +118,36 @@ TEST(ObjectDatabase, KeepsTheSiftSettingsAnObjectWasLearnedWithAndReadsObjectsSt
   db.store(small_model("old_cup", 2, 6));
   EXPECT_EQ(read(dir + "/old_cup/object.json").find("sift"), std::string::npos);
   EXPECT_FALSE(db.load("old_cup").info.sift_recorded);
+  fs::remove_all(dir);
+}
+
+TEST(ObjectDatabase, KeepsAViewsMaskBesideItsImage) {
+  const std::string dir = fresh_folder("masks");
+  const ObjectDatabase db(dir);
+  ObjectModel bottle = small_model("bottle", 3, 7);
+  cv::Mat mask(bottle.views[2].image.size(), CV_8UC1, cv::Scalar(0));
+  mask(cv::Rect(40, 10, 30, 90)).setTo(255);
+  bottle.views[2].mask = mask;  // the standing view's
+  db.store(bottle);
+  EXPECT_EQ(entries(dir + "/bottle"), (std::vector<std::string>{"features.bin", "object.json", "view_00.png", "view_01.png",
+                                                                "view_02.png", "view_02_mask.png"}));
+  const ObjectModel loaded = db.load("bottle", true);
+  expect_same(bottle, loaded);
+  EXPECT_TRUE(loaded.views[0].mask.empty());
+  ASSERT_EQ(loaded.views[2].mask.type(), CV_8UC1);
+  EXPECT_EQ(cv::norm(loaded.views[2].mask, mask, cv::NORM_INF), 0);
+  EXPECT_TRUE(db.load("bottle").views[2].mask.empty()) << "pictures only on request";
+  // A mask the metadata lists but that is gone, or of another size: refused naming its file.
+  cv::imwrite(dir + "/bottle/view_02_mask.png", cv::Mat(5, 5, CV_8UC1, cv::Scalar(255)));
+  try {
+    db.load("bottle", true);
+    ADD_FAILURE() << "a mask of another size was loaded";
+  } catch (const DatabaseError& e) {
+    EXPECT_NE(std::string(e.what()).find("view_02_mask.png: the mask is not its view's size"), std::string::npos) << e.what();
+  }
+  fs::remove(dir + "/bottle/view_02_mask.png");
+  EXPECT_THROW(db.load("bottle", true), DatabaseError);
+  EXPECT_NO_THROW(db.load("bottle")) << "the features alone need no picture";
   fs::remove_all(dir);
 }
 

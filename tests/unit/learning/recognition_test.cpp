@@ -100,6 +100,35 @@ TEST(LearningFeatures, EqualisationFindsTheTextureOfALabelInTheDark) {
   EXPECT_THROW(detect_features(dark, bad), std::invalid_argument);
 }
 
+TEST(LearningFeatures, OnlyKeypointsWhoseDiscLiesInsideTheMaskAreKept) {
+  cv::Mat mask(kImage, CV_8UC1, cv::Scalar(0));
+  mask(cv::Rect(100, 100, 100, 100)).setTo(255);
+  Features f;
+  // (centre, SIFT size = the disc's diameter): 50 px in with a 10 px radius; 5 px in with a 10 px
+  // radius (on the outline); 5 px in with a 2 px radius; outside; on the image's first column and
+  // on its fourth, with a 2 px radius.
+  f.keypoints = {cv::KeyPoint(150, 150, 20), cv::KeyPoint(105, 150, 20), cv::KeyPoint(105, 150, 4),
+                 cv::KeyPoint(50, 50, 4),    cv::KeyPoint(0, 150, 4),    cv::KeyPoint(3, 150, 4)};
+  f.descriptors = cv::Mat(6, 128, CV_32F);
+  for (int r = 0; r < 6; ++r) f.descriptors.row(r).setTo(r);
+  const Features kept = features_on_mask(f, mask, 1.0);
+  ASSERT_EQ(kept.size(), 2);
+  EXPECT_EQ(kept.keypoints[0].pt, cv::Point2f(150, 150));
+  EXPECT_EQ(kept.keypoints[1].size, 4.f);
+  EXPECT_EQ(kept.descriptors.at<float>(1, 0), 2.f) << "each descriptor stays with its keypoint";
+  EXPECT_EQ(features_on_mask(f, mask, 0.0).size(), 3) << "support 0: the centre alone";
+  EXPECT_EQ(features_on_mask(f, mask, 0.3).size(), 3);
+  // A mask reaching the image's edge: the edge is the end of what is known of the object.
+  cv::Mat to_edge(kImage, CV_8UC1, cv::Scalar(0));
+  to_edge(cv::Rect(0, 100, 100, 100)).setTo(255);
+  const Features at_edge = features_on_mask(f, to_edge, 1.0);
+  ASSERT_EQ(at_edge.size(), 1) << "(0, 150)'s disc reaches past the edge";
+  EXPECT_EQ(at_edge.keypoints[0].pt, cv::Point2f(3, 150));
+  EXPECT_EQ(features_on_mask(f, cv::Mat(), 1.0).size(), 6) << "no mask: everything";
+  EXPECT_THROW(features_on_mask(f, cv::Mat(kImage, CV_8UC3, cv::Scalar(255, 255, 255)), 1.0), std::invalid_argument);
+  EXPECT_THROW(features_on_mask(f, mask, -1), std::invalid_argument);
+}
+
 TEST(LearningFeatures, RootSiftRowsAreUnitLengthAndTheirDistanceIsHellinger) {
   const Features f = detect_features(synthetic::random_texture(kImage, 7));
   ASSERT_GT(f.size(), 50);
@@ -199,6 +228,7 @@ TEST(LearningPruning, LearnCountsWhatEachStepRemoved) {
   const auto model = learn("cup", 5, 6, &stats);
   EXPECT_EQ(model->views.size(), 12u);
   EXPECT_EQ(stats.detected, stats.outside_box + stats.background + stats.kept);
+  EXPECT_EQ(stats.outside_mask, 0) << "no view has a mask";
   EXPECT_GT(stats.outside_box, 0);
   EXPECT_GT(stats.background, 0);  // the generous box still holds some scene
   EXPECT_EQ(stats.kept, model->descriptor_count());
@@ -243,6 +273,54 @@ TEST(LearningPruning, WhatTheSceneStillShowsInPlaceIsBackgroundHoweverFewViewsSe
   EXPECT_GT(on_object(seen), 0.98 * on_object(blind)) << on_object(seen) << " of " << on_object(blind);
   // A scene still of another size is refused with its reason.
   EXPECT_THROW(learn_object({}, views, params, nullptr, {}, cv::Mat(10, 10, CV_8UC3)), std::invalid_argument);
+}
+
+// The supervisor's standing view shows the object among other things, and its box holds their
+// edges and the object's outline against them: found again wherever a like-shaped object stands
+// before a like background (docs/learning.md rule 5). With the segmentation's mask only the
+// keypoints whose disc lies on the object are learned.
+TEST(LearningPruning, AMaskedViewLearnsTheObjectsSurfaceNotItsOutline) {
+  cv::Mat scene = synthetic::random_texture(kImage, 41);
+  const cv::Rect object(170, 80, 60, 150);
+  synthetic::random_texture(object.size(), 42).copyTo(scene(object));
+  cv::Mat mask(kImage, CV_8UC1, cv::Scalar(0));
+  mask(object).setTo(255);
+  LearnParams params;
+  params.axis_tilts = {};
+  TrainingImage view{scene, object, 0, cv::Mat()};
+  LearnStats boxed_stats, masked_stats;
+  const ObjectModel boxed = learn_object({}, {view}, params, &boxed_stats);
+  view.mask = mask;
+  const ObjectModel masked = learn_object({}, {view}, params, &masked_stats);
+  // What each model holds that is not wholly the object's: a disc reaching past its outline.
+  auto off_object = [&](const ObjectModel& m) {
+    int n = 0;
+    for (const cv::KeyPoint& k : m.views[0].features.keypoints) {
+      const float r = k.size / 2;
+      n += !object.contains(k.pt - cv::Point2f(r, r)) || !object.contains(k.pt + cv::Point2f(r, r) - cv::Point2f(1, 1));
+    }
+    return n;
+  };
+  EXPECT_GT(off_object(boxed), 20) << "the generous box holds the neighbours and the outline";
+  EXPECT_EQ(off_object(masked), 0);
+  EXPECT_GT(masked.descriptor_count(), 30) << "the surface is kept";
+  EXPECT_EQ(masked_stats.outside_mask, boxed.descriptor_count() - masked.descriptor_count());
+  EXPECT_EQ(masked_stats.detected,
+            masked_stats.outside_box + masked_stats.outside_mask + masked_stats.background + masked_stats.scene + masked_stats.kept);
+  EXPECT_EQ(cv::norm(masked.views[0].mask, mask, cv::NORM_INF), 0) << "the model keeps the mask it was learned with";
+  // A mask of another size or kind is refused naming the view.
+  view.mask = cv::Mat(10, 10, CV_8UC1, cv::Scalar(255));
+  try {
+    learn_object({}, {view}, params);
+    ADD_FAILURE() << "a mask of another size was taken";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("view 0's mask"), std::string::npos) << e.what();
+  }
+  view.mask = cv::Mat(kImage, CV_8UC3, cv::Scalar(255, 255, 255));
+  EXPECT_THROW(learn_object({}, {view}, params), std::invalid_argument);
+  params.mask_support = -1;
+  view.mask = mask;
+  EXPECT_THROW(learn_object({}, {view}, params), std::invalid_argument);
 }
 
 TEST(LearningRecognizer, FindsTheRightObjectAndViewInANewScene) {
@@ -775,7 +853,7 @@ TEST(LearningRecognizer, ASqueezedCopyOfAPointIsNotItsSecondNeighbour) {
       for (auto& k : copies_as.keypoints) k.class_id = copy_class;
       auto model = std::make_shared<ObjectModel>();
       model->info.name = "red";
-      model->views.push_back({concatenate(plain, copies_as), {}, 0, {}});
+      model->views.push_back({concatenate(plain, copies_as), {}, 0, {}, {}});
       Recognizer recognizer(params);
       recognizer.add(model);
       return recognizer.recognize(query).scores[0].verified_matches;

@@ -75,6 +75,14 @@ cv::Rect generous_box(const cv::Rect& box, double margin, cv::Size image_size);
 // The features whose keypoint lies inside `box`; an empty box keeps everything.
 Features features_inside(const Features& features, const cv::Rect& box);
 
+// The features whose keypoint's disc (radius `support` times half its size, the scale SIFT found it
+// at) lies wholly inside the nonzero pixels of `mask` (8-bit, the image's size). A keypoint on the
+// mask's outline describes the object's silhouette against what stands behind it, which moves
+// with the object from scene to scene; only what lies inside is the object's own surface. An empty
+// mask keeps everything. Throws std::invalid_argument when the mask is not 8-bit single-channel
+// or `support` is negative.
+Features features_on_mask(const Features& features, const cv::Mat& mask, double support);
+
 // The features whose index `keep` marks.
 Features select_features(const Features& features, const std::vector<bool>& keep);
 

@@ -13,11 +13,14 @@
 namespace nudge::learning {
 
 // One training image as it arrives: the camera's still, where the object is (empty: unknown) and
-// how far the wrist had turned.
+// how far the wrist had turned; for a view of the object standing in a scene, its segmentation.
 struct TrainingImage {
   cv::Mat image;
   cv::Rect box;
   double wrist_angle = 0;  // radians, relative to the first view
+  // The object's pixels (8-bit, nonzero; the image's size), empty: unknown. With it only the
+  // keypoints lying inside (LearnParams::mask_support) are learned.
+  cv::Mat mask;
 };
 
 struct ModelView {
@@ -25,6 +28,7 @@ struct ModelView {
   cv::Rect box;
   double wrist_angle = 0;
   cv::Mat image;          // the training image; may be empty (a model loaded without its pictures)
+  cv::Mat mask;           // the object's pixels in it, when it was learned with them (else empty)
 };
 
 // When and how an object was learned, and its size (stored with it in the database).
@@ -75,6 +79,12 @@ struct LearnParams {
   // elsewhere in the scene still.
   double scene_ratio = 0.8;
   double scene_static_px = 4;
+  // A view with a mask (TrainingImage::mask) keeps only the keypoints whose disc, this many times
+  // the radius SIFT found them at, lies inside it (features_on_mask). A view of the object standing
+  // among other things shows its outline against them; learned, that outline is found again
+  // wherever a like-shaped object stands before a like background (the standing view's chain
+  // run, docs/learning.md rule 5). 0: the keypoint's centre alone must be inside.
+  double mask_support = 1.0;
 };
 
 // "1.5,2" -> {1.5, 2}; "" -> none. Throws std::invalid_argument naming the item that is no number
@@ -86,6 +96,7 @@ std::string axis_tilts_text(const std::vector<double>& tilts);
 struct LearnStats {
   int detected = 0;            // SIFT keypoints in every view
   int outside_box = 0;         // pruned by the generous box
+  int outside_mask = 0;        // pruned by a view's mask (its disc not wholly on the object)
   int background = 0;          // pruned by the matches-across-views rule
   int scene = 0;               // pruned as found in place in the scene still (LearnParams::scene_ratio)
   int kept = 0;
@@ -106,10 +117,11 @@ std::vector<std::vector<bool>> background_descriptors(const std::vector<Features
 // `static_px` pixels of its place: the static scene seen again, not the object.
 std::vector<bool> found_in_scene(const Features& view, const Features& scene, double ratio, double static_px);
 
-// Detects, prunes (box, then across views, then against `scene`) and keeps the images. `scene`:
+// Detects, prunes (box and mask, then across views, then against `scene`) and keeps the images. `scene`:
 // the same camera's still of the scene with the object not where the views hold it (empty: no
 // such pruning). Throws std::invalid_argument naming the view when an image is empty or not
-// 8-bit, and when no views are given; naming the scene still when it is not 8-bit or not the
+// 8-bit, when a view's mask is not 8-bit single-channel of the view's size, and when no views are
+// given; naming the scene still when it is not 8-bit or not the
 // views' size.
 // `progress`, when set, is called after each view's features with (views done, views in all), so a
 // caller learning on a worker thread can say how far it is (the learner's heartbeat).

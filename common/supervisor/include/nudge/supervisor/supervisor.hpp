@@ -342,7 +342,16 @@ struct RotateCommand { int64_t seq = 0; double angle = 0; };  // radians, relati
 struct RecognizeRequest { int64_t seq = 0; cv::Rect roi; cv::Mat image; };
 // scene: not a view but the right after still (the object on the table, the arm parked), sent
 // before the commit: what the views show in place in it is the scene behind the held object.
-struct LearnView { int index = 0; double angle = 0; cv::Rect box; cv::Mat image; int64_t utime = 0; std::string object_key; bool scene = false; };
+struct LearnView {
+  int index = 0;
+  double angle = 0;
+  cv::Rect box;
+  cv::Mat image;
+  int64_t utime = 0;
+  std::string object_key;
+  bool scene = false;
+  cv::Mat mask;  // the standing view's: the right segmentation (the learner keeps what lies inside); else empty
+};
 struct LearnCommit { int64_t seq = 0; std::string object_key; int views = 0; double height = 0, radius = 0; };
 // object_height: the pushed object's height the arm's links must clear, m; 0: the arm's default.
 struct NudgeCommand { int64_t seq = 0; Eigen::Vector3d target, direction; double object_height = 0; };
