@@ -89,6 +89,9 @@ struct Options {
   // With relearn: the standing (or table) view keeps only the keypoints inside the right
   // segmentation (learn_view_t::mask); off: the box alone, as before the mask was sent.
   bool view_mask = true;
+  // With relearn, runs recorded with the supervisor's standing view: learn without it (the 12
+  // turned views, pruned against the after still), as the learner would have had them.
+  bool drop_standing_view = false;
   learning::LearnParams learn;
   learning::RecognizeParams recognize;  // the learner's defaults unless flags say otherwise
 };
@@ -98,7 +101,7 @@ struct Options {
 // with `table_view`, its after still as one more view (see Options::table_view).
 std::shared_ptr<const learning::ObjectModel> relearned(const learning::ObjectModel& stored,
                                                        const learning::LearnParams& params, const std::string& runs_dir,
-                                                       bool table_view, bool view_mask) {
+                                                       bool table_view, bool view_mask, bool drop_standing_view) {
   std::vector<learning::TrainingImage> images;
   for (const learning::ModelView& v : stored.views) {
     if (v.image.empty()) throw std::runtime_error(stored.info.name + ": a training view without its image");
@@ -114,7 +117,11 @@ std::shared_ptr<const learning::ObjectModel> relearned(const learning::ObjectMod
   // pruned against the before still; without it the learner had the after still.
   const cv::Mat after = read("after.png", cv::IMREAD_COLOR);
   const cv::Mat& last = images.back().image;
-  const bool standing = last.size() == after.size() && last.type() == after.type() && cv::norm(last, after, cv::NORM_INF) == 0;
+  bool standing = last.size() == after.size() && last.type() == after.type() && cv::norm(last, after, cv::NORM_INF) == 0;
+  if (standing && drop_standing_view) {  // as the learner would have learned without it
+    images.pop_back();
+    standing = false;
+  }
   // The standing view's keypoints are kept only inside the right segmentation (as the learner does
   // with the mask the supervisor sends); a run stored before the mask was sent has it in mask.png.
   if (table_view && !standing) {
@@ -122,7 +129,7 @@ std::shared_ptr<const learning::ObjectModel> relearned(const learning::ObjectMod
     images.push_back({after, cv::boundingRect(mask), 0, view_mask ? mask : cv::Mat()});
   } else if (standing && view_mask && images.back().mask.empty()) {
     images.back().mask = read("mask.png", cv::IMREAD_GRAYSCALE);
-  } else if (!view_mask) {
+  } else if (standing && !view_mask) {
     images.back().mask = cv::Mat();
   }
   const cv::Mat scene = standing || table_view ? read("before.png", cv::IMREAD_COLOR) : after;
@@ -146,6 +153,7 @@ struct Run {
   std::string why_not;                // what happened instead
   std::vector<int64_t> view_utimes;   // of the learning attempt's views, in view order
   std::vector<double> grasp_plan_ms;  // every grasp the run commanded
+  std::vector<double> grasp_plan_cpu_ms;  // ... the supervisor thread's CPU time (runs since 2026-12-02)
   int attempts = 0;
   double wall_s = 0;
   fs::path most_views;                // attempt_NN/views of the attempt that took the most views
@@ -196,6 +204,7 @@ Run read_run(const fs::path& runs, const fs::path& scene_file) {
     if (!a.contains("learning")) continue;
     const auto& l = a["learning"];
     if (l.value("grasp_plan_ms", -1.0) >= 0) run.grasp_plan_ms.push_back(l["grasp_plan_ms"].get<double>());
+    if (l.value("grasp_plan_cpu_ms", -1.0) >= 0) run.grasp_plan_cpu_ms.push_back(l["grasp_plan_cpu_ms"].get<double>());
     const int views = static_cast<int>(l.value("views", nlohmann::json::array()).size());
     if (views > run.most_views_count) {
       run.most_views_count = views;
@@ -365,27 +374,42 @@ cv::Mat at_most_wide(const cv::Mat& image, int width) {
 double max_of(const std::vector<double>& v) { return v.empty() ? 0 : *std::max_element(v.begin(), v.end()); }
 
 // The question the supervisor asks before it nudges a candidate, asked of every training scene:
-// the attempt's before still (the bottle standing where the run found it, the arm's base column
-// behind it) recognised against every learned object but the bottle's own. Taken for another
-// object, the bottle would count as known and never be learned in a run after that object's
+// the first attempt's before still (the bottle standing where the run found it, the arm's base
+// column behind it) recognised against every learned object but the bottle's own. Taken for
+// another object, the bottle counts as known and is never learned in a run after that object's
 // (the standing view's first chain run, docs/learning.md rule 5).
 struct SceneCheck {
   std::string bottle, taken_for;  // taken_for: "" when nothing else was recognised
   int verified = 0;
 };
 
-std::vector<SceneCheck> check_training_scenes(learning::Recognizer& recognizer, const std::vector<std::shared_ptr<const learning::ObjectModel>>& models,
-                                              const std::map<std::string, std::string>& bottle_of, const std::string& runs_dir) {
+// The before still of the run's first attempt that has one; empty when none has.
+cv::Mat first_before_still(const Run& run) {
+  std::vector<fs::path> attempts;
+  if (fs::is_directory(run.folder))
+    for (const auto& e : fs::directory_iterator(run.folder))
+      if (e.is_directory() && e.path().filename().string().rfind("attempt_", 0) == 0) attempts.push_back(e.path());
+  std::sort(attempts.begin(), attempts.end());
+  for (const fs::path& a : attempts)
+    if (fs::exists(a / "before.png")) return cv::imread((a / "before.png").string(), cv::IMREAD_COLOR);
+  return cv::Mat();
+}
+
+std::vector<SceneCheck> check_training_scenes(learning::Recognizer& recognizer, const std::vector<Run>& runs,
+                                              const std::vector<std::shared_ptr<const learning::ObjectModel>>& models,
+                                              const std::map<std::string, std::string>& bottle_of) {
   std::vector<SceneCheck> checks;
-  for (const auto& m : models) {
-    const fs::path file = fs::path(runs_dir) / m->info.run_id / m->info.run_id / m->info.object_key / "before.png";
-    const cv::Mat before = cv::imread(file.string(), cv::IMREAD_COLOR);
-    if (before.empty()) throw std::runtime_error(file.string() + ": cannot read");
-    recognizer.remove(m->info.name);
+  for (const Run& run : runs) {
+    const cv::Mat before = first_before_still(run);
+    if (before.empty()) continue;
+    std::shared_ptr<const learning::ObjectModel> own;
+    for (const auto& m : models)
+      if (!run.learned_name.empty() && m->info.name == run.learned_name) own = m;
+    if (own) recognizer.remove(own->info.name);
     const learning::Recognition r = recognizer.recognize(before);
-    recognizer.add(m);
+    if (own) recognizer.add(own);
     SceneCheck c;
-    c.bottle = bottle_of.at(m->info.name);
+    c.bottle = run.bottle;
     if (const learning::ObjectScore* best = r.best_score()) c.taken_for = bottle_of.at(best->name), c.verified = best->verified_matches;
     checks.push_back(c);
   }
@@ -395,7 +419,7 @@ std::vector<SceneCheck> check_training_scenes(learning::Recognizer& recognizer, 
 struct Totals {
   int objects_learned = 0, test_images = 0, correct = 0, wrong = 0, unrecognised = 0, good = 0, bad = 0;
   int unknown_images = 0, false_recognitions = 0, correct_of_learned = 0, test_images_of_learned = 0;
-  std::vector<double> grasp_plan_ms, distances_m;
+  std::vector<double> grasp_plan_ms, grasp_plan_cpu_ms, distances_m;
   std::vector<SceneCheck> training_scenes;
   int training_scenes_taken = 0;  // of them, taken for another object
 };
@@ -406,6 +430,7 @@ Totals add_up(const std::vector<Run>& runs, const std::vector<Judged>& judged) {
   for (const Run& r : runs) {
     if (!r.learned_name.empty()) learned.insert(r.bottle);
     t.grasp_plan_ms.insert(t.grasp_plan_ms.end(), r.grasp_plan_ms.begin(), r.grasp_plan_ms.end());
+    t.grasp_plan_cpu_ms.insert(t.grasp_plan_cpu_ms.end(), r.grasp_plan_cpu_ms.begin(), r.grasp_plan_cpu_ms.end());
   }
   t.objects_learned = static_cast<int>(learned.size());
   for (const Judged& j : judged) {
@@ -445,6 +470,8 @@ std::string json_report(const Options& o, const std::vector<Run>& runs, const st
       .field("training_scenes_taken_for_another_object", t.training_scenes_taken);
   j.key("grasp_plan_ms").begin_object().field("median", t.grasp_plan_ms.empty() ? -1.0 : median(t.grasp_plan_ms))
       .field("max", t.grasp_plan_ms.empty() ? -1.0 : max_of(t.grasp_plan_ms)).field("grasps", static_cast<int>(t.grasp_plan_ms.size()))
+      .field("cpu_median", t.grasp_plan_cpu_ms.empty() ? -1.0 : median(t.grasp_plan_cpu_ms))
+      .field("cpu_max", t.grasp_plan_cpu_ms.empty() ? -1.0 : max_of(t.grasp_plan_cpu_ms))
       .field("thesis", 160).field("target", 50).end_object();
   j.field("recognition_ms_at_100_objects", timing.median_ms).field("recognition_cpu_ms_at_100_objects", timing.median_cpu_ms);
   j.field("recognition_at_100_objects_matcher", timing.matcher).field("recognition_at_100_objects_descriptors", padded_descriptors);
@@ -527,6 +554,9 @@ std::string markdown_report(const Options& o, const std::vector<Run>& runs, cons
      << t.training_scenes.size() << taken_list(t.training_scenes) << " | |\n"
      << "| grasp plan time, median / max of " << t.grasp_plan_ms.size() << " grasps | "
      << (t.grasp_plan_ms.empty() ? std::string("none") : fixed(median(t.grasp_plan_ms)) + " / " + fixed(max_of(t.grasp_plan_ms)) + " ms")
+     << (t.grasp_plan_cpu_ms.empty() ? std::string()
+                                     : " wall (the supervisor thread's CPU: " + fixed(median(t.grasp_plan_cpu_ms)) + " / " +
+                                           fixed(max_of(t.grasp_plan_cpu_ms)) + " ms)")
      << " | 160 ms |\n"
      << "| recognition at " << padded_objects << " objects (one test image, SIFT included) | " << fixed(timing.median_ms, 0)
      << " ms wall, " << fixed(timing.median_cpu_ms, 0) << " ms CPU | |\n\n"
@@ -623,7 +653,7 @@ int run(const Options& o) {
   learning::LoadReport loaded = db.load_all(o.relearn);
   for (const std::string& e : loaded.errors) std::cerr << "nudge-exp-learning: database: " << e << "\n";
   if (o.relearn)
-    for (auto& m : loaded.models) m = relearned(*m, o.learn, o.runs, o.table_view, o.view_mask);
+    for (auto& m : loaded.models) m = relearned(*m, o.learn, o.runs, o.table_view, o.view_mask, o.drop_standing_view);
   learning::Recognizer recognizer(o.recognize);
   std::map<std::string, std::string> bottle_of;  // learned name -> bottle
   std::map<std::string, TrainingTruth> training;
@@ -631,7 +661,8 @@ int run(const Options& o) {
     const auto run = std::find_if(runs.begin(), runs.end(), [&](const Run& r) { return r.learned_name == m->info.name; });
     if (run == runs.end()) throw std::runtime_error(db.root() + "/" + m->info.name + ": learned by no run's learning attempt");
     const bool extra_view = o.table_view && m->views.size() == run->view_utimes.size() + 1;  // --table-view's
-    if (run->view_utimes.size() != m->views.size() && !extra_view)
+    const bool dropped_view = o.drop_standing_view && m->views.size() + 1 == run->view_utimes.size();
+    if (run->view_utimes.size() != m->views.size() && !extra_view && !dropped_view)
       throw std::runtime_error(db.root() + "/" + m->info.name + ": " + std::to_string(m->views.size()) + " views, the run sent " +
                                std::to_string(run->view_utimes.size()));
     recognizer.add(m);
@@ -653,7 +684,7 @@ int run(const Options& o) {
   }
   progress.clear_status();
   Totals totals = add_up(runs, judged);
-  totals.training_scenes = check_training_scenes(recognizer, loaded.models, bottle_of, o.runs);
+  totals.training_scenes = check_training_scenes(recognizer, runs, loaded.models, bottle_of);
   for (const SceneCheck& c : totals.training_scenes) {
     totals.training_scenes_taken += !c.taken_for.empty();
     if (!c.taken_for.empty())
@@ -710,6 +741,8 @@ int main(int argc, char** argv) {
   flags.add_bool("table-view", &o.table_view,
                  "--relearn, runs recorded without the supervisor's standing view: the attempt's after still as one more "
                  "view (its mask's box), pruned against the before still (its matches are not judged)");
+  flags.add_bool("drop-standing-view", &o.drop_standing_view,
+                 "--relearn, runs recorded with the supervisor's standing view: learn without it, as the learner would have");
   std::string view_mask = o.view_mask ? "on" : "off";
   flags.add_string("view-mask", &view_mask,
                    "--relearn, on|off: the standing or table view keeps only the keypoints inside the right segmentation");

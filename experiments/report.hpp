@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "nudge/timing.hpp"
+
 namespace nudge::experiments {
 
 // Directory results go to: $NUDGE_RESULTS_DIR or <source>/docs/results.
@@ -14,9 +16,7 @@ std::string results_dir();
 void write_result(const std::string& name, const std::string& text);
 
 double median(std::vector<double> v);
-// The calling thread's CPU time, ms: what a single-threaded computation cost, whatever else the
-// (shared) host ran meanwhile.
-double thread_cpu_ms();
+using nudge::thread_cpu_ms;  // the calling thread's CPU time, ms (nudge/timing.hpp)
 double mean(const std::vector<double>& v);
 
 struct LinearFit {

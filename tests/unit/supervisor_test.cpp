@@ -2796,6 +2796,8 @@ TEST_F(LearningTest, GraspsTurnsTwelveTimesLearnsAndPutsTheObjectBack) {
   EXPECT_EQ(standing.utime, a->after_utime);
   ASSERT_TRUE(a->top[0] && a->top[1] && a->grasp);
   EXPECT_GE(a->grasp_plan_ms, 0.0) << "the grasp's plan time is recorded for the report";
+  EXPECT_GT(a->grasp_plan_cpu_ms, 0.0) << "and its CPU time on the supervisor's thread";
+  EXPECT_LE(a->grasp_plan_cpu_ms, a->grasp_plan_ms + 1.0) << "one thread's CPU time within the wall time (clock resolution)";
   EXPECT_EQ(outputs_of<sv::HomeCommand>(out).size(), 1u) << "the arm parks after putting it back";
   EXPECT_EQ(s.summary().learned, 1);
   ASSERT_TRUE(a->put_back_at);

@@ -71,6 +71,7 @@ void write_learning(JsonWriter& j, const Attempt& a) {
     j.raw("null");
   }
   j.field("grasp_plan_ms", a.grasp_plan_ms);
+  j.field("grasp_plan_cpu_ms", a.grasp_plan_cpu_ms);
   j.key("expected_grip_width_m");
   if (a.expected_grip_width_m) j.value(*a.expected_grip_width_m); else j.raw("null");
   j.field("grip_opening_m", a.grip_opening_m);

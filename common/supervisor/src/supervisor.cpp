@@ -14,6 +14,7 @@
 #include "nudge/robot/command_planner.hpp"
 #include "nudge/segmentation/motion.hpp"
 #include "nudge/supervisor/grasp.hpp"
+#include "nudge/timing.hpp"
 
 namespace nudge::supervisor {
 
@@ -677,6 +678,7 @@ bool Supervisor::verify_by_axes(int64_t now) {
 
 void Supervisor::segment(int64_t now) {
   const auto started = std::chrono::steady_clock::now();
+  const double started_cpu_ms = thread_cpu_ms();
   Attempt& a = *attempt_;
   enter(State::Segment, now, "motion segmentation of the stills");
   const auto predicted_before = scene_.right_axis_line(a.target.position, config_.object_height_m, config_.still_size);
@@ -747,8 +749,10 @@ void Supervisor::segment(int64_t now) {
   }
   if (a.learn) {
     plan_grasp(now);
-    if (state_ == State::Grasp)
+    if (state_ == State::Grasp) {
       a.grasp_plan_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started).count();
+      a.grasp_plan_cpu_ms = thread_cpu_ms() - started_cpu_ms;
+    }
     draw_stages();
     return;
   }

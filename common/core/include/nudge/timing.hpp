@@ -28,4 +28,8 @@ class Stopwatch {
 // Wall-clock time in microseconds since the epoch (for heartbeats and live capture stamps).
 int64_t wall_utime();
 
+// The calling thread's CPU time, ms: what a computation on it cost, whatever else the (shared)
+// host ran meanwhile.
+double thread_cpu_ms();
+
 }  // namespace nudge

@@ -460,6 +460,10 @@ struct Attempt {
   // and its arm plan; thesis 160 ms), -1 when no grasp was commanded. Measured for the report
   // only: no decision depends on it.
   double grasp_plan_ms = -1;
+  // The same span's CPU time on the supervisor's thread (the left camera's segmentation runs
+  // beside it on another): what the plan cost, apart from the waits a host shared with the
+  // simulator and the other services adds to the wall time.
+  double grasp_plan_cpu_ms = -1;
   std::string object_key() const;          // "attempt_NN"
 };
 struct AttemptEnded { std::shared_ptr<const Attempt> attempt; };
