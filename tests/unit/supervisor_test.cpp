@@ -2717,7 +2717,7 @@ class LearningTest : public SupervisorTest {
 
 TEST_F(LearningTest, GraspsTurnsTwelveTimesLearnsAndPutsTheObjectBack) {
   sv::Config config;
-  config.standing_view = true;  // off by default; the test without it follows
+  config.standing_view = true;  // the default, said here: the test without it follows
   sv::Supervisor s = make_learning(config);
   const sv::GraspCommand grasp = to_grasp(s);
   EXPECT_EQ(s.awaited_arm_seq(), grasp.seq);
@@ -2820,7 +2820,9 @@ TEST_F(LearningTest, GraspsTurnsTwelveTimesLearnsAndPutsTheObjectBack) {
 // segmentation is run again about the new rest: the grasp is planned on the object, its fingers
 // half way up it, not on the neighbour's top.
 TEST_F(LearningTest, WithoutTheStandingViewTwelveViewsArePrunedAgainstTheAfterStill) {
-  sv::Supervisor s = make_learning();  // the default
+  sv::Config config;
+  config.standing_view = false;
+  sv::Supervisor s = make_learning(config);
   done(s, to_grasp(s).seq);
   std::vector<sv::LearnView> sent;
   for (int view = 0; view < 12; ++view) {
