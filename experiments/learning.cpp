@@ -122,17 +122,19 @@ std::shared_ptr<const learning::ObjectModel> relearned(const learning::ObjectMod
     images.pop_back();
     standing = false;
   }
+  const cv::Mat right_mask = standing || table_view ? read("mask.png", cv::IMREAD_GRAYSCALE) : cv::Mat();
+  if (table_view && !standing) {
+    images.push_back({after, cv::boundingRect(right_mask), 0, {}});
+    standing = true;
+  }
   // The standing view's keypoints are kept only inside the right segmentation (as the learner does
   // with the mask the supervisor sends); a run stored before the mask was sent has it in mask.png.
-  if (table_view && !standing) {
-    const cv::Mat mask = read("mask.png", cv::IMREAD_GRAYSCALE);
-    images.push_back({after, cv::boundingRect(mask), 0, view_mask ? mask : cv::Mat()});
-  } else if (standing && view_mask && images.back().mask.empty()) {
-    images.back().mask = read("mask.png", cv::IMREAD_GRAYSCALE);
-  } else if (standing && !view_mask) {
-    images.back().mask = cv::Mat();
+  if (standing) {
+    cv::Mat& mask = images.back().mask;
+    if (!view_mask) mask.release();
+    else if (mask.empty()) mask = right_mask;
   }
-  const cv::Mat scene = standing || table_view ? read("before.png", cv::IMREAD_COLOR) : after;
+  const cv::Mat scene = standing ? read("before.png", cv::IMREAD_COLOR) : after;
   learning::LearnStats stats;
   const auto start = std::chrono::steady_clock::now();
   auto model = std::make_shared<learning::ObjectModel>(learning::learn_object(stored.info, images, params, &stats, {}, scene));

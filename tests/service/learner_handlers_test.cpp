@@ -102,6 +102,15 @@ struct InProcess {
       bus.publish(channel::LEARN_VIEW, &msg);
     }
   }
+  // Commits the gathered views and waits for the worker: the LEARNED answer.
+  nudge::learn_result_t commit(const std::string& run, const std::string& key, int views, int64_t utime, int64_t seq) {
+    const auto msg = commit_message(run, key, key, views, utime, seq);
+    bus.publish(channel::LEARN_COMMIT, &msg);
+    service.handle_pending();
+    handlers->finish_learning();
+    service.handle_pending();
+    return learned.get();
+  }
   lcm::LCM bus{"memq://"};
   nudge::bus::Service service;
   bool started;
@@ -187,12 +196,7 @@ TEST(LearnerHandlers, TheSceneStillPrunesWhatStandsBehindTheObject) {
       msg.kind = kind;
       run.bus.publish(channel::LEARN_VIEW, &msg);
     }
-    const auto commit = commit_message("run_5", key, key, 12, t0 + 21 * kSecond, seq);
-    run.bus.publish(channel::LEARN_COMMIT, &commit);
-    run.service.handle_pending();
-    run.handlers->finish_learning();
-    run.service.handle_pending();
-    return run.learned.get();
+    return run.commit("run_5", key, 12, t0 + 21 * kSecond, seq);
   };
   const cv::Mat behind = syn::random_texture({400, 300}, 500);  // turntable()'s scene
   const auto plain = learn("plain", {}, 0, 100 * kSecond, 1);
@@ -226,12 +230,7 @@ TEST(LearnerHandlers, AStandingViewsMaskKeepsWhatLiesOnTheObjectAndABadOneIsRefu
     auto msg = view_message("run_6", key, 12, standing, t0 + 13 * kSecond);
     if (!view_mask.empty()) msg.mask = nudge::bus::to_message(view_mask, nudge::image_t::FORMAT_PNG, msg.utime, 12, "right");
     run.bus.publish(channel::LEARN_VIEW, &msg);
-    const auto commit = commit_message("run_6", key, key, 13, t0 + 14 * kSecond, seq);
-    run.bus.publish(channel::LEARN_COMMIT, &commit);
-    run.service.handle_pending();
-    run.handlers->finish_learning();
-    run.service.handle_pending();
-    return run.learned.get();
+    return run.commit("run_6", key, 13, t0 + 14 * kSecond, seq);
   };
   const auto boxed = learn("boxed", {}, 100 * kSecond, 1);
   const auto masked = learn("masked", mask, 200 * kSecond, 2);
