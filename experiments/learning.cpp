@@ -25,7 +25,6 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
-#include <map>
 #include <set>
 #include <sstream>
 
@@ -147,6 +146,15 @@ std::shared_ptr<const learning::ObjectModel> relearned(const learning::ObjectMod
 }
 
 // One training scene's run, as its summary tells it.
+// Times by stage, in the order the stages were first seen (the order the plan runs them).
+using StageTimes = std::vector<std::pair<std::string, std::vector<double>>>;
+
+void add_stage_times(StageTimes& stages, const std::string& stage, const std::vector<double>& ms) {
+  auto it = std::find_if(stages.begin(), stages.end(), [&](const auto& s) { return s.first == stage; });
+  if (it == stages.end()) it = stages.insert(stages.end(), {stage, {}});
+  it->second.insert(it->second.end(), ms.begin(), ms.end());
+}
+
 struct Run {
   std::string scene, bottle;          // train1_white_bottle, white_bottle
   sim::ObjectSpec bottle_spec;        // the training scene's first object
@@ -156,6 +164,7 @@ struct Run {
   std::vector<int64_t> view_utimes;   // of the learning attempt's views, in view order
   std::vector<double> grasp_plan_ms;  // every grasp the run commanded
   std::vector<double> grasp_plan_cpu_ms;  // ... the supervisor thread's CPU time (runs since 2026-12-02)
+  StageTimes grasp_plan_stages_ms;  // ... by stage (runs since 2026-12-03)
   int attempts = 0;
   double wall_s = 0;
   fs::path most_views;                // attempt_NN/views of the attempt that took the most views
@@ -207,6 +216,9 @@ Run read_run(const fs::path& runs, const fs::path& scene_file) {
     const auto& l = a["learning"];
     if (l.value("grasp_plan_ms", -1.0) >= 0) run.grasp_plan_ms.push_back(l["grasp_plan_ms"].get<double>());
     if (l.value("grasp_plan_cpu_ms", -1.0) >= 0) run.grasp_plan_cpu_ms.push_back(l["grasp_plan_cpu_ms"].get<double>());
+    if (l.contains("grasp_plan_stages_ms"))
+      for (const auto& stage : l["grasp_plan_stages_ms"])
+        add_stage_times(run.grasp_plan_stages_ms, stage.at("stage").get<std::string>(), {stage.at("ms").get<double>()});
     const int views = static_cast<int>(l.value("views", nlohmann::json::array()).size());
     if (views > run.most_views_count) {
       run.most_views_count = views;
@@ -422,6 +434,7 @@ struct Totals {
   int objects_learned = 0, test_images = 0, correct = 0, wrong = 0, unrecognised = 0, good = 0, bad = 0;
   int unknown_images = 0, false_recognitions = 0, correct_of_learned = 0, test_images_of_learned = 0;
   std::vector<double> grasp_plan_ms, grasp_plan_cpu_ms, distances_m;
+  StageTimes grasp_plan_stages_ms;
   std::vector<SceneCheck> training_scenes;
   int training_scenes_taken = 0;  // of them, taken for another object
 };
@@ -433,6 +446,7 @@ Totals add_up(const std::vector<Run>& runs, const std::vector<Judged>& judged) {
     if (!r.learned_name.empty()) learned.insert(r.bottle);
     t.grasp_plan_ms.insert(t.grasp_plan_ms.end(), r.grasp_plan_ms.begin(), r.grasp_plan_ms.end());
     t.grasp_plan_cpu_ms.insert(t.grasp_plan_cpu_ms.end(), r.grasp_plan_cpu_ms.begin(), r.grasp_plan_cpu_ms.end());
+    for (const auto& [stage, ms] : r.grasp_plan_stages_ms) add_stage_times(t.grasp_plan_stages_ms, stage, ms);
   }
   t.objects_learned = static_cast<int>(learned.size());
   for (const Judged& j : judged) {
@@ -475,6 +489,9 @@ std::string json_report(const Options& o, const std::vector<Run>& runs, const st
       .field("cpu_median", t.grasp_plan_cpu_ms.empty() ? -1.0 : median(t.grasp_plan_cpu_ms))
       .field("cpu_max", t.grasp_plan_cpu_ms.empty() ? -1.0 : max_of(t.grasp_plan_cpu_ms))
       .field("thesis", 160).field("target", 50).end_object();
+  j.key("grasp_plan_stages_median_ms").begin_object();
+  for (const auto& [stage, ms] : t.grasp_plan_stages_ms) j.field(stage, median(ms));
+  j.end_object();
   j.field("recognition_ms_at_100_objects", timing.median_ms).field("recognition_cpu_ms_at_100_objects", timing.median_cpu_ms);
   j.field("recognition_at_100_objects_matcher", timing.matcher).field("recognition_at_100_objects_descriptors", padded_descriptors);
   j.field("recognition_at_100_objects_answer", timing.label);
@@ -601,8 +618,14 @@ std::string markdown_report(const Options& o, const std::vector<Run>& runs, cons
        << " grey levels on average (median over " << diffs.size() << " views; max " << fixed(max_of(diffs), 2) << ").";
   md << "\n\n**Grasp plan time**: wall time from the after-nudge stills to the grasp command in the supervisor (both "
         "cameras' motion segmentations, the object's top, the grasp and the arm's plan), as each run's "
-        "`attempt.json` records it (`learning.grasp_plan_ms`), on a machine shared with other jobs.\n\n"
-     << "**Recognition at " << padded_objects << " objects**: the learned objects padded with synthetic textured "
+        "`attempt.json` records it (`learning.grasp_plan_ms`), on a machine shared with other jobs.\n\n";
+  if (!t.grasp_plan_stages_ms.empty()) {
+    md << "By stage (`learning.grasp_plan_stages_ms`; the CPU time of the thread each ran on, the wait for the "
+          "left camera's thread in wall time), median over the grasps:\n\n| stage | ms |\n|---|---|\n";
+    for (const auto& [stage, ms] : t.grasp_plan_stages_ms) md << "| " << stage << " | " << fixed(median(ms)) << " |\n";
+    md << "\n";
+  }
+  md << "**Recognition at " << padded_objects << " objects**: the learned objects padded with synthetic textured "
         "objects of 12 views (`synthetic::object_models`, seeds " << kStandInSeed << "+), the first cluttered test "
         "image recognised " << timing.runs << " times (median; SIFT of the image included; load average " << load_average()
      << " afterwards). Answer: " << (timing.label.empty() ? "nothing" : timing.label) << ".\n\n";

@@ -2798,6 +2798,19 @@ TEST_F(LearningTest, GraspsTurnsTwelveTimesLearnsAndPutsTheObjectBack) {
   EXPECT_GE(a->grasp_plan_ms, 0.0) << "the grasp's plan time is recorded for the report";
   EXPECT_GT(a->grasp_plan_cpu_ms, 0.0) << "and its CPU time on the supervisor's thread";
   EXPECT_LE(a->grasp_plan_cpu_ms, a->grasp_plan_ms + 1.0) << "one thread's CPU time within the wall time (clock resolution)";
+  // Where the plan's time went, by stage: the supervisor thread's, then the left camera's.
+  std::vector<std::string> stage_names;
+  double supervisor_thread_ms = 0;
+  for (const auto& [stage, ms] : a->grasp_plan_stages_ms) {
+    stage_names.push_back(stage);
+    EXPECT_GE(ms, 0.0) << stage;
+    if (stage.rfind("left", 0) != 0 && stage.rfind("wait", 0) != 0) supervisor_thread_ms += ms;
+  }
+  EXPECT_EQ(stage_names, (std::vector<std::string>{"right rest from the still", "right before line", "right after line",
+                                                   "right segmentation", "right mask's neighbours cleared",
+                                                   "wait for the left camera (wall)", "right mask checks",
+                                                   "grasp and arm plan", "left lines", "left segmentation"}));
+  EXPECT_LE(supervisor_thread_ms, a->grasp_plan_cpu_ms + 1e-6) << "the thread's stages within its CPU time";
   EXPECT_EQ(outputs_of<sv::HomeCommand>(out).size(), 1u) << "the arm parks after putting it back";
   EXPECT_EQ(s.summary().learned, 1);
   ASSERT_TRUE(a->put_back_at);

@@ -9,6 +9,7 @@
 #include "nudge/robot/command_planner.hpp"
 #include "nudge/robot/kinematics.hpp"
 #include "nudge/supervisor/supervisor.hpp"
+#include "nudge/timing.hpp"
 
 namespace nudge::supervisor {
 
@@ -108,13 +109,17 @@ void Supervisor::segment_left(Attempt& a, const Eigen::Vector3d& rest) const {
   const auto predicted_after = scene_.left_axis_line(rest, config_.object_height_m, config_.still_size);
   if (!predicted_before || !predicted_after) return;
   const std::vector<symmetry::Line> column = base_column_lines(0);
+  const double started = thread_cpu_ms();
   if (!a.before_line_left) a.before_line_left = find_line_near(a.before_left, *predicted_before, config_.line_search, column);
   a.after_line_left =
       find_moved_line(a.after_left, *predicted_after, *predicted_before, a.before_line_left, config_.line_search, column);
   if (!a.before_line_left) a.before_line_left = predicted_before;
   if (!a.after_line_left) a.after_line_left = predicted_after;
+  const double lines_done = thread_cpu_ms();
   const SegmentFunction& segment = segment_left_ ? segment_left_ : segment_;
   a.segmentation_left = segment(a.before_left, a.after_left, *a.before_line_left, *a.after_line_left);
+  // Its own thread's CPU (attempt.json's grasp_plan_stages_ms); a second call replaces the first's.
+  a.left_stages_cpu_ms = {{"left lines", lines_done - started}, {"left segmentation", thread_cpu_ms() - lines_done}};
 }
 
 // Sec. 7.2.2: the top in both cameras' segmentations, triangulated and lowered by r tan(theta);

@@ -72,6 +72,9 @@ void write_learning(JsonWriter& j, const Attempt& a) {
   }
   j.field("grasp_plan_ms", a.grasp_plan_ms);
   j.field("grasp_plan_cpu_ms", a.grasp_plan_cpu_ms);
+  j.key("grasp_plan_stages_ms").begin_array();  // in the order the stages ran
+  for (const auto& [stage, ms] : a.grasp_plan_stages_ms) j.begin_object().field("stage", stage).field("ms", ms).end_object();
+  j.end_array();
   j.key("expected_grip_width_m");
   if (a.expected_grip_width_m) j.value(*a.expected_grip_width_m); else j.raw("null");
   j.field("grip_opening_m", a.grip_opening_m);

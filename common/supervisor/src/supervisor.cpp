@@ -680,6 +680,14 @@ void Supervisor::segment(int64_t now) {
   const auto started = std::chrono::steady_clock::now();
   const double started_cpu_ms = thread_cpu_ms();
   Attempt& a = *attempt_;
+  // The CPU time of each stage of the plan on this thread (attempt.json: grasp_plan_stages_ms).
+  std::vector<std::pair<std::string, double>> stages;
+  double lap_start_ms = started_cpu_ms;
+  const auto lap = [&](const char* stage) {
+    const double at = thread_cpu_ms();
+    stages.emplace_back(stage, at - lap_start_ms);
+    lap_start_ms = at;
+  };
   enter(State::Segment, now, "motion segmentation of the stills");
   const auto predicted_before = scene_.right_axis_line(a.target.position, config_.object_height_m, config_.still_size);
   const std::vector<symmetry::Line> column = base_column_lines(1);
@@ -703,7 +711,9 @@ void Supervisor::segment(int64_t now) {
                       [this, &a, rest = *a.rest] { segment_left(a, rest); });
   // The object's own lines in the stills; the calibration's prediction where none is detected.
   // (The before still's line was searched for while the arm nudged: see before_lines.)
+  lap("right rest from the still");
   if (!a.before_line) a.before_line = find_line_near(a.before, *predicted_before, config_.line_search, column);
+  lap("right before line");
   if (!a.rest_from_still) {
     a.after_line = find_moved_line(a.after, *predicted_after, *predicted_before, a.before_line, config_.line_search, column);
     if (const auto pushed = line_along_the_push(a, *predicted_before, column)) a.after_line = pushed;
@@ -714,11 +724,20 @@ void Supervisor::segment(int64_t now) {
   }
   if (!a.before_line) a.before_line = predicted_before;
   if (!a.after_line) a.after_line = predicted_after;
+  lap("right after line");
   const bool stages_later = a.learn && segment_stageless_;
   a.segmentation = (stages_later ? segment_stageless_ : segment_)(a.before, a.after, *a.before_line, *a.after_line);
+  lap("right segmentation");
   keep_object_rows(a);
   keep_object_columns(a);
-  if (left.valid()) left.get();  // joined before the attempt can end
+  lap("right mask's neighbours cleared");
+  if (left.valid()) {
+    const auto waited = std::chrono::steady_clock::now();
+    left.get();  // joined before the attempt can end
+    stages.emplace_back("wait for the left camera (wall)",
+                        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - waited).count());
+    lap_start_ms = thread_cpu_ms();  // a deferred left ran on this thread: counted as its own stages
+  }
   // Fig. 6.7's stages for the attempt's files when the segmentation went without them: drawn
   // after the grasp is planned, off its clock (an attempt that ended meanwhile waits in outputs_,
   // not yet written, and `a` is still it).
@@ -748,10 +767,14 @@ void Supervisor::segment(int64_t now) {
     return;
   }
   if (a.learn) {
+    lap("right mask checks");
     plan_grasp(now);
     if (state_ == State::Grasp) {
+      lap("grasp and arm plan");
       a.grasp_plan_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started).count();
       a.grasp_plan_cpu_ms = thread_cpu_ms() - started_cpu_ms;
+      stages.insert(stages.end(), a.left_stages_cpu_ms.begin(), a.left_stages_cpu_ms.end());
+      a.grasp_plan_stages_ms = std::move(stages);
     }
     draw_stages();
     return;

@@ -466,6 +466,11 @@ struct Attempt {
   // beside it on another): what the plan cost, apart from the waits a host shared with the
   // simulator and the other services adds to the wall time.
   double grasp_plan_cpu_ms = -1;
+  // The plan's CPU time by stage, in the order they ran (the supervisor thread's stages, then the
+  // left camera's, which run on their own thread when the shell gave it a segmenter, and the wait
+  // for them, wall time): where a slow plan spent its time. Empty when no grasp was planned.
+  std::vector<std::pair<std::string, double>> grasp_plan_stages_ms;
+  std::vector<std::pair<std::string, double>> left_stages_cpu_ms;  // segment_left's, merged in
   std::string object_key() const;          // "attempt_NN"
 };
 struct AttemptEnded { std::shared_ptr<const Attempt> attempt; };
