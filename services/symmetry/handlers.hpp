@@ -66,6 +66,9 @@ struct Options {
     int keep = 0;
     double column_px = 0;
     double max_tilt_deg = 0;  // > 0: drop lines that cannot be an upright axis's image before the keep
+    // > 0: before the keep, each place in the image offered once before any twice
+    // (symmetry::one_line_per_place_first): lines within this many pixels of a stronger one wait.
+    double one_per_place_px = 0;
   };
   std::optional<Reach> reach;
   // Objects already explored left out of the edges (geometry::columns_mask): each

@@ -1,6 +1,8 @@
 // symmetry: detects bilateral symmetry lines in every image on its input channels and publishes
 // them on the matching SYMMETRY_* channel (CAMERA_LEFT -> SYMMETRY_LEFT, CAMERA -> SYMMETRY); with
 // --contours N also the object contours of the top N lines on CONTOURS_* (thesis sec. 4.2).
+#include <cmath>
+
 #include "handlers.hpp"
 #include "nudge/bus/channels.hpp"
 #include "nudge/bus/service.hpp"
@@ -114,6 +116,9 @@ int main(int argc, char** argv) {
     f.add_double("reach-max-tilt", &reach.max_tilt_deg,
                  "with --reach-calibration: drop lines whose plane leans more than this many degrees from the table's "
                  "normal (none can be an upright object's axis) before --reach-keep; 0: keep them");
+    f.add_double("reach-one-per-place", &reach.one_per_place_px,
+                 "with --reach-calibration: before --reach-keep, offer each place in the image once before any twice: a "
+                 "line within this many pixels of a stronger one (where their supports overlap) waits behind the rest; 0: off");
     std::string explored_calibration;
     symmetry_service::Options::Explored explored;
     f.add_string("explored-calibration", &explored_calibration,
@@ -217,6 +222,8 @@ int main(int argc, char** argv) {
         if (!(reach.column_px >= 0)) throw std::invalid_argument("--reach-column-px must be >= 0");
         if (!(reach.max_tilt_deg >= 0 && reach.max_tilt_deg <= 90))
           throw std::invalid_argument("--reach-max-tilt must be in [0, 90]");
+        if (!(reach.one_per_place_px >= 0 && std::isfinite(reach.one_per_place_px)))
+          throw std::invalid_argument("--reach-one-per-place must be >= 0 (pixels)");
         const RigOnTable on_table = rig_on_table(reach_calibration, options.inputs);
         reach.rig = on_table.rig;
         reach.table = on_table.table;

@@ -1138,6 +1138,55 @@ TEST(LineDifference, OfLinesMatchesTheirParameters) {
   EXPECT_NEAR(d.theta, -5 * kDeg, 1e-12);
 }
 
+namespace {
+
+// A line of a 640x480 image through `a` and `b` (support segment a..b), with `votes`.
+Line line_through(cv::Point2d a, cv::Point2d b, double votes) {
+  Line l;
+  const cv::Point2d along = (b - a) / cv::norm(b - a);
+  l.theta = std::atan2(-along.x, along.y);  // the normal (cos, sin) is the direction turned back a quarter
+  l.r = (a - cv::Point2d(319.5, 239.5)).dot(cv::Point2d(std::cos(l.theta), std::sin(l.theta)));
+  border_endpoints(l.r, l.theta, 640, 480, &l.end1, &l.end2);
+  l.seg1 = a;
+  l.seg2 = b;
+  l.votes = votes;
+  return l;
+}
+
+std::vector<double> votes_of(const std::vector<Line>& lines) {
+  std::vector<double> v;
+  for (const Line& l : lines) v.push_back(l.votes);
+  return v;
+}
+
+}  // namespace
+
+// Each place once before any twice: a second line of the strongest object (6 px off it, leaning a
+// little) and a line hugging it (8 px) wait behind a weaker object's line 60 px away; a line
+// straight above the strong object's (an object standing behind it) is a place of its own.
+TEST(OneLinePerPlace, APlaceAlreadyOfferedWaitsBehindTheOthers) {
+  const std::vector<Line> lines = {
+      line_through({300, 200}, {300, 400}, 100),  // the strongest object
+      line_through({306, 210}, {302, 390}, 90),   // its second line
+      line_through({308, 150}, {308, 330}, 80),   // hugging it, over part of its height
+      line_through({300, 40}, {300, 160}, 70),    // above it in the image: behind it on the table
+      line_through({360, 220}, {362, 400}, 60),   // a weaker object beside it
+  };
+  EXPECT_EQ(votes_of(one_line_per_place_first(lines, 12)), (std::vector<double>{100, 70, 60, 90, 80}));
+  EXPECT_EQ(votes_of(one_line_per_place_first(lines, 7)), (std::vector<double>{100, 80, 70, 60, 90}))
+      << "8 px off is another place at 7 px";
+  EXPECT_EQ(votes_of(one_line_per_place_first(lines, 0)), votes_of(lines)) << "0: off";
+  EXPECT_TRUE(one_line_per_place_first({}, 12).empty());
+  EXPECT_THROW(one_line_per_place_first(lines, std::nan("")), std::invalid_argument);
+}
+
+// A line crossing the strongest one is near it only where they cross: it is another place.
+TEST(OneLinePerPlace, ALineCrossingAnotherIsAPlaceOfItsOwn) {
+  const std::vector<Line> lines = {line_through({300, 200}, {300, 400}, 100), line_through({301, 205}, {301, 395}, 60),
+                                   line_through({270, 200}, {330, 400}, 50), line_through({420, 200}, {420, 400}, 40)};
+  EXPECT_EQ(votes_of(one_line_per_place_first(lines, 12)), (std::vector<double>{100, 50, 40, 60}));
+}
+
 // A line found in part of an image is the same line in the whole image's coordinates: points of the
 // region's line, shifted by the region's corner, lie on the whole image's line.
 TEST(LineFromRegion, PointsOfTheRegionsLineLieOnTheWholeImagesLine) {

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <utility>
 
 namespace nudge::symmetry {
 
@@ -49,6 +51,47 @@ Line line_from_region(const Line& line, const cv::Rect& region, const cv::Size& 
   out.seg2 = line.seg2 + offset;
   border_endpoints(out.r, out.theta, whole.width, whole.height, &out.end1, &out.end2);
   return out;
+}
+
+namespace {
+
+// The support segment's ends, or the line's border points when the support is a point.
+std::pair<cv::Point2d, cv::Point2d> span_of(const Line& line) {
+  if (cv::norm(line.seg2 - line.seg1) >= 1) return {line.seg1, line.seg2};
+  return {line.end1, line.end2};
+}
+
+// Whether `line` lies within `min_px` of `taken` where their spans overlap along `taken`: both
+// ends of the overlapping stretch of `line` within min_px of `taken`'s line.
+bool same_place(const Line& line, const Line& taken, double min_px) {
+  const auto [a1, a2] = span_of(taken);
+  const cv::Point2d along = a2 - a1;
+  const double length = cv::norm(along);
+  if (length < 1e-9) return false;
+  const cv::Point2d unit = along / length;
+  const auto [b1, b2] = span_of(line);
+  // Parameters of line's ends along taken's span, and their signed distances across it.
+  const double t1 = (b1 - a1).dot(unit), t2 = (b2 - a1).dot(unit);
+  const double d1 = unit.x * (b1 - a1).y - unit.y * (b1 - a1).x;
+  const double d2 = unit.x * (b2 - a1).y - unit.y * (b2 - a1).x;
+  const double lo = std::max(0.0, std::min(t1, t2)), hi = std::min(length, std::max(t1, t2));
+  if (hi < lo) return false;  // one above the other in the image: two places
+  const auto across_at = [&](double t) { return std::abs(t2 == t1 ? d1 : d1 + (d2 - d1) * (t - t1) / (t2 - t1)); };
+  return across_at(lo) < min_px && across_at(hi) < min_px;
+}
+
+}  // namespace
+
+std::vector<Line> one_line_per_place_first(const std::vector<Line>& lines, double min_px) {
+  if (!std::isfinite(min_px)) throw std::invalid_argument("one line per place: the distance must be finite");
+  if (min_px <= 0) return lines;
+  std::vector<Line> first, waiting;
+  for (const Line& line : lines) {
+    const bool taken = std::any_of(first.begin(), first.end(), [&](const Line& t) { return same_place(line, t, min_px); });
+    (taken ? waiting : first).push_back(line);
+  }
+  first.insert(first.end(), waiting.begin(), waiting.end());
+  return first;
 }
 
 }  // namespace nudge::symmetry

@@ -6,6 +6,8 @@
 // (R, theta) and (-R, theta + 180 deg) are the same line, which is why differences must wrap.
 #include <opencv2/core/types.hpp>
 
+#include <vector>
+
 namespace nudge::symmetry {
 
 struct Line {
@@ -38,5 +40,15 @@ LineDifference line_difference(double r, double theta, double reference_r, doubl
 inline LineDifference line_difference(const Line& line, const Line& reference) {
   return line_difference(line.r, line.theta, reference.r, reference.theta);
 }
+
+// `lines` (strongest first) reordered so that each place in the image is offered once before any
+// place is offered twice: a line lying within `min_px` of a line already taken, along the stretch
+// where their support segments overlap, waits, in its order, behind every line that does not.
+// Where lines are capped (the survey's few per image), an object's second line (a handle's, a
+// shading's) or a line hugging it then no longer takes the place of a weaker object's line
+// elsewhere. Lines beside each other but at different heights in the image (one object behind
+// another) are different places. min_px <= 0: the lines as they are. Throws std::invalid_argument
+// when min_px is not finite.
+std::vector<Line> one_line_per_place_first(const std::vector<Line>& lines, double min_px);
 
 }  // namespace nudge::symmetry
