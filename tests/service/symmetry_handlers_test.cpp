@@ -393,6 +393,35 @@ TEST(SymmetryHandlers, TheArmBaseColumnsLineDoesNotTakeAPlaceAmongTheLinesKept) 
   EXPECT_NEAR(column_second[0], 60, 1.0);
 }
 
+// Each place once before any twice (Reach::one_per_place_px): a tall bottle whose label sits 12 px
+// off its axis gives two lines (its outline's and its label's) that outvote a short bottle 140 px
+// away and fill the two lines kept; with a line within 16 px of a stronger one waiting, the short
+// bottle's line takes the second place.
+TEST(SymmetryHandlers, OneLinePerPlaceLetsALoneObjectsLineIn) {
+  nudge::symmetry_service::Options options = two_bottle_options();
+  nudge::symmetry_service::Options::Reach reach = level_reach();
+  reach.centre = Eigen::Vector3d(0, 0.3, 1.0);
+  reach.keep = 2;
+  cv::Mat img(240, 320, CV_8UC3, cv::Scalar(200, 210, 220));
+  syn::draw_shape(img, syn::bottle_profile(170, 30), 60, 0, 0, cv::Scalar(40, 60, 90));
+  cv::rectangle(img, cv::Rect(213, 38, 29, 166), cv::Scalar(140, 150, 160), cv::FILLED);  // a label off its axis
+  syn::draw_shape(img, syn::bottle_profile(40, 30), -80, 0, 0, cv::Scalar(40, 60, 90));
+  auto published = [&](double one_per_place_px) {
+    reach.one_per_place_px = one_per_place_px;
+    options.reach = reach;
+    std::vector<double> r;
+    for (const auto& line : right_lines_of(options, img).lines) r.push_back(line.r);
+    return r;
+  };
+  const std::vector<double> crowded = published(0);
+  ASSERT_EQ(crowded.size(), 2u);
+  for (double r : crowded) EXPECT_GT(r, 40) << "without it both places go to the pair of bottles";
+  const std::vector<double> spread = published(16);
+  ASSERT_EQ(spread.size(), 2u);
+  EXPECT_EQ(spread[0], crowded[0]) << "the strongest line first, as before";
+  EXPECT_NEAR(spread[1], -80, 1.0) << "the lone bottle's line in the second place";
+}
+
 // Lines that cannot be an upright object's axis leave before the lines kept within reach are
 // chosen (Reach::max_tilt_deg): with one line kept, a leaning bottle (12 deg in a level camera)
 // that outvotes an upright one takes the place without the check, and gives it up with it.
