@@ -145,7 +145,6 @@ std::shared_ptr<const learning::ObjectModel> relearned(const learning::ObjectMod
   return model;
 }
 
-// One training scene's run, as its summary tells it.
 // Times by stage, in the order the stages were first seen (the order the plan runs them).
 using StageTimes = std::vector<std::pair<std::string, std::vector<double>>>;
 
@@ -155,6 +154,7 @@ void add_stage_times(StageTimes& stages, const std::string& stage, const std::ve
   it->second.insert(it->second.end(), ms.begin(), ms.end());
 }
 
+// One training scene's run, as its summary tells it.
 struct Run {
   std::string scene, bottle;          // train1_white_bottle, white_bottle
   sim::ObjectSpec bottle_spec;        // the training scene's first object

@@ -194,7 +194,8 @@ void Handlers::detect_and_publish(const cv::Mat& image, const image_t& msg, cons
     if (reach.max_tilt_deg > 0)
       result.lines = geometry::upright_lines(reach.rig, side, reach.table, result.lines, reach.max_tilt_deg);
     symmetry::drop_weak_lines(result.lines, options_.params.min_peak_ratio);
-    result.lines = symmetry::one_line_per_place_first(result.lines, reach.one_per_place_px);
+    if (reach.one_per_place_px > 0)
+      result.lines = symmetry::one_line_per_place_first(result.lines, reach.one_per_place_px);
     if (reach.keep > 0 && reach.column_px > 0)
       result.lines = geometry::first_lines_column_uncounted(reach.rig, side, reach.table, result.lines, reach.keep,
                                                             geometry::TableFrame(reach.table, reach.centre).origin(),

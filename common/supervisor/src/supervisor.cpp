@@ -732,10 +732,9 @@ void Supervisor::segment(int64_t now) {
   keep_object_columns(a);
   lap("right mask's neighbours cleared");
   if (left.valid()) {
-    const auto waited = std::chrono::steady_clock::now();
+    const Stopwatch waited;
     left.get();  // joined before the attempt can end
-    stages.emplace_back("wait for the left camera (wall)",
-                        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - waited).count());
+    stages.emplace_back("wait for the left camera (wall)", waited.elapsed_ms());
     lap_start_ms = thread_cpu_ms();  // a deferred left ran on this thread: counted as its own stages
   }
   // Fig. 6.7's stages for the attempt's files when the segmentation went without them: drawn
