@@ -11,6 +11,10 @@
 #include <opencv2/imgproc.hpp>
 
 #include <future>
+#include <string>
+
+#include "nudge/memory.hpp"
+#include "nudge/segmentation/motion.hpp"
 
 #include "nudge/robot/command_planner.hpp"
 #include "nudge/supervisor/grasp.hpp"
@@ -85,6 +89,8 @@ void BM_GraspPlanAfterNudge(benchmark::State& state) {
       if (!line_before) line_before = cam.predicted_before;
       if (!line_after) line_after = cam.predicted_after;
       const sv::Segmentation s = (c == 0 ? segment_left : segment)(cam.before, cam.after, *line_before, *line_after);
+      // The right mask's checks (Supervisor::mask_shape_problem): its mirror image about the line.
+      if (c == 1 && nudge::segmentation::mirror_agreement(s.mask, *line_after) < 0.5) return;
       const auto reading = sv::read_mask_on_line(s.mask, *line_after);
       if (!reading) return;
       top[c] = reading->top;
@@ -179,4 +185,34 @@ void BM_MaskTopAndFoot(benchmark::State& state) {
 }
 BENCHMARK(BM_MaskTopAndFoot)->Unit(benchmark::kMillisecond);
 
-BENCHMARK_MAIN();
+// The mask's mirror check of the right camera's segmentation (Supervisor::mask_shape_problem).
+void BM_MaskMirrorAgreement(benchmark::State& state) {
+  const sv::SceneGeometry scene = sv::SceneGeometry::load(NUDGE_SOURCE_DIR "/config/calibration_sim.yaml");
+  const Eigen::Vector3d before(0.25, -0.02, 0), after(0.25, 0.01, 0);
+  const cv::Mat a = draw(scene, before, false), b = draw(scene, after, false);
+  const auto la = scene.right_axis_line(before, kHeight, kStill), lb = scene.right_axis_line(after, kHeight, kStill);
+  const cv::Mat mask = sv::motion_segmentation({}, false)(a, b, *la, *lb).mask;
+  double agreement = 0;
+  for (auto _ : state) benchmark::DoNotOptimize(agreement = nudge::segmentation::mirror_agreement(mask, *lb));
+  state.counters["agreement"] = agreement;
+}
+BENCHMARK(BM_MaskMirrorAgreement)->Unit(benchmark::kMillisecond);
+
+// As the services run (bus::guarded_main keeps freed images in the heap), unless --fresh-pages
+// asks for glibc's defaults: every image a fresh map, a page fault per page (nudge/memory.hpp).
+int main(int argc, char** argv) {
+  bool fresh_pages = false;
+  int kept = 1;
+  for (int i = 1; i < argc; ++i) {
+    if (std::string(argv[i]) == "--fresh-pages") fresh_pages = true;
+    else argv[kept++] = argv[i];
+  }
+  argc = kept;
+  if (!fresh_pages) nudge::keep_large_buffers_for_reuse();
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::AddCustomContext("memory", fresh_pages ? "glibc defaults (--fresh-pages)" : "freed images kept for reuse");
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

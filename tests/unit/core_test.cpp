@@ -1,5 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <sys/resource.h>
+
+#include <cstdlib>
 #include <fstream>
 #include <stdexcept>
 #include <sstream>
@@ -9,6 +12,7 @@
 #include "nudge/flags.hpp"
 #include "nudge/image_header.hpp"
 #include "nudge/json.hpp"
+#include "nudge/memory.hpp"
 #include "nudge/yaml_file.hpp"
 
 using namespace nudge;
@@ -20,6 +24,18 @@ bool parse(Flags& flags, std::vector<std::string> args) {
   argv.push_back(program.data());
   for (auto& a : args) argv.push_back(a.data());
   return flags.parse(static_cast<int>(argv.size()), argv.data());
+}
+
+// The calling thread's minor page faults while a fresh block of `bytes` is allocated, every page
+// of it written, and freed.
+long faults_of_a_written_block(size_t bytes) {
+  rusage before{}, after{};
+  getrusage(RUSAGE_THREAD, &before);
+  auto* block = static_cast<volatile char*>(std::malloc(bytes));
+  for (size_t i = 0; i < bytes; i += 4096) block[i] = 1;
+  std::free(const_cast<char*>(block));
+  getrusage(RUSAGE_THREAD, &after);
+  return after.ru_minflt - before.ru_minflt;
 }
 }  // namespace
 
@@ -344,4 +360,17 @@ TEST(YamlFile, FilesAreReadWholeOrRefusedNamingThem) {
     EXPECT_NE(std::string(e.what()).find(path + ": larger than a scene file can be"), std::string::npos) << e.what();
   }
   std::remove(path.c_str());
+}
+
+// A still-sized image freed and allocated again comes back from the heap, its pages already
+// there: no page fault per page as a fresh map would take (docs/benchmarks.md: on a virtual
+// machine these faults were half a motion segmentation's time).
+TEST(Memory, AFreedStillSizedBlockIsReusedWithoutPageFaults) {
+  if (!keep_large_buffers_for_reuse()) GTEST_SKIP() << "the allocator is not glibc's (a sanitizer's): nothing to set";
+  EXPECT_TRUE(keep_large_buffers_for_reuse());  // again: the same settings
+  constexpr size_t kStill = 1280 * 960 * 3;
+  constexpr long kPages = kStill / 4096;
+  faults_of_a_written_block(kStill);  // the heap grows to hold it once
+  EXPECT_LT(faults_of_a_written_block(kStill), kPages / 10);
+  EXPECT_LT(faults_of_a_written_block(kStill), kPages / 10);
 }

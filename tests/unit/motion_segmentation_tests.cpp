@@ -526,6 +526,47 @@ TEST(MirrorAgreement, AnObjectsMaskIsItsOwnMirrorImageAboutItsLine) {
   EXPECT_LT(mirror_agreement(piece, line_at(80.5, 0)), 0.2);
 }
 
+// The check reads only the mask's box and its mirror image's: the same agreement as over the
+// whole image (the reflection of every pixel, grown by one, and the union counted everywhere),
+// for masks near the borders, lines at any angle and mirror images partly off the image.
+TEST(MirrorAgreement, TheBoxesAloneAgreeWithTheWholeImage) {
+  const auto whole_image = [](const cv::Mat& mask, const sym::Line& line) {
+    const cv::Mat object = mask != 0;
+    cv::Mat mirrored = mirror_image(object, line);
+    cv::dilate(mirrored, mirrored, cv::Mat::ones(3, 3, CV_8U));
+    const int either = cv::countNonZero(object | mirrored);
+    return either > 0 ? static_cast<double>(cv::countNonZero(object & mirrored)) / either : 0.0;
+  };
+  cv::RNG rng(20261203);
+  int compared = 0, agreeing = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    cv::Mat mask = cv::Mat::zeros(240 + rng.uniform(0, 80), 320 + rng.uniform(0, 80), CV_8U);
+    const cv::Point centre(rng.uniform(-20, mask.cols + 20), rng.uniform(-20, mask.rows + 20));
+    cv::ellipse(mask, centre, cv::Size(rng.uniform(2, 60), rng.uniform(2, 90)), rng.uniform(0, 180), 0, 360,
+                cv::Scalar(rng.uniform(1, 256)), cv::FILLED);
+    if (rng.uniform(0, 2)) cv::rectangle(mask, cv::Rect(rng.uniform(0, mask.cols), rng.uniform(0, mask.rows), 15, 40), cv::Scalar(255), cv::FILLED);
+    const sym::Line line = line_at(rng.uniform(-200.0, 200.0), rng.uniform(-90.0, 90.0));
+    const double expected = whole_image(mask, line);
+    const double got = mirror_agreement(mask, line);
+    ++compared;
+    agreeing += expected > 0.1;
+    EXPECT_NEAR(got, expected, 0.005) << "trial " << trial;
+  }
+  // Lines through the mask as well as beside it: ones about their own axis for the agreement's sake.
+  for (int trial = 0; trial < 50; ++trial) {
+    cv::Mat mask = cv::Mat::zeros(480, 640, CV_8U);
+    const double theta = rng.uniform(-30.0, 30.0);
+    cv::ellipse(mask, cv::Point2f(319.5f + 100 * std::cos(theta * M_PI / 180), 239.5f + 100 * std::sin(theta * M_PI / 180)),
+                cv::Size(rng.uniform(10, 60), rng.uniform(20, 150)), theta, 0, 360, cv::Scalar(255), cv::FILLED);
+    const sym::Line line = line_at(100 + rng.uniform(-3.0, 3.0), theta);
+    const double expected = whole_image(mask, line);
+    ++compared;
+    agreeing += expected > 0.1;
+    EXPECT_NEAR(mirror_agreement(mask, line), expected, 0.005) << "symmetric trial " << trial;
+  }
+  EXPECT_GE(agreeing, 50) << "of " << compared << ": the comparison must include masks that do agree";
+}
+
 TEST(MirrorAgreement, BadMasksAreNamed) {
   EXPECT_EQ(mirror_agreement(cv::Mat::zeros(10, 10, CV_8U), line_at(0, 0)), 0.0);
   EXPECT_THROW(mirror_agreement(cv::Mat(), line_at(0, 0)), std::invalid_argument);

@@ -10,6 +10,7 @@
 #include "nudge/bus/log_file.hpp"
 #include "nudge/heartbeat_t.hpp"
 #include "nudge/log.hpp"
+#include "nudge/memory.hpp"
 #include "nudge/timing.hpp"
 
 namespace nudge::bus {
@@ -245,6 +246,7 @@ void Service::report_truncated_input() const {
 
 int guarded_main(const std::string& name, const std::function<int()>& body) {
   log::set_component(name);
+  keep_large_buffers_for_reuse();  // images freed and allocated again, frame after frame: no page faults
   try {
     return body();
   } catch (const FlagError& e) {

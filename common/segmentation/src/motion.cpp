@@ -587,22 +587,57 @@ cv::Mat cut_out(const cv::Mat& image, const cv::Mat& mask) {
   return out;
 }
 
-cv::Mat mirror_image(const cv::Mat& image, const symmetry::Line& line) {
-  // Reflection about n . (p - c) = R: p' = p - 2 (n . p - n . c - R) n, its own inverse.
+namespace {
+
+// The reflection about `line` ((R, theta) about the centre of an image of `size`) in the pixel
+// coordinates of `roi`: p' = p - 2 (n . p - n . c - R) n, its own inverse.
+cv::Matx23d reflection(const symmetry::Line& line, cv::Size size, const cv::Rect& roi) {
   const double nx = std::cos(line.theta), ny = std::sin(line.theta);
-  const double offset = 2.0 * (nx * 0.5 * (image.cols - 1) + ny * 0.5 * (image.rows - 1) + line.r);
-  const cv::Matx23d reflect(1 - 2 * nx * nx, -2 * nx * ny, offset * nx,  //
-                            -2 * nx * ny, 1 - 2 * ny * ny, offset * ny);
+  const double offset = 2.0 * (nx * 0.5 * (size.width - 1) + ny * 0.5 * (size.height - 1) + line.r);
+  const cv::Matx22d a(1 - 2 * nx * nx, -2 * nx * ny, -2 * nx * ny, 1 - 2 * ny * ny);
+  // Whole image: q = A p + offset n. In the roi's coordinates (p = p' + o): q' = A p' + A o + offset n - o.
+  const cv::Vec2d o(roi.x, roi.y);
+  const cv::Vec2d t = a * o + offset * cv::Vec2d(nx, ny) - o;
+  return cv::Matx23d(a(0, 0), a(0, 1), t[0], a(1, 0), a(1, 1), t[1]);
+}
+
+// The smallest rectangle of an image of `size` holding `box` and its reflection about `line`,
+// grown by `margin` px.
+cv::Rect box_and_its_mirror(const cv::Rect& box, const symmetry::Line& line, cv::Size size, int margin) {
+  const cv::Matx23d reflect = reflection(line, size, cv::Rect(0, 0, size.width, size.height));
+  double x0 = box.x, y0 = box.y, x1 = box.x + box.width - 1, y1 = box.y + box.height - 1;
+  for (const cv::Point2d corner : {cv::Point2d(box.x, box.y), cv::Point2d(box.x + box.width - 1, box.y),
+                                   cv::Point2d(box.x, box.y + box.height - 1),
+                                   cv::Point2d(box.x + box.width - 1, box.y + box.height - 1)}) {
+    const cv::Point2d q(reflect(0, 0) * corner.x + reflect(0, 1) * corner.y + reflect(0, 2),
+                        reflect(1, 0) * corner.x + reflect(1, 1) * corner.y + reflect(1, 2));
+    x0 = std::min(x0, q.x), y0 = std::min(y0, q.y), x1 = std::max(x1, q.x), y1 = std::max(y1, q.y);
+  }
+  const cv::Rect grown(cv::Point(static_cast<int>(std::floor(x0)) - margin, static_cast<int>(std::floor(y0)) - margin),
+                       cv::Point(static_cast<int>(std::ceil(x1)) + margin + 1, static_cast<int>(std::ceil(y1)) + margin + 1));
+  return grown & cv::Rect(0, 0, size.width, size.height);
+}
+
+}  // namespace
+
+cv::Mat mirror_image(const cv::Mat& image, const symmetry::Line& line) {
   cv::Mat mirrored;
-  cv::warpAffine(image, mirrored, reflect, image.size(), cv::INTER_NEAREST, cv::BORDER_CONSTANT, 0);
+  cv::warpAffine(image, mirrored, reflection(line, image.size(), cv::Rect(0, 0, image.cols, image.rows)), image.size(),
+                 cv::INTER_NEAREST, cv::BORDER_CONSTANT, 0);
   return mirrored;
 }
 
 double mirror_agreement(const cv::Mat& mask, const symmetry::Line& line) {
   if (mask.empty() || mask.type() != CV_8UC1) throw std::invalid_argument("mirror_agreement: the mask must be 8-bit, one channel");
-  const cv::Mat object = mask != 0;
-  if (cv::countNonZero(object) == 0) return 0.0;
-  cv::Mat mirrored = mirror_image(object, line);
+  // Only the mask's box and its mirror image can hold either: a mask is a few percent of a
+  // 1280x960 still, and whole-image passes were most of this check's time.
+  const cv::Rect box = cv::boundingRect(mask);
+  if (box.empty()) return 0.0;
+  constexpr int kMargin = 2;  // the one-pixel growth and the nearest-pixel rounding
+  const cv::Rect roi = box_and_its_mirror(box, line, mask.size(), kMargin);
+  const cv::Mat object = mask(roi) != 0;
+  cv::Mat mirrored;
+  cv::warpAffine(object, mirrored, reflection(line, mask.size(), roi), roi.size(), cv::INTER_NEAREST, cv::BORDER_CONSTANT, 0);
   cv::dilate(mirrored, mirrored, cv::Mat::ones(3, 3, CV_8U));
   const int both = cv::countNonZero(object & mirrored);
   const int either = cv::countNonZero(object | mirrored);
