@@ -8,9 +8,12 @@
 #include <benchmark/benchmark.h>
 
 #include <opencv2/core/utility.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <fstream>
 #include <future>
+#include <regex>
 #include <string>
 
 #include "nudge/memory.hpp"
@@ -198,17 +201,58 @@ void BM_MaskMirrorAgreement(benchmark::State& state) {
 }
 BENCHMARK(BM_MaskMirrorAgreement)->Unit(benchmark::kMillisecond);
 
+// The right camera's part of the plan on a recorded attempt's stills (an attempt folder of a run:
+// before.png, after.png and attempt.json's line_before and line_after): the motion segmentation
+// without stages, the mask's mirror check and its top and foot, as the supervisor runs them.
+void BM_RecordedAttempt(benchmark::State& state, const std::string& folder) {
+  cv::setNumThreads(0);
+  std::ifstream in(folder + "/attempt.json");
+  const std::string json((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto line = [&](const std::string& key) -> std::optional<nudge::symmetry::Line> {
+    std::smatch m;
+    if (!std::regex_search(json, m, std::regex("\"" + key + "\":\\{\"r\":([-0-9.e]+),\"theta\":([-0-9.e]+)"))) return std::nullopt;
+    nudge::symmetry::Line l;
+    l.r = std::stod(m[1]);
+    l.theta = std::stod(m[2]);
+    return l;
+  };
+  const cv::Mat before = cv::imread(folder + "/before.png"), after = cv::imread(folder + "/after.png");
+  const auto line_before = line("line_before"), line_after = line("line_after");
+  if (before.empty() || after.empty() || !line_before || !line_after) {
+    state.SkipWithError(("not an attempt folder with stills and lines: " + folder).c_str());
+    return;
+  }
+  const sv::SegmentFunction segment = sv::motion_segmentation({}, false);
+  const int part = static_cast<int>(state.range(0));
+  const cv::Mat mask = segment(before, after, *line_before, *line_after).mask;
+  double mask_pixels = cv::countNonZero(mask);
+  for (auto _ : state) {
+    if (part == 0) benchmark::DoNotOptimize(segment(before, after, *line_before, *line_after));
+    if (part == 1) benchmark::DoNotOptimize(nudge::segmentation::mirror_agreement(mask, *line_after));
+    if (part == 2) benchmark::DoNotOptimize(sv::read_mask_on_line(mask, *line_after));
+  }
+  state.counters["mask_px"] = mask_pixels;
+}
+
 // As the services run (bus::guarded_main keeps freed images in the heap), unless --fresh-pages
 // asks for glibc's defaults: every image a fresh map, a page fault per page (nudge/memory.hpp).
+// --attempt FOLDER (repeatable) adds BM_RecordedAttempt on that attempt's stills: /0 the
+// segmentation, /1 the mirror check, /2 the mask's top and foot.
 int main(int argc, char** argv) {
   bool fresh_pages = false;
+  std::vector<std::string> attempts;
   int kept = 1;
   for (int i = 1; i < argc; ++i) {
-    if (std::string(argv[i]) == "--fresh-pages") fresh_pages = true;
+    const std::string arg = argv[i];
+    if (arg == "--fresh-pages") fresh_pages = true;
+    else if (arg == "--attempt" && i + 1 < argc) attempts.push_back(argv[++i]);
     else argv[kept++] = argv[i];
   }
   argc = kept;
   if (!fresh_pages) nudge::keep_large_buffers_for_reuse();
+  for (const std::string& folder : attempts)
+    benchmark::RegisterBenchmark(("BM_RecordedAttempt:" + folder).c_str(), BM_RecordedAttempt, folder)
+        ->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   benchmark::AddCustomContext("memory", fresh_pages ? "glibc defaults (--fresh-pages)" : "freed images kept for reuse");

@@ -149,6 +149,7 @@ class Shell {
     // Its own scratch images: a thread of its own; no stages (only the right camera's are written).
     supervisor_.set_left_segmentation(sv::motion_segmentation({}, false));
     supervisor_.set_stageless_segmentation(sv::motion_segmentation({}, false));  // the grasp's (right) one
+    supervisor_.warm_up();  // their memory touched now, not on the first grasp plan's clock
     std::error_code error;
     std::filesystem::create_directories(run_dir_, error);
     if (error) throw std::runtime_error(run_dir_ + ": cannot create the run's folder (" + error.message() + ")");

@@ -14,7 +14,10 @@
 #include <fstream>
 #include <functional>
 #include <iterator>
+#include <mutex>
 #include <random>
+#include <set>
+#include <thread>
 
 #include "nudge/segmentation/motion.hpp"
 #include "nudge/supervisor/report.hpp"
@@ -3148,6 +3151,41 @@ TEST_F(LearningTest, TheGraspIsPlannedOnTheStagelessSegmentationAndTheStagesAreD
   EXPECT_EQ(a->segmentation.stages[0].first, "c_difference");
   EXPECT_GT(cv::countNonZero(a->segmentation.mask), 1000) << "the stageless segmentation's mask";
   EXPECT_GE(a->grasp_plan_ms, 0);
+}
+
+// The warm-up runs each segmentation once, the left one on a thread of its own, on a still pair of
+// the configured size with a moved object between its lines, and leaves the run as it was.
+TEST_F(LearningTest, TheWarmUpRunsEverySegmentationOnceOnStillsOfTheConfiguredSizeAndChangesNothing) {
+  std::mutex lock;
+  std::vector<std::string> calls;
+  std::set<std::thread::id> threads;
+  const auto counting = [&](const std::string& name) {
+    return [&, name](const cv::Mat& before, const cv::Mat& after, const nudge::symmetry::Line& l0,
+                     const nudge::symmetry::Line& l1) {
+      {
+        const std::lock_guard<std::mutex> hold(lock);
+        calls.push_back(name + " " + std::to_string(after.cols) + "x" + std::to_string(after.rows));
+        threads.insert(std::this_thread::get_id());
+      }
+      EXPECT_EQ(before.size(), after.size());
+      EXPECT_GT(l1.r, l0.r) << "the object moved right between the lines";
+      return mask_of_difference(before, after, l0, l1);
+    };
+  };
+  sv::Config config;
+  config.learn = sv::Config::Learn::On;
+  sv::Supervisor s(config, scene_, sv::ArmSetup{}, counting("right"));
+  s.set_left_segmentation(counting("left"));
+  s.set_stageless_segmentation(counting("stageless"));
+  const sv::State state = s.state();
+  s.warm_up();
+  std::sort(calls.begin(), calls.end());
+  const std::string size = std::to_string(config.still_size.width) + "x" + std::to_string(config.still_size.height);
+  EXPECT_EQ(calls, (std::vector<std::string>{"left " + size, "right " + size, "stageless " + size}));
+  EXPECT_EQ(threads.size(), 2u) << "the left camera's on a thread of its own";
+  EXPECT_TRUE(s.take_outputs().empty());
+  EXPECT_EQ(s.state(), state);
+  EXPECT_EQ(s.summary().attempts, 0);
 }
 
 // Closed to 1 mm: missed, or pinching a thin part (a cup's wall between the fingers). The fingers

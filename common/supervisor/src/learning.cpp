@@ -5,9 +5,12 @@
 
 #include <cmath>
 #include <cstdio>
+#include <functional>
+#include <future>
 
 #include "nudge/robot/command_planner.hpp"
 #include "nudge/robot/kinematics.hpp"
+#include "nudge/supervisor/line_search.hpp"
 #include "nudge/supervisor/supervisor.hpp"
 #include "nudge/timing.hpp"
 
@@ -120,6 +123,36 @@ void Supervisor::segment_left(Attempt& a, const Eigen::Vector3d& rest) const {
   a.segmentation_left = segment(a.before_left, a.after_left, *a.before_line_left, *a.after_line_left);
   // Its own thread's CPU (attempt.json's grasp_plan_stages_ms); a second call replaces the first's.
   a.left_stages_cpu_ms = {{"left lines", lines_done - started}, {"left segmentation", thread_cpu_ms() - lines_done}};
+}
+
+void Supervisor::warm_up() const {
+  const cv::Size size = config_.still_size;
+  if (size.width < 64 || size.height < 64) return;
+  // An object-sized block slid a fiftieth of the width between the stills, its axes vertical.
+  cv::Mat before(size, CV_8UC3, cv::Scalar(90, 100, 110));
+  cv::Mat after = before.clone();
+  const int half_width = size.width / 20, shift = size.width / 50, top = size.height / 4, foot = 3 * size.height / 4;
+  const auto axis = [&](int x) {
+    symmetry::Line line;
+    line.r = x - (size.width - 1) / 2.0;
+    line.seg1 = cv::Point2d(x, foot);
+    line.seg2 = cv::Point2d(x, top);
+    symmetry::border_endpoints(line.r, line.theta, size.width, size.height, &line.end1, &line.end2);
+    return line;
+  };
+  const int x = size.width / 2;
+  cv::rectangle(before, cv::Rect(x - half_width, top, 2 * half_width, foot - top), cv::Scalar(40, 80, 200), cv::FILLED);
+  cv::rectangle(after, cv::Rect(x + shift - half_width, top, 2 * half_width, foot - top), cv::Scalar(40, 80, 200), cv::FILLED);
+  const symmetry::Line line_before = axis(x), line_after = axis(x + shift);
+  const auto camera = [&](const SegmentFunction& segment) {
+    find_line_near(after, line_after, config_.line_search);
+    segment(before, after, line_before, line_after);
+  };
+  std::future<void> left;
+  if (segment_left_) left = std::async(std::launch::async, camera, std::cref(segment_left_));
+  camera(segment_);
+  if (segment_stageless_) segment_stageless_(before, after, line_before, line_after);
+  if (left.valid()) left.get();
 }
 
 // Sec. 7.2.2: the top in both cameras' segmentations, triangulated and lowered by r tan(theta);

@@ -538,6 +538,13 @@ class Supervisor {
   // is planned without waiting for the stages (two thirds of a segmentation's time), and the
   // constructor's function draws them for the attempt's files once the grasp is commanded.
   void set_stageless_segmentation(SegmentFunction segment) { segment_stageless_ = std::move(segment); }
+  // Runs every segmentation set up (the left one on a thread of its own, as segment() does) and a
+  // line search once on a synthetic still pair of config.still_size, before the first attempt:
+  // their scratch images are made, and the heap pages of both threads touched, off the grasp
+  // plan's clock. In a fresh process the first segmentation of a still pair cost 17-19 ms of CPU
+  // against 6 ms once its memory was there (AMD EPYC VM: first-touch page faults; docs/benchmarks.md).
+  // No state, output or attempt changes. Call it after the set_*_segmentation calls.
+  void warm_up() const;
 
   std::vector<Output> take_outputs();
   State state() const { return state_; }
