@@ -2,10 +2,14 @@
 
 #include <sys/resource.h>
 
+#include <atomic>
+#include <chrono>
 #include <cstdlib>
 #include <fstream>
+#include <future>
 #include <stdexcept>
 #include <sstream>
+#include <thread>
 
 #include "nudge/atomic_file.hpp"
 #include "nudge/bus_clock.hpp"
@@ -13,6 +17,7 @@
 #include "nudge/image_header.hpp"
 #include "nudge/json.hpp"
 #include "nudge/memory.hpp"
+#include "nudge/worker.hpp"
 #include "nudge/yaml_file.hpp"
 
 using namespace nudge;
@@ -373,4 +378,58 @@ TEST(Memory, AFreedStillSizedBlockIsReusedWithoutPageFaults) {
   faults_of_a_written_block(kStill);  // the heap grows to hold it once
   EXPECT_LT(faults_of_a_written_block(kStill), kPages / 10);
   EXPECT_LT(faults_of_a_written_block(kStill), kPages / 10);
+}
+
+// Every task on the one thread, never the caller's, in the order given; a task's exception reaches
+// its future and the worker goes on; the tasks queued when it is destroyed still run.
+TEST(Worker, RunsEveryTaskInOrderOnItsOneThread) {
+  std::vector<int> order;
+  std::vector<std::thread::id> threads;
+  std::atomic<int> after_destruction{0};
+  {
+    Worker worker;
+    std::vector<std::future<void>> done;
+    for (int i = 0; i < 20; ++i)
+      done.push_back(worker.run([&, i] {
+        order.push_back(i);
+        threads.push_back(std::this_thread::get_id());
+      }));
+    std::future<void> failed = worker.run([] { throw std::runtime_error("task failed"); });
+    for (auto& d : done) d.get();
+    EXPECT_THROW(failed.get(), std::runtime_error);
+    worker.run([&] { order.push_back(20); }).get();
+    for (int i = 0; i < 5; ++i) worker.run([&] { ++after_destruction; });
+    EXPECT_EQ(threads.front(), worker.id());
+  }
+  EXPECT_EQ(after_destruction.load(), 5) << "queued tasks run before the worker is gone";
+  ASSERT_EQ(order.size(), 21u);
+  for (int i = 0; i <= 20; ++i) EXPECT_EQ(order[i], i);
+  for (const auto& id : threads) {
+    EXPECT_EQ(id, threads.front());
+    EXPECT_NE(id, std::this_thread::get_id());
+  }
+}
+
+// A scope left early (an exception) still waits for the task that uses its locals; a deferred
+// task that never ran is not run by it.
+TEST(Worker, WaitOnExitWaitsForTheRunningTaskButRunsNoDeferredOne) {
+  Worker worker;
+  std::atomic<bool> finished{false};
+  try {
+    std::future<void> task;
+    const WaitOnExit joined{task};
+    task = worker.run([&] {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      finished = true;
+    });
+    throw std::runtime_error("left early");
+  } catch (const std::runtime_error&) {
+    EXPECT_TRUE(finished.load()) << "the scope waited for the task";
+  }
+  bool ran = false;
+  {
+    std::future<void> deferred = std::async(std::launch::deferred, [&] { ran = true; });
+    const WaitOnExit joined{deferred};
+  }
+  EXPECT_FALSE(ran);
 }

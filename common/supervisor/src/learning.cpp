@@ -5,14 +5,15 @@
 
 #include <cmath>
 #include <cstdio>
-#include <functional>
 #include <future>
+#include <utility>
 
 #include "nudge/robot/command_planner.hpp"
 #include "nudge/robot/kinematics.hpp"
 #include "nudge/supervisor/line_search.hpp"
 #include "nudge/supervisor/supervisor.hpp"
 #include "nudge/timing.hpp"
+#include "nudge/worker.hpp"
 
 namespace nudge::supervisor {
 
@@ -149,10 +150,17 @@ void Supervisor::warm_up() const {
     segment(before, after, line_before, line_after);
   };
   std::future<void> left;
-  if (segment_left_) left = std::async(std::launch::async, camera, std::cref(segment_left_));
+  const WaitOnExit left_joined{left};  // it uses this function's stills
+  if (left_worker_) left = left_worker_->run([&] { camera(segment_left_); });
   camera(segment_);
   if (segment_stageless_) segment_stageless_(before, after, line_before, line_after);
   if (left.valid()) left.get();
+}
+
+void Supervisor::set_left_segmentation(SegmentFunction segment) {
+  segment_left_ = std::move(segment);
+  if (!segment_left_) left_worker_.reset();
+  else if (!left_worker_) left_worker_ = std::make_shared<Worker>();
 }
 
 // Sec. 7.2.2: the top in both cameras' segmentations, triangulated and lowered by r tan(theta);

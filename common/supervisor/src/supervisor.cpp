@@ -15,6 +15,7 @@
 #include "nudge/segmentation/motion.hpp"
 #include "nudge/supervisor/grasp.hpp"
 #include "nudge/timing.hpp"
+#include "nudge/worker.hpp"
 
 namespace nudge::supervisor {
 
@@ -706,9 +707,13 @@ void Supervisor::segment(int64_t now) {
   // Learning: the left camera's segmentation (for the object's top) alongside the right one's, on
   // the second core when the shell gave it its own segmenter (the grasp is planned sooner).
   std::future<void> left;
-  if (a.learn)
-    left = std::async(segment_left_ ? std::launch::async : std::launch::deferred,
-                      [this, &a, rest = *a.rest] { segment_left(a, rest); });
+  // The left camera's task writes into `a`: waited for however this function is left (a worker's
+  // future, unlike std::async's, does not wait when destroyed).
+  const WaitOnExit left_joined{left};
+  if (a.learn) {
+    auto task = [this, &a, rest = *a.rest] { segment_left(a, rest); };
+    left = left_worker_ ? left_worker_->run(task) : std::async(std::launch::deferred, task);
+  }
   // The object's own lines in the stills; the calibration's prediction where none is detected.
   // (The before still's line was searched for while the arm nudged: see before_lines.)
   lap("right rest from the still");

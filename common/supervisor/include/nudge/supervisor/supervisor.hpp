@@ -32,6 +32,10 @@
 #include "nudge/supervisor/targets.hpp"
 #include "nudge/tracking/tracker.hpp"
 
+namespace nudge {
+class Worker;  // nudge/worker.hpp
+}  // namespace nudge
+
 namespace nudge::supervisor {
 
 // Values mirror supervisor_state_t's STATE_* constants.
@@ -532,8 +536,9 @@ class Supervisor {
   // worker thread), which keeps LEARN waiting beyond learn_timeout_s, up to learn_max_wait_s.
   void on_learner_status(const std::string& status, int64_t now);
   // A second segmenter for the left stills (learning): the two cameras' segmentations then run on
-  // two threads. Without it the left one runs after the right one, with the same function.
-  void set_left_segmentation(SegmentFunction segment) { segment_left_ = std::move(segment); }
+  // two threads (the left on a worker thread of its own, kept for the run: its memory stays warm
+  // between attempts). Without it the left one runs after the right one, with the same function.
+  void set_left_segmentation(SegmentFunction segment);
   // The right camera's segmentation without fig. 6.7's stages, for a grasp (learning): the grasp
   // is planned without waiting for the stages (two thirds of a segmentation's time), and the
   // constructor's function draws them for the attempt's files once the grasp is commanded.
@@ -693,6 +698,7 @@ class Supervisor {
   std::optional<size_t> rivals_at_the_lines_foot(Attempt& a) const;
   void segment_left(Attempt& attempt, const Eigen::Vector3d& rest) const;
   SegmentFunction segment_left_;
+  std::shared_ptr<Worker> left_worker_;  // runs segment_left_ when there is one
   SegmentFunction segment_stageless_;
   void recognise(int64_t now);
   void plan_grasp(int64_t now);
