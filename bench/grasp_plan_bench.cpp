@@ -13,7 +13,6 @@
 
 #include <fstream>
 #include <future>
-#include <regex>
 #include <string>
 
 #include "nudge/memory.hpp"
@@ -22,6 +21,7 @@
 #include "nudge/robot/command_planner.hpp"
 #include "nudge/supervisor/grasp.hpp"
 #include "nudge/supervisor/line_search.hpp"
+#include "nudge/supervisor/report.hpp"
 #include "nudge/supervisor/segment.hpp"
 #include "nudge/supervisor/targets.hpp"
 
@@ -208,16 +208,8 @@ void BM_RecordedAttempt(benchmark::State& state, const std::string& folder) {
   cv::setNumThreads(0);
   std::ifstream in(folder + "/attempt.json");
   const std::string json((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const auto line = [&](const std::string& key) -> std::optional<nudge::symmetry::Line> {
-    std::smatch m;
-    if (!std::regex_search(json, m, std::regex("\"" + key + "\":\\{\"r\":([-0-9.e]+),\"theta\":([-0-9.e]+)"))) return std::nullopt;
-    nudge::symmetry::Line l;
-    l.r = std::stod(m[1]);
-    l.theta = std::stod(m[2]);
-    return l;
-  };
   const cv::Mat before = cv::imread(folder + "/before.png"), after = cv::imread(folder + "/after.png");
-  const auto line_before = line("line_before"), line_after = line("line_after");
+  const auto line_before = sv::recorded_line(json, "line_before"), line_after = sv::recorded_line(json, "line_after");
   if (before.empty() || after.empty() || !line_before || !line_after) {
     state.SkipWithError(("not an attempt folder with stills and lines: " + folder).c_str());
     return;
@@ -225,7 +217,7 @@ void BM_RecordedAttempt(benchmark::State& state, const std::string& folder) {
   const sv::SegmentFunction segment = sv::motion_segmentation({}, false);
   const int part = static_cast<int>(state.range(0));
   const cv::Mat mask = segment(before, after, *line_before, *line_after).mask;
-  double mask_pixels = cv::countNonZero(mask);
+  const double mask_pixels = cv::countNonZero(mask);
   for (auto _ : state) {
     if (part == 0) benchmark::DoNotOptimize(segment(before, after, *line_before, *line_after));
     if (part == 1) benchmark::DoNotOptimize(nudge::segmentation::mirror_agreement(mask, *line_after));

@@ -44,6 +44,7 @@
 #include "nudge/sim/mask_score.hpp"
 #include "nudge/sim/world.hpp"
 #include "nudge/sim_state_t.hpp"
+#include "nudge/supervisor/report.hpp"
 #include "nudge/supervisor_state_t.hpp"
 #include "report.hpp"
 
@@ -287,22 +288,12 @@ double time_motion_segmentation(const std::vector<fs::path>& attempt_dirs) {
   std::vector<double> ms;
   for (const fs::path& dir : attempt_dirs) {
     const std::string json = read_text(dir / "attempt.json");
-    auto line = [&](const std::string& key) {
-      symmetry::Line l;
-      std::smatch m;
-      const std::regex re("\"" + key + "\":\\{\"r\":([-0-9.e]+),\"theta\":([-0-9.e]+)");
-      if (std::regex_search(json, m, re)) {
-        l.r = std::stod(m[1]);
-        l.theta = std::stod(m[2]);
-      }
-      return l;
-    };
     const cv::Mat before = still_of(dir, "before.png"), after = still_of(dir, "after.png");
-    if (before.empty() || after.empty() || json.find("\"line_after\":{") == std::string::npos) continue;
-    const symmetry::Line lb = line("line_before"), la = line("line_after");
+    const auto lb = supervisor::recorded_line(json, "line_before"), la = supervisor::recorded_line(json, "line_after");
+    if (before.empty() || after.empty() || !lb || !la) continue;
     for (int repeat = 0; repeat < 5; ++repeat) {
       const double start = ex::thread_cpu_ms();
-      segmenter.segment(before, after, lb, la);
+      segmenter.segment(before, after, *lb, *la);
       ms.push_back(ex::thread_cpu_ms() - start);
     }
   }

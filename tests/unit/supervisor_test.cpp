@@ -3542,3 +3542,30 @@ TEST(LineSearch, TakesTheNearestLineWhenNoneReachesTheFoot) {
   ASSERT_TRUE(found);
   EXPECT_NEAR(scene.found_x(*found), scene.column_x, 3.0);
 }
+
+// The lines attempt.json records read back as written (a small angle in exponent form included);
+// an absent or null line is nothing.
+TEST(RecordedLine, ReadsBackTheLinesAttemptJsonWrote) {
+  sv::Attempt a;
+  a.number = 3;
+  nudge::symmetry::Line before, after;
+  before.r = -98.8212093;
+  before.theta = -0.118284486;
+  before.votes = 195;
+  after.r = 412.5;
+  after.theta = 1.5e-07;
+  after.votes = 1234567;
+  a.before_line = before;
+  a.after_line = after;
+  const std::string json = sv::attempt_json(a);
+  const auto read_before = sv::recorded_line(json, "line_before"), read_after = sv::recorded_line(json, "line_after");
+  ASSERT_TRUE(read_before && read_after) << json;
+  EXPECT_NEAR(read_before->r, before.r, 1e-4);
+  EXPECT_NEAR(read_before->theta, before.theta, 1e-8);
+  EXPECT_NEAR(read_before->votes, 195, 1e-9);
+  EXPECT_NEAR(read_after->r, after.r, 1e-4);
+  EXPECT_NEAR(read_after->theta, after.theta, 1e-12);
+  EXPECT_NEAR(read_after->votes, after.votes, 10.0) << "six significant digits: 1.23457e+06";
+  EXPECT_FALSE(sv::recorded_line(json, "line_before_left"));
+  EXPECT_FALSE(sv::recorded_line("{}", "line_after"));
+}

@@ -5,6 +5,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <regex>
 #include <stdexcept>
 
 #include "nudge/atomic_file.hpp"
@@ -264,6 +265,19 @@ std::string summary_json(const std::string& run_id, int64_t first_command_seq, c
   j.end_array();
   j.end_object();
   return j.str();
+}
+
+std::optional<symmetry::Line> recorded_line(const std::string& attempt_json, const std::string& key) {
+  // As write_line writes it: "key":{"r":R,"theta":T,"votes":V} (a number may carry an exponent).
+  static const std::string number = "(-?[0-9.]+(?:[eE][-+]?[0-9]+)?)";
+  std::smatch m;
+  const std::regex pattern("\"" + key + "\":\\{\"r\":" + number + ",\"theta\":" + number + ",\"votes\":" + number);
+  if (!std::regex_search(attempt_json, m, pattern)) return std::nullopt;
+  symmetry::Line line;
+  line.r = std::stod(m[1]);
+  line.theta = std::stod(m[2]);
+  line.votes = std::stod(m[3]);
+  return line;
 }
 
 }  // namespace nudge::supervisor

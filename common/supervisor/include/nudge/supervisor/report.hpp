@@ -4,6 +4,7 @@
 // written atomically (temporary file + rename): a crash leaves no half-written file.
 #include <opencv2/core.hpp>
 
+#include <optional>
 #include <string>
 
 #include "nudge/supervisor/supervisor.hpp"
@@ -28,6 +29,10 @@ std::string save_view(const std::string& directory, int attempt_number, const Le
 
 // One attempt as a JSON object (outcome, reason, target, rest, motion, lines, mask pixels, times).
 std::string attempt_json(const Attempt& attempt);
+// A line attempt_json wrote under `key` ("line_before", "line_after", "line_before_left", ...): its
+// R and theta (votes too); nothing when the key is absent or null. For the programs that replay an
+// attempt's stills (nudge-exp-nudge-segmentation, grasp_plan_bench --attempt).
+std::optional<symmetry::Line> recorded_line(const std::string& attempt_json, const std::string& key);
 // The run's summary: run id, counts, outcomes, the attempts, the end reason.
 std::string summary_json(const std::string& run_id, int64_t first_command_seq, const Summary& summary, const std::vector<std::string>& attempts_json);
 
