@@ -781,6 +781,11 @@ int main(int argc, char** argv) {
   std::string affine = o.recognize.affine_check ? "on" : "off";
   flags.add_string("affine-check", &affine, "on|off: the geometric check also tries an affine map (foreshortening)");
   flags.add_double("ratio", &o.recognize.ratio, "Lowe's ratio in recognition");
+  std::string agreement = o.recognize.keypoint_agreement.on ? "on" : "off";
+  flags.add_string("keypoint-agreement", &agreement,
+                   "on|off: a verified match's keypoints must also agree with the mapping's turn and scale");
+  flags.add_double("agreement-angle", &o.recognize.keypoint_agreement.angle_deg, "--keypoint-agreement: degrees");
+  flags.add_double("agreement-scale", &o.recognize.keypoint_agreement.scale_factor, "--keypoint-agreement: factor");
   flags.add_double("ransac-px", &o.recognize.ransac_px, "the geometric check's inlier distance, pixels");
   flags.add_int("min-support", &o.recognize.min_support, "matches agreeing with a mapping beyond those that fixed it");
   std::string root_sift = o.recognize.root_sift ? "on" : "off";
@@ -800,6 +805,8 @@ int main(int argc, char** argv) {
     o.view_mask = view_mask == "on";
     if (!(o.learn.mask_support >= 0)) throw FlagError("--mask-support must be >= 0");
     o.recognize.affine_check = affine == "on";
+    if (agreement != "on" && agreement != "off") throw FlagError("--keypoint-agreement must be on or off");
+    o.recognize.keypoint_agreement.on = agreement == "on";
     if (root_sift != "on" && root_sift != "off") throw FlagError("--root-sift must be on or off");
     o.recognize.root_sift = root_sift == "on";
     if (tilts_as_fallback != "on" && tilts_as_fallback != "off") throw FlagError("--tilts-as-fallback must be on or off");

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <complex>
 #include <map>
 #include <mutex>
 #include <set>
@@ -133,19 +134,171 @@ bool plausible_view_map(const cv::Mat& linear) {
   return cv::determinant(linear) > 0 && s_min > 1e-3 && s_max / s_min <= kMaxAnisotropy;
 }
 
-std::vector<cv::DMatch> inliers_of(const std::vector<cv::DMatch>& matches, const std::vector<uchar>& mask) {
+// The local linear part of `map` (a 2x3 affine map or a 3x3 homography, CV_64F) at `p`: how a
+// small neighbourhood of p is turned, scaled and squeezed.
+cv::Matx22d local_linear(const cv::Mat& map, const cv::Point2f& p) {
+  const cv::Mat_<double> m(map);
+  if (m.rows == 2) return {m(0, 0), m(0, 1), m(1, 0), m(1, 1)};
+  const double w = m(2, 0) * p.x + m(2, 1) * p.y + m(2, 2);
+  const double x = (m(0, 0) * p.x + m(0, 1) * p.y + m(0, 2)) / w, y = (m(1, 0) * p.x + m(1, 1) * p.y + m(1, 2)) / w;
+  return cv::Matx22d(m(0, 0) - x * m(2, 0), m(0, 1) - x * m(2, 1), m(1, 0) - y * m(2, 0), m(1, 1) - y * m(2, 1)) * (1 / w);
+}
+
+// A training keypoint's SIFT orientation (radians) and size in its view's own coordinates. One found
+// at a simulated tilt was found in the view squeezed by the tilt (its rows shrunk): unsqueezed, its
+// direction is stretched along the rows and its size grows with the square root of the tilt.
+struct ViewFrame {
+  double angle = 0, size = 0;
+};
+
+ViewFrame view_frame(const cv::KeyPoint& train) {
+  const double tilt = at_simulated_tilt(train) ? train.class_id / 100.0 : 1;
+  const double a = train.angle * CV_PI / 180;
+  return {std::atan2(tilt * std::sin(a), std::cos(a)), train.size * std::sqrt(tilt)};
+}
+
+// Whether a match's two keypoints agree with the mapping found from the matches' positions: SIFT
+// gives each keypoint an orientation and a scale, and a true match's query keypoint is its
+// training keypoint turned and scaled as the mapping turns and scales that spot (Lowe 2004 votes on
+// these for the same reason). A chance match whose position happens to fit a mapping rarely fits
+// its orientation and scale as well, so a few such matches no longer make a recognition.
+bool keypoint_agrees(const cv::Matx22d& linear_at_train, const cv::KeyPoint& train, const cv::KeyPoint& query,
+                     const KeypointAgreement& tolerance) {
+  const ViewFrame t = view_frame(train);
+  const cv::Vec2d turned = linear_at_train * cv::Vec2d(std::cos(t.angle), std::sin(t.angle));
+  const double off = std::remainder(query.angle * CV_PI / 180 - std::atan2(turned[1], turned[0]), 2 * CV_PI);
+  const double scale = std::sqrt(std::abs(cv::determinant(linear_at_train)));
+  if (!(scale > 0) || t.size <= 0 || query.size <= 0) return false;
+  const double scale_off = std::abs(std::log(query.size / (t.size * scale)));
+  return std::abs(off) <= tolerance.angle_deg * CV_PI / 180 && scale_off <= std::log(tolerance.scale_factor);
+}
+
+// The inliers of `map` whose keypoints also agree with it (keypoint_agrees); all of them when the
+// agreement is off.
+std::vector<cv::DMatch> agreeing_inliers(const std::vector<cv::DMatch>& matches, const std::vector<uchar>& mask,
+                                         const cv::Mat& map, const Features& query, const Features& view,
+                                         const KeypointAgreement& agreement) {
   std::vector<cv::DMatch> out;
-  for (size_t i = 0; i < matches.size(); ++i)
-    if (mask[i]) out.push_back(matches[i]);
+  for (size_t i = 0; i < matches.size(); ++i) {
+    if (!mask[i]) continue;
+    const cv::KeyPoint& t = view.keypoints[matches[i].trainIdx];
+    if (agreement.on && !keypoint_agrees(local_linear(map, t.pt), t, query.keypoints[matches[i].queryIdx], agreement))
+      continue;
+    out.push_back(matches[i]);
+  }
+  return out;
+}
+
+// What one match says by itself about a similarity of the training view onto the query (Lowe
+// 2004): the turn and the scale between its two keypoints' SIFT orientations and sizes.
+struct MatchFrame {
+  std::complex<double> from, to;
+  double turn = 0, log_scale = 0;
+};
+
+MatchFrame frame_of(const cv::KeyPoint& train, const cv::KeyPoint& query) {
+  const ViewFrame t = view_frame(train);
+  MatchFrame f;
+  f.from = {train.pt.x, train.pt.y};
+  f.to = {query.pt.x, query.pt.y};
+  f.turn = query.angle * CV_PI / 180 - t.angle;
+  f.log_scale = std::log(std::max(query.size, 1e-3f) / std::max(t.size, 1e-3));
+  return f;
+}
+
+// The matches a similarity q = a * t + b (complex numbers: a turns and scales, b shifts) explains:
+// within `px` of where it puts them and, with the agreement on, their keypoints turned and scaled
+// as it turns and scales.
+std::vector<int> similarity_support(const std::vector<MatchFrame>& frames, std::complex<double> a, std::complex<double> b,
+                                    double px, const KeypointAgreement& agreement) {
+  std::vector<int> out;
+  const double turn = std::arg(a), log_scale = std::log(std::abs(a));
+  const double max_turn = agreement.angle_deg * CV_PI / 180, max_log_scale = std::log(agreement.scale_factor);
+  for (int i = 0; i < static_cast<int>(frames.size()); ++i) {
+    const MatchFrame& f = frames[i];
+    if (std::norm(a * f.from + b - f.to) > px * px) continue;
+    if (agreement.on) {
+      const double off = std::remainder(f.turn - turn, 2 * CV_PI);
+      if (std::abs(off) > max_turn || std::abs(f.log_scale - log_scale) > max_log_scale) continue;
+    }
+    out.push_back(i);
+  }
+  return out;
+}
+
+// The least-squares similarity through the matches `chosen` (closed form, Umeyama's for 2-D).
+std::pair<std::complex<double>, std::complex<double>> fitted_similarity(const std::vector<MatchFrame>& frames,
+                                                                      const std::vector<int>& chosen) {
+  std::complex<double> mean_from, mean_to;
+  for (int i : chosen) {
+    mean_from += frames[i].from;
+    mean_to += frames[i].to;
+  }
+  mean_from /= static_cast<double>(chosen.size());
+  mean_to /= static_cast<double>(chosen.size());
+  std::complex<double> cross;
+  double spread = 0;
+  for (int i : chosen) {
+    cross += (frames[i].to - mean_to) * std::conj(frames[i].from - mean_from);
+    spread += std::norm(frames[i].from - mean_from);
+  }
+  const std::complex<double> a = spread > 0 ? cross / spread : std::complex<double>();
+  return {a, mean_to - a * mean_from};
+}
+
+// The largest set of matches one similarity explains, by RANSAC on pairs of matches (every pair
+// when there are few, else a fixed number drawn from a fixed seed), its consensus judged on place
+// and keypoint agreement together: a mapping found from places alone may win on chance matches and
+// leave too few agreeing ones, where another would have kept them all. Refitted to its consensus.
+std::vector<cv::DMatch> similarity_inliers(const std::vector<cv::DMatch>& matches, const Features& query,
+                                           const Features& view, const RecognizeParams& params) {
+  std::vector<MatchFrame> frames;
+  for (const auto& m : matches) frames.push_back(frame_of(view.keypoints[m.trainIdx], query.keypoints[m.queryIdx]));
+  const int n = static_cast<int>(frames.size());
+  constexpr int kMaxPairs = 2000;
+  std::vector<std::pair<int, int>> pairs;
+  if (n * (n - 1) / 2 <= kMaxPairs) {
+    for (int i = 0; i < n; ++i)
+      for (int j = i + 1; j < n; ++j) pairs.emplace_back(i, j);
+  } else {
+    cv::RNG rng(kRansacSeed);
+    while (static_cast<int>(pairs.size()) < kMaxPairs) {
+      const int i = rng.uniform(0, n), j = rng.uniform(0, n);
+      if (i != j) pairs.emplace_back(i, j);
+    }
+  }
+  std::vector<int> best;
+  for (const auto& [i, j] : pairs) {
+    const std::complex<double> span = frames[j].from - frames[i].from;
+    if (std::abs(span) < 1) continue;  // one spot: no turn or scale to fix
+    const std::complex<double> a = (frames[j].to - frames[i].to) / span;
+    if (std::abs(a) < 1e-3) continue;
+    std::vector<int> support = similarity_support(frames, a, frames[i].to - a * frames[i].from, params.ransac_px,
+                                                  params.keypoint_agreement);
+    if (support.size() > best.size()) best = std::move(support);
+  }
+  if (best.size() >= 2) {
+    const auto [a, b] = fitted_similarity(frames, best);
+    if (std::abs(a) > 1e-3) {
+      std::vector<int> refitted = similarity_support(frames, a, b, params.ransac_px, params.keypoint_agreement);
+      if (refitted.size() >= best.size()) best = std::move(refitted);
+    }
+  }
+  std::vector<cv::DMatch> out;
+  for (int i : best) out.push_back(matches[i]);
   return out;
 }
 
 // The largest set of matches one mapping of the training view onto the query explains: a
 // similarity (rotation, scale, shift: 2 matches fix it) or, with enough matches, a homography (4
-// fix it). The matches that fixed the mapping agree with it by construction, so a set counts only
-// when `min_support` more matches agree; otherwise none are verified.
+// fix it); every match of the set also agrees with the mapping in its keypoints' orientation and
+// scale (RecognizeParams::keypoint_agreement). The matches that fixed the mapping agree with it by
+// construction, so a set counts only when `min_support` more matches agree; otherwise none are
+// verified.
 std::vector<cv::DMatch> geometric_inliers(const std::vector<cv::DMatch>& matches, const Features& query,
-                                          const Features& view, double ransac_px, int min_support, bool affine) {
+                                          const Features& view, const RecognizeParams& params) {
+  const double ransac_px = params.ransac_px;
+  const int min_support = params.min_support;
   if (matches.size() < 3) return {};
   const detail::SeededThreadRng seeded(kRansacSeed);  // the same matches, the same inliers
   std::vector<cv::Point2f> from, to;
@@ -155,20 +308,15 @@ std::vector<cv::DMatch> geometric_inliers(const std::vector<cv::DMatch>& matches
   }
   std::vector<cv::DMatch> best;
   std::vector<uchar> mask;
-  // A few matches have few pairs to try: no need for RANSAC's full 2000 random draws.
-  const int n = static_cast<int>(matches.size());
-  const int similarity_iterations = std::min(2000, std::max(50, 3 * n * (n - 1) / 2));
-  if (!cv::estimateAffinePartial2D(from, to, mask, cv::RANSAC, ransac_px, similarity_iterations, 0.995).empty()) {
-    auto inliers = inliers_of(matches, mask);
-    if (static_cast<int>(inliers.size()) >= 2 + min_support) best = std::move(inliers);
-  }
+  auto similar = similarity_inliers(matches, query, view, params);
+  if (static_cast<int>(similar.size()) >= 2 + min_support) best = std::move(similar);
   // A label seen at another tilt (a bottle lying down, seen from above) is foreshortened along one
   // direction: an affine map (3 matches fix it) explains it where a similarity cannot. Mirrored or
   // nearly collapsed maps are no view of a surface.
-  if (affine && static_cast<int>(matches.size()) >= kAffineMinMatches) {
+  if (params.affine_check && static_cast<int>(matches.size()) >= kAffineMinMatches) {
     const cv::Mat a = cv::estimateAffine2D(from, to, mask, cv::RANSAC, ransac_px, 2000, 0.995);
     if (!a.empty() && plausible_view_map(a(cv::Rect(0, 0, 2, 2)))) {
-      auto inliers = inliers_of(matches, mask);
+      auto inliers = agreeing_inliers(matches, mask, a, query, view, params.keypoint_agreement);
       if (static_cast<int>(inliers.size()) >= 3 + min_support && inliers.size() > best.size()) best = std::move(inliers);
     }
   }
@@ -176,7 +324,7 @@ std::vector<cv::DMatch> geometric_inliers(const std::vector<cv::DMatch>& matches
     const cv::Mat h = cv::findHomography(from, to, cv::RANSAC, ransac_px, mask, 2000, 0.995);
     // A mirrored or collapsed mapping is not a view of a surface.
     if (!h.empty() && cv::determinant(h(cv::Rect(0, 0, 2, 2))) > 1e-4) {
-      auto inliers = inliers_of(matches, mask);
+      auto inliers = agreeing_inliers(matches, mask, h, query, view, params.keypoint_agreement);
       if (static_cast<int>(inliers.size()) >= 4 + min_support && inliers.size() > best.size()) best = std::move(inliers);
     }
   }
@@ -410,9 +558,7 @@ Recognition Recognizer::recognize_all_features(const Features& query) const {
       if (static_cast<int>(matches.size()) <= score.verified_matches) continue;
       const Features& features = entry->model->views[view].features;
       const std::vector<cv::DMatch> kept =
-          params_.geometric_check ? geometric_inliers(matches, query, features, params_.ransac_px, params_.min_support,
-                                                      params_.affine_check)
-                                  : matches;
+          params_.geometric_check ? geometric_inliers(matches, query, features, params_) : matches;
       if (static_cast<int>(kept.size()) > score.verified_matches) {
         score.verified_matches = static_cast<int>(kept.size());
         score.best_view = view;
