@@ -118,7 +118,9 @@ int main(int argc, char** argv) {
     md << "# Learning OpenCV's box (real-data check, issue 11)\n\n"
        << "`nudge-exp-learning-box`: `box.png` (Debian's opencv-doc) learned as an object from its one image (no "
           "turntable, so no background pruning), then recognised in `box_in_scene.png` with the learner's defaults "
-          "(ratio 0.6 within the nearest view, >= 3 verified matches, RANSAC similarity/homography check).\n\n"
+          "(ratio "
+       << learning::RecognizeParams{}.ratio << " within the nearest view, >= " << learning::RecognizeParams{}.min_matches
+       << " verified matches, RANSAC similarity/affine/homography check with keypoint agreement).\n\n"
        << "| | |\n|---|---|\n"
        << "| box descriptors | " << model->descriptor_count() << " |\n"
        << "| scene descriptors | " << found.query.size() << " |\n"

@@ -812,9 +812,6 @@ TEST(LearningRecognizer, SimulatedTiltsAreSearchedOnlyWhenTheViewsAsTakenRecogni
   // random: two indexes of the same descriptors differ a little).
   RecognizeParams exhaustive;
   exhaustive.matcher = MatcherKind::BruteForce;
-  // The thesis' ratio: at the default 0.8 the views as taken find even the threefold squeeze below
-  // (its affine map verified), leaving no second pass to test.
-  exhaustive.ratio = 0.6;
   Recognizer plain(exhaustive), fallback(exhaustive);
   plain.add(plain_model);
   fallback.add(tilted_model);

@@ -31,10 +31,9 @@ struct KeypointAgreement {
 };
 
 struct RecognizeParams {
-  // d1 < ratio * d2. The thesis' N = 0.6 passes only 2-5 matches on a label seen lying down or
-  // partly hidden; Lowe's own 0.8 passes many more true and chance matches, and the geometric
-  // check's keypoint agreement refuses the chance ones (docs/learning.md, "A looser ratio test").
-  double ratio = 0.8;
+  // d1 < ratio * d2 (thesis: N = 0.6). Looser ratios recognise more lying and hidden labels but
+  // take one bottle's outline for another's (docs/learning.md, "A looser ratio test").
+  double ratio = 0.6;
   int min_matches = 3;          // the best object needs this many verified matches (thesis: 3)
   bool geometric_check = true;  // similarity, affine map or homography per training view (RANSAC)
   int min_support = 2;          // matches agreeing with a mapping beyond those that fixed it
