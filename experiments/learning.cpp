@@ -819,7 +819,7 @@ int main(int argc, char** argv) {
       throw FlagError(std::string("--axis-tilts: ") + e.what());
     }
     o.learn.sift = o.recognize.sift;  // as the learner: both find the same keypoints
-    o.learn.ratio = o.recognize.ratio;
+    // (the learner's own ratio between views stays LearnParams' 0.6, as nudge-learner's does)
     if (o.runs.empty() || o.scenes.empty() || o.test_images.empty()) throw FlagError("--runs, --scenes and --test-images are required");
     if (!(o.tolerance_mm > 0)) throw FlagError("--tolerance-mm must be positive");
     return run(o);

@@ -365,6 +365,14 @@ Recognizer::Recognizer(const RecognizeParams& params)
                                 std::to_string(params.shared_neighbours));
   if (shared_ && params.shared_checks < 1)
     throw std::invalid_argument("RecognizeParams::shared_checks must be >= 1, not " + std::to_string(params.shared_checks));
+  // A tolerance that nothing passes (or that everything does, past half a turn) is a mistake.
+  const KeypointAgreement& agreement = params.keypoint_agreement;
+  if (agreement.on && !(agreement.angle_deg > 0 && agreement.angle_deg <= 180))
+    throw std::invalid_argument("RecognizeParams::keypoint_agreement.angle_deg must be in (0, 180], not " +
+                                std::to_string(agreement.angle_deg));
+  if (agreement.on && !(agreement.scale_factor >= 1))
+    throw std::invalid_argument("RecognizeParams::keypoint_agreement.scale_factor must be >= 1, not " +
+                                std::to_string(agreement.scale_factor));
 }
 Recognizer::~Recognizer() = default;
 Recognizer::Recognizer(Recognizer&&) noexcept = default;

@@ -513,6 +513,20 @@ TEST(LearningRecognizer, BadSettingsAndBadModelsAreRefusedByName) {
   params.shared_neighbours = 16;
   params.shared_checks = 0;
   EXPECT_THROW(Recognizer{params}, std::invalid_argument);
+  params.shared_checks = 64;
+  for (auto [angle, scale] : {std::pair{0.0, 2.0}, {200.0, 2.0}, {30.0, 0.5}}) {
+    RecognizeParams p = params;
+    p.keypoint_agreement.angle_deg = angle;
+    p.keypoint_agreement.scale_factor = scale;
+    try {
+      Recognizer r(p);
+      ADD_FAILURE() << "agreement " << angle << " deg, " << scale << "x accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("keypoint_agreement"), std::string::npos) << e.what();
+    }
+    p.keypoint_agreement.on = false;  // off: its tolerances are not used
+    EXPECT_NO_THROW(Recognizer{p});
+  }
   auto bad = std::make_shared<ObjectModel>();
   bad->info.name = "odd";
   bad->views.resize(2);

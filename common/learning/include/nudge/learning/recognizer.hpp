@@ -76,7 +76,8 @@ struct Recognition {
 
 class Recognizer {
  public:
-  // Throws std::invalid_argument naming the parameter when a SharedFlann setting is out of range.
+  // Throws std::invalid_argument naming the parameter when a SharedFlann setting or a keypoint
+  // agreement tolerance is out of range.
   explicit Recognizer(const RecognizeParams& params = {});
   ~Recognizer();
   Recognizer(Recognizer&&) noexcept;
