@@ -157,6 +157,13 @@ ViewFrame view_frame(const cv::KeyPoint& train) {
   return {std::atan2(tilt * std::sin(a), std::cos(a)), train.size * std::sqrt(tilt)};
 }
 
+// The agreement's rule, said once: a keypoint turned `turn_off` radians and scaled by exp(log_scale_off)
+// away from what the mapping says at its place is within the tolerances.
+bool within_agreement(double turn_off, double log_scale_off, const KeypointAgreement& tolerance) {
+  return std::abs(std::remainder(turn_off, 2 * CV_PI)) <= tolerance.angle_deg * CV_PI / 180 &&
+         std::abs(log_scale_off) <= std::log(tolerance.scale_factor);
+}
+
 // Whether a match's two keypoints agree with the mapping found from the matches' positions: SIFT
 // gives each keypoint an orientation and a scale, and a true match's query keypoint is its
 // training keypoint turned and scaled as the mapping turns and scales that spot (Lowe 2004 votes on
@@ -166,11 +173,10 @@ bool keypoint_agrees(const cv::Matx22d& linear_at_train, const cv::KeyPoint& tra
                      const KeypointAgreement& tolerance) {
   const ViewFrame t = view_frame(train);
   const cv::Vec2d turned = linear_at_train * cv::Vec2d(std::cos(t.angle), std::sin(t.angle));
-  const double off = std::remainder(query.angle * CV_PI / 180 - std::atan2(turned[1], turned[0]), 2 * CV_PI);
+  const double off = query.angle * CV_PI / 180 - std::atan2(turned[1], turned[0]);
   const double scale = std::sqrt(std::abs(cv::determinant(linear_at_train)));
   if (!(scale > 0) || t.size <= 0 || query.size <= 0) return false;
-  const double scale_off = std::abs(std::log(query.size / (t.size * scale)));
-  return std::abs(off) <= tolerance.angle_deg * CV_PI / 180 && scale_off <= std::log(tolerance.scale_factor);
+  return within_agreement(off, std::log(query.size / (t.size * scale)), tolerance);
 }
 
 // The inliers of `map` whose keypoints also agree with it (keypoint_agrees); all of them when the
@@ -206,24 +212,22 @@ MatchFrame frame_of(const cv::KeyPoint& train, const cv::KeyPoint& query) {
   return f;
 }
 
-// The matches a similarity q = a * t + b (complex numbers: a turns and scales, b shifts) explains:
-// within `px` of where it puts them and, with the agreement on, their keypoints turned and scaled
-// as it turns and scales.
-std::vector<int> similarity_support(const std::vector<MatchFrame>& frames, std::complex<double> a, std::complex<double> b,
-                                    double px, const KeypointAgreement& agreement) {
-  std::vector<int> out;
+// How many matches a similarity q = a * t + b (complex numbers: a turns and scales, b shifts)
+// explains: within `px` of where it puts them and, with the agreement on, their keypoints turned and
+// scaled as it turns and scales. Their indices go to `members` when given (RANSAC counts each
+// hypothesis and collects only the best one's).
+int similarity_support(const std::vector<MatchFrame>& frames, std::complex<double> a, std::complex<double> b,
+                       double px, const KeypointAgreement& agreement, std::vector<int>* members = nullptr) {
   const double turn = std::arg(a), log_scale = std::log(std::abs(a));
-  const double max_turn = agreement.angle_deg * CV_PI / 180, max_log_scale = std::log(agreement.scale_factor);
+  int count = 0;
   for (int i = 0; i < static_cast<int>(frames.size()); ++i) {
     const MatchFrame& f = frames[i];
     if (std::norm(a * f.from + b - f.to) > px * px) continue;
-    if (agreement.on) {
-      const double off = std::remainder(f.turn - turn, 2 * CV_PI);
-      if (std::abs(off) > max_turn || std::abs(f.log_scale - log_scale) > max_log_scale) continue;
-    }
-    out.push_back(i);
+    if (agreement.on && !within_agreement(f.turn - turn, f.log_scale - log_scale, agreement)) continue;
+    ++count;
+    if (members) members->push_back(i);
   }
-  return out;
+  return count;
 }
 
 // The least-squares similarity through the matches `chosen` (closed form, Umeyama's for 2-D).
@@ -267,20 +271,27 @@ std::vector<cv::DMatch> similarity_inliers(const std::vector<cv::DMatch>& matche
       if (i != j) pairs.emplace_back(i, j);
     }
   }
-  std::vector<int> best;
+  int best_count = 0;
+  std::complex<double> best_a, best_b;
   for (const auto& [i, j] : pairs) {
     const std::complex<double> span = frames[j].from - frames[i].from;
     if (std::abs(span) < 1) continue;  // one spot: no turn or scale to fix
     const std::complex<double> a = (frames[j].to - frames[i].to) / span;
     if (std::abs(a) < 1e-3) continue;
-    std::vector<int> support = similarity_support(frames, a, frames[i].to - a * frames[i].from, params.ransac_px,
-                                                  params.keypoint_agreement);
-    if (support.size() > best.size()) best = std::move(support);
+    const std::complex<double> b = frames[i].to - a * frames[i].from;
+    const int count = similarity_support(frames, a, b, params.ransac_px, params.keypoint_agreement);
+    if (count <= best_count) continue;
+    best_count = count;
+    best_a = a;
+    best_b = b;
   }
+  std::vector<int> best;
+  if (best_count > 0) similarity_support(frames, best_a, best_b, params.ransac_px, params.keypoint_agreement, &best);
   if (best.size() >= 2) {
     const auto [a, b] = fitted_similarity(frames, best);
     if (std::abs(a) > 1e-3) {
-      std::vector<int> refitted = similarity_support(frames, a, b, params.ransac_px, params.keypoint_agreement);
+      std::vector<int> refitted;
+      similarity_support(frames, a, b, params.ransac_px, params.keypoint_agreement, &refitted);
       if (refitted.size() >= best.size()) best = std::move(refitted);
     }
   }
