@@ -551,7 +551,9 @@ std::string markdown_report(const Options& o, const std::vector<Run>& runs, cons
         "(`nudge-exp-learning-scenes --set eval`, seeds fixed in advance: `learning_scenes.md`) with the learner's "
         "`Recognizer` (ratio "
      << o.recognize.ratio << ", >= " << o.recognize.min_matches << " verified matches, RANSAC check"
-     << (o.recognize.keypoint_agreement.on ? " with keypoint agreement" : " on places only") << ", SIFT contrast threshold "
+     << (o.recognize.keypoint_agreement.on ? " with keypoint agreement" : " on places only")
+     << (o.recognize.colour_tolerance > 0 ? ", ratio test by colour within " + std::to_string(o.recognize.colour_tolerance).substr(0, 5) : "")
+     << ", SIFT contrast threshold "
      << o.recognize.sift.contrast_threshold << ", " << timing.matcher << "). The test images are the right camera's "
      << test_size.width << "x" << test_size.height << (test_size.width > 640 ? " high-resolution stills (as the robot "
         "takes them to look closely and learn; the 640x480 video frames of the same scenes show the bottles at a third "
@@ -788,6 +790,8 @@ int main(int argc, char** argv) {
                    "on|off: a verified match's keypoints must also agree with the mapping's turn and scale");
   flags.add_double("agreement-angle", &o.recognize.keypoint_agreement.angle_deg, "--keypoint-agreement: degrees");
   flags.add_double("agreement-scale", &o.recognize.keypoint_agreement.scale_factor, "--keypoint-agreement: factor");
+  flags.add_double("colour-tolerance", &o.recognize.colour_tolerance,
+                   "the ratio test by colour: chromaticity distance a candidate may be off the query keypoint's; 0 off");
   flags.add_double("ransac-px", &o.recognize.ransac_px, "the geometric check's inlier distance, pixels");
   flags.add_int("min-support", &o.recognize.min_support, "matches agreeing with a mapping beyond those that fixed it");
   std::string root_sift = o.recognize.root_sift ? "on" : "off";

@@ -15,8 +15,10 @@ int main(int argc, char** argv) {
     auto& f = service.flags();
     f.add_string("db", &options.db_dir, "the object database's folder (created if missing); required");
     f.add_string("matcher", &matcher, "descriptor matching: shared-flann (one index for the database), flann or bf (per object); docs/benchmarks.md");
-    f.add_double("ratio", &options.recognize.ratio, "recognition's ratio test: d1 < RATIO * d2 (thesis 0.6; docs/learning.md)");
+    f.add_double("ratio", &options.recognize.ratio, "recognition's ratio test: d1 < RATIO * d2 (thesis 0.6, Lowe 0.8; docs/learning.md)");
     f.add_int("min-matches", &options.recognize.min_matches, "verified matches the best object needs (thesis 3)");
+    f.add_double("colour-tolerance", &options.recognize.colour_tolerance,
+                 "recognition's ratio test by colour: a candidate's chromaticity within this of the query keypoint's; 0 off (docs/learning.md)");
     f.add_double("ransac-px", &options.recognize.ransac_px, "geometric check: inlier distance, pixels");
     f.add_double("box-margin", &options.learn.box_margin, "training box grown by this fraction each side");
     f.add_int("background-matches", &options.learn.background_matches,

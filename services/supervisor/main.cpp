@@ -62,7 +62,7 @@ struct Options {
   // A gentle push: tall objects (bottles) tip when the pad meets them at the arm's usual speed.
   double nudge_speed_scale = 0.25;
   bool keep_running = false;
-  std::string standing_view = "on";      // Config::standing_view
+  std::string standing_view = "off";     // Config::standing_view
   std::string line_pick = "strongest";  // strongest, nearest (LineSearchParams::strongest)
   std::string candidate_order = "nearest";  // nearest, support (TargetParams::order)
   int rest_from_still = 1;               // Config::rest_from_still

@@ -141,7 +141,7 @@ TEST(SupervisorLearn, GraspsTurnsTwelveViewsAndPutsTheCupBack) {
   LoopServices services(setup);
   ASSERT_EQ(services.start_all(), std::vector<std::string>{}) << "services that did not start";
   // One attempt, with the held-object check on: the sim arm reports the world's measured finger
-  // opening, which stops on the cup. The standing view is on by default; said here, so that its
+  // opening, which stops on the cup. The standing view (off by default) is on here, so that its
   // path over the bus (with its mask) stays covered whatever the default.
   const std::vector<std::string> learn_once = {"--learn", "on", "--max-attempts", "1", "--standing-view", "on"};
   Process supervisor(loop_supervisor_command(setup, "learn", learn_once), dir + "/supervisor.log");

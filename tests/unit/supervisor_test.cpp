@@ -2720,7 +2720,7 @@ class LearningTest : public SupervisorTest {
 
 TEST_F(LearningTest, GraspsTurnsTwelveTimesLearnsAndPutsTheObjectBack) {
   sv::Config config;
-  config.standing_view = true;  // the default, said here: the test without it follows
+  config.standing_view = true;  // off by default (Config::standing_view); the test without it follows
   sv::Supervisor s = make_learning(config);
   const sv::GraspCommand grasp = to_grasp(s);
   EXPECT_EQ(s.awaited_arm_seq(), grasp.seq);

@@ -9,6 +9,8 @@ namespace nudge::learning::detail {
 namespace {
 
 constexpr char kMagic[8] = {'N', 'U', 'D', 'G', 'E', 'F', 'T', '1'};
+// Version 1: keypoints and descriptors; 2 adds each keypoint's colour (Features::colours).
+constexpr uint32_t kFirstVersionWithColours = 2;
 
 uint64_t fnv1a(const char* data, size_t size) {
   uint64_t h = 1469598103934665603ull;
@@ -67,6 +69,12 @@ std::string encode_features(const std::vector<const Features*>& views, int forma
     }
     for (int r = 0; r < f->descriptors.rows; ++r)
       out.append(reinterpret_cast<const char*>(f->descriptors.ptr<float>(r)), dims * sizeof(float));
+    if (static_cast<uint32_t>(format_version) < kFirstVersionWithColours) continue;
+    // Version 2: the keypoints' colours, 3 values each, or 0 when the view has none.
+    const bool coloured = f->colours.rows == f->size() && f->size() > 0;
+    put<uint32_t>(out, coloured ? 3u : 0u);
+    for (int r = 0; coloured && r < f->colours.rows; ++r)
+      out.append(reinterpret_cast<const char*>(f->colours.ptr<float>(r)), 3 * sizeof(float));
   }
   put<uint64_t>(out, fnv1a(out.data(), out.size()));
   return out;
@@ -107,6 +115,15 @@ std::vector<Features> decode_features(const std::string& bytes, int max_format_v
     }
     f.descriptors.create(static_cast<int>(n), static_cast<int>(dims), CV_32F);
     if (n > 0) in.read(f.descriptors.data, static_cast<size_t>(n) * dims * sizeof(float));
+    if (version >= kFirstVersionWithColours) {
+      const auto channels = in.get<uint32_t>();
+      if (channels != 0 && channels != 3)
+        throw std::runtime_error("view " + std::to_string(v) + ": colours of " + std::to_string(channels) + " values, not 3");
+      if (channels == 3) {
+        f.colours.create(static_cast<int>(n), 3, CV_32F);
+        in.read(f.colours.data, static_cast<size_t>(n) * 3 * sizeof(float));
+      }
+    }
     views.push_back(std::move(f));
   }
   if (!in.at_end()) throw std::runtime_error("trailing bytes after the last view");

@@ -1,6 +1,7 @@
 #include "database_index.hpp"
 
 #include "seeded_rng.hpp"
+#include "nudge/learning/features.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -22,9 +23,14 @@ void DatabaseIndex::build(const std::vector<IndexedObject>& objects) {
   row_object_.resize(total);
   row_local_.resize(total);
   row_group_.resize(total);
+  row_chroma_.create(total, 2, CV_32F);
+  row_chroma_.setTo(-1);
   int row = 0;
   for (size_t o = 0; o < objects.size(); ++o) {
     if (object_rows_[o] == 0) continue;
+    const cv::Mat* chroma = objects[o].row_chroma;
+    if (chroma && !chroma->empty() && chroma->rows == object_rows_[o])
+      chroma->copyTo(row_chroma_.rowRange(row, row + object_rows_[o]));
     int local = 0;
     for (const cv::Mat& d : objects[o].view_descriptors) {
       if (d.empty()) continue;
@@ -65,13 +71,15 @@ struct ObjectNeighbours {
 // ones lie beyond the farthest result, so its distance stands in for d2: never more than the true
 // d2, so the test is only stricter. Other objects' neighbours never enter an object's test: a
 // feature two objects share passes for both.
-std::vector<std::vector<cv::DMatch>> DatabaseIndex::ratio_matches(const cv::Mat& query, const IndexSearch& search) const {
+std::vector<std::vector<cv::DMatch>> DatabaseIndex::ratio_matches(const cv::Mat& query, const cv::Mat& query_chroma,
+                                                                   const IndexSearch& search) const {
   std::vector<std::vector<cv::DMatch>> out(object_rows_.size());
   if (!index_ || query.empty()) return out;
   const int k = std::min(search.neighbours, rows());
   cv::Mat indices, squared;  // FLANN's L2 gives squared distances
   index_->knnSearch(query, indices, squared, k, cv::flann::SearchParams(search.checks));
   const bool complete = k == rows();  // every row is among the results: nothing is missing
+  const bool by_colour = search.colour_tolerance > 0 && query_chroma.rows == query.rows;
   std::vector<ObjectNeighbours> seen;
   for (int q = 0; q < query.rows; ++q) {
     const int* idx = indices.ptr<int>(q);
@@ -83,6 +91,9 @@ std::vector<std::vector<cv::DMatch>> DatabaseIndex::ratio_matches(const cv::Mat&
       const float d = std::sqrt(std::max(0.f, d2[j]));
       farthest = d;
       const int row = idx[j], object = row_object_[row];
+      // A neighbour of another colour is no candidate; the farthest result still bounds what lies beyond.
+      if (by_colour && !chromaticities_agree(query_chroma.ptr<float>(q), row_chroma_.ptr<float>(row), search.colour_tolerance))
+        continue;
       auto it = std::find_if(seen.begin(), seen.end(), [&](const ObjectNeighbours& n) { return n.object == object; });
       if (it == seen.end()) {
         seen.push_back({object, 1, row, d, -1, d});

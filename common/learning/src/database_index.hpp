@@ -20,12 +20,17 @@ struct IndexedObject {
   // Each row's ratio-test group: its view, told apart by the simulated tilt it was found at (the
   // Recognizer's row_group).
   const std::vector<int>* row_group = nullptr;
+  // Each row's chromaticity (chromaticities(), N x 2); null or empty: every colour unknown.
+  const cv::Mat* row_chroma = nullptr;
 };
 
 struct IndexSearch {
   int neighbours = 16;  // fetched per query descriptor over the whole database
   int checks = 64;      // k-d tree leaves visited
   double ratio = 0.6;
+  // A neighbour whose colour disagrees with the query descriptor's by more than this
+  // (chromaticities_agree) is not a candidate at all, nearest or second; 0: colours ignored.
+  float colour_tolerance = 0;
 };
 
 class DatabaseIndex {
@@ -37,11 +42,14 @@ class DatabaseIndex {
 
   // Per object (in build order), the query rows passing its ratio test: queryIdx into the query,
   // trainIdx the row in that object's stack, distance the L2 distance.
-  std::vector<std::vector<cv::DMatch>> ratio_matches(const cv::Mat& query, const IndexSearch& search) const;
+  // `query_chroma`: the query rows' chromaticities (N x 2), used when search.colour_tolerance > 0.
+  std::vector<std::vector<cv::DMatch>> ratio_matches(const cv::Mat& query, const cv::Mat& query_chroma,
+                                                     const IndexSearch& search) const;
 
  private:
   cv::Mat descriptors_;                   // the index points into it: kept alive with it
   std::vector<int> row_object_, row_local_, row_group_;
+  cv::Mat row_chroma_;                    // total x 2, -1 where unknown
   std::vector<int> object_rows_;          // rows per object (0 for one left out)
   std::unique_ptr<cv::flann::Index> index_;
 };

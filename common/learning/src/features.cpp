@@ -77,8 +77,49 @@ std::string sift_settings_difference(const SiftParams& a, const SiftParams& b) {
   return out;
 }
 
+cv::Mat keypoint_colours(const cv::Mat& image, const std::vector<cv::KeyPoint>& keypoints) {
+  if (image.empty() || image.depth() != CV_8U || (image.channels() != 3 && image.channels() != 4)) return {};
+  cv::Mat bgr = image;
+  if (image.channels() == 4) cv::cvtColor(image, bgr, cv::COLOR_BGRA2BGR);
+  cv::Mat sums;  // (rows + 1) x (cols + 1), CV_64FC3
+  cv::integral(bgr, sums, CV_64F);
+  cv::Mat out(static_cast<int>(keypoints.size()), 3, CV_32F);
+  for (int i = 0; i < out.rows; ++i) {
+    const cv::KeyPoint& k = keypoints[i];
+    const double tilt = at_simulated_tilt(k) ? k.class_id / 100.0 : 1;
+    const double half_w = std::max(1.0, k.size / 2.0), half_h = std::max(1.0, k.size * tilt / 2.0);
+    const int x0 = std::clamp(static_cast<int>(std::floor(k.pt.x - half_w)), 0, bgr.cols - 1);
+    const int y0 = std::clamp(static_cast<int>(std::floor(k.pt.y - half_h)), 0, bgr.rows - 1);
+    const int x1 = std::clamp(static_cast<int>(std::ceil(k.pt.x + half_w)), x0 + 1, bgr.cols);
+    const int y1 = std::clamp(static_cast<int>(std::ceil(k.pt.y + half_h)), y0 + 1, bgr.rows);
+    const cv::Vec3d total = sums.at<cv::Vec3d>(y1, x1) - sums.at<cv::Vec3d>(y0, x1) - sums.at<cv::Vec3d>(y1, x0) +
+                            sums.at<cv::Vec3d>(y0, x0);
+    const double area = static_cast<double>(x1 - x0) * (y1 - y0);
+    for (int c = 0; c < 3; ++c) out.at<float>(i, c) = static_cast<float>(total[c] / area);
+  }
+  return out;
+}
+
+cv::Mat chromaticities(const cv::Mat& colours, int rows) {
+  cv::Mat out(rows, 2, CV_32F, cv::Scalar(-1));
+  if (colours.empty()) return out;
+  if (colours.type() != CV_32F || colours.cols != 3 || colours.rows != rows)
+    throw std::invalid_argument("chromaticities: " + std::to_string(colours.rows) + " colour rows of " +
+                                std::to_string(colours.cols) + " for " + std::to_string(rows) + " keypoints");
+  for (int i = 0; i < rows; ++i) {
+    const float* c = colours.ptr<float>(i);
+    const float sum = c[0] + c[1] + c[2];
+    if (c[0] < 0 || sum < 3 * kMinColourLevel) continue;
+    out.at<float>(i, 0) = c[2] / sum;  // r
+    out.at<float>(i, 1) = c[1] / sum;  // g
+  }
+  return out;
+}
+
 Features detect_features(const cv::Mat& image, const SiftParams& params) {
-  return sift_on_grey(sift_grey(image, params), params);
+  Features features = sift_on_grey(sift_grey(image, params), params);
+  features.colours = keypoint_colours(image, features.keypoints);
+  return features;
 }
 
 Features detect_features_tilted(const cv::Mat& image, double tilt, const SiftParams& params, const cv::Rect& roi) {
@@ -102,6 +143,7 @@ Features detect_features_tilted(const cv::Mat& image, double tilt, const SiftPar
     k.pt.y = k.pt.y * y_scale + static_cast<float>(area.y);
     k.class_id = tilt_layer_id(tilt);
   }
+  features.colours = keypoint_colours(image, features.keypoints);
   return features;
 }
 
@@ -113,6 +155,12 @@ Features concatenate(const Features& a, const Features& b) {
   out.keypoints.insert(out.keypoints.end(), b.keypoints.begin(), b.keypoints.end());
   cv::vconcat(a.descriptors.empty() ? cv::Mat(0, 128, CV_32F) : a.descriptors,
               b.descriptors.empty() ? cv::Mat(0, 128, CV_32F) : b.descriptors, out.descriptors);
+  if (a.colours.empty() && b.colours.empty()) return out;
+  // One side's colours unknown: rows of -1 for it (chromaticities treats them as agreeing with any).
+  auto or_unknown = [](const Features& f) {
+    return f.colours.empty() ? cv::Mat(f.size(), 3, CV_32F, cv::Scalar(-1)) : f.colours;
+  };
+  cv::vconcat(or_unknown(a), or_unknown(b), out.colours);
   return out;
 }
 
@@ -144,7 +192,9 @@ Features select_features(const Features& features, const std::vector<bool>& keep
     if (!keep[i]) continue;
     out.keypoints.push_back(features.keypoints[i]);
     out.descriptors.push_back(features.descriptors.row(i));
+    if (!features.colours.empty()) out.colours.push_back(features.colours.row(i));
   }
+  if (!features.colours.empty() && out.colours.empty()) out.colours.create(0, 3, CV_32F);
   return out;
 }
 

@@ -42,6 +42,7 @@ struct Recognizer::Entry {
   // found at (LearnParams::axis_tilts), so that a point's squeezed copy is not its own second
   // neighbour.
   std::vector<int> row_group;
+  cv::Mat row_chroma;  // each row's chromaticity (chromaticities()), N x 2
   cv::Ptr<cv::DescriptorMatcher> matcher;  // null for a set of < 2 descriptors, and for SharedFlann
   // Views' features found at simulated tilts (at_simulated_tilt): the model without them, and for
   // each of its views the index of each of its features in the model's view. Null without any.
@@ -81,22 +82,30 @@ constexpr int kNeighbours = detail::kObjectNeighbours;
 // nearest one; when none of the kNeighbours nearest is, the last of them stands in for it (the
 // true d2 is no smaller, so the test is only stricter).
 std::vector<cv::DMatch> view_ratio_matches(cv::DescriptorMatcher& matcher, const std::vector<int>& row_group,
-                                           const cv::Mat& query, double ratio) {
+                                           const cv::Mat& row_chroma, const cv::Mat& query, const cv::Mat& query_chroma,
+                                           double ratio, float colour_tolerance) {
   std::vector<cv::DMatch> out;
   if (query.empty()) return out;
+  const bool by_colour = colour_tolerance > 0 && query_chroma.rows == query.rows && !row_chroma.empty();
   std::vector<std::vector<cv::DMatch>> knn;
   matcher.knnMatch(query, knn, kNeighbours);
   for (const auto& neighbours : knn) {
     if (neighbours.size() < 2) continue;
-    const cv::DMatch& nearest = neighbours[0];
+    // A neighbour of another colour is no candidate, nearest or second (RecognizeParams::colour_tolerance).
+    auto candidate = [&](const cv::DMatch& m) {
+      return !by_colour || chromaticities_agree(query_chroma.ptr<float>(m.queryIdx), row_chroma.ptr<float>(m.trainIdx),
+                                                colour_tolerance);
+    };
+    const auto nearest = std::find_if(neighbours.begin(), neighbours.end(), candidate);
+    if (nearest == neighbours.end()) continue;
     float second = neighbours.back().distance;
-    for (size_t i = 1; i < neighbours.size(); ++i) {
-      if (row_group[neighbours[i].trainIdx] == row_group[nearest.trainIdx]) {
-        second = neighbours[i].distance;
+    for (auto it = std::next(nearest); it != neighbours.end(); ++it) {
+      if (candidate(*it) && row_group[it->trainIdx] == row_group[nearest->trainIdx]) {
+        second = it->distance;
         break;
       }
     }
-    if (nearest.distance < ratio * second) out.push_back(nearest);
+    if (nearest->distance < ratio * second) out.push_back(*nearest);
   }
   return out;
 }
@@ -381,6 +390,9 @@ Recognizer::Recognizer(const RecognizeParams& params)
   if (agreement.on && !(agreement.angle_deg > 0 && agreement.angle_deg <= 180))
     throw std::invalid_argument("RecognizeParams::keypoint_agreement.angle_deg must be in (0, 180], not " +
                                 std::to_string(agreement.angle_deg));
+  if (!(params.colour_tolerance >= 0))
+    throw std::invalid_argument("RecognizeParams::colour_tolerance must be >= 0, not " +
+                                std::to_string(params.colour_tolerance));
   if (agreement.on && !(agreement.scale_factor >= 1))
     throw std::invalid_argument("RecognizeParams::keypoint_agreement.scale_factor must be >= 1, not " +
                                 std::to_string(agreement.scale_factor));
@@ -410,6 +422,11 @@ void Recognizer::add(std::shared_ptr<const ObjectModel> model) {
       if (fresh) it->second = next_group++;
       entry->row_group.push_back(it->second);
     }
+    if (!f.colours.empty() && (f.colours.rows != f.size() || f.colours.cols != 3 || f.colours.type() != CV_32F))
+      throw std::invalid_argument("object '" + model->info.name + "' view " + std::to_string(v) + ": " +
+                                  std::to_string(f.size()) + " keypoints but " + std::to_string(f.colours.rows) +
+                                  " colours of " + std::to_string(f.colours.cols) + " values");
+    entry->row_chroma.push_back(chromaticities(f.colours, f.size()));
     if (!f.descriptors.empty() && !shared_) all.push_back(matching_descriptors(f.descriptors, params_.root_sift));
   }
   if (all.rows >= 2 && !shared_) {
@@ -483,24 +500,29 @@ void Recognizer::build_index() const {
     for (const auto& view : entries_[i]->model->views)
       objects[i].view_descriptors.push_back(matching_descriptors(view.features.descriptors, params_.root_sift));
     objects[i].row_group = &entries_[i]->row_group;
+    objects[i].row_chroma = &entries_[i]->row_chroma;
   }
   shared_->index.build(objects);
   shared_->stale = false;
 }
 
 // Per entry, the query descriptors passing its ratio test, trainIdx the row in the entry's stack.
-std::vector<std::vector<cv::DMatch>> Recognizer::ratio_matches_per_object(const cv::Mat& query) const {
+std::vector<std::vector<cv::DMatch>> Recognizer::ratio_matches_per_object(const cv::Mat& query,
+                                                                         const cv::Mat& query_chroma) const {
+  const auto tolerance = static_cast<float>(params_.colour_tolerance);
   if (shared_) {
     build_index();
     detail::IndexSearch search;
     search.neighbours = params_.shared_neighbours;
     search.checks = params_.shared_checks;
     search.ratio = params_.ratio;
-    return shared_->index.ratio_matches(query, search);
+    search.colour_tolerance = tolerance;
+    return shared_->index.ratio_matches(query, query_chroma, search);
   }
   std::vector<std::vector<cv::DMatch>> out;
   for (const auto& entry : entries_) {
-    out.push_back(entry->matcher ? view_ratio_matches(*entry->matcher, entry->row_group, query, params_.ratio)
+    out.push_back(entry->matcher ? view_ratio_matches(*entry->matcher, entry->row_group, entry->row_chroma, query,
+                                                      query_chroma, params_.ratio, tolerance)
                                  : std::vector<cv::DMatch>{});
   }
   return out;
@@ -527,6 +549,7 @@ Recognition Recognizer::recognize(const cv::Mat& image, const cv::Rect& roi) con
   const cv::Mat source = params_.sift.equalise_clip > 0 ? sift_grey(image, params_.sift) : image;
   Features query = detect_features(source(area), as_is);
   for (auto& k : query.keypoints) k.pt += cv::Point2f(static_cast<float>(area.x), static_cast<float>(area.y));
+  query.colours = keypoint_colours(image, query.keypoints);  // from the image as given (SIFT's may be grey)
   Recognition result = recognize(query);
   result.elapsed_ms = watch.elapsed_ms();
   return result;
@@ -551,8 +574,8 @@ Recognition Recognizer::recognize_all_features(const Features& query) const {
   Stopwatch watch;
   Recognition result;
   result.query = query;
-  const std::vector<std::vector<cv::DMatch>> object_matches =
-      ratio_matches_per_object(matching_descriptors(query.descriptors, params_.root_sift));
+  const std::vector<std::vector<cv::DMatch>> object_matches = ratio_matches_per_object(
+      matching_descriptors(query.descriptors, params_.root_sift), chromaticities(query.colours, query.size()));
   for (size_t e = 0; e < entries_.size(); ++e) {
     const auto& entry = entries_[e];
     ObjectScore score;

@@ -71,7 +71,34 @@ void expect_same(const ObjectModel& a, const ObjectModel& b) {
     EXPECT_EQ(cv::norm(a.views[v].features.descriptors, b.views[v].features.descriptors, cv::NORM_INF), 0);
     for (int k = 0; k < a.views[v].features.size(); ++k)
       EXPECT_EQ(a.views[v].features.keypoints[k].pt, b.views[v].features.keypoints[k].pt);
+    ASSERT_EQ(a.views[v].features.colours.size(), b.views[v].features.colours.size());
+    if (!a.views[v].features.colours.empty())
+      EXPECT_EQ(cv::norm(a.views[v].features.colours, b.views[v].features.colours, cv::NORM_INF), 0);
   }
+}
+
+// features.bin as format version 1 wrote it (before colours): magic, version, view count; per view
+// the keypoint count, 128, each keypoint's x, y, size, angle, response (float) and octave,
+// class_id (int32), the descriptors (float); then the FNV-1a hash of everything before it.
+std::string version_one_features(const std::vector<Features>& views) {
+  std::string out = "NUDGEFT1";
+  auto put = [&out](auto value) { out.append(reinterpret_cast<const char*>(&value), sizeof value); };
+  put(uint32_t{1});
+  put(static_cast<uint32_t>(views.size()));
+  for (const Features& f : views) {
+    put(static_cast<uint32_t>(f.size()));
+    put(uint32_t{128});
+    for (const cv::KeyPoint& k : f.keypoints) {
+      for (float x : {k.pt.x, k.pt.y, k.size, k.angle, k.response}) put(x);
+      put(static_cast<int32_t>(k.octave));
+      put(static_cast<int32_t>(k.class_id));
+    }
+    out.append(reinterpret_cast<const char*>(f.descriptors.data), f.descriptors.total() * sizeof(float));
+  }
+  uint64_t hash = 1469598103934665603ull;
+  for (char c : out) hash = (hash ^ static_cast<unsigned char>(c)) * 1099511628211ull;
+  put(hash);
+  return out;
 }
 
 void overwrite(const std::string& path, const std::string& text) {
@@ -98,7 +125,33 @@ TEST(ObjectDatabase, StoresAndLoadsAnObjectWithItsImages) {
   EXPECT_EQ(cv::norm(loaded.views[1].image, cup.views[1].image, cv::NORM_INF), 0);
   EXPECT_TRUE(db.load("cup").views[0].image.empty());  // pictures only on request
   EXPECT_EQ(db.load_view_image("cup", 2).size(), cup.views[2].image.size());
-  EXPECT_NE(read(dir + "/cup/object.json").find("\"format_version\": 1"), std::string::npos);
+  EXPECT_NE(read(dir + "/cup/object.json").find("\"format_version\": " + std::to_string(kDatabaseFormatVersion)),
+            std::string::npos);
+  fs::remove_all(dir);
+}
+
+// Format 2 added each keypoint's colour; an object stored by format 1 loads, its colours unknown.
+TEST(ObjectDatabase, KeepsEachKeypointsColourAndReadsObjectsStoredWithout) {
+  const std::string dir = fresh_folder("colours");
+  const ObjectDatabase db(dir);
+  const ObjectModel cup = small_model("cup", 2, 7);
+  ASSERT_EQ(cup.views[0].features.colours.rows, cup.views[0].features.size()) << "a colour image's keypoints have colours";
+  db.store(cup);
+  expect_same(cup, db.load("cup"));  // colours included
+  std::vector<Features> views;
+  for (const ModelView& v : cup.views) views.push_back(v.features);
+  overwrite(dir + "/cup/features.bin", version_one_features(views));
+  std::string json = read(dir + "/cup/object.json");
+  const std::string now = "\"format_version\": " + std::to_string(kDatabaseFormatVersion);
+  json.replace(json.find(now), now.size(), "\"format_version\": 1");
+  overwrite(dir + "/cup/object.json", json);
+  const ObjectModel old = db.load("cup");
+  ASSERT_EQ(old.views.size(), 2u);
+  for (size_t v = 0; v < old.views.size(); ++v) {
+    EXPECT_EQ(old.views[v].features.size(), cup.views[v].features.size());
+    EXPECT_EQ(cv::norm(old.views[v].features.descriptors, cup.views[v].features.descriptors, cv::NORM_INF), 0);
+    EXPECT_TRUE(old.views[v].features.colours.empty()) << "format 1 kept no colours";
+  }
   fs::remove_all(dir);
 }
 
@@ -220,7 +273,8 @@ TEST(ObjectDatabase, ACorruptOrNewerObjectIsRefusedNamingItsFileTheRestLoad) {
   overwrite(dir + "/cup/object.json", json.substr(0, json.size() / 2));
   // mug: written by a newer program.
   std::string newer = read(dir + "/mug/object.json");
-  newer.replace(newer.find("\"format_version\": 1"), 19, "\"format_version\": 2");
+  const std::string now = "\"format_version\": " + std::to_string(kDatabaseFormatVersion);
+  newer.replace(newer.find(now), now.size(), "\"format_version\": " + std::to_string(kDatabaseFormatVersion + 1));
   overwrite(dir + "/mug/object.json", newer);
   const LoadReport report = db.load_all();
   ASSERT_EQ(report.models.size(), 1u);
@@ -228,7 +282,9 @@ TEST(ObjectDatabase, ACorruptOrNewerObjectIsRefusedNamingItsFileTheRestLoad) {
   ASSERT_EQ(report.errors.size(), 3u);
   EXPECT_NE(report.errors[0].find(dir + "/bottle/features.bin: checksum mismatch"), std::string::npos) << report.errors[0];
   EXPECT_NE(report.errors[1].find(dir + "/cup/object.json"), std::string::npos) << report.errors[1];
-  EXPECT_NE(report.errors[2].find(dir + "/mug/object.json: format version 2 is newer"), std::string::npos)
+  EXPECT_NE(report.errors[2].find(dir + "/mug/object.json: format version " + std::to_string(kDatabaseFormatVersion + 1) +
+                                  " is newer"),
+            std::string::npos)
       << report.errors[2];
   // A missing training image is named when the pictures are asked for.
   fs::remove(dir + "/vase/view_01.png");

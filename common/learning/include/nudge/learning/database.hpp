@@ -16,7 +16,8 @@
 
 namespace nudge::learning {
 
-inline constexpr int kDatabaseFormatVersion = 1;
+// 1: keypoints and descriptors; 2: also each keypoint's colour (older objects load without).
+inline constexpr int kDatabaseFormatVersion = 2;
 
 class DatabaseError : public std::runtime_error {
  public:

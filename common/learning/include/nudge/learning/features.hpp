@@ -11,6 +11,12 @@ namespace nudge::learning {
 struct Features {
   std::vector<cv::KeyPoint> keypoints;
   cv::Mat descriptors;
+  // Each keypoint's mean colour, B, G, R (CV_32F, one row per keypoint), over the box its SIFT scale
+  // covers: SIFT sees grey levels only, and a label of like shapes in different colours (red, green
+  // and blue drops) gives near-equal descriptors that the ratio test cannot tell apart. Empty when
+  // the image was grey, or for a database written before colours were kept; a row of -1 is a
+  // keypoint whose colour is unknown (keypoint_colours).
+  cv::Mat colours;
 
   int size() const { return static_cast<int>(keypoints.size()); }
   bool empty() const { return keypoints.empty(); }
@@ -37,6 +43,26 @@ struct SiftParams {
 // non-8-bit image, or settings SIFT refuses (a threshold not positive, fewer than 1 layer, a
 // negative clip limit, a tile under 8 pixels).
 Features detect_features(const cv::Mat& image, const SiftParams& params = {});
+
+// Each keypoint's mean B, G, R over its box (side its SIFT size; a keypoint found at a simulated
+// tilt covers `class_id / 100` times more rows), CV_32F, one row per keypoint; empty for a grey
+// image. Integral images: a few operations per keypoint.
+cv::Mat keypoint_colours(const cv::Mat& image, const std::vector<cv::KeyPoint>& keypoints);
+
+// Chromaticity (r, g of r + g + b) of each colour row, CV_32F N x 2: a colour's hue and saturation
+// without its brightness, which differs between a view held near the camera and a scene. A row
+// whose colour is unknown, or too dark to tell (mean below kMinColourLevel of 255), is (-1, -1);
+// rows of -1 for every keypoint when `colours` is empty.
+inline constexpr float kMinColourLevel = 24;
+cv::Mat chromaticities(const cv::Mat& colours, int rows);
+
+// Whether two chromaticity rows could be the same surface's: within `tolerance` of each other
+// (Euclidean); an unknown one agrees with anything.
+inline bool chromaticities_agree(const float* a, const float* b, float tolerance) {
+  if (a[0] < 0 || b[0] < 0) return true;
+  const float dr = a[0] - b[0], dg = a[1] - b[1];
+  return dr * dr + dg * dg <= tolerance * tolerance;
+}
 
 // "" when `a` and `b` find the same keypoints, else what differs, e.g. "contrast 0.04 against 0.02".
 std::string sift_settings_difference(const SiftParams& a, const SiftParams& b);
