@@ -6,6 +6,8 @@
 // a recognition. Figures: docs/benchmarks.md.
 #include <benchmark/benchmark.h>
 
+#include <opencv2/imgproc.hpp>
+
 #include <map>
 
 #include "nudge/learning/recognizer.hpp"
@@ -116,8 +118,26 @@ void BM_RecognizeTiltedDatabase(benchmark::State& state) {
   state.counters["descriptors"] = descriptors;
 }
 
+// What keeping each keypoint's colour (Features::colours) adds to SIFT on a 1280x960 still, the
+// size the learner's views and the test images have: arg 0 times SIFT alone (detect_features on
+// the grey image), arg 1 the colours alone for the keypoints SIFT found there.
+void BM_KeypointColours(benchmark::State& state) {
+  const cv::Mat still = synthetic::place_in_scene(objects()[0]->views[4].image,
+                                                  synthetic::random_texture({1280, 960}, 4343), 10, 1.5, {640, 480});
+  cv::Mat grey;
+  cv::cvtColor(still, grey, cv::COLOR_BGR2GRAY);
+  const Features features = detect_features(still);
+  for (auto _ : state) {
+    if (state.range(0) == 0) benchmark::DoNotOptimize(detect_features(grey));
+    else benchmark::DoNotOptimize(keypoint_colours(still, features.keypoints));
+  }
+  state.counters["keypoints"] = features.size();
+  state.SetLabel(state.range(0) == 0 ? "sift" : "colours");
+}
+
 }  // namespace
 
+BENCHMARK(BM_KeypointColours)->Arg(0)->Arg(1)->ArgName("colours")->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Recognize)->Apply(Sizes);
 // Args: tilts learned (1) or not (0); the scene shows a learned object (1) or none (0).
 BENCHMARK(BM_RecognizeTiltedDatabase)->Args({0, 1})->Args({1, 1})->Args({0, 0})->Args({1, 0})
