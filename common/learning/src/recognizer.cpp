@@ -166,11 +166,18 @@ ViewFrame view_frame(const cv::KeyPoint& train) {
   return {std::atan2(tilt * std::sin(a), std::cos(a)), train.size * std::sqrt(tilt)};
 }
 
+// The agreement's tolerances as its rule compares them (radians, log of the scale factor): made
+// once per check, not per match.
+struct AgreementBounds {
+  double max_turn, max_log_scale;
+  explicit AgreementBounds(const KeypointAgreement& tolerance)
+      : max_turn(tolerance.angle_deg * CV_PI / 180), max_log_scale(std::log(tolerance.scale_factor)) {}
+};
+
 // The agreement's rule, said once: a keypoint turned `turn_off` radians and scaled by exp(log_scale_off)
 // away from what the mapping says at its place is within the tolerances.
-bool within_agreement(double turn_off, double log_scale_off, const KeypointAgreement& tolerance) {
-  return std::abs(std::remainder(turn_off, 2 * CV_PI)) <= tolerance.angle_deg * CV_PI / 180 &&
-         std::abs(log_scale_off) <= std::log(tolerance.scale_factor);
+bool within_agreement(double turn_off, double log_scale_off, const AgreementBounds& bounds) {
+  return std::abs(std::remainder(turn_off, 2 * CV_PI)) <= bounds.max_turn && std::abs(log_scale_off) <= bounds.max_log_scale;
 }
 
 // Whether a match's two keypoints agree with the mapping found from the matches' positions: SIFT
@@ -185,7 +192,7 @@ bool keypoint_agrees(const cv::Matx22d& linear_at_train, const cv::KeyPoint& tra
   const double off = query.angle * CV_PI / 180 - std::atan2(turned[1], turned[0]);
   const double scale = std::sqrt(std::abs(cv::determinant(linear_at_train)));
   if (!(scale > 0) || t.size <= 0 || query.size <= 0) return false;
-  return within_agreement(off, std::log(query.size / (t.size * scale)), tolerance);
+  return within_agreement(off, std::log(query.size / (t.size * scale)), AgreementBounds(tolerance));
 }
 
 // The inliers of `map` whose keypoints also agree with it (keypoint_agrees); all of them when the
@@ -228,11 +235,12 @@ MatchFrame frame_of(const cv::KeyPoint& train, const cv::KeyPoint& query) {
 int similarity_support(const std::vector<MatchFrame>& frames, std::complex<double> a, std::complex<double> b,
                        double px, const KeypointAgreement& agreement, std::vector<int>* members = nullptr) {
   const double turn = std::arg(a), log_scale = std::log(std::abs(a));
+  const AgreementBounds bounds(agreement);
   int count = 0;
   for (int i = 0; i < static_cast<int>(frames.size()); ++i) {
     const MatchFrame& f = frames[i];
     if (std::norm(a * f.from + b - f.to) > px * px) continue;
-    if (agreement.on && !within_agreement(f.turn - turn, f.log_scale - log_scale, agreement)) continue;
+    if (agreement.on && !within_agreement(f.turn - turn, f.log_scale - log_scale, bounds)) continue;
     ++count;
     if (members) members->push_back(i);
   }
