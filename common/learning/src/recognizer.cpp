@@ -557,7 +557,8 @@ Recognition Recognizer::recognize(const cv::Mat& image, const cv::Rect& roi) con
   const cv::Mat source = params_.sift.equalise_clip > 0 ? sift_grey(image, params_.sift) : image;
   Features query = detect_features(source(area), as_is);
   for (auto& k : query.keypoints) k.pt += cv::Point2f(static_cast<float>(area.x), static_cast<float>(area.y));
-  query.colours = keypoint_colours(image, query.keypoints);  // from the image as given (SIFT's may be grey)
+  // SIFT's source was grey when equalised: the colours then come from the image as given.
+  if (query.colours.empty()) query.colours = keypoint_colours(image, query.keypoints);
   Recognition result = recognize(query);
   result.elapsed_ms = watch.elapsed_ms();
   return result;
@@ -582,8 +583,9 @@ Recognition Recognizer::recognize_all_features(const Features& query) const {
   Stopwatch watch;
   Recognition result;
   result.query = query;
-  const std::vector<std::vector<cv::DMatch>> object_matches = ratio_matches_per_object(
-      matching_descriptors(query.descriptors, params_.root_sift), chromaticities(query.colours, query.size()));
+  const cv::Mat query_chroma = params_.colour_tolerance > 0 ? chromaticities(query.colours, query.size()) : cv::Mat();
+  const std::vector<std::vector<cv::DMatch>> object_matches =
+      ratio_matches_per_object(matching_descriptors(query.descriptors, params_.root_sift), query_chroma);
   for (size_t e = 0; e < entries_.size(); ++e) {
     const auto& entry = entries_[e];
     ObjectScore score;
