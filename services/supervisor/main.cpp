@@ -700,6 +700,8 @@ void add_flags(Flags& f, Options& o) {
                "a finger on its rim or inside it, put down again; 0: neither check");
   f.add_double("grip-width-slack", &o.config.grip_width_slack_m, "added to --grip-width-high's width, m");
   f.add_double("top-radius", &o.config.grasp.top_radius_m, "r of the grasp height's r*tan(theta) lowering, m (thesis: 36 mm at 30 deg)");
+  f.add_double("grip-depth", &o.config.grasp.grip_depth_m,
+               "the fingers' middle this far below the object's estimated top (short objects: half way up), m");
   f.add_int("first-seq", &o.first_seq, "first ARM_COMMAND seq (default: from the wall clock; set it to replay a run)");
 }
 
@@ -789,6 +791,9 @@ int main(int argc, char** argv) {
       throw FlagError("--grip-width-high must be 0 (no check) or lie in (1, 10)");
     if (!(opt.config.grip_width_slack_m >= 0 && opt.config.grip_width_slack_m < 0.1)) throw FlagError("--grip-width-slack must lie in [0, 0.1) m");
     if (!(opt.config.held_min_opening_m >= 0 && opt.config.held_min_opening_m < 0.1)) throw FlagError("--held-min-opening must lie in [0, 0.1) m");
+    static_assert(sv::GraspTargetParams{}.max_object_height_m == 0.35, "--grip-depth's message names the tallest object");
+    if (!(opt.config.grasp.grip_depth_m >= 0 && opt.config.grasp.grip_depth_m < opt.config.grasp.max_object_height_m))
+      throw FlagError("--grip-depth must lie in [0, 0.35) m (below the tallest object's top)");
     if (opt.config.views <= 0 || opt.config.views > 36) throw FlagError("--views must lie in [1, 36]");
     if (!(opt.config.view_step_deg > 0 && opt.config.view_step_deg <= 90)) throw FlagError("--view-step must lie in (0, 90] deg");
     if (opt.standing_view != "on" && opt.standing_view != "off") throw FlagError("--standing-view must be on or off");

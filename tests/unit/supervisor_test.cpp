@@ -2596,18 +2596,19 @@ TEST(Grasp, TheObjectsWidthAtTheGraspHeightComesFromItsMask) {
   EXPECT_FALSE(sv::object_width_at(scene, cv::Mat::zeros(still, CV_8U), foot, 0.05)) << "no mask";
 }
 
-// The fingers close 90 mm below the estimated top (below a bottle's shoulder, where its sides are
-// vertical), and no lower than half way up a short object.
+// The fingers close 65 mm below the estimated top (both rows of faces below a bottle's shoulder,
+// where its sides are vertical, and over as little of its label as that allows), and no lower
+// than half way up a short object.
 TEST(Grasp, TheFingersCloseBelowTheTopOnTheSidesNotOnTheCap) {
   const sv::GraspTargetParams params;
-  EXPECT_NEAR(sv::grip_height(0.20, params), 0.11, 1e-12);   // a 200 mm bottle: below its shoulder
-  EXPECT_NEAR(sv::grip_height(0.35, params), 0.26, 1e-12);
-  EXPECT_NEAR(sv::grip_height(0.12, params), 0.06, 1e-12);   // a can: half way up, not 30 mm
-  EXPECT_NEAR(sv::grip_height(0.18, params), 0.09, 1e-12);   // where the two rules meet
+  EXPECT_NEAR(sv::grip_height(0.20, params), 0.135, 1e-12);  // a 200 mm bottle: below its shoulder
+  EXPECT_NEAR(sv::grip_height(0.35, params), 0.285, 1e-12);
+  EXPECT_NEAR(sv::grip_height(0.12, params), 0.06, 1e-12);   // a can: half way up, not 55 mm
+  EXPECT_NEAR(sv::grip_height(0.13, params), 0.065, 1e-12);  // where the two rules meet
   sv::GraspTargetParams shallow = params;
   shallow.grip_depth_m = 0.01;
   EXPECT_NEAR(sv::grip_height(0.20, shallow), 0.19, 1e-12);
-  // Through grasp_target: a 250 mm top, seen by both cameras, is gripped 90 mm below its
+  // Through grasp_target: a 250 mm top, seen by both cameras, is gripped 65 mm below its
   // estimated (lowered) top.
   const sv::SceneGeometry scene = make_scene();
   const Eigen::Vector3d foot(0.28, -0.05, 0), top(0.28, -0.05, 0.25);
@@ -2615,7 +2616,8 @@ TEST(Grasp, TheFingersCloseBelowTheTopOnTheSidesNotOnTheCap) {
   const sv::GraspTarget g = sv::grasp_target(scene, *scene.project_left(top, still), *scene.project_right(top, still), still, foot);
   ASSERT_TRUE(g.ok()) << g.reason;
   EXPECT_NEAR(g.top_height_m, 0.25 - g.overestimate_m, 1e-6);
-  EXPECT_NEAR(g.grasp_height_m, g.top_height_m - 0.09, 1e-6);
+  EXPECT_NEAR(g.grasp_height_m, g.top_height_m - params.grip_depth_m, 1e-6);
+  EXPECT_NEAR(params.grip_depth_m, 0.065, 1e-12);
   EXPECT_LT(g.grasp_height_m, g.top_height_m);
 }
 

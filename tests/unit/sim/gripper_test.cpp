@@ -85,10 +85,11 @@ LiftTurnPlace lift_turn_place(const Scene& scene, double grasp, const Eigen::Vec
   return r;
 }
 
-void expect_lift_turn_place(const LiftTurnPlace& r, double bottle_diameter) {
+// `lift_slip`: how far the bottle may sink in the fingers while it is lifted 5 cm.
+void expect_lift_turn_place(const LiftTurnPlace& r, double bottle_diameter, double lift_slip = 0.003) {
   EXPECT_NEAR(r.closed_opening, bottle_diameter, 0.005) << "the fingers stop on the bottle";
   EXPECT_TRUE(r.held_throughout);
-  EXPECT_NEAR(r.lift, 0.05, 0.003);
+  EXPECT_NEAR(r.lift, 0.05, lift_slip);
   EXPECT_LT(r.turned_drop, 0.003);
   EXPECT_LT(r.worst_tilt, 3 * kDeg);
   EXPECT_LT(r.worst_lag, 2 * kDeg) << "the bottle turns with the wrist";
@@ -212,17 +213,19 @@ TEST(SimGripper, DeterministicAndRestoredStatesReplay) {
   EXPECT_NEAR(world.gripper_opening(), gripper_geometry().max_opening, 1e-9);
 }
 
-// Where the supervisor grips a bottle (supervisor/grasp.hpp, grip_height: 90 mm below its estimated
-// top, 183-200 mm for this 200 mm bottle, so 93-110 mm): on its vertical sides, below the shoulder.
-// Empty and half full, it is lifted, turned and put back without slipping. (Gripped at the cap,
-// 183-200 mm, the squeeze on the sloping hull of the shoulder and neck lets it slip 5-9 mm while
-// turning, more with a stronger grip: why the grip is not higher.)
+// Where the supervisor grips a bottle (supervisor/grasp.hpp, grip_height: 65 mm below its estimated
+// top, 170-194 mm in the learning runs for this 200 mm bottle, so 105-129 mm; 130 mm a little
+// beyond): the lower row of faces on its vertical sides, the upper row at the start of the
+// shoulder. Empty and half full, it is lifted, turned and put back. Gripped this high it sinks up
+// to 4-5 mm in the fingers while lifted (under 1 mm at 93-110 mm), then holds while turning.
+// (Gripped at the cap, 183-200 mm, the squeeze on the sloping hull of the shoulder and neck lets it
+// slip 5-9 mm while turning, more with a stronger grip: why the grip is not higher.)
 TEST(SimGripper, HoldsABottleWhereTheSupervisorGripsIt) {
   for (double fill : {0.0, 0.5})
-    for (double grip : {0.093, 0.110}) {
+    for (double grip : {0.105, 0.120, 0.130}) {
       Scene scene = one_object("bottle");
       scene.objects[0].fill = fill;
       SCOPED_TRACE("fill " + std::to_string(fill) + ", tool point at " + std::to_string(grip) + " m");
-      expect_lift_turn_place(lift_turn_place(scene, grip, Eigen::Vector2d(0.002, -0.002), 10 * kDeg), 0.07);
+      expect_lift_turn_place(lift_turn_place(scene, grip, Eigen::Vector2d(0.002, -0.002), 10 * kDeg), 0.07, 0.006);
     }
 }

@@ -23,10 +23,14 @@ struct GraspTargetParams {
   // middle value (36 mm at 30 deg: +-18 mm tolerance, which its foam pads exceed).
   double top_radius_m = 0.06;
   // The tool point (the middle of the fingers, which span +-19 mm) this far below the estimated
-  // top: a bottle's top 75 mm narrow to the neck and cap (sim bottle: vertical sides up to 125 of
-  // its 200 mm), and a grip there slips out (the gripper test measures it); the thesis' foam pads
-  // gripped whatever they met.
-  double grip_depth_m = 0.09;
+  // top. High enough that the fingers hide little of what the object shows (sim bottle: label at
+  // 30-120 mm of its 200 mm), low enough that both rows of faces close on vertical sides: a
+  // bottle's top 75 mm narrow to the neck and cap, and a grip there slips out (the gripper test
+  // measures both). The estimated tops of the learning runs lay 6-30 mm below the true 200 mm, so
+  // the tool point lands at 105-129 mm, the lower row on the body, the fingers over the label's top
+  // 15-20 mm (at 90 mm below they covered its upper half); the thesis' foam pads gripped whatever
+  // they met.
+  double grip_depth_m = 0.065;
   double min_grip_fraction = 0.5;  // a short object is gripped no lower than this part of its height
   double min_grasp_height_m = 0.03;  // the fingers never close lower (the table)
   double max_object_height_m = 0.35; // a taller triangulated top is a mismatch, not an object
