@@ -341,14 +341,20 @@ std::vector<cv::DMatch> geometric_inliers(const std::vector<cv::DMatch>& matches
   // A label seen at another tilt (a bottle lying down, seen from above) is foreshortened along one
   // direction: an affine map (3 matches fix it) explains it where a similarity cannot. Mirrored or
   // nearly collapsed maps are no view of a surface.
+  // Whether a homography is worth its RANSAC (2000 draws of four matches, ~10 ms on a view of
+  // chance matches, most of a recognition's time): only when an affine map already puts enough
+  // matches in place. A label is a small patch of the view, where a true homography is close to
+  // affine; chance matches rarely fit either.
+  bool homography_worth_trying = static_cast<int>(matches.size()) >= kHomographyMinMatches;
   if (params.affine_check && static_cast<int>(matches.size()) >= kAffineMinMatches) {
     const cv::Mat a = cv::estimateAffine2D(from, to, mask, cv::RANSAC, ransac_px, 2000, 0.995);
+    homography_worth_trying = homography_worth_trying && !a.empty() && cv::countNonZero(mask) >= 4 + min_support;
     if (!a.empty() && plausible_view_map(a(cv::Rect(0, 0, 2, 2)))) {
       auto inliers = agreeing_inliers(matches, mask, a, query, view, params.keypoint_agreement);
       if (static_cast<int>(inliers.size()) >= 3 + min_support && inliers.size() > best.size()) best = std::move(inliers);
     }
   }
-  if (static_cast<int>(matches.size()) >= kHomographyMinMatches) {
+  if (homography_worth_trying) {
     const cv::Mat h = cv::findHomography(from, to, cv::RANSAC, ransac_px, mask, 2000, 0.995);
     // A mirrored or collapsed mapping is not a view of a surface.
     if (!h.empty() && cv::determinant(h(cv::Rect(0, 0, 2, 2))) > 1e-4) {
