@@ -338,14 +338,14 @@ std::vector<cv::DMatch> geometric_inliers(const std::vector<cv::DMatch>& matches
   std::vector<uchar> mask;
   auto similar = similarity_inliers(matches, query, view, params);
   if (static_cast<int>(similar.size()) >= 2 + min_support) best = std::move(similar);
+  // Whether a homography is worth its RANSAC (2000 draws of four matches, ~10 ms on a view of
+  // chance matches, most of a recognition's time): with the affine check on, only when an affine
+  // map already puts enough matches in place. A label is a small patch of the view, where a true
+  // homography is close to affine; chance matches rarely fit either.
+  bool homography_worth_trying = static_cast<int>(matches.size()) >= kHomographyMinMatches;
   // A label seen at another tilt (a bottle lying down, seen from above) is foreshortened along one
   // direction: an affine map (3 matches fix it) explains it where a similarity cannot. Mirrored or
   // nearly collapsed maps are no view of a surface.
-  // Whether a homography is worth its RANSAC (2000 draws of four matches, ~10 ms on a view of
-  // chance matches, most of a recognition's time): only when an affine map already puts enough
-  // matches in place. A label is a small patch of the view, where a true homography is close to
-  // affine; chance matches rarely fit either.
-  bool homography_worth_trying = static_cast<int>(matches.size()) >= kHomographyMinMatches;
   if (params.affine_check && static_cast<int>(matches.size()) >= kAffineMinMatches) {
     const cv::Mat a = cv::estimateAffine2D(from, to, mask, cv::RANSAC, ransac_px, 2000, 0.995);
     homography_worth_trying = homography_worth_trying && !a.empty() && cv::countNonZero(mask) >= 4 + min_support;
