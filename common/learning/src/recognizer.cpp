@@ -186,13 +186,13 @@ bool within_agreement(double turn_off, double log_scale_off, const AgreementBoun
 // these for the same reason). A chance match whose position happens to fit a mapping rarely fits
 // its orientation and scale as well, so a few such matches no longer make a recognition.
 bool keypoint_agrees(const cv::Matx22d& linear_at_train, const cv::KeyPoint& train, const cv::KeyPoint& query,
-                     const KeypointAgreement& tolerance) {
+                     const AgreementBounds& bounds) {
   const ViewFrame t = view_frame(train);
   const cv::Vec2d turned = linear_at_train * cv::Vec2d(std::cos(t.angle), std::sin(t.angle));
   const double off = query.angle * CV_PI / 180 - std::atan2(turned[1], turned[0]);
   const double scale = std::sqrt(std::abs(cv::determinant(linear_at_train)));
   if (!(scale > 0) || t.size <= 0 || query.size <= 0) return false;
-  return within_agreement(off, std::log(query.size / (t.size * scale)), AgreementBounds(tolerance));
+  return within_agreement(off, std::log(query.size / (t.size * scale)), bounds);
 }
 
 // The inliers of `map` whose keypoints also agree with it (keypoint_agrees); all of them when the
@@ -200,11 +200,12 @@ bool keypoint_agrees(const cv::Matx22d& linear_at_train, const cv::KeyPoint& tra
 std::vector<cv::DMatch> agreeing_inliers(const std::vector<cv::DMatch>& matches, const std::vector<uchar>& mask,
                                          const cv::Mat& map, const Features& query, const Features& view,
                                          const KeypointAgreement& agreement) {
+  const AgreementBounds bounds(agreement);
   std::vector<cv::DMatch> out;
   for (size_t i = 0; i < matches.size(); ++i) {
     if (!mask[i]) continue;
     const cv::KeyPoint& t = view.keypoints[matches[i].trainIdx];
-    if (agreement.on && !keypoint_agrees(local_linear(map, t.pt), t, query.keypoints[matches[i].queryIdx], agreement))
+    if (agreement.on && !keypoint_agrees(local_linear(map, t.pt), t, query.keypoints[matches[i].queryIdx], bounds))
       continue;
     out.push_back(matches[i]);
   }
