@@ -793,6 +793,8 @@ int main(int argc, char** argv) {
   flags.add_double("colour-tolerance", &o.recognize.colour_tolerance,
                    "the ratio test by colour: chromaticity distance a candidate may be off the query keypoint's; 0 off");
   flags.add_double("ransac-px", &o.recognize.ransac_px, "the geometric check's inlier distance, pixels");
+  flags.add_double("distinct-place-px", &o.recognize.distinct_place_px,
+                   "matches whose training keypoints lie within this many pixels are one place of the label (0: each match one)");
   flags.add_int("min-support", &o.recognize.min_support, "matches agreeing with a mapping beyond those that fixed it");
   std::string root_sift = o.recognize.root_sift ? "on" : "off";
   flags.add_string("root-sift", &root_sift, "on|off: match RootSIFT descriptors (Hellinger distance)");

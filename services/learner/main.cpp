@@ -20,6 +20,8 @@ int main(int argc, char** argv) {
     f.add_double("colour-tolerance", &options.recognize.colour_tolerance,
                  "recognition's ratio test by colour: a candidate's chromaticity within this of the query keypoint's; 0 off (docs/learning.md)");
     f.add_double("ransac-px", &options.recognize.ransac_px, "geometric check: inlier distance, pixels");
+    f.add_double("distinct-place-px", &options.recognize.distinct_place_px,
+                 "geometric check: matches whose training keypoints lie within this many pixels are one place; a mapping needs 4 places (0: each match one)");
     f.add_double("box-margin", &options.learn.box_margin, "training box grown by this fraction each side");
     f.add_int("background-matches", &options.learn.background_matches,
               "a descriptor matching this many other views is background (thesis 3)");

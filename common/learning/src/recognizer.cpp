@@ -318,6 +318,22 @@ std::vector<cv::DMatch> similarity_inliers(const std::vector<cv::DMatch>& matche
   return out;
 }
 
+// How many distinct places of the training view `matches` show: greedy clusters of their training
+// keypoints, a keypoint joining the first cluster whose seed lies within `radius_px` of it.
+int distinct_places(const std::vector<cv::DMatch>& matches, const Features& view, double radius_px) {
+  if (radius_px <= 0) return static_cast<int>(matches.size());
+  std::vector<cv::Point2f> seeds;
+  for (const auto& m : matches) {
+    const cv::Point2f p = view.keypoints[m.trainIdx].pt;
+    const bool near_seed = std::any_of(seeds.begin(), seeds.end(), [&](const cv::Point2f& s) {
+      const cv::Point2f d = p - s;
+      return d.dot(d) < radius_px * radius_px;
+    });
+    if (!near_seed) seeds.push_back(p);
+  }
+  return static_cast<int>(seeds.size());
+}
+
 // The largest set of matches one mapping of the training view onto the query explains: a
 // similarity (rotation, scale, shift: 2 matches fix it) or, with enough matches, a homography (4
 // fix it); every match of the set also agrees with the mapping in its keypoints' orientation and
@@ -337,8 +353,14 @@ std::vector<cv::DMatch> geometric_inliers(const std::vector<cv::DMatch>& matches
   }
   std::vector<cv::DMatch> best;
   std::vector<uchar> mask;
+  // A mapping fixed by `fixing` matches counts when `min_support` more agree, and its inliers lie at
+  // as many distinct places as a similarity needs (the fewest any mapping needs).
+  auto enough = [&](const std::vector<cv::DMatch>& inliers, int fixing) {
+    return static_cast<int>(inliers.size()) >= fixing + min_support &&
+           distinct_places(inliers, view, params.distinct_place_px) >= 2 + min_support;
+  };
   auto similar = similarity_inliers(matches, query, view, params);
-  if (static_cast<int>(similar.size()) >= 2 + min_support) best = std::move(similar);
+  if (enough(similar, 2)) best = std::move(similar);
   // Whether a homography is worth its RANSAC (2000 draws of four matches, ~10 ms on a view of
   // chance matches, most of a recognition's time): with the affine check on, only when an affine
   // map already puts enough matches in place. A label is a small patch of the view, where a true
@@ -352,7 +374,7 @@ std::vector<cv::DMatch> geometric_inliers(const std::vector<cv::DMatch>& matches
     homography_worth_trying = homography_worth_trying && !a.empty() && cv::countNonZero(mask) >= 4 + min_support;
     if (!a.empty() && plausible_view_map(a(cv::Rect(0, 0, 2, 2)))) {
       auto inliers = agreeing_inliers(matches, mask, a, query, view, params.keypoint_agreement);
-      if (static_cast<int>(inliers.size()) >= 3 + min_support && inliers.size() > best.size()) best = std::move(inliers);
+      if (enough(inliers, 3) && inliers.size() > best.size()) best = std::move(inliers);
     }
   }
   if (homography_worth_trying) {
@@ -360,7 +382,7 @@ std::vector<cv::DMatch> geometric_inliers(const std::vector<cv::DMatch>& matches
     // A mirrored or collapsed mapping is not a view of a surface.
     if (!h.empty() && cv::determinant(h(cv::Rect(0, 0, 2, 2))) > 1e-4) {
       auto inliers = agreeing_inliers(matches, mask, h, query, view, params.keypoint_agreement);
-      if (static_cast<int>(inliers.size()) >= 4 + min_support && inliers.size() > best.size()) best = std::move(inliers);
+      if (enough(inliers, 4) && inliers.size() > best.size()) best = std::move(inliers);
     }
   }
   return best;
@@ -408,6 +430,9 @@ Recognizer::Recognizer(const RecognizeParams& params)
   if (!(params.colour_tolerance >= 0))
     throw std::invalid_argument("RecognizeParams::colour_tolerance must be >= 0, not " +
                                 std::to_string(params.colour_tolerance));
+  if (!(params.distinct_place_px >= 0))
+    throw std::invalid_argument("RecognizeParams::distinct_place_px must be >= 0, not " +
+                                std::to_string(params.distinct_place_px));
   if (agreement.on && !(agreement.scale_factor >= 1))
     throw std::invalid_argument("RecognizeParams::keypoint_agreement.scale_factor must be >= 1, not " +
                                 std::to_string(agreement.scale_factor));

@@ -527,6 +527,16 @@ TEST(LearningRecognizer, BadSettingsAndBadModelsAreRefusedByName) {
     p.keypoint_agreement.on = false;  // off: its tolerances are not used
     EXPECT_NO_THROW(Recognizer{p});
   }
+  for (double radius : {-1.0, std::nan("")}) {
+    RecognizeParams p = params;
+    p.distinct_place_px = radius;
+    try {
+      Recognizer r(p);
+      ADD_FAILURE() << "distinct place radius " << radius << " accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("distinct_place_px"), std::string::npos) << e.what();
+    }
+  }
   for (double tolerance : {-0.1, std::nan("")}) {
     RecognizeParams p = params;
     p.colour_tolerance = tolerance;
@@ -816,6 +826,44 @@ TEST(LearningRecognizer, AHomographyStillVerifiesALabelSeenInStrongPerspective) 
   ASSERT_TRUE(with_gate.recognised()) << with_gate.reason;
   EXPECT_GE(with_gate.scores[0].verified_matches, seen.size() * 8 / 10);
   EXPECT_GE(with_gate.scores[0].verified_matches, without_gate.scores[0].verified_matches);
+}
+
+// Matches at one small place of the label are one piece of evidence, however many keypoints SIFT
+// finds there (the scales and corners of one mark). A scene that shares only such a mark with the
+// label (a 32 px square of it, around the view's densest cluster of keypoints, pasted into another
+// texture) is not the object; a few matches at places of the label 25 px apart are.
+TEST(LearningRecognizer, MatchesAtOnePlaceOfTheLabelDoNotMakeARecognition) {
+  const auto model = learned("red", 10, 20);
+  const Features& view = model->views[2].features;
+  int densest = 0, most = -1;
+  for (int i = 0; i < view.size(); ++i) {
+    int near = 0;
+    for (const auto& k : view.keypoints) near += cv::norm(k.pt - view.keypoints[i].pt) < 8;
+    if (near > most) {
+      most = near;
+      densest = i;
+    }
+  }
+  const cv::Point centre(view.keypoints[densest].pt);
+  const cv::Rect mark = cv::Rect(centre.x - 16, centre.y - 16, 32, 32) & cv::Rect(cv::Point(), model->views[2].image.size());
+  cv::Mat scene = synthetic::random_texture({640, 480}, 77);
+  model->views[2].image(mark).copyTo(scene(cv::Rect(cv::Point(300, 200), mark.size())));
+  RecognizeParams every_match_a_place;
+  every_match_a_place.distinct_place_px = 0;
+  Recognizer by_places, by_matches(every_match_a_place);
+  by_places.add(model);
+  by_matches.add(model);
+  const Recognition counted_by_matches = by_matches.recognize(scene);
+  ASSERT_TRUE(counted_by_matches.recognised()) << "the mark alone gives a recognition when every match counts";
+  EXPECT_FALSE(by_places.recognize(scene).recognised());
+  // Six features of the view, 25 px or more apart, where a similarity puts them.
+  const double turn = 0.3;
+  const cv::Matx23d similarity(std::cos(turn), -std::sin(turn), 250, std::sin(turn), std::cos(turn), 60);
+  const Features spread = spread_features_mapped(view, similarity, 6);
+  ASSERT_EQ(spread.size(), 6);
+  const Recognition six_places = by_places.recognize(spread);
+  ASSERT_TRUE(six_places.recognised()) << six_places.reason;
+  EXPECT_EQ(six_places.scores[0].verified_matches, by_matches.recognize(spread).scores[0].verified_matches);
 }
 
 // Matches whose places fit a mapping but whose keypoints do not turn or scale with it are chance:
