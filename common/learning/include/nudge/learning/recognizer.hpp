@@ -45,9 +45,10 @@ struct RecognizeParams {
   double ransac_px = 6.0;       // reprojection error an inlier may have, pixels
   // Matches whose training keypoints lie within this many pixels of one another show one place of
   // the label (SIFT finds several keypoints at the scales and corners of one small mark): a
-  // mapping counts only when its inliers hold as many distinct places as it needs matches. A
-  // cluster of keypoints on one shared mark (a letter of the same font, a line's corner) otherwise
-  // verifies any object carrying that mark. 0: every match is a place of its own.
+  // mapping counts only when its inliers lie at 2 + min_support distinct places or more (what a
+  // similarity needs in matches). A cluster of keypoints on one shared mark (a letter of the same
+  // font, a line's corner) otherwise verifies any object carrying that mark. 0: every match is a
+  // place of its own.
   double distinct_place_px = 10.0;
   KeypointAgreement keypoint_agreement;  // and the keypoints' orientation and scale must fit it too
   // The ratio test by colour as well: a training keypoint whose mean colour's chromaticity lies
