@@ -658,6 +658,8 @@ void add_flags(Flags& f, Options& o) {
                "of the lines near a still's predicted object line: the strongest (most votes) or the nearest");
   f.add_double("min-mask-mirror", &o.config.min_mask_mirror_agreement,
                "a mask that agrees less with its own mirror image about the object's line (IoU) is no segmentation (0: any)");
+  f.add_double("min-mask-side-edges", &o.config.min_mask_side_edges,
+               "a mask with a side on an edge of the after still in fewer than this share of its rows is no segmentation (0: any)");
   f.add_double("snapshot-timeout", &o.config.snapshot_timeout_s, "for a still, s of the task clock");
   f.add_double("snapshot-retry", &o.config.snapshot_retry_s, "a still not come within this many s of the task clock is asked for again (a lost UDP fragment loses it)");
   f.add_double("candidates-timeout", &o.config.candidates_timeout_s, "for a CANDIDATES answer, s of the task clock");
@@ -786,6 +788,8 @@ int main(int argc, char** argv) {
       throw FlagError("--max-object-half-width must lie in [0, 0.5] m");
     if (!(opt.config.min_mask_mirror_agreement >= 0 && opt.config.min_mask_mirror_agreement <= 1))
       throw FlagError("--min-mask-mirror must lie in [0, 1]");
+    if (!(opt.config.min_mask_side_edges >= 0 && opt.config.min_mask_side_edges <= 1))
+      throw FlagError("--min-mask-side-edges must lie in [0, 1]");
     if (!(opt.config.grip_width_low >= 0 && opt.config.grip_width_low < 1)) throw FlagError("--grip-width-low must lie in [0, 1)");
     if (!(opt.config.grip_width_high == 0 || (opt.config.grip_width_high > 1 && opt.config.grip_width_high < 10)))
       throw FlagError("--grip-width-high must be 0 (no check) or lie in (1, 10)");

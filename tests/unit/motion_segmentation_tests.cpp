@@ -573,6 +573,45 @@ TEST(MirrorAgreement, BadMasksAreNamed) {
   EXPECT_THROW(mirror_agreement(cv::Mat::zeros(10, 10, CV_8UC3), line_at(0, 0)), std::invalid_argument);
 }
 
+// A mask cut about the right line runs along the object's outline on both sides; one cut about a
+// line through the object's left part (symmetric about that line, as the filling makes it) ends
+// inside the object on its right, where the image has no edge.
+TEST(SideEdgeSupport, AMasksSidesFollowTheObjectsOutlineOnlyWhenItIsTheObject) {
+  cv::Mat image(480, 640, CV_8UC3, cv::Scalar(150, 170, 190));  // a plain table
+  cv::rectangle(image, cv::Rect(340, 120, 121, 240), cv::Scalar(40, 40, 200), cv::FILLED);  // a red cup, x 340..460
+  cv::Mat whole = cv::Mat::zeros(image.size(), CV_8U);
+  whole(cv::Rect(340, 120, 121, 240)).setTo(255);
+  EXPECT_GT(side_edge_support(whole, image), 0.95);
+  // About x = 370 instead of the cup's 400: from its left edge to 60 px inside it.
+  cv::Mat half = cv::Mat::zeros(image.size(), CV_8U);
+  half(cv::Rect(340, 120, 61, 240)).setTo(255);
+  EXPECT_LT(side_edge_support(half, image), 0.1);
+  // Spilling 30 px past both sides onto the plain table: no edge on either side.
+  cv::Mat spilled = cv::Mat::zeros(image.size(), CV_8U);
+  spilled(cv::Rect(310, 120, 181, 240)).setTo(255);
+  EXPECT_LT(side_edge_support(spilled, image), 0.1);
+  // An outline between two colours of one brightness is an edge too; a grey image works alike.
+  cv::Mat isoluminant(480, 640, CV_8UC3, cv::Scalar(0, 128, 0));
+  cv::rectangle(isoluminant, cv::Rect(340, 120, 121, 240), cv::Scalar(0, 0, 255), cv::FILLED);
+  cv::Mat luminance;
+  cv::cvtColor(isoluminant, luminance, cv::COLOR_BGR2GRAY);
+  ASSERT_LT(std::abs(luminance.at<uint8_t>(10, 10) - luminance.at<uint8_t>(240, 400)), 3) << "the two colours are one grey";
+  EXPECT_GT(side_edge_support(whole, isoluminant), 0.95);
+  cv::Mat grey;
+  cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
+  EXPECT_GT(side_edge_support(whole, grey), 0.95);
+  EXPECT_LT(side_edge_support(half, grey), 0.1);
+}
+
+TEST(SideEdgeSupport, BadInputsAreNamed) {
+  const cv::Mat image(48, 64, CV_8UC3, cv::Scalar(0));
+  EXPECT_EQ(side_edge_support(cv::Mat::zeros(48, 64, CV_8U), image), 0.0);
+  EXPECT_THROW(side_edge_support(cv::Mat(), image), std::invalid_argument);
+  EXPECT_THROW(side_edge_support(cv::Mat::zeros(48, 64, CV_8UC3), image), std::invalid_argument);
+  EXPECT_THROW(side_edge_support(cv::Mat::zeros(48, 64, CV_8U), cv::Mat(48, 65, CV_8UC3)), std::invalid_argument);
+  EXPECT_THROW(side_edge_support(cv::Mat::zeros(48, 64, CV_8U), cv::Mat(48, 64, CV_32F)), std::invalid_argument);
+}
+
 TEST(KeepNearLine, MotionBeyondTheWidestHalfWidthIsCleared) {
   // An object about x = 400 (R = 80.5, theta = 0) 120 px wide, and a neighbour that moved with it
   // joined to its right side (x 460..560).

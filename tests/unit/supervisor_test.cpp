@@ -67,12 +67,18 @@ struct Shape {
   double height = 0.12, half_width = 0.035;
   bool grey = false;  // shades of grey: edges for the detector, no colour for a mask of coloured pixels
 };
-cv::Mat draw_scene(const sv::SceneGeometry& scene, cv::Size size, const std::vector<Eigen::Vector3d>& objects,
-                   bool left = false, const std::vector<Shape>& shapes = {}) {
+// The textured table every drawn scene stands on (the same for every image of a size).
+cv::Mat drawn_background(cv::Size size) {
   cv::Mat image(size, CV_8UC3);
   cv::RNG rng(7);
   rng.fill(image, cv::RNG::UNIFORM, 90, 110);
   cv::GaussianBlur(image, image, cv::Size(5, 5), 0);
+  return image;
+}
+
+cv::Mat draw_scene(const sv::SceneGeometry& scene, cv::Size size, const std::vector<Eigen::Vector3d>& objects,
+                   bool left = false, const std::vector<Shape>& shapes = {}) {
+  cv::Mat image = drawn_background(size);
   const Eigen::Vector3d across = Eigen::Vector3d(0, 1, 0);
   for (size_t k = 0; k < objects.size(); ++k) {
     const Eigen::Vector3d& foot = objects[k];
@@ -109,6 +115,15 @@ sv::Segmentation mask_of_difference(const cv::Mat& before, const cv::Mat& after,
   cv::threshold(grey, s.mask, 40, 255, cv::THRESH_BINARY);
   s.mask |= nudge::segmentation::mirror_image(s.mask, after_line);
   return s;
+}
+
+// The supervisor's defaults, but for the check that a mask's sides follow the after still's edges
+// (Config::min_mask_side_edges): mask_of_difference's masks span the object's places before and
+// after the push, beyond its outline in the after still. The check's own test turns it on.
+sv::Config drawn_config() {
+  sv::Config config;
+  config.min_mask_side_edges = 0;
+  return config;
 }
 
 // `line` turned by `degrees` about the middle of its support segment (a line a label leans).
@@ -166,7 +181,7 @@ class SupervisorTest : public ::testing::Test {
  protected:
   SupervisorTest() : scene_(make_scene()) {}
 
-  sv::Supervisor make(sv::Config config = {}) {
+  sv::Supervisor make(sv::Config config = drawn_config()) {
     return sv::Supervisor(config, scene_, sv::ArmSetup{}, mask_of_difference);
   }
 
@@ -336,8 +351,8 @@ class SupervisorTest : public ::testing::Test {
     return ended[0].attempt;
   }
   // One attempt on the object at (0.28, -0.05) whose stills `segment` segments: how it ended.
-  sv::Attempt attempt_segmented_by(const sv::SegmentFunction& segment) {
-    sv::Supervisor s(sv::Config{}, scene_, sv::ArmSetup{}, segment);
+  sv::Attempt attempt_segmented_by(const sv::SegmentFunction& segment, const sv::Config& config = drawn_config()) {
+    sv::Supervisor s(config, scene_, sv::ArmSetup{}, segment);
     const Eigen::Vector3d rest = nudge_and_park(s, Eigen::Vector3d(0.28, -0.05, 0));
     EXPECT_EQ(s.state(), sv::State::SnapshotAfter);
     s.on_right_still(draw_scene(scene_, {1280, 960}, {rest}), now_, now_);
@@ -880,7 +895,7 @@ TEST_F(SupervisorTest, APushClearingOnlyAShortObjectIsMadeWhenTheStillMeasuresIt
                                         arm_state_joints(), sv::TargetParams{});
   ASSERT_TRUE(choice.found);
   ASSERT_GT(choice.height_limit, 0.135);  // the drawn object, 0.12 m, and a margin of 5 mm fit under it
-  sv::Config config;
+  sv::Config config = drawn_config();
   config.height.margin_m = 0.005;
   sv::Supervisor s(config, scene_, sv::ArmSetup{}, mask_of_difference);
   start_with(s, {kLeanedWristNearTallObject});
@@ -895,7 +910,7 @@ TEST_F(SupervisorTest, APushClearingOnlyAShortObjectIsMadeWhenTheStillMeasuresIt
 }
 
 TEST_F(SupervisorTest, APushClearingOnlyAShortObjectIsRefusedWhenTheStillMeasuresItTaller) {
-  sv::Config config;
+  sv::Config config = drawn_config();
   config.height.margin_m = 0.2;  // as if the object were 0.32 m tall
   sv::Supervisor s(config, scene_, straight_down_arm(), mask_of_difference);
   start_with(s, {kWristNearTallObject});
@@ -909,7 +924,7 @@ TEST_F(SupervisorTest, APushClearingOnlyAShortObjectIsRefusedWhenTheStillMeasure
   ASSERT_TRUE(ended[0].attempt->measured_height);
   EXPECT_NEAR(*ended[0].attempt->measured_height, 0.12, 0.006);
   // Not measured at all (nothing symmetric where it stands): refused too, with its reason.
-  sv::Supervisor blind(sv::Config{}, scene_, straight_down_arm(), mask_of_difference);
+  sv::Supervisor blind(drawn_config(), scene_, straight_down_arm(), mask_of_difference);
   start_with(blind, {kWristNearTallObject});
   blind.on_right_still(draw_scene(scene_, {1280, 960}, {}), now_, now_);
   ended = outputs_of<sv::AttemptEnded>(blind.take_outputs());
@@ -919,7 +934,7 @@ TEST_F(SupervisorTest, APushClearingOnlyAShortObjectIsRefusedWhenTheStillMeasure
 }
 
 TEST_F(SupervisorTest, SegmentsTheObjectThenFindsNothingLeftToNudge) {
-  sv::Config with_trackers;
+  sv::Config with_trackers = drawn_config();
   with_trackers.track = true;
   sv::Supervisor s = make(with_trackers);
   const Eigen::Vector3d object(0.28, -0.05, 0);
@@ -1012,7 +1027,7 @@ TEST_F(SupervisorTest, NoCandidateAtAllEndsTheRunWithItsReason) {
 // upright, before the run ends (a lone bottle whose label leans its line past the service's 2 deg);
 // what the second look finds is nudged.
 TEST_F(SupervisorTest, AnEmptySurveyIsAskedOnceMoreWithWiderLinesBeforeTheRunEnds) {
-  sv::Config config;
+  sv::Config config = drawn_config();
   config.wide_survey_tilt_deg = 5;
   for (bool found_later : {false, true}) {
     sv::Supervisor s = make(config);
@@ -1208,7 +1223,7 @@ TEST_F(SupervisorTest, ADoubtfulLeanWhoseMaskShowsNoBaseIsTipped) {
   for (const Case& c : {Case{11, false, sv::Outcome::Tipped}, Case{11, true, sv::Outcome::Segmented},
                         Case{3, false, sv::Outcome::Segmented}}) {
     SCOPED_TRACE(std::to_string(c.tilt_deg) + (c.base ? " deg, with a base" : " deg, no base"));
-    const auto a = attempt(sv::Config{}, c.base, c.tilt_deg);
+    const auto a = attempt(drawn_config(), c.base, c.tilt_deg);
     ASSERT_TRUE(a);
     EXPECT_EQ(a->outcome, c.outcome) << a->reason;
     EXPECT_EQ(a->rest_from_mask.has_value(), c.base) << "the base gives the mask's foot";
@@ -1217,7 +1232,7 @@ TEST_F(SupervisorTest, ADoubtfulLeanWhoseMaskShowsNoBaseIsTipped) {
     }
   }
   // Off, the doubtful lean is segmented as before.
-  sv::Config off;
+  sv::Config off = drawn_config();
   off.doubtful_tilt_deg = 0;
   const auto a = attempt(off, false, 11);
   ASSERT_TRUE(a);
@@ -1247,7 +1262,7 @@ TEST_F(SupervisorTest, AHiddenBaseVouchesForADoubtfulLeanOnlyOfATargetTheSurveyC
   };
   auto attempt = [&](int frames_seen_of_10) -> std::shared_ptr<const sv::Attempt> {
     behind_and_front.reset();
-    sv::Supervisor s(sv::Config{}, scene_, sv::ArmSetup{}, segment);
+    sv::Supervisor s(drawn_config(), scene_, sv::ArmSetup{}, segment);
     // First the object in front: nudged, segmented, known where it rests.
     const Eigen::Vector3d found = Eigen::Vector3d(0.22, -0.10, 0) + 0.10 * towards;
     const sv::NudgeCommand first_nudge = nudge_command_for(s, found, front_shape);
@@ -1305,7 +1320,7 @@ TEST_F(SupervisorTest, AnObjectNoSettledAxisPlacedIsFoundAsANewLineAlongThePush)
   const Eigen::Vector3d object(0.28, -0.05, 0);
   for (const bool from_still : {true, false}) {
     SCOPED_TRACE(from_still ? "rest from the still" : "no rest from the still");
-    sv::Config config;
+    sv::Config config = drawn_config();
     config.rest_from_still = from_still;
     sv::Supervisor s = make(config);
     const sv::NudgeCommand nudge = nudge_command_for(s, object);
@@ -1333,7 +1348,7 @@ TEST_F(SupervisorTest, AnObjectNoSettledAxisPlacedIsFoundAsANewLineAlongThePush)
 // tipped over, is not taken for it.
 TEST_F(SupervisorTest, ANeighbourStandingAlongThePushIsNotTakenForAnObjectNoSettledAxisPlaced) {
   const Eigen::Vector3d object(0.28, -0.05, 0);
-  sv::Config config;
+  sv::Config config = drawn_config();
   config.push_travel_m = 0.09;  // where the neighbour stands, clear of the object
   sv::Supervisor s = make(config);
   const auto [nudge, neighbour] = nudge_command_with_neighbour_along(s, config, object, config.push_travel_m);
@@ -1355,7 +1370,7 @@ TEST_F(SupervisorTest, AxesOfFramesTakenWhileTheObjectSettledAreIgnoredHoweverLa
   ASSERT_EQ(s.state(), sv::State::Track);
   const int64_t arm_done = now_;
   const int64_t lag = 7 * kSecond / 10;
-  const sv::Config config;
+  const sv::Config config = drawn_config();
   while (s.state() == sv::State::Track && now_ < arm_done + 3 * kSecond) {
     now_ += kSecond / 10;
     const int64_t taken = now_ - lag;
@@ -1402,7 +1417,7 @@ TEST_F(SupervisorTest, ALaggingPipelineIsWaitedForNotTakenForATippedObjectOrAPha
 // upright axis in the settling second: the settling goes on, up to max_settle_s, and its axes
 // found then place it. Without them by then it is tipped or lost.
 TEST_F(SupervisorTest, AnAxisHiddenPastTheSettlingTimeIsWaitedForUpToTheLongestSettling) {
-  const sv::Config config;
+  const sv::Config config = drawn_config();
   for (const double hidden_s : {2.5, config.max_settle_s + 0.5}) {
     SCOPED_TRACE("axes hidden for " + std::to_string(hidden_s) + " s");
     sv::Supervisor s = make();
@@ -1438,7 +1453,7 @@ TEST_F(SupervisorTest, AxesThatNeverComeEndTheAttemptAfterTheLagLimit) {
   const sv::NudgeCommand nudge = nudge_command_for(s, object);
   play_nudge(s, nudge.seq, object, object + 0.03 * nudge.direction);
   const int64_t arm_done = now_;
-  const sv::Config config;
+  const sv::Config config = drawn_config();
   while (s.state() == sv::State::Track && now_ < arm_done + 30 * kSecond) s.on_time(now_ += kSecond / 10);
   const auto ended = outputs_of<sv::AttemptEnded>(s.take_outputs());
   ASSERT_EQ(ended.size(), 1u);
@@ -1725,7 +1740,7 @@ std::vector<sv::Output> SupervisorTest::slide_without_symmetry(sv::Supervisor& s
 }
 
 TEST_F(SupervisorTest, WhatTheTrackersSawDecidesNotTheSettledAxes) {
-  sv::Config with_trackers;
+  sv::Config with_trackers = drawn_config();
   with_trackers.track = true;
   sv::Supervisor s = make(with_trackers);
   const auto out = slide_without_symmetry(s);  // AXES would say "fine": the trackers decide
@@ -1741,7 +1756,7 @@ TEST_F(SupervisorTest, WhatTheTrackersSawDecidesNotTheSettledAxes) {
 // Traced only, the same trackers are watched (their per-frame states kept for the report's plot)
 // while the settled AXES decide: the attempt goes on to the after still.
 TEST_F(SupervisorTest, TracedTrackersAreKeptButTheSettledAxesDecide) {
-  sv::Config traced;
+  sv::Config traced = drawn_config();
   traced.track_trace = true;
   sv::Supervisor s = make(traced);
   const auto out = slide_without_symmetry(s);
@@ -1768,7 +1783,7 @@ TEST_F(SupervisorTest, MotionFarAboveTheObjectIsNotKeptInItsMask) {
     s.mask(cv::Rect(600, 10, 80, 60)).setTo(255);
     return s;
   };
-  sv::Supervisor s(sv::Config{}, scene_, sv::ArmSetup{}, with_arm);
+  sv::Supervisor s(drawn_config(), scene_, sv::ArmSetup{}, with_arm);
   const Eigen::Vector3d object(0.28, -0.05, 0);
   const Eigen::Vector3d rest = nudge_and_park(s, object);
   ASSERT_EQ(s.state(), sv::State::SnapshotAfter);
@@ -1806,7 +1821,7 @@ TEST_F(SupervisorTest, MotionBesideTheObjectBeyondTheWidestObjectIsNotKeptInItsM
   EXPECT_GT(a.mask_pixels_beside, 200 * neighbour.height) << "the cleared pixels are counted";
 
   // Turned off, the neighbour stays, and the mask is too lopsided to be an object's.
-  sv::Config keep;
+  sv::Config keep = drawn_config();
   keep.max_object_half_width_m = 0;
   sv::Supervisor s(keep, scene_, sv::ArmSetup{}, with_neighbour);
   const Eigen::Vector3d rest = nudge_and_park(s, Eigen::Vector3d(0.28, -0.05, 0));
@@ -1869,6 +1884,34 @@ TEST_F(SupervisorTest, AMaskNotSymmetricAboutTheObjectsLineIsNoSegmentation) {
   EXPECT_EQ(attempt_segmented_by(mask_of_difference).outcome, sv::Outcome::Segmented);
 }
 
+// A mask symmetric about the object's line whose sides leave the object's outline is no
+// segmentation: cut about a wrong line (development m02: half a red cup, its right side inside the
+// cup) or, as here, spilling past both sides of the object onto the table. The masks of
+// mask_of_difference span both places of the object: cut here to the after still's object first.
+TEST_F(SupervisorTest, AMaskWhoseSidesLeaveTheObjectsOutlineIsNoSegmentation) {
+  auto cut_to_the_object = [](const cv::Mat& before, const cv::Mat& after, const nudge::symmetry::Line& l0,
+                              const nudge::symmetry::Line& l1) {
+    sv::Segmentation s = mask_of_difference(before, after, l0, l1);
+    cv::Mat from_table, off;
+    cv::absdiff(after, drawn_background(after.size()), from_table);
+    cv::transform(from_table, off, cv::Matx13f(1, 1, 1));
+    s.mask &= off > 20;
+    return s;
+  };
+  auto spilled = [&](const cv::Mat& before, const cv::Mat& after, const nudge::symmetry::Line& l0, const nudge::symmetry::Line& l1) {
+    sv::Segmentation s = cut_to_the_object(before, after, l0, l1);
+    cv::dilate(s.mask, s.mask, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(61, 1)));  // 30 px each side
+    return s;
+  };
+  const sv::Config checked;  // the check as the supervisor has it by default
+  ASSERT_GT(checked.min_mask_side_edges, 0);
+  const sv::Attempt a = attempt_segmented_by(spilled, checked);
+  EXPECT_EQ(a.outcome, sv::Outcome::SegmentationFailed);
+  EXPECT_NE(a.reason.find("sides leave the object's outline"), std::string::npos) << a.reason;
+  const sv::Attempt whole = attempt_segmented_by(cut_to_the_object, checked);
+  EXPECT_EQ(whole.outcome, sv::Outcome::Segmented) << whole.reason;
+}
+
 // A mug's handle moves its symmetry line differently in the two cameras: the settled axes lie
 // several cm nearer or farther along the right camera's ray than the mug stands (s03_red_mug:
 // 4.7 cm). They are still the pushed object, and its mask keeps the rows down to its real foot.
@@ -1905,7 +1948,7 @@ TEST_F(SupervisorTest, AxesOfSomethingElseFurtherAlongTheRayDoNotMoveTheRest) {
 TEST_F(SupervisorTest, AnAfterLineWhereNothingMovedGivesWayToTheObjectsAlongThePush) {
   const Eigen::Vector3d object(0.28, -0.05, 0);
   auto run = [&](double push_travel_m) {
-    sv::Config config;
+    sv::Config config = drawn_config();
     config.push_travel_m = push_travel_m;
     sv::Supervisor s = make(config);
     const sv::NudgeCommand nudge = nudge_command_for(s, object);
@@ -1936,7 +1979,7 @@ TEST_F(SupervisorTest, AnAfterLineWhereNothingMovedGivesWayToTheObjectsAlongTheP
 // neighbour where the search would look).
 TEST_F(SupervisorTest, AnObjectThatBarelySlidKeepsItsLineWhateverStandsAlongThePush) {
   const Eigen::Vector3d object(0.28, -0.05, 0);
-  sv::Config config;
+  sv::Config config = drawn_config();
   config.push_travel_m = 0.10;  // where the neighbour stands, clear of the object
   sv::Supervisor s = make(config);
   const sv::NudgeCommand nudge = nudge_command_for(s, object);
@@ -1958,7 +2001,7 @@ TEST_F(SupervisorTest, AnObjectThatBarelySlidKeepsItsLineWhateverStandsAlongTheP
 TEST_F(SupervisorTest, AFarRestWhereNothingChangedGivesWayToTheObjectsNewLineAlongThePush) {
   const Eigen::Vector3d object(0.28, -0.05, 0);
   auto run = [&](double far_rest_m) {
-    sv::Config config;
+    sv::Config config = drawn_config();
     config.far_rest_m = far_rest_m;
     sv::Supervisor s = make(config);
     const auto [nudge, neighbour] = nudge_command_with_neighbour_along(s, config, object, 0.10);
@@ -1989,7 +2032,7 @@ TEST_F(SupervisorTest, AWeakAfterLineAboutTheSettledAxesGivesWayToAStrongerOneAl
   const Eigen::Vector3d object(0.28, -0.05, 0);
   const Shape small{0.025, 0.022};
   auto run = [&](double weak_share) {
-    sv::Config config;
+    sv::Config config = drawn_config();
     config.weak_after_line_share = weak_share;
     // The rest as the stills' lines place it: the drawn objects' masks (flat outlines, the small
     // one half behind the other) show no cylinder's base to check it against.
@@ -2067,7 +2110,7 @@ TEST_F(SupervisorTest, AStableMismatchAlongTheRayGivesWayToTheMasksFoot) {
       out.mask = cylinder_mask(scene_, after.size(), truth, 0.035, 0.12);
       return out;
     };
-    sv::Supervisor s(sv::Config{}, scene_, sv::ArmSetup{}, segment_cylinder);
+    sv::Supervisor s(drawn_config(), scene_, sv::ArmSetup{}, segment_cylinder);
     const sv::NudgeCommand nudge = nudge_command_for(s, object);
     truth = object + 0.03 * nudge.direction;
     const Eigen::Vector3d ray = along_ray(truth);
@@ -2127,7 +2170,7 @@ TEST_F(SupervisorTest, ACandidateOnTheRestedObjectsLineInACameraIsThatObjectNotN
 // a phantom's push barely moved a neighbour, and leaving out the phantom's lines - the cup's and
 // the bottle's - left the cup no candidate again).
 TEST_F(SupervisorTest, AFailedSegmentationsRestIsNoObjectToLeaveOut) {
-  sv::Supervisor s(sv::Config{}, scene_, sv::ArmSetup{}, segment_nothing);
+  sv::Supervisor s(drawn_config(), scene_, sv::ArmSetup{}, segment_nothing);
   const Eigen::Vector3d object(0.28, -0.05, 0);
   const Eigen::Vector3d rest = nudge_and_park(s, object);
   s.on_right_still(draw_scene(scene_, {1280, 960}, {rest}), now_, now_);
@@ -2147,7 +2190,7 @@ TEST_F(SupervisorTest, AFailedSegmentationsRestIsNoObjectToLeaveOut) {
 TEST_F(SupervisorTest, AnObjectWhoseSegmentationFailedIsNudgedAgainFromItsRestOnce) {
   for (const int retries : {1, 0}) {
     SCOPED_TRACE("segmentation_retries " + std::to_string(retries));
-    sv::Config config;
+    sv::Config config = drawn_config();
     config.segmentation_retries = retries;
     sv::Supervisor s(config, scene_, sv::ArmSetup{}, segment_nothing);
     const Eigen::Vector3d object(0.28, -0.05, 0);
@@ -2179,7 +2222,7 @@ TEST_F(SupervisorTest, AnObjectWhoseSegmentationFailedIsNudgedAgainFromItsRestOn
     EXPECT_EQ(s.state(), sv::State::Done) << s.report().reason;
     EXPECT_EQ(s.summary().rejections.count("already explored"), 1u);
   }
-  sv::Config bad;
+  sv::Config bad = drawn_config();
   bad.segmentation_retries = -1;
   EXPECT_THROW(sv::Supervisor(bad, scene_, sv::ArmSetup{}, segment_nothing), std::invalid_argument);
 }
@@ -2198,7 +2241,7 @@ TEST_F(SupervisorTest, TheTargetIsPlacedAnewFromItsLinesInBothBeforeStills) {
   };
   for (const Case& c : {Case{0.05, true, true}, Case{0.0, true, false}, Case{0.02, true, false}, Case{0.05, false, false}}) {
     SCOPED_TRACE("refine_target_max_m " + std::to_string(c.max_m) + (c.left_still ? "" : ", no left still"));
-    sv::Config config;
+    sv::Config config = drawn_config();
     config.refine_target_max_m = c.max_m;
     sv::Supervisor s = make(config);
     const auto survey = start_with(s, {surveyed});
@@ -2223,7 +2266,7 @@ TEST_F(SupervisorTest, TheTargetIsPlacedAnewFromItsLinesInBothBeforeStills) {
       EXPECT_NEAR((nudges[0].target - surveyed).norm(), 0.0, 1e-9);
     }
   }
-  sv::Config bad;
+  sv::Config bad = drawn_config();
   bad.refine_target_max_m = -0.01;
   EXPECT_THROW(make(bad), std::invalid_argument);
 }
@@ -2235,7 +2278,7 @@ TEST_F(SupervisorTest, TheTargetIsPlacedAnewFromItsLinesInBothBeforeStills) {
 TEST_F(SupervisorTest, AnEmptySegmentationWhoseLineStoodStillIsNotNudgedAgain) {
   for (const double still_px : {2.0, 0.0}) {
     SCOPED_TRACE("retry_still_line_px " + std::to_string(still_px));
-    sv::Config config;
+    sv::Config config = drawn_config();
     config.retry_still_line_px = still_px;
     sv::Supervisor s(config, scene_, sv::ArmSetup{}, segment_nothing);
     const Eigen::Vector3d object(0.28, -0.05, 0);
@@ -2259,7 +2302,7 @@ TEST_F(SupervisorTest, AnEmptySegmentationWhoseLineStoodStillIsNotNudgedAgain) {
       EXPECT_EQ(s.state(), sv::State::SnapshotBefore) << s.report().reason;
     }
   }
-  sv::Config bad;
+  sv::Config bad = drawn_config();
   bad.retry_still_line_px = -1;
   EXPECT_THROW(sv::Supervisor(bad, scene_, sv::ArmSetup{}, segment_nothing), std::invalid_argument);
 }
@@ -2274,7 +2317,7 @@ TEST_F(SupervisorTest, ACandidateWhoseLineCrossesASegmentedObjectIsThatObjectNot
     // A segmentation that is the whole object where it rests (the difference marks only the
     // edges of the drawing's flat bands).
     const cv::Mat empty_table = draw_scene(scene_, {1280, 960}, {});
-    sv::Supervisor s(sv::Config{}, scene_, sv::ArmSetup{}, [&](const cv::Mat&, const cv::Mat& after, const auto&, const auto&) {
+    sv::Supervisor s(drawn_config(), scene_, sv::ArmSetup{}, [&](const cv::Mat&, const cv::Mat& after, const auto&, const auto&) {
       sv::Segmentation whole;
       cv::Mat diff, channels[3];
       cv::absdiff(empty_table, after, diff);
@@ -2380,7 +2423,7 @@ TEST_F(SupervisorTest, ACandidateBeyondTheFootOfItsLineGivesWayToTheOneOnThatLin
   // 10 cm before the object (a mismatch) stands 15 cm from the typical 3 cm beyond the foot, the
   // object 5 cm: the object's own candidate is nudged instead.
   EXPECT_NEAR((nudged_of_rivals_on_one_right_line({}, -0.10) - object).norm(), 0.0, 1e-9);
-  sv::Config off;
+  sv::Config off = drawn_config();
   off.rival_by_foot = false;
   EXPECT_NEAR((nudged_of_rivals_on_one_right_line(off, -0.10) - object).norm(), 0.10, 1e-9);
   // 5 cm behind fits the foot better than the object does: the survey's choice stands.
@@ -2434,7 +2477,7 @@ std::pair<std::optional<sv::NudgeCommand>, std::string> SupervisorTest::nudge_be
 
 TEST_F(SupervisorTest, AnObjectOnlyOneCameraSawIsKeptOffThePushWithLineObstaclesOn) {
   const Eigen::Vector3d object(0.22, -0.05, 0);
-  sv::Config on;
+  sv::Config on = drawn_config();
   on.line_obstacle_share = 0.5;
   // Where the push goes with nothing else on the table.
   const auto [free, free_reason] = nudge_beside_an_unpaired_object(on, Eigen::Vector3d(0.22, 0.30, 0));
@@ -2657,7 +2700,7 @@ class LearningTest : public SupervisorTest {
   const Eigen::Vector3d object_{0.28, -0.05, 0};
   Eigen::Vector3d rest_;
 
-  sv::Supervisor make_learning(sv::Config config = {}) {
+  sv::Supervisor make_learning(sv::Config config = drawn_config()) {
     config.learn = sv::Config::Learn::On;
     return sv::Supervisor(config, scene_, sv::ArmSetup{}, mask_of_the_moved_object);
   }
@@ -2721,7 +2764,7 @@ class LearningTest : public SupervisorTest {
 }  // namespace
 
 TEST_F(LearningTest, GraspsTurnsTwelveTimesLearnsAndPutsTheObjectBack) {
-  sv::Config config;
+  sv::Config config = drawn_config();
   config.standing_view = true;  // off by default (Config::standing_view); the test without it follows
   sv::Supervisor s = make_learning(config);
   const sv::GraspCommand grasp = to_grasp(s);
@@ -2838,7 +2881,7 @@ TEST_F(LearningTest, GraspsTurnsTwelveTimesLearnsAndPutsTheObjectBack) {
 // segmentation is run again about the new rest: the grasp is planned on the object, its fingers
 // half way up it, not on the neighbour's top.
 TEST_F(LearningTest, WithoutTheStandingViewTwelveViewsArePrunedAgainstTheAfterStill) {
-  sv::Config config;
+  sv::Config config = drawn_config();
   config.standing_view = false;
   sv::Supervisor s = make_learning(config);
   done(s, to_grasp(s).seq);
@@ -2870,7 +2913,7 @@ TEST_F(LearningTest, WithoutTheStandingViewTwelveViewsArePrunedAgainstTheAfterSt
 
 TEST_F(LearningTest, AWeakAfterLineMovesTheLeftCamerasSegmentationWithTheRest) {
   const Shape small{0.025, 0.022, /*grey=*/true};  // outside these tests' masks of coloured pixels
-  sv::Config config;
+  sv::Config config = drawn_config();
   config.rest_mask_disagreement_m = 0;  // the rest as the stills' lines place it (see the rule's test)
   // The drawn object's bands are thin beside its width: a line a few px off its drawn middle
   // mirrors them onto each other's gaps (the mirror check is not what this test is about).
@@ -2934,7 +2977,7 @@ TEST_F(LearningTest, AStableMismatchIsGraspedWhereTheMaskStandsAndPutBackWhereIt
       return out;
     };
   };
-  sv::Config config;
+  sv::Config config = drawn_config();
   config.learn = sv::Config::Learn::On;
   config.views = 1;
   sv::Supervisor s(config, scene_, sv::ArmSetup{}, cylinder(false));
@@ -3003,7 +3046,7 @@ TEST_F(LearningTest, ASilentLearnerDoesNotStopTheNudge) {
 }
 
 TEST_F(LearningTest, ALearnerSilentAfterTheViewsStillGetsTheObjectPutBack) {
-  sv::Config few;  // 2 views suffice here
+  sv::Config few = drawn_config();  // 2 views suffice here
   few.learn = sv::Config::Learn::On;
   few.views = 2;
   sv::Supervisor s = make_learning(few);
@@ -3028,7 +3071,7 @@ TEST_F(LearningTest, ALearnerSilentAfterTheViewsStillGetsTheObjectPutBack) {
 // The learner learns on a worker thread and says so in its heartbeat: LEARN waits while it does
 // (beyond --learn-timeout), up to --learn-max-wait; heartbeats about another object do not count.
 TEST_F(LearningTest, LearnWaitsWhileTheLearnersHeartbeatSaysItLearnsTheObject) {
-  sv::Config few;
+  sv::Config few = drawn_config();
   few.learn = sv::Config::Learn::On;
   few.views = 2;
   few.learn_timeout_s = 30;
@@ -3081,7 +3124,7 @@ TEST_F(LearningTest, LearnWaitsWhileTheLearnersHeartbeatSaysItLearnsTheObject) {
 
 // A learner that stops saying it learns the object: learn_timeout_s after its last such heartbeat.
 TEST_F(LearningTest, LearnEndsWhenTheLearnerStopsSayingItLearns) {
-  sv::Config few;
+  sv::Config few = drawn_config();
   few.learn = sv::Config::Learn::On;
   few.views = 2;
   sv::Supervisor s = make_learning(few);
@@ -3139,7 +3182,7 @@ TEST_F(LearningTest, TheGraspIsPlannedOnTheStagelessSegmentationAndTheStagesAreD
     calls.push_back("stageless");
     return mask_of_difference(before, after, l0, l1);
   };
-  sv::Config config;
+  sv::Config config = drawn_config();
   config.learn = sv::Config::Learn::On;
   sv::Supervisor s(config, scene_, sv::ArmSetup{}, with_stages);
   s.set_left_segmentation(mask_of_difference);
@@ -3174,7 +3217,7 @@ TEST_F(LearningTest, TheWarmUpRunsEverySegmentationOnceOnStillsOfTheConfiguredSi
       return mask_of_difference(before, after, l0, l1);
     };
   };
-  sv::Config config;
+  sv::Config config = drawn_config();
   config.learn = sv::Config::Learn::On;
   sv::Supervisor s(config, scene_, sv::ArmSetup{}, counting("right"));
   s.set_left_segmentation(counting("left"));
@@ -3257,7 +3300,7 @@ TEST_F(LearningTest, AnObjectDroppedWhileTurningIsNoticedAndTheRunGoesOn) {
 }
 
 TEST_F(LearningTest, AutoLearnsOnlyWhileTheLearnerIsHeard) {
-  sv::Config config;
+  sv::Config config = drawn_config();
   config.learn = sv::Config::Learn::Auto;
   sv::Supervisor s = make(config);
   auto out = start_with(s, {object_});

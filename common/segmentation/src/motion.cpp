@@ -644,6 +644,64 @@ double mirror_agreement(const cv::Mat& mask, const symmetry::Line& line) {
   return either > 0 ? static_cast<double>(both) / either : 0.0;
 }
 
+namespace {
+
+// Canny edges of `image` (grey, and each channel of a colour image: an outline between two colours
+// of one brightness is an edge too), blurred first.
+cv::Mat edges_of(const cv::Mat& image, const SideEdgeParams& params) {
+  std::vector<cv::Mat> planes;
+  if (image.channels() == 3) {
+    cv::split(image, planes);
+    cv::Mat grey;
+    cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
+    planes.push_back(grey);
+  } else {
+    planes.push_back(image);
+  }
+  cv::Mat edges = cv::Mat::zeros(image.size(), CV_8UC1);
+  for (const cv::Mat& plane : planes) {
+    cv::Mat blurred, found;
+    if (params.blur_sigma > 0) cv::GaussianBlur(plane, blurred, cv::Size(), params.blur_sigma);
+    else blurred = plane;
+    cv::Canny(blurred, found, params.canny_low, params.canny_high);
+    edges |= found;
+  }
+  return edges;
+}
+
+}  // namespace
+
+double side_edge_support(const cv::Mat& mask, const cv::Mat& image, const SideEdgeParams& params) {
+  if (mask.empty() || mask.type() != CV_8UC1) throw std::invalid_argument("side_edge_support: the mask must be 8-bit, one channel");
+  if (image.size() != mask.size() || image.depth() != CV_8U || (image.channels() != 1 && image.channels() != 3))
+    throw std::invalid_argument("side_edge_support: the image must be 8-bit grey or BGR, of the mask's size");
+  const cv::Rect box = cv::boundingRect(mask);
+  if (box.empty()) return 0.0;
+  // Edges around the box only (the blur and Canny's own window need a margin beyond it).
+  const int margin = params.tolerance_px + static_cast<int>(std::ceil(3 * params.blur_sigma)) + 2;
+  const cv::Rect roi = cv::Rect(box.x - margin, box.y - margin, box.width + 2 * margin, box.height + 2 * margin) &
+                       cv::Rect(cv::Point(), mask.size());
+  cv::Mat near_edge;
+  const int reach = 2 * params.tolerance_px + 1;
+  cv::dilate(edges_of(image(roi), params), near_edge, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(reach, reach)));
+  const int first = box.y + static_cast<int>(params.trim * box.height), last = box.y + box.height - static_cast<int>(params.trim * box.height);
+  int rows = 0, left_on = 0, right_on = 0;
+  for (int y = first; y < last; ++y) {
+    const uint8_t* row = mask.ptr<uint8_t>(y);
+    int left = -1, right = -1;
+    for (int x = box.x; x < box.x + box.width; ++x) {
+      if (!row[x]) continue;
+      if (left < 0) left = x;
+      right = x;
+    }
+    if (left < 0) continue;
+    ++rows;
+    left_on += near_edge.at<uint8_t>(y - roi.y, left - roi.x) != 0;
+    right_on += near_edge.at<uint8_t>(y - roi.y, right - roi.x) != 0;
+  }
+  return rows > 0 ? static_cast<double>(std::min(left_on, right_on)) / rows : 0.0;
+}
+
 int keep_near_line(cv::Mat& mask, const symmetry::Line& line, double half_width_px) {
   if (mask.empty() || mask.type() != CV_8UC1) throw std::invalid_argument("keep_near_line: the mask must be 8-bit, one channel");
   if (!(half_width_px >= 0)) throw std::invalid_argument("keep_near_line: half_width_px must be >= 0");

@@ -755,7 +755,7 @@ void Supervisor::segment(int64_t now) {
                 "segmentation empty" + (a.segmentation.error.empty() ? std::string() : ": " + a.segmentation.error), now);
     return;
   }
-  const std::string not_an_object = mask_shape_problem(a.segmentation.mask, *a.rest, *a.after_line);
+  const std::string not_an_object = mask_shape_problem(a.segmentation.mask, a.after, *a.rest, *a.after_line);
   if (!not_an_object.empty()) {
     draw_stages();
     end_attempt(Outcome::SegmentationFailed, not_an_object, now);
@@ -897,7 +897,8 @@ bool Supervisor::axes_rest_gives_way_to_after_still(Attempt& a, const symmetry::
   return true;
 }
 
-std::string Supervisor::mask_shape_problem(const cv::Mat& mask, const Eigen::Vector3d& rest, const symmetry::Line& line) const {
+std::string Supervisor::mask_shape_problem(const cv::Mat& mask, const cv::Mat& still, const Eigen::Vector3d& rest,
+                                           const symmetry::Line& line) const {
   const int pixels = cv::countNonZero(mask);
   const cv::Size2d smallest = smallest_object_image(rest);
   const double share = config_.min_mask_share;
@@ -917,6 +918,16 @@ std::string Supervisor::mask_shape_problem(const cv::Mat& mask, const Eigen::Vec
     char text[16];
     std::snprintf(text, sizeof text, "%.2f", mirrored);
     return std::string("segmentation not symmetric about the object's line: it agrees ") + text + " with its mirror image";
+  }
+  if (config_.min_mask_side_edges > 0 && still.size() == mask.size()) {
+    const double on_edges = segmentation::side_edge_support(mask, still);
+    if (on_edges < config_.min_mask_side_edges) {
+      char text[160];
+      std::snprintf(text, sizeof text,
+                    "segmentation's sides leave the object's outline: one side lies on an edge of the still in only %.0f%% of its rows",
+                    100 * on_edges);
+      return text;
+    }
   }
   return "";
 }

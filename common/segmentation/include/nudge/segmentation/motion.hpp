@@ -145,6 +145,25 @@ cv::Mat mirror_image(const cv::Mat& image, const symmetry::Line& line);
 // std::invalid_argument for an empty image or one that is not 8-bit single-channel.
 double mirror_agreement(const cv::Mat& mask, const symmetry::Line& line);
 
+// How closely a mask's sides follow edges of the image it was cut from. A mask that is the object
+// runs along the object's outline on both sides; one cut about a wrong line (the after line on a
+// neighbour's edge or between two objects) ends on one side inside the object, where the image
+// has no edge (development m02, 2026-12-03: half a red cup, IoU 0.37, its right side on an edge in
+// 11 % of its rows; the development runs' masks of IoU 0.73 or more: 34 % or more on both sides).
+struct SideEdgeParams {
+  double blur_sigma = 1.0;             // Gaussian blur before Canny, px
+  double canny_low = 20, canny_high = 60;  // on the grey image and on each colour channel
+  int tolerance_px = 3;                // a side pixel this close to an edge pixel is on it
+  double trim = 0.1;                   // the mask's top and bottom tenth (a lid, the foot's shadow) left out
+};
+
+// The smaller of the two sides' shares: over the mask's rows (trimmed), the share of rows whose
+// leftmost mask pixel lies within tolerance_px of an edge, and likewise the rightmost; in [0, 1],
+// 0 for an empty mask. The edges are found only around the mask's box. Throws
+// std::invalid_argument for a mask that is not 8-bit single-channel, or an image (8-bit, 1 or 3
+// channels) of another size.
+double side_edge_support(const cv::Mat& mask, const cv::Mat& image, const SideEdgeParams& params = {});
+
 // Clears the pixels of `mask` (8-bit, one channel) farther than `half_width_px` from `line`
 // ((R, theta) about the image centre), measured along the line's normal; returns how many were
 // cleared. Every part of an upright object lies within its widest half-width of its symmetry line:

@@ -220,6 +220,15 @@ struct Config {
   // Chosen on the development runs of 2026-11-25: every correct mask 0.79 or more, the wrong ones
   // (a piece of a cup, a neighbour's edge) 0.32-0.81.
   double min_mask_mirror_agreement = 0.7;
+  // Nor is a mask whose sides leave the image's edges: on fewer than this share of its rows does
+  // one of its sides lie within 3 px of an edge of the after still (segmentation::side_edge_support).
+  // A mask cut about a wrong after line (on a neighbour's edge, between two objects) is half an
+  // object, mirror-symmetric about that line, and ends on one side inside the object where the
+  // still shows no edge. Chosen on both development sets' runs of 2026-12-03 (34 masks): half a red
+  // cup (m02, IoU 0.37) 0.11 and a cup with its neighbour's shadow beside it (dev2 hm1, 0.58) 0.08;
+  // every other mask 0.28 or more (a bottle's mask 5-10 px off its side, IoU 0.88: 0.34; masks of
+  // IoU 0.73 or more: 0.34-1.00). 0: off.
+  double min_mask_side_edges = 0.2;
   // A push that moved something but gave no segmentation (a mask too small, lopsided or empty)
   // leaves the place it pushed from explored; where the object came to rest is nudged again, up to
   // this many times for one object (a nudge from the new place is a new view of it; held-out h11:
@@ -633,7 +642,8 @@ class Supervisor {
   std::optional<double> width_across_view_px(const Eigen::Vector3d& at, double width_m, cv::Size size) const;
   // Why a non-empty right mask (the still's size) is no object standing at `rest`, upright about
   // `line`: too small, too flat, too thin, or not its own mirror image; "" when it may be one.
-  std::string mask_shape_problem(const cv::Mat& mask, const Eigen::Vector3d& rest, const symmetry::Line& line) const;
+  std::string mask_shape_problem(const cv::Mat& mask, const cv::Mat& still, const Eigen::Vector3d& rest,
+                                 const symmetry::Line& line) const;
   bool same_object_in_a_camera(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const;
   // The share of the object's mask rows (its bounding box's) where the right camera's image of an
   // upright axis at `foot` passes through the mask (within 2 px): 1 on the object, 0 beside it.
