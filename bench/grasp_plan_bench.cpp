@@ -201,9 +201,24 @@ void BM_MaskMirrorAgreement(benchmark::State& state) {
 }
 BENCHMARK(BM_MaskMirrorAgreement)->Unit(benchmark::kMillisecond);
 
+// The mask's side-edge check (Supervisor::mask_shape_problem): Canny on the grey still and each
+// colour channel around the mask's box, then each row's two sides looked up.
+void BM_MaskSideEdgeSupport(benchmark::State& state) {
+  const sv::SceneGeometry scene = sv::SceneGeometry::load(NUDGE_SOURCE_DIR "/config/calibration_sim.yaml");
+  const Eigen::Vector3d before(0.25, -0.02, 0), after(0.25, 0.01, 0);
+  const cv::Mat a = draw(scene, before, false), b = draw(scene, after, false);
+  const auto la = scene.right_axis_line(before, kHeight, kStill), lb = scene.right_axis_line(after, kHeight, kStill);
+  const cv::Mat mask = sv::motion_segmentation({}, false)(a, b, *la, *lb).mask;
+  double support = 0;
+  for (auto _ : state) benchmark::DoNotOptimize(support = nudge::segmentation::side_edge_support(mask, b));
+  state.counters["support"] = support;
+  state.counters["mask_px"] = cv::countNonZero(mask);
+}
+BENCHMARK(BM_MaskSideEdgeSupport)->Unit(benchmark::kMillisecond);
+
 // The right camera's part of the plan on a recorded attempt's stills (an attempt folder of a run:
 // before.png, after.png and attempt.json's line_before and line_after): the motion segmentation
-// without stages, the mask's mirror check and its top and foot, as the supervisor runs them.
+// without stages, the mask's mirror check, its top and foot and its side-edge check, as the supervisor runs them.
 void BM_RecordedAttempt(benchmark::State& state, const std::string& folder) {
   cv::setNumThreads(0);
   std::ifstream in(folder + "/attempt.json");
@@ -222,6 +237,7 @@ void BM_RecordedAttempt(benchmark::State& state, const std::string& folder) {
     if (part == 0) benchmark::DoNotOptimize(segment(before, after, *line_before, *line_after));
     if (part == 1) benchmark::DoNotOptimize(nudge::segmentation::mirror_agreement(mask, *line_after));
     if (part == 2) benchmark::DoNotOptimize(sv::read_mask_on_line(mask, *line_after));
+    if (part == 3) benchmark::DoNotOptimize(nudge::segmentation::side_edge_support(mask, after));
   }
   state.counters["mask_px"] = mask_pixels;
 }
@@ -229,7 +245,7 @@ void BM_RecordedAttempt(benchmark::State& state, const std::string& folder) {
 // As the services run (bus::guarded_main keeps freed images in the heap), unless --fresh-pages
 // asks for glibc's defaults: every image a fresh map, a page fault per page (nudge/memory.hpp).
 // --attempt FOLDER (repeatable) adds BM_RecordedAttempt on that attempt's stills: /0 the
-// segmentation, /1 the mirror check, /2 the mask's top and foot.
+// segmentation, /1 the mirror check, /2 the mask's top and foot, /3 the side-edge check.
 int main(int argc, char** argv) {
   bool fresh_pages = false;
   std::vector<std::string> attempts;
@@ -244,7 +260,7 @@ int main(int argc, char** argv) {
   if (!fresh_pages) nudge::keep_large_buffers_for_reuse();
   for (const std::string& folder : attempts)
     benchmark::RegisterBenchmark(("BM_RecordedAttempt:" + folder).c_str(), BM_RecordedAttempt, folder)
-        ->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
+        ->Arg(0)->Arg(1)->Arg(2)->Arg(3)->Unit(benchmark::kMillisecond);
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   benchmark::AddCustomContext("memory", fresh_pages ? "glibc defaults (--fresh-pages)" : "freed images kept for reuse");
