@@ -188,15 +188,26 @@ void BM_MaskTopAndFoot(benchmark::State& state) {
 }
 BENCHMARK(BM_MaskTopAndFoot)->Unit(benchmark::kMillisecond);
 
-// The mask's mirror check of the right camera's segmentation (Supervisor::mask_shape_problem).
-void BM_MaskMirrorAgreement(benchmark::State& state) {
+// A drawn object pushed 3 cm across the right camera's view: its after still, its line there and
+// the motion segmentation's mask of it (the mask checks' input).
+struct DrawnPush {
+  cv::Mat after, mask;
+  nudge::symmetry::Line after_line;
+};
+
+DrawnPush drawn_push() {
   const sv::SceneGeometry scene = sv::SceneGeometry::load(NUDGE_SOURCE_DIR "/config/calibration_sim.yaml");
   const Eigen::Vector3d before(0.25, -0.02, 0), after(0.25, 0.01, 0);
   const cv::Mat a = draw(scene, before, false), b = draw(scene, after, false);
   const auto la = scene.right_axis_line(before, kHeight, kStill), lb = scene.right_axis_line(after, kHeight, kStill);
-  const cv::Mat mask = sv::motion_segmentation({}, false)(a, b, *la, *lb).mask;
+  return {b, sv::motion_segmentation({}, false)(a, b, *la, *lb).mask, *lb};
+}
+
+// The mask's mirror check of the right camera's segmentation (Supervisor::mask_shape_problem).
+void BM_MaskMirrorAgreement(benchmark::State& state) {
+  const DrawnPush push = drawn_push();
   double agreement = 0;
-  for (auto _ : state) benchmark::DoNotOptimize(agreement = nudge::segmentation::mirror_agreement(mask, *lb));
+  for (auto _ : state) benchmark::DoNotOptimize(agreement = nudge::segmentation::mirror_agreement(push.mask, push.after_line));
   state.counters["agreement"] = agreement;
 }
 BENCHMARK(BM_MaskMirrorAgreement)->Unit(benchmark::kMillisecond);
@@ -204,15 +215,11 @@ BENCHMARK(BM_MaskMirrorAgreement)->Unit(benchmark::kMillisecond);
 // The mask's side-edge check (Supervisor::mask_shape_problem): Canny on the grey still and each
 // colour channel around the mask's box, then each row's two sides looked up.
 void BM_MaskSideEdgeSupport(benchmark::State& state) {
-  const sv::SceneGeometry scene = sv::SceneGeometry::load(NUDGE_SOURCE_DIR "/config/calibration_sim.yaml");
-  const Eigen::Vector3d before(0.25, -0.02, 0), after(0.25, 0.01, 0);
-  const cv::Mat a = draw(scene, before, false), b = draw(scene, after, false);
-  const auto la = scene.right_axis_line(before, kHeight, kStill), lb = scene.right_axis_line(after, kHeight, kStill);
-  const cv::Mat mask = sv::motion_segmentation({}, false)(a, b, *la, *lb).mask;
+  const DrawnPush push = drawn_push();
   double support = 0;
-  for (auto _ : state) benchmark::DoNotOptimize(support = nudge::segmentation::side_edge_support(mask, b));
+  for (auto _ : state) benchmark::DoNotOptimize(support = nudge::segmentation::side_edge_support(push.mask, push.after));
   state.counters["support"] = support;
-  state.counters["mask_px"] = cv::countNonZero(mask);
+  state.counters["mask_px"] = cv::countNonZero(push.mask);
 }
 BENCHMARK(BM_MaskSideEdgeSupport)->Unit(benchmark::kMillisecond);
 

@@ -527,26 +527,21 @@ TEST(LearningRecognizer, BadSettingsAndBadModelsAreRefusedByName) {
     p.keypoint_agreement.on = false;  // off: its tolerances are not used
     EXPECT_NO_THROW(Recognizer{p});
   }
-  for (double radius : {-1.0, std::nan("")}) {
-    RecognizeParams p = params;
-    p.distinct_place_px = radius;
-    try {
-      Recognizer r(p);
-      ADD_FAILURE() << "distinct place radius " << radius << " accepted";
-    } catch (const std::invalid_argument& e) {
-      EXPECT_NE(std::string(e.what()).find("distinct_place_px"), std::string::npos) << e.what();
+  // A negative or NaN value of `field` (a member of RecognizeParams) is refused by its name.
+  auto refused_by_name = [&](double RecognizeParams::*field, const std::string& name) {
+    for (double value : {-1.0, std::nan("")}) {
+      RecognizeParams p = params;
+      p.*field = value;
+      try {
+        Recognizer r(p);
+        ADD_FAILURE() << name << " " << value << " accepted";
+      } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
+      }
     }
-  }
-  for (double tolerance : {-0.1, std::nan("")}) {
-    RecognizeParams p = params;
-    p.colour_tolerance = tolerance;
-    try {
-      Recognizer r(p);
-      ADD_FAILURE() << "colour tolerance " << tolerance << " accepted";
-    } catch (const std::invalid_argument& e) {
-      EXPECT_NE(std::string(e.what()).find("colour_tolerance"), std::string::npos) << e.what();
-    }
-  }
+  };
+  refused_by_name(&RecognizeParams::distinct_place_px, "distinct_place_px");
+  refused_by_name(&RecognizeParams::colour_tolerance, "colour_tolerance");
   auto bad = std::make_shared<ObjectModel>();
   bad->info.name = "odd";
   bad->views.resize(2);
