@@ -105,6 +105,7 @@ struct Segmented {
   int mask_pixels = 0;
   double object_tilt_deg = 0;  // the segmented object's lean in the simulator at the after still
   cv::Mat gallery;           // before | after | mask over after
+  std::string reason;        // a refused mask's: why the supervisor refused it (attempt.json)
 };
 
 struct Run {
@@ -121,6 +122,10 @@ struct Run {
   double wall_s = 0;
   std::string end_reason;
   std::vector<Segmented> segmented;
+  // Masks the supervisor cut but refused (the attempt ended "segmentation failed" with its
+  // mask.png written), scored against the same truth: whether the refusal checks
+  // (Supervisor::mask_shape_problem) turn away good masks as well as bad ones.
+  std::vector<Segmented> refused;
   std::set<int> objects_found;  // scene indices segmented with IoU >= 0.5, standing
   // Scene indices of the objects the scene stages outside the arm's workspace ring (the object's
   // axis nearer the base than ring_inner or farther than ring_outer): the candidates the
@@ -211,6 +216,26 @@ std::set<int> objects_beyond_reach(const sim::Scene& scene, const robot::Workspa
   return beyond;
 }
 
+// Scores every mask an attempt cut but did not publish (refused by the supervisor's checks) against
+// the truth at the state recorded when that attempt began to segment.
+void score_refused_masks(Run& run, const fs::path& run_dir, sim::World& world,
+                         const std::map<int, sim_state_t>& state_at_segment) {
+  for (const auto& [attempt, state] : state_at_segment) {
+    const bool published = std::any_of(run.segmented.begin(), run.segmented.end(),
+                                        [&](const Segmented& s) { return s.attempt == attempt; });
+    char folder[32];
+    std::snprintf(folder, sizeof folder, "attempt_%02d", attempt);
+    const fs::path mask_file = run_dir / folder / "mask.png";
+    if (published || !fs::exists(mask_file)) continue;
+    const cv::Mat mask = cv::imread(mask_file.string(), cv::IMREAD_GRAYSCALE);
+    if (mask.empty() || cv::countNonZero(mask) == 0) continue;  // an empty segmentation: nothing to score
+    Segmented s = score(mask, render_truth(world, state), run.objects_present);
+    s.attempt = attempt;
+    s.reason = json_string(read_text(run_dir / folder / "attempt.json"), "reason");
+    run.refused.push_back(std::move(s));
+  }
+}
+
 Run evaluate(const std::string& name, const fs::path& run_dir, const fs::path& scene_file, const robot::Workspace& workspace) {
   Run run;
   run.name = name;
@@ -234,6 +259,7 @@ Run evaluate(const std::string& name, const fs::path& run_dir, const fs::path& s
   std::optional<supervisor_state_t> supervisor;
   std::map<int, std::string> fell;  // object -> when it fell
   std::map<int, sim_state_t> tipping;  // object -> the first state of its latest lean past kTippingDeg
+  std::map<int, sim_state_t> state_at_segment;  // attempt -> the last state when it began to segment
   while (const lcm::LogEvent* e = log.readNextEvent()) {
     if (e->channel == "SIM_STATE") {
       sim_state_t state;
@@ -250,6 +276,9 @@ Run evaluate(const std::string& name, const fs::path& run_dir, const fs::path& s
     } else if (e->channel == "SUPERVISOR_STATE") {
       supervisor_state_t state;
       if (state.decode(e->data, 0, e->datalen) >= 0) supervisor = state;
+      // The after still is taken before SEGMENT: the scene as it was then, for a refused mask.
+      if (supervisor && supervisor->state == supervisor_state_t::STATE_SEGMENT && last_state)
+        state_at_segment.emplace(supervisor->attempt, *last_state);
     } else if (e->channel == "SEGMENTATION" && last_state) {
       segmentation_t seg;
       if (seg.decode(e->data, 0, e->datalen) < 0) continue;
@@ -277,6 +306,7 @@ Run evaluate(const std::string& name, const fs::path& run_dir, const fs::path& s
       }
   }
   run.other_failures = run.attempts - static_cast<int>(run.segmented.size()) - run.no_motion - run.tipped;
+  score_refused_masks(run, run_dir, world, state_at_segment);
   return run;
 }
 
@@ -309,6 +339,10 @@ struct SetScore {
   int multi_in_reach = 0, multi_found_in_reach = 0;  // the same, over the objects within the workspace ring
   std::vector<std::string> beyond_reach;             // "run: object i at r mm" for the objects outside it
   std::vector<double> ious;
+  std::vector<double> refused_ious;  // of the masks the supervisor refused (Run::refused)
+  int refused_good() const {
+    return static_cast<int>(std::count_if(refused_ious.begin(), refused_ious.end(), [](double iou) { return iou >= 0.5; }));
+  }
   std::string table;
   std::vector<cv::Mat> gallery;
   double mean_iou() const { return ious.empty() ? 0 : ex::mean(ious); }
@@ -392,8 +426,8 @@ SetScore score_set(const fs::path& runs_dir, const fs::path& scene_dir, std::vec
   std::sort(set.attempt_dirs.begin(), set.attempt_dirs.end());
 
   std::ostringstream table;
-  table << "| run | objects | attempts | segmented (object: IoU) | effector px | no motion | tipped | other | fallen: segmented, at the end | wall s | end |\n"
-        << "|---|---|---|---|---|---|---|---|---|---|---|\n";
+  table << "| run | objects | attempts | segmented (object: IoU) | effector px | no motion | tipped | other | refused masks (object: IoU) | fallen: segmented, at the end | wall s | end |\n"
+        << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const Run& r : set.runs) {
     if (r.objects_present > 1) {
       set.multi_found += static_cast<int>(r.objects_found.size());
@@ -421,11 +455,18 @@ SetScore score_set(const fs::path& runs_dir, const fs::path& scene_dir, std::vec
       if (!s.gallery.empty()) set.gallery.push_back(s.gallery);
     }
     set.effector += run_effector;
+    std::string refused;
+    for (const Segmented& s : r.refused) {
+      char text[48];
+      std::snprintf(text, sizeof text, "%s%d: %.3f", refused.empty() ? "" : ", ", s.object, s.iou);
+      refused += text;
+      set.refused_ious.push_back(s.iou);
+    }
     char wall[32];
     std::snprintf(wall, sizeof wall, "%.0f", r.wall_s);
     table << "| " << r.name << " | " << r.objects_present << " | " << r.attempts << " | "
           << (segmented.empty() ? "–" : segmented) << " | " << run_effector << " | " << r.no_motion << " | " << r.tipped
-          << " | " << r.other_failures << " | " << r.segmented_fallen << ", " << r.objects_fallen.size() << " | " << wall << " | " << r.end_reason << " |\n";
+          << " | " << r.other_failures << " | " << (refused.empty() ? "–" : refused) << " | " << r.segmented_fallen << ", " << r.objects_fallen.size() << " | " << wall << " | " << r.end_reason << " |\n";
   }
   std::vector<std::string> falls;
   for (const Run& r : set.runs)
@@ -443,6 +484,7 @@ void json_fields(JsonWriter& j, const SetScore& s, double ms) {
   j.field("multi_object_in_reach", s.multi_in_reach).field("multi_object_found_in_reach", s.multi_found_in_reach);
   j.field("phantoms_rejected", s.phantoms);
   j.field("segmentations_of_fallen_objects", s.segmented_fallen).field("objects_fallen", s.objects_fallen);
+  j.field("refused_masks", static_cast<int>(s.refused_ious.size())).field("refused_masks_iou_at_least_half", s.refused_good());
 }
 
 std::string figures_table(const SetScore& s, double ms) {
@@ -461,7 +503,9 @@ std::string figures_table(const SetScore& s, double ms) {
      << "| attempts that found no motion (phantoms, out-of-view) | – | " << s.phantoms << " |\n"
      << "| segmentations of an object lying fallen (leaning over " << kFallenDeg << " deg in the simulator; not counted as segmented) | – | "
      << s.segmented_fallen << " |\n"
-     << "| objects lying fallen at the runs' ends | – | " << s.objects_fallen << " |\n";
+     << "| objects lying fallen at the runs' ends | – | " << s.objects_fallen << " |\n"
+     << "| masks the supervisor cut and refused (its shape checks), of them IoU 0.5 or more | – | " << s.refused_ious.size() << ", "
+     << s.refused_good() << " |\n";
   return md.str();
 }
 
@@ -574,8 +618,10 @@ int main(int argc, char** argv) {
     md << "## Development scenes (`" << development->second.filename().string() << "`)\n\n" << figures_table(*dev_set, ms)
        << "\n" << dev_set->table << "\n";
   md << "`segmented`: scene index of the object covered and the mask's IoU with its true mask. `other`: attempts "
-        "refused by the arm, segmentations that came out empty, lost stills. The motion segmentation time is over "
-        "both sets' stills.\n\n"
+        "refused by the arm, segmentations that came out empty or were refused, lost stills. `refused masks`: the "
+        "masks the supervisor cut and refused (too small, thin, not mirrored, sides off the still's edges; counted "
+        "under `other`), scored against the truth at the state recorded when the attempt began to segment. The "
+        "motion segmentation time is over both sets' stills.\n\n"
      << "## Gallery\n\nPer segmentation (" << gallery_order << "): before, after, the mask over the after still.\n\n"
      << "![gallery](" << name << "_gallery.png)\n";
   ex::write_result(name + ".md", md.str());
