@@ -216,6 +216,17 @@ std::set<int> objects_beyond_reach(const sim::Scene& scene, const robot::Workspa
   return beyond;
 }
 
+// "object: IoU" of each segmentation, comma-separated ("–" for none): a cell of the runs' table.
+std::string objects_and_ious(const std::vector<Segmented>& masks) {
+  std::string cell;
+  for (const Segmented& s : masks) {
+    char text[48];
+    std::snprintf(text, sizeof text, "%s%d: %.3f", cell.empty() ? "" : ", ", s.object, s.iou);
+    cell += text;
+  }
+  return cell.empty() ? "–" : cell;
+}
+
 // Scores every mask an attempt cut but did not publish (refused by the supervisor's checks) against
 // the truth at the state recorded when that attempt began to segment.
 void score_refused_masks(Run& run, const fs::path& run_dir, sim::World& world,
@@ -426,6 +437,7 @@ SetScore score_set(const fs::path& runs_dir, const fs::path& scene_dir, std::vec
   std::sort(set.attempt_dirs.begin(), set.attempt_dirs.end());
 
   std::ostringstream table;
+  std::vector<std::string> refusals;  // "run attempt N (object k, IoU x): why it was refused"
   table << "| run | objects | attempts | segmented (object: IoU) | effector px | no motion | tipped | other | refused masks (object: IoU) | fallen: segmented, at the end | wall s | end |\n"
         << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const Run& r : set.runs) {
@@ -443,35 +455,32 @@ SetScore score_set(const fs::path& runs_dir, const fs::path& scene_dir, std::vec
     set.phantoms += r.no_motion;
     set.segmented_fallen += r.segmented_fallen;
     set.objects_fallen += static_cast<int>(r.objects_fallen.size());
-    std::string segmented;
+    const std::string segmented = objects_and_ious(r.segmented), refused = objects_and_ious(r.refused);
     int run_effector = 0;
     for (const Segmented& s : r.segmented) {
-      char text[48];
-      std::snprintf(text, sizeof text, "%s%d: %.3f", segmented.empty() ? "" : ", ", s.object, s.iou);
-      segmented += text;
       set.ious.push_back(s.iou);
       run_effector += s.effector_pixels;
       set.tool_changed += s.tool_changed_pixels;
       if (!s.gallery.empty()) set.gallery.push_back(s.gallery);
     }
     set.effector += run_effector;
-    std::string refused;
     for (const Segmented& s : r.refused) {
-      char text[48];
-      std::snprintf(text, sizeof text, "%s%d: %.3f", refused.empty() ? "" : ", ", s.object, s.iou);
-      refused += text;
       set.refused_ious.push_back(s.iou);
+      char text[64];
+      std::snprintf(text, sizeof text, "%s attempt %d (object %d, IoU %.3f): ", r.name.c_str(), s.attempt, s.object, s.iou);
+      refusals.push_back(text + s.reason);
     }
     char wall[32];
     std::snprintf(wall, sizeof wall, "%.0f", r.wall_s);
     table << "| " << r.name << " | " << r.objects_present << " | " << r.attempts << " | "
-          << (segmented.empty() ? "–" : segmented) << " | " << run_effector << " | " << r.no_motion << " | " << r.tipped
-          << " | " << r.other_failures << " | " << (refused.empty() ? "–" : refused) << " | " << r.segmented_fallen << ", " << r.objects_fallen.size() << " | " << wall << " | " << r.end_reason << " |\n";
+          << segmented << " | " << run_effector << " | " << r.no_motion << " | " << r.tipped
+          << " | " << r.other_failures << " | " << refused << " | " << r.segmented_fallen << ", " << r.objects_fallen.size() << " | " << wall << " | " << r.end_reason << " |\n";
   }
   std::vector<std::string> falls;
   for (const Run& r : set.runs)
     for (const std::string& fall : r.falls) falls.push_back(r.name + ": " + fall);
   if (!falls.empty()) table << "\nObjects that fell (the first recorded state showing each lying): " << join(falls, "; ") << ".\n";
+  if (!refusals.empty()) table << "\nMasks refused: " << join(refusals, "; ") << ".\n";
   set.table = table.str();
   return set;
 }
